@@ -1,0 +1,53 @@
+# Two entry points for a fresh Debian machine with Python 3.11 and root:
+#   make run   - virtual environment, install, start the dashboard with the demo takes
+#   make test  - install what the tests need (system packages too), then lint, types and the suite
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+HOST ?= 127.0.0.1
+PORT ?= 8000
+APT_PACKAGES := chromium libegl1 libegl-mesa0 libgl1-mesa-dri postgresql
+
+.PHONY: run test venv install install-dev system-deps lint typecheck unit serve clean
+
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+
+venv: $(BIN)/python
+
+install: venv
+	$(BIN)/pip install --quiet -e .
+
+install-dev: venv
+	$(BIN)/pip install --quiet -e ".[dev]"
+
+# Debian packages the tests use: chromium (browser tests), Mesa EGL (off-screen pyvista),
+# PostgreSQL (store and API tests against a real server). Installed only when missing.
+system-deps:
+	@missing=""; for p in $(APT_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing Debian packages:$$missing"; \
+	  SUDO=""; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing >/dev/null; \
+	fi
+
+run: install system-deps
+	$(BIN)/mocapqa serve --host $(HOST) --port $(PORT) --demo
+
+lint: install-dev
+	$(BIN)/ruff check backend tests
+	$(BIN)/ruff format --check backend tests
+	$(BIN)/lint-imports
+	$(BIN)/check-jsonschema --builtin-schema vendor.compose-spec docker-compose.yml
+
+typecheck: install-dev
+	$(BIN)/mypy
+
+unit: install-dev system-deps
+	bash scripts/with-postgres.sh $(BIN)/python -m pytest -q --cov --cov-report=term:skip-covered
+
+test: install-dev system-deps lint typecheck unit
+
+clean:
+	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache

@@ -1,0 +1,3 @@
+"""``mocapqa info``: what a file holds."""
+
+from __future__ import annotations

@@ -1,0 +1,39 @@
+"""Entry point of the ``mocapqa`` command: registers every command module and maps errors."""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+from mocapqa.cli import info  # noqa: F401  (registers commands)
+from mocapqa.cli.app import app, err_console, exit_code_for
+from mocapqa.errors import MocapQAError
+
+__all__ = ["main"]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the CLI; user errors print one line and exit non-zero, without a traceback."""
+    try:
+        result = app(args=argv, standalone_mode=False)
+    except click.exceptions.Exit as e:
+        return int(e.exit_code)
+    except click.exceptions.Abort:
+        err_console.print("aborted")
+        return 130
+    except click.ClickException as e:
+        e.show()
+        return int(e.exit_code)
+    except MocapQAError as e:
+        err_console.print(f"[bold red]error:[/] {e}")
+        return exit_code_for(e)
+    return int(result) if isinstance(result, int) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
+
+
+def _entry() -> None:
+    sys.exit(main())

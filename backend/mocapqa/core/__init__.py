@@ -1,0 +1,1 @@
+"""Data types shared by every layer: skeletons, motions, keypoint sequences, rig roles."""

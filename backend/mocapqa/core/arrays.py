@@ -1,0 +1,83 @@
+"""Array type aliases and shape guards.
+
+Conventions: time is axis 0; local unit quaternions are ``(F, J, 4)`` float64 in scalar-last
+``(x, y, z, w)`` order (scipy's default); positions are ``(F, J, 3)``; keypoints are
+``(F, K, 3)`` with a confidence array ``(F, K)``. Guards raise :class:`~mocapqa.errors.ShapeError`
+in scipy's style: ``Expected `quats` to have shape (F, J, 4), got (120, 4)``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from mocapqa.errors import ShapeError
+
+__all__ = ["BoolArray", "FloatArray", "IntArray", "as_float_array", "check_shape"]
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.intp]
+BoolArray = NDArray[np.bool_]
+
+
+def check_shape(array: NDArray[Any], name: str, pattern: tuple[int | str, ...]) -> None:
+    """Raise ShapeError unless ``array`` matches ``pattern``.
+
+    Parameters
+    ----------
+    array : ndarray
+        The array to check.
+    name : str
+        The argument's name, used in the message.
+    pattern : tuple of int or str
+        One entry per axis: an int fixes that axis' length, a str (``"F"``, ``"J"``) is free.
+
+    Raises
+    ------
+    ShapeError
+        If the number of axes or a fixed length differs.
+    """
+    ok = array.ndim == len(pattern) and all(
+        isinstance(p, str) or array.shape[i] == p for i, p in enumerate(pattern)
+    )
+    if not ok:
+        expected = "(" + ", ".join(str(p) for p in pattern) + ("," if len(pattern) == 1 else "") + ")"
+        raise ShapeError(f"Expected `{name}` to have shape {expected}, got {tuple(array.shape)}")
+
+
+def as_float_array(
+    values: Any, name: str, pattern: tuple[int | str, ...], *, finite: bool = True
+) -> FloatArray:
+    """Convert ``values`` to a float64 array, check its shape and (optionally) finiteness.
+
+    Parameters
+    ----------
+    values : array_like
+        Input values.
+    name : str
+        The argument's name, used in messages.
+    pattern : tuple of int or str
+        Expected shape, as in :func:`check_shape`.
+    finite : bool, default True
+        Reject NaN and infinity.
+
+    Returns
+    -------
+    ndarray
+        A float64 array (a copy only when a conversion was needed).
+
+    Raises
+    ------
+    ShapeError
+        On a wrong shape, a non-numeric dtype or non-finite values.
+    """
+    try:
+        array = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise ShapeError(f"Expected `{name}` to be numeric, got {type(values).__name__}") from e
+    check_shape(array, name, pattern)
+    if finite and not np.all(np.isfinite(array)):
+        raise ShapeError(f"Expected `{name}` to be finite, got NaN or infinity")
+    return array

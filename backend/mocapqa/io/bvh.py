@@ -1,0 +1,532 @@
+"""BVH reader and writer.
+
+Conventions
+-----------
+* Reads any hierarchy, 3- or 6-channel joints (position channels on non-root joints are kept
+  and used by forward kinematics), any rotation order per joint, End Sites, tabs or spaces,
+  CRLF/LF/mixed line endings, trailing spaces, exponents, ``-0`` and ``.0083333``.
+* Rotation channels are intrinsic in channel order (see :mod:`mocapqa.kinematics.euler`) and are
+  converted to local quaternions ``(F, J, 4)``; the angles read are kept as the motion's
+  ``euler_hint_deg`` so that writing an unchanged take reproduces its numbers.
+* Root translation semantics: BVH says position channels replace the OFFSET. Character Creator
+  exports whose root keeps a large rest OFFSET write small deltas instead; ``"auto"`` detects
+  this (channels much nearer zero than the OFFSET) and records ``root_translation="add"``.
+* Every problem raises :class:`~mocapqa.errors.ParseError` (alias :data:`BvhParseError`) with
+  the file, the 1-based line and what was expected.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from mocapqa.core.arrays import FloatArray
+from mocapqa.core.motion import (
+    POSITION_CHANNELS,
+    ROTATION_CHANNELS,
+    EndSite,
+    Motion,
+    Skeleton,
+)
+from mocapqa.errors import ParseError
+from mocapqa.kinematics.euler import euler_from_quats, quats_from_euler
+from mocapqa.kinematics.quaternion import geodesic_angle
+
+__all__ = [
+    "MAX_JOINTS",
+    "BvhParseError",
+    "channel_values",
+    "format_bvh",
+    "parse_bvh",
+    "read_bvh",
+    "write_bvh",
+]
+
+BvhParseError = ParseError
+MAX_JOINTS = 1000
+_KNOWN_CHANNELS = set(POSITION_CHANNELS) | set(ROTATION_CHANNELS)
+
+
+@dataclass(slots=True)
+class _Token:
+    text: str
+    line: int
+
+
+def _decode(data: bytes, path: str) -> str:
+    if b"\x00" in data[:65536]:
+        raise ParseError("Expected a text file, got binary data (NUL bytes)", path, 1)
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        line = data[: e.start].count(b"\n") + 1
+        raise ParseError("Expected UTF-8 or ASCII text, got undecodable bytes", path, line) from e
+    return text
+
+
+def _tokens(lines: list[str], stop: int) -> Iterator[_Token]:
+    for number, line in enumerate(lines[:stop], start=1):
+        for text in line.split():
+            yield _Token(text, number)
+
+
+class _HierarchyParser:
+    def __init__(self, tokens: list[_Token], path: str) -> None:
+        self.tokens = tokens
+        self.pos = 0
+        self.path = path
+        self.names: list[str] = []
+        self.parents: list[int] = []
+        self.offsets: list[tuple[float, float, float]] = []
+        self.channels: list[tuple[str, ...]] = []
+        self.end_sites: list[EndSite] = []
+
+    def _fail(self, message: str, line: int | None = None) -> ParseError:
+        if line is None:
+            line = self.tokens[min(self.pos, len(self.tokens) - 1)].line if self.tokens else 1
+        return ParseError(message, self.path, line)
+
+    def _next(self, what: str) -> _Token:
+        if self.pos >= len(self.tokens):
+            last = self.tokens[-1].line if self.tokens else 1
+            raise self._fail(f"Expected {what}, got end of hierarchy (truncated file?)", last)
+        token = self.tokens[self.pos]
+        self.pos += 1
+        return token
+
+    def _expect(self, word: str) -> _Token:
+        token = self._next(repr(word))
+        if token.text != word:
+            raise self._fail(f"Expected {word!r}, got {token.text!r}", token.line)
+        return token
+
+    def _number(self, what: str) -> float:
+        token = self._next(what)
+        try:
+            value = float(token.text)
+        except ValueError:
+            raise self._fail(f"Expected a number for {what}, got {token.text!r}", token.line) from None
+        if not math.isfinite(value):
+            raise self._fail(f"Expected a finite number for {what}, got {token.text!r}", token.line)
+        return value
+
+    def parse(self) -> None:
+        self._expect("HIERARCHY")
+        if self.pos < len(self.tokens) and self.tokens[self.pos].text == "ROOT":
+            while self.pos < len(self.tokens) and self.tokens[self.pos].text == "ROOT":
+                self.pos += 1
+                self._joint(parent=-1)
+        else:
+            token = self._next("'ROOT'")
+            raise self._fail(f"Expected 'ROOT', got {token.text!r}", token.line)
+        if self.pos < len(self.tokens):
+            token = self.tokens[self.pos]
+            raise self._fail(f"Expected 'ROOT' or 'MOTION', got {token.text!r}", token.line)
+
+    def _joint(self, parent: int) -> None:
+        name_token = self._next("a joint name")
+        name = name_token.text
+        if name == "{":
+            raise self._fail("Expected a joint name, got '{'", name_token.line)
+        if name in self.names:
+            raise self._fail(f"Expected unique joint names, got {name!r} twice", name_token.line)
+        if len(self.names) >= MAX_JOINTS:
+            raise self._fail(f"Expected at most {MAX_JOINTS} joints, got more", name_token.line)
+        index = len(self.names)
+        self.names.append(name)
+        self.parents.append(parent)
+        self.offsets.append((0.0, 0.0, 0.0))
+        self.channels.append(())
+        self._expect("{")
+        seen_offset = False
+        while True:
+            token = self._next("'OFFSET', 'CHANNELS', 'JOINT', 'End' or '}'")
+            if token.text == "OFFSET":
+                self.offsets[index] = (
+                    self._number("OFFSET x"),
+                    self._number("OFFSET y"),
+                    self._number("OFFSET z"),
+                )
+                seen_offset = True
+            elif token.text == "CHANNELS":
+                count_token = self._next("a channel count")
+                try:
+                    count = int(count_token.text)
+                except ValueError:
+                    raise self._fail(
+                        f"Expected a channel count, got {count_token.text!r}", count_token.line
+                    ) from None
+                if not 0 <= count <= 6:
+                    raise self._fail(f"Expected 0 to 6 channels, got {count}", count_token.line)
+                names = tuple(self._next("a channel name").text for _ in range(count))
+                for channel in names:
+                    if channel not in _KNOWN_CHANNELS:
+                        raise self._fail(
+                            f"Expected a channel name like 'Xrotation', got {channel!r}",
+                            count_token.line,
+                        )
+                rot = [c for c in names if c in ROTATION_CHANNELS]
+                if len(set(names)) != len(names) or len(rot) not in (0, 3):
+                    raise self._fail(
+                        f"Expected 0 or 3 distinct rotation channels, got {' '.join(names)}",
+                        count_token.line,
+                    )
+                self.channels[index] = names
+            elif token.text == "JOINT":
+                self._joint(parent=index)
+            elif token.text == "End":
+                self._expect("Site")
+                self._expect("{")
+                self._expect("OFFSET")
+                offset = (
+                    self._number("End Site x"),
+                    self._number("End Site y"),
+                    self._number("End Site z"),
+                )
+                self._expect("}")
+                self.end_sites.append(EndSite(index, offset))
+            elif token.text == "}":
+                break
+            else:
+                raise self._fail(
+                    f"Expected 'OFFSET', 'CHANNELS', 'JOINT', 'End' or '}}', got {token.text!r}",
+                    token.line,
+                )
+        if not seen_offset:
+            raise self._fail(f"Expected an OFFSET for joint {name!r}", name_token.line)
+
+
+def _header_value(line: str, key: str, path: str, number: int) -> str:
+    stripped = line.strip()
+    if not stripped.startswith(key):
+        raise ParseError(f"Expected {key!r}, got {stripped[:40]!r}", path, number)
+    return stripped[len(key) :].strip()
+
+
+def _parse_frames_fast(data: str, n_frames: int, n_channels: int) -> FloatArray | None:
+    """Parse the frame block with pandas' C reader; None when the text needs the careful path."""
+    if n_frames == 0 or n_channels == 0:
+        return None
+    try:
+        import pandas as pd
+
+        table = pd.read_csv(
+            io.StringIO(data.replace("\t", " ")),
+            sep=" ",
+            header=None,
+            engine="c",
+            dtype=np.float64,
+            skip_blank_lines=True,
+            na_filter=True,
+        ).to_numpy()
+    except Exception:  # noqa: BLE001 - any pandas complaint means "use the careful path"
+        return None
+    if table.shape[0] != n_frames or table.shape[1] < n_channels:
+        return None
+    values = table[:, :n_channels]
+    if table.shape[1] > n_channels and not np.all(np.isnan(table[:, n_channels:])):
+        return None
+    if not np.all(np.isfinite(values)):
+        return None
+    return np.ascontiguousarray(values)
+
+
+def _parse_frames_careful(
+    lines: list[str], first: int, n_frames: int, n_channels: int, path: str
+) -> FloatArray:
+    values = np.empty((n_frames, n_channels), dtype=np.float64)
+    row = 0
+    for number in range(first, len(lines)):
+        tokens = lines[number].split()
+        if not tokens:
+            continue
+        if row >= n_frames:
+            raise ParseError(
+                f"Expected {n_frames} frame lines (Frames:), got more", path, number + 1
+            )
+        if len(tokens) != n_channels:
+            raise ParseError(
+                f"Expected {n_channels} values on a frame line, got {len(tokens)}", path, number + 1
+            )
+        try:
+            parsed = [float(t) for t in tokens]
+        except ValueError:
+            bad = next(t for t in tokens if not _is_float(t))
+            raise ParseError(f"Expected a number, got {bad!r}", path, number + 1) from None
+        if not all(math.isfinite(v) for v in parsed):
+            raise ParseError("Expected finite numbers, got NaN or infinity", path, number + 1)
+        values[row] = parsed
+        row += 1
+    if row != n_frames:
+        raise ParseError(
+            f"Expected {n_frames} frame lines (Frames:), got {row} (truncated file?)",
+            path,
+            len(lines),
+        )
+    return values
+
+
+def _is_float(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def parse_bvh(
+    data: bytes | str,
+    path: str | Path = "<bvh>",
+    root_translation: Literal["auto", "replace", "add"] = "auto",
+    length_unit: str = "unknown",
+) -> Motion:
+    """Parse BVH text into a :class:`~mocapqa.core.motion.Motion`.
+
+    Parameters
+    ----------
+    data : bytes or str
+        The file's content.
+    path : str or Path
+        Name used in error messages.
+    root_translation : {"auto", "replace", "add"}
+        How root position channels combine with the root OFFSET (see module notes).
+    length_unit : str
+        Unit of lengths in the file, when the caller knows it.
+
+    Returns
+    -------
+    Motion
+
+    Raises
+    ------
+    ParseError
+        On any malformed input, with the file and line.
+    """
+    path = str(path)
+    text = _decode(data, path) if isinstance(data, bytes) else data
+    lines = text.splitlines()
+    motion_line = next(
+        (i for i, line in enumerate(lines) if line.strip() == "MOTION"), None
+    )
+    if motion_line is None:
+        raise ParseError("Expected a 'MOTION' section, got none", path, len(lines) or 1)
+    tokens = list(_tokens(lines, motion_line))
+    if not tokens:
+        raise ParseError("Expected 'HIERARCHY', got an empty header", path, 1)
+    parser = _HierarchyParser(tokens, path)
+    parser.parse()
+    idx = motion_line + 1
+    while idx < len(lines) and not lines[idx].strip():
+        idx += 1
+    if idx >= len(lines):
+        raise ParseError("Expected 'Frames:', got end of file", path, idx)
+    frames_text = _header_value(lines[idx], "Frames:", path, idx + 1)
+    try:
+        n_frames = int(frames_text)
+    except ValueError:
+        raise ParseError(f"Expected a frame count, got {frames_text!r}", path, idx + 1) from None
+    if n_frames < 0:
+        raise ParseError(f"Expected a frame count >= 0, got {n_frames}", path, idx + 1)
+    idx += 1
+    if idx >= len(lines):
+        raise ParseError("Expected 'Frame Time:', got end of file", path, idx)
+    time_text = _header_value(lines[idx], "Frame Time:", path, idx + 1)
+    try:
+        frame_time = float(time_text)
+    except ValueError:
+        raise ParseError(f"Expected a frame time in seconds, got {time_text!r}", path, idx + 1) from None
+    if not (math.isfinite(frame_time) and frame_time > 0):
+        raise ParseError(f"Expected a frame time > 0 s, got {time_text!r}", path, idx + 1)
+    first_data = idx + 1
+    n_channels = sum(len(c) for c in parser.channels)
+    data_text = "\n".join(lines[first_data:])
+    values = _parse_frames_fast(data_text, n_frames, n_channels)
+    if values is None:
+        values = _parse_frames_careful(lines, first_data, n_frames, n_channels, path)
+    return _motion_from_channels(parser, values, 1.0 / frame_time, root_translation, length_unit)
+
+
+def _motion_from_channels(
+    parser: _HierarchyParser,
+    values: FloatArray,
+    fps: float,
+    root_translation: Literal["auto", "replace", "add"],
+    length_unit: str,
+) -> Motion:
+    n_frames = values.shape[0]
+    n_joints = len(parser.names)
+    quats = np.zeros((n_frames, n_joints, 4))
+    quats[..., 3] = 1.0
+    translations = np.zeros((n_frames, n_joints, 3))
+    euler_deg = np.zeros((n_frames, n_joints, 3))
+    by_order: dict[str, list[tuple[int, list[int]]]] = {}
+    column = 0
+    for j, chans in enumerate(parser.channels):
+        rot_cols: list[int] = []
+        order = ""
+        for k, channel in enumerate(chans):
+            if channel in POSITION_CHANNELS:
+                translations[:, j, "XYZ".index(channel[0])] = values[:, column + k]
+            else:
+                rot_cols.append(column + k)
+                order += channel[0]
+        if order:
+            by_order.setdefault(order, []).append((j, rot_cols))
+        column += len(chans)
+    for order, entries in by_order.items():
+        joints = [j for j, _ in entries]
+        cols = np.array([c for _, c in entries])
+        angles_deg = values[:, cols]  # (F, n, 3)
+        euler_deg[:, joints] = angles_deg
+        quats[:, joints] = quats_from_euler(np.deg2rad(angles_deg), order)
+    offsets = np.array(parser.offsets, dtype=np.float64).reshape(n_joints, 3)
+    mode = root_translation
+    if mode == "auto":
+        mode = _detect_root_translation(parser, offsets, translations)
+    skeleton = Skeleton(
+        names=tuple(parser.names),
+        parents=np.array(parser.parents, dtype=np.intp),
+        offsets=offsets,
+        channels=tuple(parser.channels),
+        end_sites=tuple(parser.end_sites),
+        length_unit=length_unit,
+        root_translation=mode,
+    )
+    return Motion(skeleton, quats, translations, fps, euler_hint_deg=euler_deg)
+
+
+def _detect_root_translation(
+    parser: _HierarchyParser, offsets: FloatArray, translations: FloatArray
+) -> Literal["replace", "add"]:
+    root_offset = offsets[0]
+    has_pos = any(c in POSITION_CHANNELS for c in parser.channels[0])
+    if not has_pos or not np.any(root_offset) or translations.shape[0] == 0:
+        return "replace"
+    # Along the OFFSET's dominant axis (the height, for a hip root), deltas sit near zero while
+    # absolute positions sit near the rest OFFSET.
+    axis = int(np.argmax(np.abs(root_offset)))
+    median = float(np.median(np.abs(translations[:, 0, axis])))
+    return "add" if median < 0.25 * abs(float(root_offset[axis])) else "replace"
+
+
+def read_bvh(
+    path: str | Path,
+    root_translation: Literal["auto", "replace", "add"] = "auto",
+    length_unit: str = "unknown",
+) -> Motion:
+    """Read a BVH file. See :func:`parse_bvh` for parameters and errors."""
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        raise ParseError(f"Expected a readable file, got {e.strerror}", path) from e
+    return parse_bvh(data, path, root_translation=root_translation, length_unit=length_unit)
+
+
+def _format_number(value: float) -> str:
+    text = repr(float(value))
+    if text.endswith(".0"):
+        text = text[:-2]
+    return "0" if text == "-0" else text
+
+
+def format_bvh(motion: Motion, precision: int = 6) -> str:
+    """BVH text for a motion: hierarchy as read, continuous Euler angles in each joint's order.
+
+    Parameters
+    ----------
+    motion : Motion
+        The take to write.
+    precision : int, default 6
+        Decimal places of channel values.
+
+    Returns
+    -------
+    str
+        The file's text, LF line endings.
+    """
+    sk = motion.skeleton
+    out: list[str] = ["HIERARCHY"]
+    children: dict[int, list[int]] = {}
+    for j, p in enumerate(sk.parents):
+        children.setdefault(int(p), []).append(j)
+
+    def emit(j: int, depth: int) -> None:
+        pad = "\t" * depth
+        keyword = "ROOT" if sk.parents[j] < 0 else "JOINT"
+        out.append(f"{pad}{keyword} {sk.names[j]}")
+        out.append(f"{pad}{{")
+        off = " ".join(_format_number(v) for v in sk.offsets[j])
+        out.append(f"{pad}\tOFFSET {off}")
+        if sk.channels[j]:
+            out.append(f"{pad}\tCHANNELS {len(sk.channels[j])} {' '.join(sk.channels[j])}")
+        for c in children.get(j, []):
+            emit(c, depth + 1)
+        for site in sk.end_sites:
+            if site.parent == j:
+                out.append(f"{pad}\tEnd Site")
+                out.append(f"{pad}\t{{")
+                site_off = " ".join(_format_number(v) for v in site.offset)
+                out.append(f"{pad}\t\tOFFSET {site_off}")
+                out.append(f"{pad}\t}}")
+        out.append(f"{pad}}}")
+
+    for root in children.get(-1, []):
+        emit(root, 0)
+    out.append("MOTION")
+    out.append(f"Frames: {motion.n_frames}")
+    out.append(f"Frame Time: {1.0 / motion.fps:.7g}")
+    values = channel_values(motion)
+    if values.size:
+        body = np.char.mod(f"%.{precision}f", np.round(values, precision) + 0.0)
+        out.extend(" ".join(row) for row in body)
+    return "\n".join(out) + "\n"
+
+
+def channel_values(motion: Motion) -> FloatArray:
+    """Channel values ``(F, C)`` in file order: positions in file units, angles in degrees."""
+    sk = motion.skeleton
+    n_channels = sum(len(c) for c in sk.channels)
+    values = np.zeros((motion.n_frames, n_channels))
+    euler = np.zeros((motion.n_frames, sk.n_joints, 3))
+    by_order: dict[str, list[int]] = {}
+    for j in range(sk.n_joints):
+        order = sk.rotation_order(j)
+        if order:
+            by_order.setdefault(order, []).append(j)
+    for order, joints in by_order.items():
+        quats = motion.quats[:, joints]
+        if motion.euler_hint_deg is None:
+            euler[:, joints] = np.rad2deg(euler_from_quats(quats, order))
+            continue
+        hint_deg = motion.euler_hint_deg[:, joints]
+        angles = np.rad2deg(euler_from_quats(quats, order, np.deg2rad(hint_deg)))
+        # Where the hint still describes the rotation, write it verbatim: near gimbal lock the
+        # quaternion → Euler step loses digits that the file had.
+        same = geodesic_angle(quats_from_euler(np.deg2rad(hint_deg), order), quats) < 1e-9
+        euler[:, joints] = np.where(same[..., None], hint_deg, angles)
+    column = 0
+    for j, chans in enumerate(sk.channels):
+        k_rot = 0
+        for channel in chans:
+            if channel in POSITION_CHANNELS:
+                values[:, column] = motion.translations[:, j, "XYZ".index(channel[0])]
+            else:
+                values[:, column] = euler[:, j, k_rot]
+                k_rot += 1
+            column += 1
+    return values
+
+
+def write_bvh(path: str | Path, motion: Motion, precision: int = 6) -> None:
+    """Write a motion as BVH (written to a temporary name, then renamed into place)."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(format_bvh(motion, precision), encoding="utf-8", newline="\n")
+    tmp.replace(path)
