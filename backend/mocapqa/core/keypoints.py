@@ -46,6 +46,9 @@ class KeypointSequence:
         2 or 3.
     source_format : str
         The format the data was read from ("trc", "openpose", ...), for display.
+    assumptions : tuple of str
+        What a reader had to assume because the file did not say (for example
+        ``"fps 30 assumed: OpenPose JSON stores no frame rate"``); empty when nothing was assumed.
     """
 
     names: tuple[str, ...]
@@ -55,6 +58,7 @@ class KeypointSequence:
     length_unit: str = "unknown"
     n_dims: int = 3
     source_format: str = "unknown"
+    assumptions: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         k = len(self.names)

@@ -1,0 +1,255 @@
+"""Format detection and dispatch for takes: BVH motions and keypoint sequences.
+
+Conventions
+-----------
+* :func:`detect_format` looks at the extension first and sniffs the content to tell the
+  variants apart (OpenPose, MediaPipe or generic JSON; MediaPipe or generic CSV); a file with an
+  unknown extension is sniffed by its first bytes. A folder of OpenPose JSON is "openpose".
+* :func:`read_take` returns a :class:`~mocapqa.core.motion.Motion` for BVH and a
+  :class:`~mocapqa.core.keypoints.KeypointSequence` for every keypoint format. ``fps`` and
+  ``length_unit`` are used only where a format does not store them (see each reader).
+* :func:`write_keypoints` picks the writer from the extension (or ``format``).
+* Unknown formats raise :class:`~mocapqa.errors.UnsupportedFormatError`.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from mocapqa.core.keypoints import KeypointSequence
+from mocapqa.core.motion import Motion
+from mocapqa.errors import ParseError, UnsupportedFormatError
+from mocapqa.io.bvh import read_bvh
+from mocapqa.io.keypoint_arrays import (
+    read_keypoint_npy,
+    read_keypoint_npz,
+    write_keypoint_npy,
+    write_keypoint_npz,
+)
+from mocapqa.io.keypoint_csv import read_keypoint_csv, write_keypoint_csv
+from mocapqa.io.keypoint_json import read_keypoint_json, write_keypoint_json
+from mocapqa.io.mediapipe import read_mediapipe_csv, read_mediapipe_json, read_mediapipe_pbtxt
+from mocapqa.io.openpose import openpose_frame_files, read_openpose
+from mocapqa.io.trc import read_trc, write_trc
+
+__all__ = [
+    "KEYPOINT_FORMATS",
+    "KEYPOINT_WRITE_FORMATS",
+    "TAKE_FORMATS",
+    "detect_format",
+    "read_take",
+    "write_keypoints",
+]
+
+KEYPOINT_FORMATS: tuple[str, ...] = (
+    "trc",
+    "openpose",
+    "mediapipe-csv",
+    "mediapipe-json",
+    "mediapipe-pbtxt",
+    "csv",
+    "npy",
+    "npz",
+    "json",
+)
+TAKE_FORMATS: tuple[str, ...] = ("bvh", *KEYPOINT_FORMATS)
+KEYPOINT_WRITE_FORMATS: tuple[str, ...] = ("trc", "csv", "npy", "npz", "json")
+
+_SNIFF_BYTES = 4096
+_BY_EXTENSION = {
+    ".bvh": "bvh",
+    ".trc": "trc",
+    ".npy": "npy",
+    ".npz": "npz",
+    ".pbtxt": "mediapipe-pbtxt",
+}
+
+
+def _head(path: Path) -> bytes:
+    try:
+        with path.open("rb") as handle:
+            return handle.read(_SNIFF_BYTES)
+    except OSError as e:
+        raise ParseError(f"Expected a readable file, got {e.strerror or e}", path) from e
+
+
+def _json_kind(path: Path) -> str:
+    head = _head(path)
+    text = head.decode("utf-8", errors="replace")
+    if '"people"' in text:
+        return "openpose"
+    if '"keypoints"' in text:
+        return "json"
+    if '"visibility"' in text or '"landmarks"' in text:
+        return "mediapipe-json"
+    try:
+        document: Any = json.loads(path.read_bytes())
+    except (OSError, ValueError, RecursionError):
+        return "json"
+    if isinstance(document, list) or (isinstance(document, dict) and "keypoints" not in document):
+        return "mediapipe-json"
+    return "json"
+
+
+def _csv_kind(head: bytes) -> str:
+    lines = [ln for ln in head.decode("utf-8", errors="replace").splitlines() if ln.strip()]
+    header = next((ln for ln in lines if not ln.startswith("#")), "").lower()
+    columns = [c.strip() for c in header.split(",")]
+    return "mediapipe-csv" if "frame_number" in columns and "landmark" in columns else "csv"
+
+
+def _sniff(path: Path) -> str | None:
+    head = _head(path)
+    stripped = head.lstrip(b"\xef\xbb\xbf \t\r\n")
+    if stripped.startswith(b"HIERARCHY"):
+        return "bvh"
+    if stripped.startswith(b"PathFileType"):
+        return "trc"
+    if head.startswith(b"\x93NUMPY"):
+        return "npy"
+    if head.startswith(b"PK\x03\x04"):
+        return "npz"
+    if stripped[:1] in (b"{", b"["):
+        return _json_kind(path)
+    if stripped.startswith(b"# proto-") or stripped.startswith(b"landmarks {"):
+        return "mediapipe-pbtxt"
+    first = stripped.split(b"\n", 1)[0].lower()
+    if b"," in first and (b"frame" in first or stripped.startswith(b"#")):
+        return _csv_kind(head)
+    return None
+
+
+def detect_format(path: str | Path) -> str:
+    """Name the format of a take file or folder.
+
+    Parameters
+    ----------
+    path : str or Path
+        A file, or a folder of OpenPose JSON frames.
+
+    Returns
+    -------
+    str
+        One of :data:`TAKE_FORMATS`: "bvh", "trc", "openpose", "mediapipe-csv",
+        "mediapipe-json", "mediapipe-pbtxt", "csv", "npy", "npz" or "json".
+
+    Raises
+    ------
+    ParseError
+        When the path cannot be read.
+    UnsupportedFormatError
+        When neither the extension nor the content names a supported format.
+    """
+    path = Path(path)
+    if path.is_dir():
+        files = openpose_frame_files(path)
+        if _json_kind(files[0]) == "openpose":
+            return "openpose"
+        raise UnsupportedFormatError(
+            f"Expected a folder of OpenPose JSON frames, got JSON without 'people' in {path}"
+        )
+    if not path.exists():
+        raise ParseError("Expected an existing file or folder, got nothing there", path)
+    suffix = path.suffix.lower()
+    if suffix in _BY_EXTENSION:
+        return _BY_EXTENSION[suffix]
+    if suffix == ".json":
+        return _json_kind(path)
+    if suffix == ".csv":
+        return _csv_kind(_head(path))
+    found = _sniff(path)
+    if found is None:
+        raise UnsupportedFormatError(
+            f"Expected one of {', '.join(TAKE_FORMATS)} (by extension or content), "
+            f"got an unrecognised file {path.name!r}"
+        )
+    return found
+
+
+def read_take(
+    path: str | Path,
+    fps: float | None = None,
+    person_index: int = 0,
+    length_unit: str | None = None,
+) -> Motion | KeypointSequence:
+    """Read a take of any supported format.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file or OpenPose folder.
+    fps : float, optional
+        Frames per second for formats that do not store it (OpenPose, MediaPipe, NPY, CSV
+        without time); ignored by BVH and TRC, which store their own.
+    person_index : int
+        Person to read from OpenPose output.
+    length_unit : str, optional
+        Unit for formats that do not store one.
+
+    Returns
+    -------
+    Motion or KeypointSequence
+        A Motion for BVH, a KeypointSequence otherwise.
+
+    Raises
+    ------
+    ParseError
+        On unreadable or malformed input.
+    UnsupportedFormatError
+        On an unknown format.
+    """
+    kind = detect_format(path)
+    if kind == "bvh":
+        return read_bvh(path, length_unit=length_unit or "unknown")
+    if kind == "trc":
+        return read_trc(path)
+    if kind == "openpose":
+        return read_openpose(path, fps=fps, person_index=person_index)
+    if kind == "mediapipe-pbtxt":
+        return read_mediapipe_pbtxt(path, fps=fps)
+    readers: dict[str, Callable[[Path, float | None, str | None], KeypointSequence]] = {
+        "mediapipe-csv": read_mediapipe_csv,
+        "mediapipe-json": read_mediapipe_json,
+        "csv": read_keypoint_csv,
+        "npy": read_keypoint_npy,
+        "npz": read_keypoint_npz,
+        "json": read_keypoint_json,
+    }
+    return readers[kind](Path(path), fps, length_unit)
+
+
+def write_keypoints(path: str | Path, seq: KeypointSequence, format: str | None = None) -> None:
+    """Write a keypoint sequence, choosing the writer by ``format`` or the file extension.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination file.
+    seq : KeypointSequence
+        The data.
+    format : str, optional
+        One of :data:`KEYPOINT_WRITE_FORMATS`; default from the extension.
+
+    Raises
+    ------
+    UnsupportedFormatError
+        When the format (or extension) has no writer.
+    """
+    path = Path(path)
+    kind = format if format is not None else path.suffix.lower().lstrip(".")
+    writers: dict[str, Callable[[Path, KeypointSequence], None]] = {
+        "trc": write_trc,
+        "csv": write_keypoint_csv,
+        "npy": write_keypoint_npy,
+        "npz": write_keypoint_npz,
+        "json": write_keypoint_json,
+    }
+    if kind not in writers:
+        raise UnsupportedFormatError(
+            f"Expected a keypoint output format among {', '.join(KEYPOINT_WRITE_FORMATS)}, "
+            f"got {kind or 'no extension'!r} for {path.name!r}"
+        )
+    writers[kind](path, seq)

@@ -1,0 +1,245 @@
+"""The documented long keypoint CSV: one row per frame and keypoint.
+
+Conventions
+-----------
+* Header ``frame,time,keypoint,x,y,z,confidence``; ``frame``, ``keypoint``, ``x`` and ``y`` are
+  required, ``time``, ``z`` and ``confidence`` optional, extra columns ignored. Without ``z`` the
+  data are 2D (``n_dims=2``, Z = 0).
+* Optional leading comment lines ``# fps: 30`` and ``# unit: m`` carry the frame rate and the
+  length unit (the writer emits them so that a written file reads back exactly); other ``#``
+  lines are ignored.
+* The frame rate is the caller's ``fps``, else the ``# fps`` line, else derived from ``time``
+  (median seconds per frame-number step); without any of these the reader raises an error that
+  asks for ``fps``.
+* Keypoints keep the order of their first appearance. Frame numbers may start anywhere; a frame
+  missing from the file is missing in the sequence. An empty cell or ``nan`` is missing;
+  an empty ``confidence`` is 1.0 where the position exists.
+* The unit is the caller's ``length_unit``, else the ``# unit`` line, else "unknown".
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+
+from mocapqa.core.keypoints import KeypointSequence
+from mocapqa.errors import ParseError
+from mocapqa.io.keypoint_input import (
+    build_keypoint_sequence,
+    decode_text,
+    float_from_text,
+    read_file_bytes,
+    resolve_fps,
+    resolve_length_unit,
+)
+
+__all__ = [
+    "KEYPOINT_CSV_COLUMNS",
+    "format_keypoint_csv",
+    "parse_keypoint_csv",
+    "read_keypoint_csv",
+    "write_keypoint_csv",
+]
+
+KEYPOINT_CSV_COLUMNS = ("frame", "time", "keypoint", "x", "y", "z", "confidence")
+_REQUIRED = ("frame", "keypoint", "x", "y")
+_MAX_FRAME_GAP_FACTOR = 4
+
+
+def _metadata(lines: list[str], path: str) -> tuple[dict[str, str], int]:
+    meta: dict[str, str] = {}
+    start = 0
+    while start < len(lines) and (lines[start].startswith("#") or not lines[start].strip()):
+        key, sep, value = lines[start].lstrip("#").partition(":")
+        if sep:
+            meta[key.strip().lower()] = value.strip()
+        start += 1
+    return meta, start
+
+
+def _frame_number(text: str, path: str, line: int) -> int:
+    value = float_from_text(text, path, line, "frame")
+    if not (math.isfinite(value) and value == int(value) and abs(value) < 2**53):
+        raise ParseError(f"Expected a whole frame number, got {text[:20]!r}", path, line, "frame")
+    return int(value)
+
+
+def _fps_from_times(frames: dict[int, float], path: str) -> float | None:
+    known = sorted((f, t) for f, t in frames.items() if not math.isnan(t))
+    if len(known) < 2:
+        return None
+    steps = np.diff(np.array(known, dtype=np.float64), axis=0)
+    seconds_per_frame = float(np.median(steps[:, 1] / steps[:, 0]))
+    if not (math.isfinite(seconds_per_frame) and seconds_per_frame > 0):
+        raise ParseError("Expected times increasing with frame numbers", path, field="time")
+    return 1.0 / seconds_per_frame
+
+
+def parse_keypoint_csv(
+    data: bytes | str,
+    path: str | Path = "<keypoints.csv>",
+    fps: float | None = None,
+    length_unit: str | None = None,
+) -> KeypointSequence:
+    """Parse the long keypoint CSV into a :class:`~mocapqa.core.keypoints.KeypointSequence`.
+
+    Parameters
+    ----------
+    data : bytes or str
+        The file's content.
+    path : str or Path
+        The file name used in messages.
+    fps : float, optional
+        Frames per second; required when the file has neither ``time`` nor ``# fps``.
+    length_unit : str, optional
+        Unit of x, y, z when the file has no ``# unit`` line.
+
+    Returns
+    -------
+    KeypointSequence
+        Positions ``(F, K, 3)``; F spans the first to the last frame number.
+
+    Raises
+    ------
+    ParseError
+        On a bad header, row, cell, duplicate (frame, keypoint), or a missing frame rate,
+        naming the file, the line and the column.
+    """
+    path = str(path)
+    lines = decode_text(data, path).splitlines()
+    meta, start = _metadata(lines, path)
+    try:
+        table = list(csv.reader(io.StringIO("\n".join(lines[start:]), newline="")))
+    except csv.Error as e:
+        raise ParseError(f"Expected CSV, got {e}", path) from e
+    if not table:
+        raise ParseError("Expected a header line, got an empty file", path, start + 1)
+    header = [c.strip().lower() for c in table[0]]
+    missing = [name for name in _REQUIRED if name not in header]
+    if missing or len(set(header)) != len(header):
+        raise ParseError(
+            f"Expected unique columns including {','.join(_REQUIRED)}, got {header[:8]}",
+            path,
+            start + 1,
+        )
+    col = {name: header.index(name) for name in KEYPOINT_CSV_COLUMNS if name in header}
+    axes = [a for a in "xyz" if a in col]
+    names: dict[str, int] = {}
+    times: dict[int, float] = {}
+    rows: list[tuple[int, int, list[float], float, int]] = []
+    for offset, cells in enumerate(table[1:], start=start + 2):
+        if not cells or not "".join(cells).strip():
+            continue
+        if len(cells) != len(header):
+            raise ParseError(f"Expected {len(header)} cells, got {len(cells)}", path, offset)
+        frame = _frame_number(cells[col["frame"]], path, offset)
+        name = cells[col["keypoint"]].strip()
+        if not name:
+            raise ParseError(
+                "Expected a keypoint name, got an empty cell", path, offset, "keypoint"
+            )
+        xyz = [float_from_text(cells[col[a]], path, offset, a) for a in axes]
+        if len(axes) == 2:
+            xyz.append(0.0 if not any(map(math.isnan, xyz)) else math.nan)
+        conf = 1.0
+        if "confidence" in col and cells[col["confidence"]].strip():
+            conf = float_from_text(cells[col["confidence"]], path, offset, "confidence")
+            if not 0.0 <= conf <= 1.0:
+                raise ParseError(f"Expected confidence in [0, 1], got {conf}", path, offset)
+        if "time" in col:
+            t = float_from_text(cells[col["time"]], path, offset, "time")
+            if times.setdefault(frame, t) != t and not (math.isnan(t) and math.isnan(times[frame])):
+                raise ParseError(f"Expected one time per frame {frame}", path, offset, "time")
+        rows.append((frame, names.setdefault(name, len(names)), xyz, conf, offset))
+    if not rows:
+        raise ParseError("Expected at least one data row, got none", path, len(lines))
+    first = min(r[0] for r in rows)
+    n_frames = max(r[0] for r in rows) - first + 1
+    if n_frames > _MAX_FRAME_GAP_FACTOR * len(rows):
+        raise ParseError(f"Expected contiguous frame numbers, got a span of {n_frames}", path)
+    positions = np.full((n_frames, len(names), 3), np.nan)
+    confidence = np.zeros((n_frames, len(names)))
+    seen = np.zeros((n_frames, len(names)), dtype=bool)
+    for frame, index, xyz, conf, line in rows:
+        if seen[frame - first, index]:
+            raise ParseError("Expected one row per frame and keypoint, got a repeat", path, line)
+        seen[frame - first, index] = True
+        positions[frame - first, index] = xyz
+        confidence[frame - first, index] = conf
+    notes: list[str] = []
+    file_fps = float_from_text(meta["fps"], path, None, "fps") if "fps" in meta else None
+    rate = resolve_fps(
+        fps,
+        file_fps if file_fps is not None else _fps_from_times(times, path),
+        None,
+        path,
+        "CSV",
+        notes,
+    )
+    unit = resolve_length_unit(length_unit or meta.get("unit"), "unknown", path, notes)
+    return build_keypoint_sequence(
+        path, tuple(names), positions, confidence, rate,
+        length_unit=unit, n_dims=len(axes), source_format="csv", assumptions=notes,
+    )  # fmt: skip
+
+
+def read_keypoint_csv(
+    path: str | Path, fps: float | None = None, length_unit: str | None = None
+) -> KeypointSequence:
+    """Read a long keypoint CSV file. See :func:`parse_keypoint_csv`."""
+    return parse_keypoint_csv(read_file_bytes(path), path, fps, length_unit)
+
+
+def _cell(value: float) -> str:
+    return "" if math.isnan(value) else repr(float(value))
+
+
+def format_keypoint_csv(seq: KeypointSequence) -> str:
+    """Format a sequence as the long keypoint CSV, with ``# fps`` and ``# unit`` lines.
+
+    Parameters
+    ----------
+    seq : KeypointSequence
+        The data; 2D sequences are written without ``z``.
+
+    Returns
+    -------
+    str
+        The file content (LF line endings); missing values are empty cells.
+    """
+    axes = 2 if seq.n_dims == 2 else 3
+    columns = [c for c in KEYPOINT_CSV_COLUMNS if c != "z" or axes == 3]
+    out = [f"# fps: {seq.fps!r}", f"# unit: {seq.length_unit}", ",".join(columns)]
+    for frame in range(seq.n_frames):
+        time = repr(frame / seq.fps)
+        for k, name in enumerate(seq.names):
+            coords = ",".join(_cell(v) for v in seq.positions[frame, k, :axes])
+            conf = repr(float(seq.confidence[frame, k]))
+            out.append(f"{frame},{time},{_quoted(name)},{coords},{conf}")
+    return "\n".join(out) + "\n"
+
+
+def _quoted(name: str) -> str:
+    buffer = io.StringIO()
+    csv.writer(buffer, lineterminator="").writerow([name])
+    return buffer.getvalue()
+
+
+def write_keypoint_csv(path: str | Path, seq: KeypointSequence) -> None:
+    """Write a sequence as a long keypoint CSV file (temporary name, then renamed into place).
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination file.
+    seq : KeypointSequence
+        The data.
+    """
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(format_keypoint_csv(seq), encoding="utf-8", newline="\n")
+    tmp.replace(path)

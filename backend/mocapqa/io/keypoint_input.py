@@ -1,0 +1,277 @@
+"""Shared input steps of the keypoint readers: reading text, parsing numbers, building sequences.
+
+Conventions
+-----------
+* Every problem becomes :class:`~mocapqa.errors.ParseError` naming the file and, where known,
+  the 1-based line or the field; a :class:`~mocapqa.errors.ShapeError` raised while building
+  the :class:`~mocapqa.core.keypoints.KeypointSequence` is wrapped the same way.
+* Number text follows Python's ``float``: ``nan`` means missing; infinity is rejected.
+* The frame rate is resolved in one place: a caller's ``fps`` wins, then the file's, then a
+  reader-specific default that is recorded in ``KeypointSequence.assumptions``, or an error
+  when the format has no default.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from mocapqa.core.arrays import FloatArray
+from mocapqa.core.keypoints import LENGTH_UNITS, KeypointSequence
+from mocapqa.errors import ParseError, ShapeError
+
+__all__ = [
+    "MAX_FILE_BYTES",
+    "build_keypoint_sequence",
+    "decode_text",
+    "float_from_text",
+    "read_file_bytes",
+    "resolve_fps",
+    "resolve_length_unit",
+]
+
+MAX_FILE_BYTES = 2**31
+
+
+def read_file_bytes(path: str | Path) -> bytes:
+    """Read a whole file, turning OS errors into ParseError.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+
+    Returns
+    -------
+    bytes
+        The content.
+
+    Raises
+    ------
+    ParseError
+        When the file cannot be read.
+    """
+    try:
+        return Path(path).read_bytes()
+    except OSError as e:
+        raise ParseError(f"Expected a readable file, got {e.strerror or e}", path) from e
+
+
+def decode_text(data: bytes | str, path: str | Path) -> str:
+    """Decode file content as UTF-8 (a BOM is dropped); binary content raises ParseError.
+
+    Parameters
+    ----------
+    data : bytes or str
+        Raw content, or already decoded text.
+    path : str or Path
+        The file name used in messages.
+
+    Returns
+    -------
+    str
+        The text.
+
+    Raises
+    ------
+    ParseError
+        On NUL bytes or bytes that are not UTF-8, with the line where they occur.
+    """
+    if isinstance(data, str):
+        text = data
+    else:
+        try:
+            text = data.decode("utf-8-sig")
+        except UnicodeDecodeError as e:
+            line = data[: e.start].count(b"\n") + 1
+            raise ParseError("Expected UTF-8 text, got undecodable bytes", path, line) from e
+    if "\x00" in text:
+        line = text[: text.index("\x00")].count("\n") + 1
+        raise ParseError("Expected a text file, got binary data (NUL bytes)", path, line)
+    return text
+
+
+def float_from_text(
+    text: str, path: str | Path, line: int | None = None, field: str | None = None
+) -> float:
+    """Parse one number cell; an empty cell or ``nan`` gives NaN.
+
+    Parameters
+    ----------
+    text : str
+        The cell, surrounding spaces allowed.
+    path : str or Path
+        The file name used in messages.
+    line : int, optional
+        1-based line number, for messages.
+    field : str, optional
+        Column or field name, for messages.
+
+    Returns
+    -------
+    float
+        The value, NaN for a missing cell.
+
+    Raises
+    ------
+    ParseError
+        On text that is not a number, or on infinity.
+    """
+    cell = text.strip()
+    if not cell:
+        return math.nan
+    try:
+        value = float(cell)
+    except ValueError as e:
+        raise ParseError(f"Expected a number, got {cell[:40]!r}", path, line, field) from e
+    if math.isinf(value):
+        raise ParseError(f"Expected a finite number or NaN, got {cell[:40]!r}", path, line, field)
+    return value
+
+
+def resolve_fps(
+    caller_fps: float | None,
+    file_fps: float | None,
+    default_fps: float | None,
+    path: str | Path,
+    format_name: str,
+    assumptions: list[str],
+) -> float:
+    """Choose the frame rate: the caller's, else the file's, else a recorded default.
+
+    Parameters
+    ----------
+    caller_fps : float or None
+        Frames per second passed by the caller.
+    file_fps : float or None
+        Frames per second stored in the file.
+    default_fps : float or None
+        The reader's default when neither is known; None makes the frame rate required.
+    path : str or Path
+        The file name used in messages.
+    format_name : str
+        The format's name, used in messages and assumptions.
+    assumptions : list of str
+        Appended to when the default is used.
+
+    Returns
+    -------
+    float
+        Frames per second (> 0).
+
+    Raises
+    ------
+    ParseError
+        When no frame rate is known and there is no default, or a value is not positive.
+    """
+    fps = caller_fps if caller_fps is not None else file_fps
+    if fps is None:
+        if default_fps is None:
+            raise ParseError(
+                f"Expected a frame rate: {format_name} input without a time column or fps "
+                "field needs the fps argument (for example --fps 30)",
+                path,
+                field="fps",
+            )
+        fps = default_fps
+        assumptions.append(f"fps {default_fps:g} assumed: {format_name} stores no frame rate")
+    if not (math.isfinite(fps) and fps > 0):
+        raise ParseError(f"Expected fps > 0, got {fps}", path, field="fps")
+    return float(fps)
+
+
+def resolve_length_unit(
+    caller_unit: str | None, default_unit: str, path: str | Path, assumptions: list[str]
+) -> str:
+    """Choose the length unit of a format that does not store one.
+
+    Parameters
+    ----------
+    caller_unit : str or None
+        The caller's ``length_unit``; wins when given.
+    default_unit : str
+        The unit the format implies ("unknown" when it implies none).
+    path : str or Path
+        The file name used in messages.
+    assumptions : list of str
+        Appended to when a unit other than "unknown" is implied rather than given.
+
+    Returns
+    -------
+    str
+        One of :data:`~mocapqa.core.keypoints.LENGTH_UNITS`.
+
+    Raises
+    ------
+    ParseError
+        When the caller's unit is not a known one.
+    """
+    if caller_unit is not None:
+        if caller_unit not in LENGTH_UNITS:
+            raise ParseError(
+                f"Expected length_unit in {LENGTH_UNITS}, got {caller_unit!r}", path, field="unit"
+            )
+        return caller_unit
+    if default_unit != "unknown":
+        assumptions.append(f"length unit {default_unit!r} implied by the format, not stored")
+    return default_unit
+
+
+def build_keypoint_sequence(
+    path: str | Path,
+    names: tuple[str, ...],
+    positions: FloatArray,
+    confidence: FloatArray,
+    fps: float,
+    *,
+    length_unit: str,
+    n_dims: int,
+    source_format: str,
+    assumptions: list[str] | tuple[str, ...] = (),
+) -> KeypointSequence:
+    """Build a KeypointSequence, turning its validation errors into ParseError for ``path``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file the data came from.
+    names : tuple of str
+        Keypoint names, K of them.
+    positions : ndarray, shape (F, K, 3)
+        Coordinates in ``length_unit``, NaN where missing.
+    confidence : ndarray, shape (F, K)
+        Confidence in [0, 1].
+    fps : float
+        Frames per second.
+    length_unit, source_format : str
+        As in :class:`~mocapqa.core.keypoints.KeypointSequence`.
+    n_dims : int
+        2 or 3.
+    assumptions : sequence of str
+        Recorded assumptions.
+
+    Returns
+    -------
+    KeypointSequence
+        The sequence.
+
+    Raises
+    ------
+    ParseError
+        When the data do not make a valid sequence (duplicate names, confidence outside [0, 1]).
+    """
+    try:
+        return KeypointSequence(
+            names=tuple(names),
+            positions=np.asarray(positions, dtype=np.float64),
+            confidence=np.asarray(confidence, dtype=np.float64),
+            fps=fps,
+            length_unit=length_unit,
+            n_dims=n_dims,
+            source_format=source_format,
+            assumptions=tuple(assumptions),
+        )
+    except ShapeError as e:
+        raise ParseError(str(e), path) from e
