@@ -1,0 +1,153 @@
+"""``mocapqa filter`` and ``mocapqa bench filters``."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from mocapqa.cli.app import app, bench_app
+from mocapqa.errors import InputError
+
+__all__ = ["bench_filters", "filter_command", "parse_overrides"]
+
+console = Console(highlight=False)
+
+
+def parse_overrides(items: list[str]) -> dict[str, str]:
+    """``["k=v", ...]`` → ``{"k": "v"}``; raises InputError on an item without ``=``."""
+    out: dict[str, str] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key:
+            raise InputError(f"Expected --param NAME=VALUE, got {item!r}")
+        out[key.strip()] = value.strip()
+    return out
+
+
+@app.command("filter")
+def filter_command(
+    input_path: Annotated[Path, typer.Argument(help="Keypoint file (any format) or BVH.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Output file.")],
+    method: Annotated[str, typer.Option(help="Filter method (see the registry).")] = "",
+    preset: Annotated[str, typer.Option(help="Parameter preset: default or note.")] = "default",
+    param: Annotated[
+        list[str] | None, typer.Option(help="Override, NAME=VALUE (repeatable).")
+    ] = None,
+    report: Annotated[Path | None, typer.Option(help="Write a JSON report here.")] = None,
+    fps: Annotated[float | None, typer.Option(help="Frame rate for formats without one.")] = None,
+) -> None:
+    """Filter a keypoint file or the rotations of a BVH take."""
+    from mocapqa.core.motion import Motion
+    from mocapqa.filters.apply import filter_keypoints, filter_motion
+    from mocapqa.filters.registry import FILTERS
+    from mocapqa.io.bvh import write_bvh
+    from mocapqa.io.formats import read_take, write_keypoints
+    from mocapqa.metrics.smoothness import lag_frames, mean_abs_jerk
+
+    overrides = parse_overrides(param or [])
+    take = read_take(input_path, fps=fps)
+    summary: dict[str, Any]
+    if isinstance(take, Motion):
+        method = method or "quat-pd"
+        if preset != "default":
+            raise InputError(f"Expected preset 'default' for rotation filters, got {preset!r}")
+        out_motion = filter_motion(take, method, overrides)
+        write_bvh(output, out_motion)
+        summary = {"method": method, "frames": take.n_frames, "joints": take.skeleton.n_joints}
+    else:
+        method = method or "adaptive"
+        if method not in FILTERS:
+            raise InputError(f"Expected --method in {sorted(FILTERS)}, got {method!r}")
+        result = filter_keypoints(take, method, preset, overrides)
+        write_keypoints(output, result.sequence)
+        summary = result.to_json(max_points=2000)
+        per_key = []
+        for k, name in enumerate(take.names):
+            raw, out = take.positions[:, k], result.sequence.positions[:, k]
+            per_key.append(
+                {
+                    "keypoint": name,
+                    "jerk_raw": mean_abs_jerk(raw, take.fps),
+                    "jerk_filtered": mean_abs_jerk(out, take.fps),
+                    "lag_frames_vs_input": lag_frames(raw, out),
+                }
+            )
+        summary["per_keypoint"] = per_key
+    if report is not None:
+        report.write_text(json.dumps(summary, indent=1, default=str, allow_nan=True))
+    console.print(f"filtered {input_path} with {method} → {output}")
+
+
+def _table(title: str, rows: list[dict[str, Any]]) -> Table:
+    table = Table(title=title)
+    if not rows:
+        return table
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    for k in keys:
+        table.add_column(k)
+    for r in rows:
+        table.add_row(*(_fmt(r.get(k, "")) for k in keys))
+    return table
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    if hasattr(value, "tolist"):
+        return " ".join(f"{v:.3g}" for v in value.tolist())
+    return str(value)
+
+
+def _default_corpus() -> Path:
+    env = os.environ.get("MOCAPQA_CORPUS_DIR")
+    if env:
+        return Path(env)
+    for base in (Path.cwd(), *Path.cwd().parents):
+        if (base / "shared" / "data" / "MANIFEST.tsv").is_file():
+            return base / "shared" / "data"
+    return Path.cwd() / "shared" / "data"
+
+
+@bench_app.command("filters")
+def bench_filters(
+    data: Annotated[Path | None, typer.Option(help="Corpus folder (shared/data).")] = None,
+    seed: Annotated[int, typer.Option(help="Noise seed.")] = 0,
+    limit: Annotated[int | None, typer.Option(help="Use only the first N takes.")] = None,
+) -> None:
+    """Keypoint and rotation filters on real takes with seeded noise; prints tables."""
+    from mocapqa.bench.filters import (
+        keypoint_cases,
+        keypoint_table,
+        load_takes,
+        note_table,
+        pose2sim_table,
+        speed_table,
+        split_takes,
+    )
+    from mocapqa.bench.rotation_filters import (
+        quamo_table,
+        rotation_cases,
+        rotation_table,
+        tune_quat_pd,
+    )
+
+    root = data or _default_corpus()
+    if not (root / "bvh" / "bandai").is_dir():
+        raise InputError(f"Expected a corpus folder with bvh/bandai (--data), got {root}")
+    train, test = split_takes(load_takes(root, limit))
+    console.print(f"Bandai takes: {len(train)} training, {len(test)} test; seed {seed}")
+    k_train, k_test = keypoint_cases(train, seed), keypoint_cases(test, seed)
+    console.print(_table("Keypoints (cm; test takes)", keypoint_table(k_train, k_test)))
+    console.print(_table("The note's table (note preset; test takes)", note_table(k_test)))
+    r_train, r_test = rotation_cases(train, seed), rotation_cases(test, seed)
+    tuned = tune_quat_pd(r_train)
+    console.print(_table("Rotations (test takes)", rotation_table(r_test, tuned)))
+    console.print(_table("QuaMo ablation (tuned gains; test takes)", quamo_table(r_test, tuned)))
+    console.print(_table("Pose2Sim raw TRC vs its Butterworth file", pose2sim_table(root)))
+    console.print(_table("Speed", speed_table()))

@@ -1,0 +1,156 @@
+"""filter_keypoints, filter_motion, the registry and the CLI on the real data."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mocapqa.cli.main import main
+from mocapqa.core.keypoints import KeypointSequence
+from mocapqa.errors import InputError
+from mocapqa.filters.apply import data_scale, filter_keypoints, filter_motion
+from mocapqa.filters.registry import FILTERS, DataScale
+from mocapqa.io.bvh import read_bvh
+from mocapqa.io.formats import read_take
+from mocapqa.metrics.smoothness import mean_abs_jerk
+
+BALANCING = (
+    "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d/S00_P00_T01_BalancingTrial_0-100.trc"
+)
+BANDAI = "bvh/bandai/dataset-2_wave-right-hand_active_001.bvh"
+
+
+@pytest.fixture(scope="module")
+def trc(corpus_dir: Path) -> KeypointSequence:
+    take = read_take(corpus_dir / BALANCING)
+    assert isinstance(take, KeypointSequence)
+    return take
+
+
+@pytest.mark.parametrize("method", ["adaptive", "kalman", "one-euro", "ema", "butterworth"])
+@pytest.mark.parametrize("preset", ["default", "note"])
+def test_every_keypoint_method_smooths_real_trc_without_nan(
+    trc: KeypointSequence, method: str, preset: str
+) -> None:
+    if preset not in FILTERS[method].presets:
+        with pytest.raises(InputError, match="Expected a preset"):
+            filter_keypoints(trc, method, preset)
+        return
+    res = filter_keypoints(trc, method, preset)
+    out = res.sequence
+    assert out.positions.shape == trc.positions.shape
+    assert out.length_unit == "m"
+    assert not np.isnan(out.positions).any()
+    assert mean_abs_jerk(out.positions, out.fps) < mean_abs_jerk(trc.positions, trc.fps)
+    assert res.bridged.shape == (trc.n_frames, trc.n_keypoints)
+    if method == "adaptive":
+        assert res.weights is not None
+        assert res.weights.shape == (trc.n_frames, trc.n_keypoints, 3)
+        assert res.weight_names == ("kalman", "one_euro", "ema")
+    report = res.to_json(max_points=10)
+    assert len(report["timeline_frames"]) <= 10
+    json.dumps(report)
+
+
+def test_presets_follow_the_data_units(trc: KeypointSequence) -> None:
+    metres = data_scale("m", 60.0)
+    millimetres = data_scale("mm", 60.0)
+    k_m = FILTERS["kalman"].preset("default", metres)
+    k_mm = FILTERS["kalman"].preset("default", millimetres)
+    assert k_mm.measurement_noise == pytest.approx(k_m.measurement_noise * 1e6)
+    # The note's thresholds: 1.0 normalised unit/s = 2.0 m/s (stated assumption).
+    assert FILTERS["adaptive"].preset("note", metres).fast_speed == pytest.approx(2.0)
+    assert FILTERS["adaptive"].preset("note", data_scale("normalized", 30.0)).fast_speed == 1.0
+    # Pixels: scale from the body extent, so the same take in mm and "px" filters alike.
+    px = dataclasses.replace(trc, positions=trc.positions * 1000.0, length_unit="px")
+    assert data_scale("px", 60.0, px.positions).units_per_metre == pytest.approx(
+        1000.0 * data_scale("unknown", 60.0, trc.positions).units_per_metre
+    )
+    with pytest.raises(InputError, match="Expected metric units or keypoints"):
+        data_scale("px", 60.0)
+
+
+def test_missing_keypoint_is_bridged_and_an_empty_one_stays_a_marked_gap(
+    trc: KeypointSequence,
+) -> None:
+    pos = trc.positions.copy()
+    conf = trc.confidence.copy()
+    pos[:5, 0] = np.nan
+    pos[40:50, 1] = np.nan
+    pos[:, 2] = np.nan
+    seq = dataclasses.replace(trc, positions=pos, confidence=conf)
+    res = filter_keypoints(seq, "adaptive")
+    out = res.sequence.positions
+    assert not np.isnan(out[:, :2]).any()
+    assert np.isnan(out[:, 2]).all()
+    assert res.bridged[:5, 0].all()
+    assert res.bridged[40:50, 1].all()
+    assert res.bridged[:, 2].all()
+
+
+def test_unknown_method_preset_and_parameter_are_refused(trc: KeypointSequence) -> None:
+    with pytest.raises(InputError, match="Expected a filter method"):
+        filter_keypoints(trc, "median")
+    with pytest.raises(InputError, match="Expected a keypoint filter method"):
+        filter_keypoints(trc, "quat-pd")
+    with pytest.raises(InputError, match="Expected a parameter in"):
+        filter_keypoints(trc, "kalman", params={"speed": "1"})
+    with pytest.raises(InputError, match="Expected a number"):
+        filter_keypoints(trc, "kalman", params={"process_noise": "fast"})
+    res = filter_keypoints(trc, "adaptive", params={"kalman.gate_sigma": "3.5"})
+    assert res.params.kalman.gate_sigma == 3.5
+
+
+def test_registry_describes_every_method() -> None:
+    for name, entry in FILTERS.items():
+        assert entry.name == name
+        assert entry.kind in ("keypoints", "rotations", "both")
+        infos = entry.describe(DataScale(100.0, 200.0, 30.0))
+        assert infos
+        names = [i.name for i in infos]
+        assert len(names) == len(set(names))
+        assert isinstance(entry.preset("default", DataScale()), entry.params)
+    units = {i.name: i.unit for i in FILTERS["adaptive"].describe()}
+    assert units["kalman.process_noise"] == "unit²/s⁴"
+    assert units["one_euro.min_cutoff_hz"] == "Hz"
+    assert units["window_s"] == "s"
+
+
+@pytest.mark.parametrize("method", ["quat-pd", "quat-one-euro", "euler-pd", "butterworth"])
+def test_filter_motion_keeps_unit_rotations_on_a_real_take(corpus_dir: Path, method: str) -> None:
+    motion = read_bvh(corpus_dir / BANDAI, length_unit="cm")
+    out = filter_motion(motion, method)
+    assert out.quats.shape == motion.quats.shape
+    np.testing.assert_allclose(np.linalg.norm(out.quats, axis=-1), 1.0, atol=1e-9)
+    assert np.isfinite(out.translations).all()
+    with pytest.raises(InputError, match="Expected a rotation filter method"):
+        filter_motion(motion, "adaptive")
+
+
+def test_cli_filters_trc_to_csv_with_a_report(corpus_dir: Path, tmp_path: Path) -> None:
+    out = tmp_path / "out.csv"
+    report = tmp_path / "report.json"
+    argv = ["filter", str(corpus_dir / BALANCING), "-o", str(out), "--method", "adaptive"]
+    code = main([*argv, "--param", "window_s=0.2", "--report", str(report)])
+    assert code == 0
+    back = read_take(out, fps=60.0)
+    assert isinstance(back, KeypointSequence)
+    assert back.positions.shape[1] == 21
+    data = json.loads(report.read_text())
+    assert data["weight_names"] == ["kalman", "one_euro", "ema"]
+    assert len(data["per_keypoint"]) == 21
+    # The CSV written is read back and filtered again (long format in and out).
+    assert main(["filter", str(out), "-o", str(tmp_path / "again.csv"), "--fps", "60"]) == 0
+
+
+def test_cli_filters_a_bvh_and_refuses_bad_parameters(corpus_dir: Path, tmp_path: Path) -> None:
+    out = tmp_path / "out.bvh"
+    assert main(["filter", str(corpus_dir / BANDAI), "-o", str(out), "--method", "quat-pd"]) == 0
+    assert read_bvh(out).n_frames == read_bvh(corpus_dir / BANDAI).n_frames
+    bad = ["filter", str(corpus_dir / BANDAI), "-o", str(out), "--param", "natural_frequency_hz=9"]
+    assert main(bad) == 3
+    assert main([*bad[:4], "--param", "oops"]) == 3
