@@ -1,0 +1,388 @@
+"""Detection of axial twist level shifts: candidate frames, offsets and error intervals.
+
+Conventions
+-----------
+* Works on C chains at once: increments are ``(F, C)`` arrays in radians, wrapped to (−π, π].
+* ``offset(t)`` is the parent's twist offset: a corrupted take is ``qP ⊗ R(a, offset)`` with the
+  child compensated, so :func:`mocapqa.twist.refine.refine_quats` applies ``R(a, −offset)``.
+* ``method="paper"`` is the published rule as written (Kim et al., methods §1): candidates where
+  ``ΔθP · ΔθC < 0`` and both magnitudes exceed τ; ``err = sign(ΔθP) · min(|ΔθP|, |ΔθC|)`` is
+  accumulated into the offset on every candidate frame, so residues persist to the end of the
+  take. Intervals are the runs where the wrapped offset exceeds a reporting tolerance.
+* ``method="robust"`` looks for level-shift *events*: frames where the parent's twist increment
+  departs from its local natural velocity (the median of its neighbours) by more than a
+  threshold scaled to the chain's own noise, and the child counter-rotates by the same amount
+  modulo 2π (offsets near ±180° wrap). Each onset is paired with the release that brings the
+  accumulated level back to zero within ``max_interval_s``; events left unpaired are ignored,
+  so a single spurious event cannot shift the rest of a take.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.ndimage import median_filter
+
+from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.errors import InputError
+from mocapqa.twist.angles import wrap_angle
+
+__all__ = [
+    "DetectedInterval",
+    "Detection",
+    "PaperParams",
+    "RobustParams",
+    "detect_paper",
+    "detect_robust",
+    "runs",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class PaperParams:
+    """Parameters of the paper's rule.
+
+    Parameters
+    ----------
+    threshold_deg : float
+        τ: both |ΔθP| and |ΔθC| must exceed it (the paper gives no value).
+    report_tolerance_deg : float
+        Frames whose wrapped offset exceeds this are reported as inside an interval.
+    """
+
+    threshold_deg: float = 1.0
+    report_tolerance_deg: float = 0.5
+
+    def __post_init__(self) -> None:
+        if not (self.threshold_deg >= 0 and self.report_tolerance_deg >= 0):
+            raise InputError(
+                f"Expected non-negative thresholds, got {self.threshold_deg}, "
+                f"{self.report_tolerance_deg}"
+            )
+
+
+@dataclass(frozen=True, slots=True)
+class RobustParams:
+    """Parameters of the robust detector.
+
+    Parameters
+    ----------
+    min_threshold_deg : float
+        Floor of the jump threshold.
+    noise_factor : float
+        The threshold is ``max(min_threshold_deg, noise_factor × σ)`` with σ the chain's robust
+        (MAD) scale of increment residuals; 0 disables the noise scaling.
+    neighbour_frames : int
+        Frames on each side whose median increment is the natural velocity.
+    consistency : float
+        Counter-rotation check: ``|wrap(rP + rC)| ≤ consistency × min(|rP|, |rC|)``.
+    closure_fraction : float
+        An onset is released when the accumulated level is within
+        ``max(threshold, closure_fraction × largest jump)`` of zero.
+    max_interval_s : float
+        Longest interval searched for a release, seconds.
+    parent_source : {"increment", "swing_twist"}
+        Parent twist from the body-frame increment or from swing–twist angle differences.
+    child_source : {"increment", "azimuth", "auto"}
+        Child twist from its parent-frame increment, the grandchild azimuth, or the azimuth where
+        well-conditioned (``|v⊥| ≥ min_conditioning``) and the increment elsewhere.
+    min_conditioning : float
+        Sine of the smallest angle between ``v`` and the axis for which the azimuth is used.
+    pair_events : bool
+        Pair onsets with releases (True) or accumulate every event (False).
+    modular : bool
+        Compare counter-rotations modulo 2π (True) or require opposite signs (False).
+    passes : int
+        Detection passes; each later pass re-estimates the natural velocities with the events of
+        the previous pass left out.
+    """
+
+    min_threshold_deg: float = 2.0
+    noise_factor: float = 8.0
+    neighbour_frames: int = 3
+    consistency: float = 0.5
+    closure_fraction: float = 0.2
+    max_interval_s: float = 2.0
+    parent_source: str = "increment"
+    child_source: str = "increment"
+    min_conditioning: float = 0.4
+    pair_events: bool = True
+    modular: bool = True
+    passes: int = 2
+
+    def __post_init__(self) -> None:
+        if self.parent_source not in ("increment", "swing_twist"):
+            raise InputError(
+                f"Expected parent_source 'increment' or 'swing_twist', got {self.parent_source!r}"
+            )
+        if self.child_source not in ("increment", "azimuth", "auto"):
+            raise InputError(
+                f"Expected child_source 'increment', 'azimuth' or 'auto', got {self.child_source!r}"
+            )
+        if self.neighbour_frames < 1 or self.max_interval_s <= 0 or self.passes < 1:
+            raise InputError(
+                "Expected neighbour_frames ≥ 1, max_interval_s > 0 and passes ≥ 1, got "
+                f"{self.neighbour_frames}, {self.max_interval_s}, {self.passes}"
+            )
+
+
+@dataclass(frozen=True, slots=True)
+class DetectedInterval:
+    """One error interval on one chain.
+
+    Parameters
+    ----------
+    chain : int
+        Index of the chain.
+    start_frame, end_frame : int
+        First and last corrupted frame (inclusive).
+    offset_rad : float
+        Circular mean of the offset over the interval, radians (−π, π].
+    confidence : float
+        Score in [0, 1].
+    """
+
+    chain: int
+    start_frame: int
+    end_frame: int
+    offset_rad: float
+    confidence: float
+
+
+@dataclass(frozen=True, slots=True)
+class Detection:
+    """Detection result for C chains over F frames.
+
+    Parameters
+    ----------
+    parent_increments : ndarray, shape (F, C)
+        ΔθP, radians.
+    child_increments : ndarray, shape (F, C)
+        ΔθC, radians.
+    candidates : ndarray of bool, shape (F, C)
+        Candidate (paper) or event (robust) frames.
+    offsets : ndarray, shape (F, C)
+        offset(t), radians; exactly 0 outside intervals for the robust method.
+    intervals : tuple of DetectedInterval
+    """
+
+    parent_increments: FloatArray
+    child_increments: FloatArray
+    candidates: BoolArray
+    offsets: FloatArray
+    intervals: tuple[DetectedInterval, ...]
+
+
+def runs(mask: BoolArray) -> list[tuple[int, int]]:
+    """Inclusive ``(start, end)`` of each run of True in a 1-D mask."""
+    padded = np.concatenate(([False], mask, [False])).astype(np.int8)
+    edges = np.diff(padded)
+    starts = np.flatnonzero(edges == 1)
+    ends = np.flatnonzero(edges == -1) - 1
+    return [(int(s), int(e)) for s, e in zip(starts, ends, strict=True)]
+
+
+def _circular_mean(angles: FloatArray) -> float:
+    return float(np.angle(np.mean(np.exp(1j * angles))))
+
+
+def detect_paper(
+    parent_increments: FloatArray, child_increments: FloatArray, params: PaperParams
+) -> Detection:
+    """The paper's candidate rule and cumulative offset.
+
+    Parameters
+    ----------
+    parent_increments, child_increments : ndarray, shape (F, C)
+        ΔθP and ΔθC in radians.
+    params : PaperParams
+
+    Returns
+    -------
+    Detection
+    """
+    tau = np.deg2rad(params.threshold_deg)
+    dp, dc = parent_increments, child_increments
+    candidates = (dp * dc < 0) & (np.abs(dp) > tau) & (np.abs(dc) > tau)
+    err = np.where(candidates, np.sign(dp) * np.minimum(np.abs(dp), np.abs(dc)), 0.0)
+    offsets = np.cumsum(err, axis=0)
+    tolerance = np.deg2rad(params.report_tolerance_deg)
+    intervals: list[DetectedInterval] = []
+    for c in range(offsets.shape[1]):
+        wrapped = wrap_angle(offsets[:, c])
+        for start, end in runs(np.abs(wrapped) > tolerance):
+            level = _circular_mean(wrapped[start : end + 1])
+            confidence = float(min(1.0, abs(level) / np.deg2rad(10.0)))
+            intervals.append(DetectedInterval(c, start, end, level, confidence))
+    return Detection(dp, dc, candidates, offsets, tuple(intervals))
+
+
+# An optimal sorting network for six values (12 compare–exchanges, depth 5).
+_SORT6 = ((0, 5), (1, 3), (2, 4), (1, 2), (3, 4), (0, 3), (2, 5), (0, 1), (2, 3), (4, 5), (1, 2),
+          (3, 4))  # fmt: skip
+
+
+def _neighbour_median(
+    increments: FloatArray, half: int, rows: IntArray | None = None
+) -> FloatArray:
+    """Median of the ``half`` increments on each side of each frame (itself excluded).
+
+    Edges are mirrored. For an even count the upper of the two middle values is taken. With
+    ``rows``, only those frames are computed (shape (R, C)).
+    """
+    n_frames = increments.shape[0]
+    padded = np.pad(increments, ((half, half), (0, 0)), mode="reflect")
+    shifts = [k for k in range(2 * half + 1) if k != half]
+    if rows is not None:
+        return np.sort(padded[rows[:, None] + np.array(shifts)[None, :]], axis=1)[:, half]
+    if half == 3:
+        values = [np.ascontiguousarray(padded[k : k + n_frames]) for k in shifts]
+        for i, j in _SORT6:
+            low = np.minimum(values[i], values[j])
+            values[j] = np.maximum(values[i], values[j])
+            values[i] = low
+        return values[half]
+    footprint = np.ones((2 * half + 1, 1), dtype=bool)
+    footprint[half] = False
+    result: FloatArray = median_filter(increments, footprint=footprint, mode="mirror")
+    return result
+
+
+def _pair_events(
+    frames: IntArray,
+    jumps: FloatArray,
+    strengths: FloatArray,
+    threshold: float,
+    params: RobustParams,
+    max_frames: int,
+    n_frames: int,
+) -> tuple[FloatArray, list[tuple[int, int, float]]]:
+    """Offsets of one chain from its events; also (start, end, confidence) per interval.
+
+    Events are matched like brackets: each new event closes the most recent open events whose
+    jumps it cancels (modulo 2π), the shortest closure first. Open events older than
+    ``max_frames`` are dropped, and so are events never closed.
+    """
+    offsets = np.zeros(n_frames)
+    found: list[tuple[int, int, float]] = []
+    stack: list[int] = []
+    for k in range(len(frames)):
+        stack = [i for i in stack if frames[k] - frames[i] <= max_frames]
+        level = float(jumps[k])
+        largest = abs(level)
+        closed = -1
+        for p in range(len(stack) - 1, -1, -1):
+            level = float(wrap_angle(np.array(level + jumps[stack[p]])))
+            largest = max(largest, abs(float(jumps[stack[p]])))
+            if abs(level) <= max(threshold, params.closure_fraction * largest):
+                closed = p
+                break
+        if closed < 0:
+            stack.append(k)
+            continue
+        members = [*stack[closed:], k]
+        stack = stack[:closed]
+        # Levels between events; the closure residual is spread evenly over the steps.
+        steps = jumps[members] - level / len(members)
+        levels = wrap_angle(np.cumsum(steps)[:-1])
+        for m, value in enumerate(levels):
+            offsets[frames[members[m]] : frames[members[m + 1]]] += value
+        tolerance = max(threshold, params.closure_fraction * largest)
+        closure = max(0.0, 1.0 - abs(level) / tolerance)
+        strength = float(np.min(strengths[members]))
+        found.append((int(frames[members[0]]), int(frames[k]) - 1, closure * strength))
+    return wrap_angle(offsets), found
+
+
+def detect_robust(
+    parent_increments: FloatArray,
+    child_increments: FloatArray,
+    fps: float,
+    params: RobustParams,
+) -> Detection:
+    """Level-shift events paired into intervals.
+
+    Parameters
+    ----------
+    parent_increments, child_increments : ndarray, shape (F, C)
+        ΔθP and ΔθC in radians.
+    fps : float
+        Frame rate (sets the longest interval in frames).
+    params : RobustParams
+
+    Returns
+    -------
+    Detection
+    """
+    dp, dc = parent_increments, child_increments
+    n_frames, n_chains = dp.shape
+    half = params.neighbour_frames
+    if n_frames <= 2 * half + 1:
+        zeros = np.zeros_like(dp)
+        return Detection(dp, dc, zeros.astype(bool), zeros, ())
+    floor = np.deg2rad(params.min_threshold_deg)
+    natural_p = _neighbour_median(dp, half)
+    natural_c = _neighbour_median(dc, half)
+    for done in range(1, params.passes + 1):
+        rp = wrap_angle(dp - natural_p)
+        rc = wrap_angle(dc - natural_c)
+        smaller = np.minimum(np.abs(rp), np.abs(rc))
+        scale = 1.4826 * np.median(smaller, axis=0)
+        threshold = np.maximum(floor, params.noise_factor * scale)  # (C,)
+        mismatch = np.abs(wrap_angle(rp + rc)) if params.modular else np.abs(rp + rc)
+        allowed = params.consistency * smaller
+        events = (smaller > threshold) & (mismatch <= allowed)
+        if not params.modular:
+            events &= rp * rc < 0
+        if done == params.passes:
+            break
+        # Natural velocities again, with the event frames replaced by the residual-free
+        # estimate, so that clustered events do not bias each other's neighbours. Only rows
+        # within reach of an event can change.
+        near = np.flatnonzero(
+            np.convolve(events.any(axis=1), np.ones(2 * half + 1), mode="same") > 0
+        )
+        natural_p = natural_p.copy()
+        natural_c = natural_c.copy()
+        natural_p[near] = _neighbour_median(np.where(events, natural_p, dp), half, near)
+        natural_c[near] = _neighbour_median(np.where(events, natural_c, dc), half, near)
+    # The jump is the circular mean of the parent's step and the child's counter-step.
+    rows, cols = np.nonzero(events)
+    jumps = np.zeros_like(dp)
+    jumps[rows, cols] = np.angle(np.exp(1j * rp[rows, cols]) + np.exp(-1j * rc[rows, cols]))
+    strengths = np.zeros_like(dp)
+    small = smaller[rows, cols]
+    strengths[rows, cols] = (1.0 - np.exp(-(small / threshold[cols] - 1.0))) * (
+        1.0 - mismatch[rows, cols] / np.maximum(allowed[rows, cols], 1e-12)
+    )
+    offsets = np.zeros_like(dp)
+    intervals: list[DetectedInterval] = []
+    max_frames = max(2, round(params.max_interval_s * fps))
+    for c in range(n_chains):
+        frames = np.flatnonzero(events[:, c])
+        if len(frames) == 0:
+            continue
+        if params.pair_events:
+            offsets[:, c], found = _pair_events(
+                frames,
+                jumps[frames, c],
+                np.clip(strengths[frames, c], 0.0, 1.0),
+                float(threshold[c]),
+                params,
+                max_frames,
+                n_frames,
+            )
+        else:
+            steps = np.zeros(n_frames)
+            steps[frames] = jumps[frames, c]
+            offsets[:, c] = wrap_angle(np.cumsum(steps))
+            offsets[np.abs(offsets[:, c]) < 1e-12, c] = 0.0
+            found = [
+                (s, e, float(np.clip(np.min(strengths[frames, c]), 0.0, 1.0)))
+                for s, e in runs(offsets[:, c] != 0.0)
+            ]
+        for start, end, confidence in found:
+            level = _circular_mean(offsets[start : end + 1, c])
+            intervals.append(DetectedInterval(c, start, end, level, confidence))
+    return Detection(dp, dc, events, offsets, tuple(intervals))
