@@ -1,0 +1,213 @@
+"""``mocapqa render`` (stills, clips, contact sheets) and ``mocapqa bench render``."""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.progress import Progress
+from rich.table import Table
+
+from mocapqa.cli.app import app, bench_app
+from mocapqa.cli.report import TakeRun, analyze_take, build_take_report, sheet_tiles
+from mocapqa.errors import InputError, NotFoundError
+
+__all__ = ["bench_render", "flagged_at", "parse_interval", "raw_run", "render"]
+
+console = Console(highlight=False)
+
+
+def parse_interval(text: str) -> tuple[str, int, int]:
+    """Split ``JOINT:START-END`` (inclusive, 0-based frames) into its parts."""
+    joint, _, frames = text.rpartition(":")
+    start_text, _, end_text = frames.partition("-")
+    try:
+        start, end = int(start_text), int(end_text)
+    except ValueError as e:
+        raise InputError(f"Expected --interval JOINT:START-END, got {text!r}") from e
+    if not joint or start > end:
+        raise InputError(f"Expected --interval JOINT:START-END with START <= END, got {text!r}")
+    return joint, start, end
+
+
+def raw_run(path: Path) -> TakeRun:
+    """A take read without analysis: corrected is the raw take, no findings."""
+    from mocapqa.core.motion import Motion
+    from mocapqa.io.formats import read_take
+    from mocapqa.render.scene import track_from_keypoints, track_from_motion
+
+    take = read_take(path)
+    track = track_from_motion(take) if isinstance(take, Motion) else track_from_keypoints(take)
+    return TakeRun({"findings": [], "summary": {"fps": track.fps}}, track, track)
+
+
+def flagged_at(run: TakeRun, frame: int) -> np.ndarray:
+    """Joints with a finding covering ``frame``, as a ``(J,)`` boolean mask."""
+    mask = np.zeros(len(run.raw.names), dtype=bool)
+    for finding in run.analysis.get("findings", []):
+        joint = finding.get("joint")
+        if joint in run.raw.names and finding["start_frame"] <= frame <= finding["end_frame"]:
+            mask[run.raw.names.index(joint)] = True
+    return mask
+
+
+@app.command()
+def render(
+    input_path: Annotated[Path, typer.Argument(metavar="IN", help="Take (BVH or keypoints).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="PNG, GIF or MP4 to write.")],
+    frame: Annotated[int | None, typer.Option(help="Still of this frame (0-based).")] = None,
+    interval: Annotated[
+        str | None, typer.Option(help="Clip JOINT:START-END (inclusive), raw | corrected.")
+    ] = None,
+    contact_sheet: Annotated[
+        bool, typer.Option("--contact-sheet", help="One tile per flagged interval.")
+    ] = False,
+    compare: Annotated[
+        bool, typer.Option("--compare", help="Still as raw | corrected side by side.")
+    ] = False,
+    analyze: Annotated[
+        bool, typer.Option("--analyze/--no-analyze", help="Run the checks to flag joints.")
+    ] = True,
+    up_axis: Annotated[
+        str | None, typer.Option(help="Override the detected up axis (+y, -y, +z, ...).")
+    ] = None,
+    width: Annotated[int, typer.Option(help="Width of one view, px.")] = 640,
+    height: Annotated[int, typer.Option(help="Height of one view, px.")] = 480,
+) -> None:
+    """Render a still (--frame), a clip (--interval) or a contact sheet (--contact-sheet)."""
+    from mocapqa.render.service import RenderService
+    from mocapqa.render.still import StillOptions
+
+    chosen = sum([frame is not None, interval is not None, contact_sheet])
+    if chosen != 1:
+        raise InputError(
+            f"Expected exactly one of --frame, --interval, --contact-sheet, got {chosen}"
+        )
+    if not input_path.exists():
+        raise NotFoundError(f"Expected an existing take file, got {input_path}")
+    with Progress(console=console, transient=True) as bar, RenderService() as service:
+        task = bar.add_task("reading", total=100)
+
+        def step(percent: int, text: str) -> None:
+            bar.update(task, completed=percent, description=text)
+
+        run = analyze_take(input_path, None, step) if analyze else raw_run(input_path)
+        if up_axis is not None:
+            run = TakeRun(
+                run.analysis,
+                replace(run.raw, up_axis=up_axis),
+                replace(run.corrected, up_axis=up_axis),
+            )
+        tick: Callable[[int, int], None] = lambda done, total: bar.update(  # noqa: E731
+            task, completed=100 * done / total, description=f"rendering {done}/{total}"
+        )
+        if frame is not None:
+            options = StillOptions(width_px=width, height_px=height)
+            flags = flagged_at(run, frame) if 0 <= frame < run.raw.n_frames else None
+            step(0, "rendering")
+            if compare:
+                data = service.side_by_side(run.raw, run.corrected, frame, flags, options)
+            else:
+                data = service.still(run.raw, frame, flags, options=options)
+        elif interval is not None:
+            joint, start, end = parse_interval(interval)
+            if joint not in run.raw.names:
+                raise InputError(f"Expected a joint of the take in --interval, got {joint!r}")
+            fmt = output.suffix.lower().lstrip(".")
+            flags = np.zeros(len(run.raw.names), dtype=bool)
+            flags[run.raw.names.index(joint)] = True
+            data = service.clip(run.raw, start, end, run.corrected, flags, fmt, tick)
+        else:
+            tiles = sheet_tiles(run)
+            if not tiles:
+                raise InputError(
+                    f"Expected flagged intervals for a contact sheet, got none in {input_path}"
+                )
+            data = service.contact_sheet(run.raw, tiles, run.corrected, progress=tick)
+    output.write_bytes(data)
+    console.print(f"{output} ({len(data) / 1e3:.0f} kB)")
+
+
+def _long_take(source: Path, n_frames: int, folder: Path) -> Path:
+    """A BVH of ``n_frames`` frames made by repeating a real take end to end."""
+    from mocapqa.io.bvh import read_bvh, write_bvh
+
+    motion = read_bvh(source)
+    index = np.arange(n_frames) % motion.n_frames
+    hint = motion.euler_hint_deg
+    longer = replace(
+        motion,
+        quats=motion.quats[index],
+        translations=motion.translations[index],
+        euler_hint_deg=None if hint is None else hint[index],
+    )
+    path = folder / f"{source.stem}_x{n_frames}.bvh"
+    write_bvh(path, longer)
+    return path
+
+
+@bench_app.command("render")
+def bench_render(
+    take: Annotated[Path, typer.Argument(help="A BVH take to draw.")],
+    long_take: Annotated[
+        Path | None, typer.Option(help="BVH repeated to --report-frames for the report timing.")
+    ] = None,
+    stills: Annotated[int, typer.Option(help="Stills to time.")] = 10,
+    clip_frames: Annotated[int, typer.Option(help="Frames in the timed GIF.")] = 30,
+    report_frames: Annotated[int, typer.Option(help="Frames of the timed report's take.")] = 2000,
+) -> None:
+    """Time stills, side-by-side images, a GIF and a full report; prints a table."""
+    from mocapqa.render.service import RenderService
+
+    rows: list[tuple[str, str, str]] = []
+    run = analyze_take(take)
+    n = run.raw.n_frames
+    frames = np.linspace(0, n - 1, stills).round().astype(int)
+    with RenderService() as service:
+        started = time.perf_counter()
+        service.still(run.raw, int(frames[0]))
+        rows.append(("first still (VTK start-up)", "1", f"{time.perf_counter() - started:.2f}"))
+        started = time.perf_counter()
+        for f in frames:
+            service.still(run.raw, int(f), flagged_at(run, int(f)))
+        per = (time.perf_counter() - started) / len(frames)
+        rows.append(("still 640×480, per image", str(len(frames)), f"{per:.3f}"))
+        started = time.perf_counter()
+        for f in frames:
+            service.side_by_side(run.raw, run.corrected, int(f), flagged_at(run, int(f)))
+        per = (time.perf_counter() - started) / len(frames)
+        rows.append(("raw | corrected 1280×480, per image", str(len(frames)), f"{per:.3f}"))
+        started = time.perf_counter()
+        service.thumbnail(run.raw)
+        rows.append(("thumbnail 192×144", "1", f"{time.perf_counter() - started:.3f}"))
+        end = min(n - 1, clip_frames - 1)
+        started = time.perf_counter()
+        gif = service.clip(run.raw, 0, end, run.corrected, None, "gif")
+        rows.append(
+            (f"GIF raw | corrected, {end + 1} frames ({len(gif) / 1e3:.0f} kB)", "1",
+             f"{time.perf_counter() - started:.2f}")
+        )  # fmt: skip
+        with tempfile.TemporaryDirectory() as folder:
+            source = _long_take(long_take or take, report_frames, Path(folder))
+            started = time.perf_counter()
+            html = build_take_report(source, service)
+            elapsed = time.perf_counter() - started
+            external = html.count('src="http') + html.count("src='http")
+            rows.append(
+                (f"report, {report_frames} frames ({len(html) / 1e6:.1f} MB, "
+                 f"{external} external sources)", "1", f"{elapsed:.2f}")
+            )  # fmt: skip
+    table = Table(title=f"mocapqa bench render · {take.name}")
+    table.add_column("what")
+    table.add_column("n", justify="right")
+    table.add_column("seconds", justify="right")
+    for row in rows:
+        table.add_row(*row)
+    console.print(table)

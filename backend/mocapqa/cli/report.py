@@ -1,0 +1,263 @@
+"""``mocapqa report``: a self-contained HTML (optionally PDF) QA report of one take.
+
+The take is analysed with the pipeline (or a stored run's folder is read with ``--run``), the
+contact sheet is rendered on the one render thread, and
+:func:`mocapqa.report.html.report_from_analysis` writes the page. The helpers here are
+shared with ``mocapqa render``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+import subprocess
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.progress import Progress
+
+from mocapqa.cli.app import app
+from mocapqa.errors import InputError, MocapQAError, NotFoundError
+
+if TYPE_CHECKING:
+    from mocapqa.render.scene import SkeletonTrack
+    from mocapqa.render.service import RenderService
+    from mocapqa.render.sheet import SheetTile
+
+__all__ = [
+    "CHROMIUM",
+    "TakeRun",
+    "analyze_take",
+    "build_take_report",
+    "load_run",
+    "print_pdf",
+    "report",
+    "sheet_tiles",
+    "take_facts",
+]
+
+# Debian's Chromium, used for print-to-PDF.
+CHROMIUM = Path("/usr/bin/chromium")
+MAX_TILES = 8
+
+console = Console(highlight=False)
+
+
+@dataclass(frozen=True)
+class TakeRun:
+    """One analysed take, ready to draw and report.
+
+    Parameters
+    ----------
+    analysis : dict
+        The pipeline's report JSON (summary, steps, findings, series, options).
+    raw, corrected : SkeletonTrack
+        Points as recorded and after correction (twist refinement or filtering).
+    """
+
+    analysis: dict[str, Any]
+    raw: SkeletonTrack
+    corrected: SkeletonTrack
+
+
+def take_facts(path: Path) -> dict[str, Any]:
+    """Name, size and sha256 of a take file (or of an OpenPose folder's name)."""
+    facts: dict[str, Any] = {"name": path.name, "file": str(path)}
+    if path.is_file():
+        data = path.read_bytes()
+        facts["bytes"] = len(data)
+        facts["sha256"] = hashlib.sha256(data).hexdigest()
+    return facts
+
+
+def analyze_take(
+    path: Path,
+    options: dict[str, Any] | None = None,
+    progress: Callable[[int, str], None] | None = None,
+) -> TakeRun:
+    """Read and analyse a take with the pipeline's defaults (or ``options``)."""
+    from mocapqa.core.keypoints import KeypointSequence
+    from mocapqa.io.formats import read_take
+    from mocapqa.pipeline.analyze import analyze
+    from mocapqa.pipeline.options import AnalysisOptions
+    from mocapqa.render.scene import track_from_points
+
+    take = read_take(path)
+    result = analyze(take, AnalysisOptions.from_json(options), progress)
+    points = result.report["points"]
+    fps = float(result.report["summary"]["fps"])
+    raw_positions = result.raw_points
+    corrected_positions = result.corrected_points
+    if isinstance(take, KeypointSequence):
+        # Keep missing keypoints missing (the pipeline zero-fills them for its 3D view).
+        raw_positions = take.positions
+        if result.filtered_keypoints is not None:
+            corrected_positions = result.filtered_keypoints.positions
+    raw = track_from_points(points["names"], points["parents"], raw_positions, fps)
+    corrected = track_from_points(
+        points["names"], points["parents"], corrected_positions, fps, raw.up_axis
+    )
+    return TakeRun(result.report, raw, corrected)
+
+
+def load_run(folder: Path) -> TakeRun:
+    """Read a stored run's folder (``report.json`` and ``points.npz``) without re-analysing."""
+    from mocapqa.render.scene import track_from_points
+
+    try:
+        analysis = json.loads((folder / "report.json").read_text(encoding="utf-8"))
+        with np.load(folder / "points.npz") as data:
+            raw_positions = np.asarray(data["raw"], dtype=np.float64)
+            corrected_positions = np.asarray(data["corrected"], dtype=np.float64)
+    except FileNotFoundError as e:
+        raise NotFoundError(
+            f"Expected a run folder with report.json and points.npz, got {e.filename}"
+        ) from e
+    except (ValueError, KeyError) as e:
+        raise InputError(f"{folder}: Expected a readable run report and points, got {e}") from e
+    points = analysis["points"]
+    fps = float(analysis["summary"]["fps"])
+    raw = track_from_points(points["names"], points["parents"], raw_positions, fps)
+    corrected = track_from_points(
+        points["names"], points["parents"], corrected_positions, fps, raw.up_axis
+    )
+    return TakeRun(analysis, raw, corrected)
+
+
+def sheet_tiles(run: TakeRun, max_tiles: int = MAX_TILES) -> list[SheetTile]:
+    """Contact-sheet tiles for a run's findings: twist intervals first, then the largest
+    limit violations, at most ``max_tiles``."""
+    from mocapqa.render.sheet import tiles_from_intervals
+    from mocapqa.report.findings import normalise_findings
+
+    findings = normalise_findings(list(run.analysis.get("findings", [])))
+    twists = [f for f in findings if f["kind"] == "twist"]
+    others = sorted(
+        (f for f in findings if f["kind"] != "twist"),
+        key=lambda f: -float(f.get("violation_deg", 0)),
+    )
+    return tiles_from_intervals([*twists, *others][:max_tiles], run.raw, run.corrected)
+
+
+def build_take_report(
+    path: Path,
+    service: RenderService,
+    run_folder: Path | None = None,
+    options: dict[str, Any] | None = None,
+    progress: Callable[[int, str], None] | None = None,
+) -> str:
+    """Analyse (or load) a take, render its contact sheet and return the report's HTML."""
+    from mocapqa.report.html import report_from_analysis
+
+    step = progress or (lambda percent, text: None)
+    run = load_run(run_folder) if run_folder is not None else analyze_take(path, options, progress)
+    tiles = sheet_tiles(run)
+    sheet: bytes | None = None
+    unavailable: dict[str, str] = {}
+    if tiles:
+        step(90, f"contact sheet ({len(tiles)} tiles)")
+        try:
+            sheet = service.contact_sheet(run.raw, tiles, run.corrected)
+        except MocapQAError as e:
+            unavailable["contact_sheet"] = f"rendering unavailable: {e}"
+    step(97, "writing the report")
+    facts = take_facts(path)
+    if run_folder is not None:
+        facts["run"] = str(run_folder)
+    settings = {
+        "options": run.analysis.get("options", {}),
+        "command": "mocapqa report "
+        + str(path)
+        + (f" --run {run_folder}" if run_folder is not None else ""),
+        "analysis_version": run.analysis.get("version"),
+        "up_axis": run.raw.up_axis,
+    }
+    return report_from_analysis(
+        run.analysis,
+        facts,
+        contact_sheet_png=sheet,
+        settings=settings,
+        unavailable=unavailable,
+    )
+
+
+def print_pdf(html_path: Path, pdf_path: Path, timeout_s: float = 120.0) -> str | None:
+    """Print an HTML file to PDF with Debian's Chromium; returns why not, or None on success."""
+    if not CHROMIUM.is_file():
+        return f"no PDF: {CHROMIUM} is not installed (Debian package chromium)"
+    with tempfile.TemporaryDirectory() as profile:
+        command = [
+            str(CHROMIUM),
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-dev-shm-usage",
+            "--disable-background-networking",
+            "--no-first-run",
+            f"--user-data-dir={profile}",
+            "--no-pdf-header-footer",
+            "--virtual-time-budget=10000",
+            f"--print-to-pdf={pdf_path}",
+            html_path.resolve().as_uri(),
+        ]
+        try:
+            done = subprocess.run(command, capture_output=True, timeout=timeout_s, check=False)
+        except (OSError, subprocess.TimeoutExpired) as e:
+            return f"no PDF: Chromium did not finish ({e})"
+    if done.returncode != 0 or not pdf_path.is_file():
+        tail = done.stderr.decode(errors="replace").strip().splitlines()[-1:] or ["no output"]
+        return f"no PDF: Chromium exited {done.returncode} ({tail[0]})"
+    return None
+
+
+@app.command()
+def report(
+    input_path: Annotated[Path, typer.Argument(metavar="IN", help="Take (BVH or keypoints).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="HTML file to write.")] = Path(
+        "report.html"
+    ),
+    run: Annotated[
+        Path | None,
+        typer.Option(help="A stored run's folder (report.json, points.npz) to report on."),
+    ] = None,
+    options: Annotated[
+        Path | None, typer.Option(help="JSON file of analysis options (checks, methods).")
+    ] = None,
+    pdf: Annotated[
+        Path | None, typer.Option(help="Also print the report to this PDF (needs Chromium).")
+    ] = None,
+) -> None:
+    """Write a self-contained HTML QA report: summary, findings, timelines, contact sheet."""
+    from mocapqa.render.service import RenderService
+
+    if not input_path.exists():
+        raise NotFoundError(f"Expected an existing take file, got {input_path}")
+    option_values = None
+    if options is not None:
+        try:
+            option_values = json.loads(options.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as e:
+            raise InputError(f"{options}: Expected a JSON object of options, got {e}") from e
+    with Progress(console=console, transient=True) as bar, RenderService() as service:
+        task = bar.add_task("analysing", total=100)
+
+        def progress(percent: int, text: str) -> None:
+            bar.update(task, completed=percent, description=text)
+
+        html = build_take_report(input_path, service, run, option_values, progress)
+    output.write_text(html, encoding="utf-8")
+    console.print(f"report → {output} ({len(html) / 1e6:.1f} MB)")
+    if pdf is not None:
+        # Chromium needs the HTML as a file; a copy keeps the user's output untouched.
+        with tempfile.TemporaryDirectory() as folder:
+            page = Path(folder) / "report.html"
+            shutil.copyfile(output, page)
+            reason = print_pdf(page, pdf)
+        console.print(reason if reason else f"PDF → {pdf}")

@@ -1,0 +1,229 @@
+"""Contact sheets: one tile per flagged interval, at the interval's frame of largest error.
+
+Conventions
+-----------
+A tile shows the raw pose (flagged joints red) and, when a corrected take is given, the
+corrected pose beside it (same joints green), with the camera framed on that pose so small
+twists stay visible. Tiles are laid out row by row on a white sheet with a gap between them.
+The frame of largest error is where raw and corrected positions differ most inside the
+interval; with no corrected take (or no difference) it is the interval's middle frame.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from mocapqa.core.arrays import FloatArray
+from mocapqa.errors import ShapeError
+from mocapqa.render.engine import FIXED_COLOR, FLAG_COLOR, CanvasPool, ImageArray
+from mocapqa.render.scene import SkeletonTrack, check_same_shape, frame_camera
+
+__all__ = [
+    "SheetTile",
+    "frame_of_largest_difference",
+    "render_contact_sheet",
+    "tiles_from_intervals",
+]
+
+_GAP_PX = 8
+
+
+@dataclass(frozen=True, slots=True)
+class SheetTile:
+    """One tile of a contact sheet.
+
+    Parameters
+    ----------
+    frame : int
+        Frame to draw, 0-based.
+    joints : tuple of int
+        Flagged joint indices.
+    label : str
+        Caption (joint, frames, offset or violation).
+    """
+
+    frame: int
+    joints: tuple[int, ...]
+    label: str
+
+
+def frame_of_largest_difference(
+    raw_positions: FloatArray,
+    corrected_positions: FloatArray | None,
+    start_frame: int,
+    end_frame: int,
+) -> int:
+    """Frame in ``[start_frame, end_frame]`` where raw and corrected positions differ most.
+
+    Parameters
+    ----------
+    raw_positions, corrected_positions : ndarray, shape (F, J, 3)
+        World positions; ``corrected_positions`` may be None.
+    start_frame, end_frame : int
+        Inclusive frame range, 0-based.
+
+    Returns
+    -------
+    int
+        The frame index (the middle of the range when nothing differs).
+    """
+    n_frames = raw_positions.shape[0]
+    start = int(np.clip(start_frame, 0, n_frames - 1))
+    end = int(np.clip(end_frame, start, n_frames - 1))
+    middle = (start + end) // 2
+    if corrected_positions is None:
+        return middle
+    gap = np.linalg.norm(
+        raw_positions[start : end + 1] - corrected_positions[start : end + 1], axis=-1
+    )
+    per_frame = np.nanmax(np.nan_to_num(gap, nan=0.0), axis=1)
+    if not np.any(per_frame > 0):
+        return middle
+    return start + int(np.argmax(per_frame))
+
+
+def _two_lines(label: str) -> str:
+    # Break after the joint name so long captions stay inside their view.
+    parts = label.split(" · ")
+    return " · ".join(parts[:2]) + ("\n" + " · ".join(parts[2:]) if len(parts) > 2 else "")
+
+
+def _joint_index(value: Any, names: Sequence[str]) -> int | None:
+    if isinstance(value, (int, np.integer)) and 0 <= int(value) < len(names):
+        return int(value)
+    if isinstance(value, str) and value in names:
+        return list(names).index(value)
+    return None
+
+
+def tiles_from_intervals(
+    intervals: Sequence[Mapping[str, Any]],
+    raw: SkeletonTrack,
+    corrected: SkeletonTrack | None = None,
+) -> list[SheetTile]:
+    """Tiles for interval records such as the ``intervals`` of a twist analysis' JSON.
+
+    Parameters
+    ----------
+    intervals : sequence of mapping
+        Each with ``joint`` (name or index), ``start_frame`` and ``end_frame`` (inclusive), and
+        optionally ``offset_deg`` or ``violation_deg`` for the caption. Records naming an
+        unknown joint are skipped.
+    raw, corrected : SkeletonTrack
+        The takes; ``corrected`` picks the frame of largest error.
+    """
+    tiles = []
+    for record in intervals:
+        joint = _joint_index(record.get("joint"), raw.names)
+        if joint is None:
+            continue
+        start, end = int(record.get("start_frame", 0)), int(record.get("end_frame", 0))
+        frame = frame_of_largest_difference(
+            raw.positions, None if corrected is None else corrected.positions, start, end
+        )
+        frames = f"frame {start}" if start == end else f"frames {start}–{end}"
+        label = f"{raw.names[joint]} · {frames}"
+        if record.get("offset_deg") is not None:
+            label += f" · offset {float(record['offset_deg']):+.1f}°"
+        if record.get("violation_deg") is not None:
+            label += f" · violation {float(record['violation_deg']):.1f}°"
+        tiles.append(SheetTile(frame=frame, joints=(joint,), label=label))
+    return tiles
+
+
+def render_contact_sheet(
+    raw: SkeletonTrack,
+    tiles: Sequence[SheetTile],
+    corrected: SkeletonTrack | None = None,
+    columns: int = 2,
+    tile_width_px: int = 300,
+    tile_height_px: int = 300,
+    canvases: CanvasPool | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> ImageArray:
+    """Draw the tiles on one sheet.
+
+    Parameters
+    ----------
+    raw : SkeletonTrack
+        The take as recorded.
+    tiles : sequence of SheetTile
+        At least one tile.
+    corrected : SkeletonTrack, optional
+        The corrected take; each tile then shows raw | corrected.
+    columns : int
+        Tiles per row.
+    tile_width_px, tile_height_px : int
+        Size of one view; a raw | corrected tile is twice as wide.
+    canvases : CanvasPool, optional
+        Reused windows.
+    progress : callable, optional
+        Called with ``(done, total)`` after each tile.
+
+    Returns
+    -------
+    ndarray, shape (H, W, 3), uint8
+    """
+    if not tiles:
+        raise ShapeError("Expected at least one tile for a contact sheet, got none")
+    if corrected is not None:
+        check_same_shape(raw, corrected)
+    views = 1 if corrected is None else 2
+    pool = canvases or CanvasPool()
+    images = []
+    try:
+        for done, tile in enumerate(tiles, start=1):
+            if not 0 <= tile.frame < raw.n_frames:
+                raise ShapeError(
+                    f"Expected tile frames in [0, {raw.n_frames - 1}], got {tile.frame}"
+                )
+            flagged = np.zeros(len(raw.names), dtype=bool)
+            flagged[list(tile.joints)] = True
+            camera = frame_camera(
+                raw, (tile.frame, tile.frame + 1), aspect=tile_width_px / tile_height_px
+            )
+            canvas = pool.get(views * tile_width_px, tile_height_px, views)
+            canvas.draw(
+                0,
+                raw,
+                tile.frame,
+                camera,
+                flagged,
+                _two_lines(f"raw · {tile.label}"),
+                FLAG_COLOR,
+                legend=False,
+            )
+            if corrected is not None:
+                canvas.draw(
+                    1,
+                    corrected,
+                    tile.frame,
+                    camera,
+                    flagged,
+                    "corrected",
+                    FIXED_COLOR,
+                    legend=False,
+                )
+            images.append(canvas.image())
+            if progress is not None:
+                progress(done, len(tiles))
+    finally:
+        if canvases is None:
+            pool.close()
+    columns = max(1, min(columns, len(images)))
+    rows = -(-len(images) // columns)
+    tile_h, tile_w = images[0].shape[:2]
+    sheet = np.full(
+        (rows * tile_h + (rows + 1) * _GAP_PX, columns * tile_w + (columns + 1) * _GAP_PX, 3),
+        255,
+        dtype=np.uint8,
+    )
+    for k, image in enumerate(images):
+        r, c = divmod(k, columns)
+        top, left = _GAP_PX + r * (tile_h + _GAP_PX), _GAP_PX + c * (tile_w + _GAP_PX)
+        sheet[top : top + tile_h, left : left + tile_w] = image
+    return sheet

@@ -1,0 +1,109 @@
+"""Findings (flagged intervals) read from the analyses' JSON outputs.
+
+Conventions
+-----------
+A finding is a dict ``{"kind", "joint", "start_frame", "end_frame", ...}`` with inclusive,
+0-based frames, plus ``offset_deg`` and ``confidence`` for twist intervals or
+``violation_deg`` (largest distance outside the limits) for limit runs. Limit runs are the
+maximal stretches of consecutive listed frames marked invalid; when the limits JSON was
+decimated (``max_points``) a run covers the listed frames it spans. Inputs are the
+``to_json()`` dicts of :class:`mocapqa.twist.analysis.TwistAnalysis` and
+:class:`mocapqa.limits.analysis.LimitsReport`, or the pipeline's sampled limits heat map
+(``joints``, ``frames``, ``score_deg`` as joints × frames); unknown keys are ignored. The
+pipeline's own findings (``value`` and ``unit``) are mapped to the same keys by
+:func:`normalise_findings`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+__all__ = ["limit_findings", "normalise_findings", "twist_findings"]
+
+
+def twist_findings(twist: Mapping[str, Any] | None) -> list[dict[str, Any]]:
+    """Twist intervals as findings, in the analysis' order (empty for None)."""
+    if not twist:
+        return []
+    found = []
+    for record in twist.get("intervals", []):
+        found.append(
+            {
+                "kind": "twist",
+                "joint": str(record.get("joint")),
+                "start_frame": int(record.get("start_frame", 0)),
+                "end_frame": int(record.get("end_frame", 0)),
+                "offset_deg": float(record.get("offset_deg", 0.0)),
+                "confidence": float(record.get("confidence", 0.0)),
+            }
+        )
+    return found
+
+
+def limit_findings(limits: Mapping[str, Any] | None, min_frames: int = 1) -> list[dict[str, Any]]:
+    """Runs of frames outside the joint limits, per joint, ordered by joint then frame.
+
+    Parameters
+    ----------
+    limits : mapping or None
+        A limits report's ``to_json()``.
+    min_frames : int
+        Shortest run reported, in listed frames.
+    """
+    if not limits:
+        return []
+    found = []
+    if "score_deg" in limits and limits.get("joints") and isinstance(limits["joints"][0], str):
+        frames = np.asarray(limits.get("frames", []), dtype=np.int64)
+        heat = np.asarray(limits["score_deg"], dtype=np.float64).reshape(len(limits["joints"]), -1)
+        limits = {
+            "joints": [
+                {
+                    "name": name,
+                    "frames": {"frame": frames, "valid": heat[j] <= 0, "score_deg": heat[j]},
+                }
+                for j, name in enumerate(limits["joints"])
+            ]
+        }
+    for joint in limits.get("joints", []):
+        series = joint.get("frames", {})
+        frames = np.asarray(series.get("frame", []), dtype=np.int64)
+        valid = np.asarray(series.get("valid", []), dtype=bool)
+        scores = np.asarray(series.get("score_deg", np.zeros(len(frames))), dtype=np.float64)
+        if len(frames) == 0 or len(valid) != len(frames):
+            continue
+        invalid = np.concatenate([[False], ~valid, [False]])
+        edges = np.flatnonzero(np.diff(invalid.astype(np.int8)))
+        for start, stop in zip(edges[::2], edges[1::2], strict=True):
+            if stop - start < min_frames:
+                continue
+            found.append(
+                {
+                    "kind": "limit",
+                    "joint": str(joint.get("name")),
+                    "start_frame": int(frames[start]),
+                    "end_frame": int(frames[stop - 1]),
+                    "violation_deg": float(np.max(scores[start:stop])) if len(scores) else 0.0,
+                }
+            )
+    return found
+
+
+def normalise_findings(findings: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Pipeline findings (``kind, joint, start_frame, end_frame, value, unit, confidence``)
+    in this module's keys: ``offset_deg`` for twist, ``violation_deg`` for limits."""
+    out = []
+    for record in findings:
+        item = dict(record)
+        kind = str(item.get("kind", ""))
+        if "value" in item and item["value"] is not None:
+            key = "offset_deg" if kind == "twist" else "violation_deg"
+            item.setdefault(key, float(item["value"]))
+        item["kind"] = "limit" if kind == "limits" else kind
+        item["start_frame"] = int(item.get("start_frame", 0))
+        item["end_frame"] = int(item.get("end_frame", item["start_frame"]))
+        out.append(item)
+    return out
