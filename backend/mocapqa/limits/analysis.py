@@ -1,0 +1,231 @@
+"""Check a take against a limits model: validity and a soft score per frame and joint.
+
+The lookup map decides validity (the fast path); the score is the distance outside the valid
+region, ``√(swing_deg² + twist_deg²)``, so violations can be ranked, not only flagged (see
+:func:`mocapqa.limits.occupancy.limit_distances`). The discriminator can be asked instead of the
+map with ``method="network"``; the score always comes from the map. The JSON forms are
+documented in ``docs/limits.md``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from mocapqa.core.arrays import BoolArray, FloatArray
+from mocapqa.core.motion import Motion
+from mocapqa.errors import InputError, LimitsFileError
+from mocapqa.limits.discriminator import network_valid
+from mocapqa.limits.expmap import limit_params_from_quats
+from mocapqa.limits.model import LimitsModel, check_rig, load_default_model
+from mocapqa.limits.occupancy import is_valid, limit_distances
+
+__all__ = ["LimitsReport", "check_limits", "joint_map_json", "limit_params"]
+
+_WORST = 5
+
+
+@dataclass(frozen=True, slots=True)
+class LimitsReport:
+    """Per frame × joint validity and scores of one take.
+
+    Parameters
+    ----------
+    joint_names : tuple of str
+        The model's joints, in model order (J).
+    roles : tuple of str
+        Their role keys.
+    params_deg : ndarray, shape (F, J, 3)
+        ``(s1, s2, τ)`` in degrees.
+    valid : ndarray of bool, shape (F, J)
+    score_deg : ndarray, shape (F, J)
+        Distance outside the valid region (0 when valid by the map).
+    swing_deg, twist_deg : ndarray, shape (F, J)
+        The swing and twist parts of the score.
+    fps : float
+    rig_family : str
+    method : {"map", "network"}
+    """
+
+    joint_names: tuple[str, ...]
+    roles: tuple[str, ...]
+    params_deg: FloatArray
+    valid: BoolArray
+    score_deg: FloatArray
+    swing_deg: FloatArray
+    twist_deg: FloatArray
+    fps: float
+    rig_family: str
+    method: str
+
+    @property
+    def flagged_fraction(self) -> float:
+        """Share of frame × joints outside the limits."""
+        return float(1.0 - self.valid.mean()) if self.valid.size else 0.0
+
+    def to_json(self, max_points: int | None = None) -> dict[str, Any]:
+        """A JSON-ready summary (layout in ``docs/limits.md``).
+
+        Parameters
+        ----------
+        max_points : int, optional
+            At most this many frames per joint in the ``frames`` series (evenly strided); None
+            keeps every frame.
+        """
+        n = self.valid.shape[0]
+        step = 1 if max_points is None or n <= max_points else int(np.ceil(n / max(max_points, 1)))
+        frames = np.arange(0, n, step)
+        joints = []
+        for j, name in enumerate(self.joint_names):
+            order = np.argsort(-self.score_deg[:, j], kind="stable")
+            worst = [int(f) for f in order[:_WORST] if not self.valid[f, j]]
+            joints.append(
+                {
+                    "name": name,
+                    "role": self.roles[j],
+                    "flagged_fraction": float(1.0 - self.valid[:, j].mean()) if n else 0.0,
+                    "max_score_deg": float(self.score_deg[:, j].max()) if n else 0.0,
+                    "worst_frames": [
+                        {
+                            "frame": f,
+                            "s1_deg": round(float(self.params_deg[f, j, 0]), 3),
+                            "s2_deg": round(float(self.params_deg[f, j, 1]), 3),
+                            "tau_deg": round(float(self.params_deg[f, j, 2]), 3),
+                            "score_deg": round(float(self.score_deg[f, j]), 3),
+                            "swing_deg": round(float(self.swing_deg[f, j]), 3),
+                            "twist_deg": round(float(self.twist_deg[f, j]), 3),
+                        }
+                        for f in worst
+                    ],
+                    "frames": {
+                        "frame": frames.tolist(),
+                        "valid": self.valid[frames, j].tolist(),
+                        "score_deg": np.round(self.score_deg[frames, j], 3).tolist(),
+                    },
+                }
+            )
+        return {
+            "rig_family": self.rig_family,
+            "method": self.method,
+            "fps": self.fps,
+            "n_frames": n,
+            "flagged_fraction": self.flagged_fraction,
+            "joints": joints,
+        }
+
+
+def limit_params(motion: Motion, model: LimitsModel) -> FloatArray:
+    """``(s1, s2, τ)`` in radians of the model's joints over ``motion``, shape (F, J, 3).
+
+    Raises
+    ------
+    LimitsFileError
+        If the model does not cover the take's rig.
+    """
+    check_rig(model, motion.skeleton)
+    index = [motion.skeleton.index(j.name) for j in model.joints]
+    axes = np.stack([j.axis for j in model.joints])
+    references = np.stack([j.reference for j in model.joints])
+    return limit_params_from_quats(motion.quats[:, index], axes, references)
+
+
+def check_limits(
+    motion: Motion, model: LimitsModel | None = None, method: str = "map"
+) -> LimitsReport:
+    """Check every frame of a take against joint limits.
+
+    Parameters
+    ----------
+    motion : Motion
+    model : LimitsModel, optional
+        Defaults to the shipped model covering the take's rig.
+    method : {"map", "network"}
+        Who decides validity: the lookup map or the discriminator.
+
+    Returns
+    -------
+    LimitsReport
+
+    Raises
+    ------
+    LimitsFileError
+        If no model covers the rig, or ``method="network"`` and the model has no networks.
+    InputError
+        On an unknown ``method``.
+    """
+    if method not in ("map", "network"):
+        raise InputError(f"Expected `method` 'map' or 'network', got {method!r}")
+    if model is None:
+        model = load_default_model(motion.skeleton)
+    params = limit_params(motion, model)
+    n_frames, n_joints = params.shape[:2]
+    swing = np.zeros((n_frames, n_joints))
+    twist = np.zeros((n_frames, n_joints))
+    valid = np.zeros((n_frames, n_joints), dtype=bool)
+    for j, joint in enumerate(model.joints):
+        swing[:, j], twist[:, j] = limit_distances(joint.occupancy, params[:, j])
+        if method == "map":
+            valid[:, j] = is_valid(joint.occupancy, params[:, j])
+        elif joint.network is None:
+            raise LimitsFileError(f"Expected a discriminator for joint {joint.name!r}, got none")
+        else:
+            valid[:, j] = network_valid(joint.network, params[:, j])
+    score = np.where(valid & (method == "map"), 0.0, np.hypot(swing, twist))
+    return LimitsReport(
+        joint_names=tuple(j.name for j in model.joints),
+        roles=tuple(j.role for j in model.joints),
+        params_deg=np.rad2deg(params),
+        valid=valid,
+        score_deg=score,
+        swing_deg=swing,
+        twist_deg=twist,
+        fps=motion.fps,
+        rig_family=model.rig_family,
+        method=method,
+    )
+
+
+def joint_map_json(model: LimitsModel, joint: str) -> dict[str, Any]:
+    """The lookup map of one joint for plotting (layout in ``docs/limits.md``).
+
+    Parameters
+    ----------
+    model : LimitsModel
+    joint : str
+        Joint name or role key.
+
+    Raises
+    ------
+    LimitsFileError
+        If the model has no such joint.
+    """
+    limits = model.joint(joint)
+    occupancy = limits.occupancy
+    n = occupancy.n_bins
+    centres = -180.0 + (np.arange(n) + 0.5) * occupancy.bin_deg
+    i1, i2 = np.nonzero(occupancy.occupied)
+    return {
+        "name": limits.name,
+        "role": limits.role,
+        "rig_family": model.rig_family,
+        "bin_deg": occupancy.bin_deg,
+        "n_bins": n,
+        "bin_centres_deg": centres.tolist(),
+        "occupied_bins": {
+            "i1": i1.tolist(),
+            "i2": i2.tolist(),
+            "s1_deg": centres[i1].tolist(),
+            "s2_deg": centres[i2].tolist(),
+            "tau_min_deg": np.round(np.rad2deg(occupancy.tau_min[i1, i2]), 3).tolist(),
+            "tau_max_deg": np.round(np.rad2deg(occupancy.tau_max[i1, i2]), 3).tolist(),
+        },
+        "scores": None
+        if limits.scores is None
+        else {
+            "accuracy": limits.scores.accuracy,
+            "precision": limits.scores.precision,
+            "recall": limits.scores.recall,
+        },
+    }

@@ -1,0 +1,154 @@
+"""Build a limits model from takes of one rig family.
+
+Steps per modelled joint (roles from :data:`mocapqa.limits.rig.MODELLED_ROLES`): gather its local
+rotations over every frame of every take; choose the reference rotation (the chordal mean,
+the dominant eigenvector of ``Σ q qᵀ``, or the identity for the paper's setting); chart the
+rotations as ``(s1, s2, τ)`` relative to it; build the lookup map; optionally train the
+discriminator on the map's synthetic labels.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mocapqa.core.arrays import FloatArray
+from mocapqa.core.motion import Motion
+from mocapqa.errors import InputError
+from mocapqa.limits.discriminator import DiscriminatorParams, train_discriminator
+from mocapqa.limits.expmap import limit_params_from_quats
+from mocapqa.limits.model import JointLimits, LimitsModel
+from mocapqa.limits.occupancy import OccupancyParams, build_occupancy
+from mocapqa.limits.rig import bone_axis, fingerprint_mismatches, rig_family, rig_fingerprint
+
+__all__ = ["DEFAULT_BUILD", "PAPER_BUILD", "BuildParams", "build_model", "mean_rotation"]
+
+
+@dataclass(frozen=True, slots=True)
+class BuildParams:
+    """How a model is built.
+
+    Parameters
+    ----------
+    occupancy : OccupancyParams
+    discriminator : DiscriminatorParams or None
+        None skips the networks (map only).
+    reference : {"mean", "identity"}
+        Reference rotation per joint; "identity" is the paper's setting.
+    seed : int
+        Seed of the synthetic sets and networks.
+    """
+
+    occupancy: OccupancyParams = field(default_factory=OccupancyParams)
+    discriminator: DiscriminatorParams | None = field(default_factory=DiscriminatorParams)
+    reference: str = "mean"
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.reference not in ("mean", "identity"):
+            raise InputError(f"Expected `reference` 'mean' or 'identity', got {self.reference!r}")
+
+
+# The shipped models' setting, chosen by `mocapqa bench limits --sweep` (docs/limits.md).
+DEFAULT_BUILD = BuildParams(
+    occupancy=OccupancyParams(bin_deg=15.0, dilation_bins=2, tau_margin_deg=40.0)
+)
+# The paper's setting: 1° bins, no dilation, no margin, identity reference.
+PAPER_BUILD = BuildParams(occupancy=OccupancyParams(bin_deg=1.0), reference="identity")
+
+
+def mean_rotation(quats: FloatArray) -> FloatArray:
+    """Chordal L2 mean of unit quaternions ``(N, 4)``: the top eigenvector of ``Σ q qᵀ``, (4,)."""
+    _, vectors = np.linalg.eigh(quats.T @ quats)
+    mean = vectors[:, -1]
+    return np.asarray(mean if mean[3] >= 0 else -mean, dtype=np.float64)
+
+
+def build_model(
+    motions: Sequence[Motion],
+    take_names: Sequence[str],
+    settings: BuildParams = DEFAULT_BUILD,
+    progress: Callable[[str], None] | None = None,
+) -> LimitsModel:
+    """Build a limits model from takes of one rig.
+
+    Parameters
+    ----------
+    motions : sequence of Motion
+        Takes of one rig family (same fingerprint).
+    take_names : sequence of str
+        One name per take, stored in the model.
+    settings : BuildParams
+    progress : callable, optional
+        Called with a joint name after each joint is built.
+
+    Returns
+    -------
+    LimitsModel
+
+    Raises
+    ------
+    InputError
+        If there are no takes, the names do not match the takes, a take is of another rig, or
+        the rig has none of the modelled roles.
+    """
+    if not motions or len(motions) != len(take_names):
+        raise InputError(
+            f"Expected one name per take and at least one take, got {len(motions)} takes and "
+            f"{len(take_names)} names"
+        )
+    skeleton = motions[0].skeleton
+    fingerprint = rig_fingerprint(skeleton)
+    if not fingerprint:
+        raise InputError(f"Expected a skeleton with limb roles, got none in {take_names[0]!r}")
+    for motion, name in zip(motions, take_names, strict=True):
+        problems = fingerprint_mismatches(fingerprint, motion.skeleton)
+        if problems:
+            raise InputError(f"Expected every take of one rig, got {name!r}: {problems[0]}")
+    roles = list(fingerprint)
+    per_take = [m.quats[:, [m.skeleton.index(fingerprint[r][0]) for r in roles]] for m in motions]
+    quats = np.concatenate(per_take, axis=0)
+    digest = hashlib.sha256()
+    for name, q in zip(take_names, per_take, strict=True):
+        digest.update(name.encode("utf-8"))
+        digest.update(np.ascontiguousarray(q).tobytes())
+    axes = np.stack([bone_axis(skeleton, skeleton.index(fingerprint[r][0])) for r in roles])
+    if settings.reference == "mean":
+        references = np.stack([mean_rotation(quats[:, j]) for j in range(len(roles))])
+    else:
+        references = np.tile([0.0, 0.0, 0.0, 1.0], (len(roles), 1))
+    params = limit_params_from_quats(quats, axes, references)
+    rng = np.random.default_rng(settings.seed)
+    joints = []
+    for j, role in enumerate(roles):
+        occupancy = build_occupancy(params[:, j], settings.occupancy)
+        network, scores = None, None
+        if settings.discriminator is not None:
+            network, scores = train_discriminator(occupancy, settings.discriminator, rng)
+        joints.append(
+            JointLimits(
+                role=role,
+                name=fingerprint[role][0],
+                axis=axes[j],
+                reference=references[j],
+                occupancy=occupancy,
+                network=network,
+                scores=scores,
+                n_samples=int(quats.shape[0]),
+            )
+        )
+        if progress is not None:
+            progress(fingerprint[role][0])
+    return LimitsModel(
+        rig_family=rig_family(skeleton),
+        fingerprint=fingerprint,
+        joints=tuple(joints),
+        occupancy_params=settings.occupancy,
+        reference=settings.reference,
+        corpus_hash=digest.hexdigest(),
+        takes=tuple(take_names),
+        n_frames=int(quats.shape[0]),
+    )

@@ -1,0 +1,353 @@
+"""Limits models: the per-joint maps and networks of one rig family, and their file format.
+
+File format (safe to load from users: no pickle)
+-------------------------------------------------
+One ``.npz`` archive read with ``allow_pickle=False``. The array ``meta`` holds UTF-8 JSON::
+
+    {"format": "mocapqa-limits", "format_version": 1, "mocapqa_version": "0.1.0",
+     "rig_family": "bandai", "fingerprint": {"left_upper_arm": ["UpperArm_L", "+x"], ...},
+     "bin_deg": 5.0, "occupancy": {...OccupancyParams...}, "reference": "mean",
+     "corpus_hash": "<sha256>", "takes": [...], "n_frames": 9000,
+     "joints": [{"role": "left_upper_arm", "name": "UpperArm_L", "n_samples": 9000,
+                 "activation": "relu", "scores": {"accuracy": ...} | null}, ...]}
+
+and, for joint ``k`` of ``joints``, arrays ``k/axis`` (3,), ``k/reference`` (4,),
+``k/occupied`` (N, N) bool, ``k/tau_min`` and ``k/tau_max`` (N, N) float32 radians, and when a
+network was trained ``k/hidden_weights`` (3, H), ``k/hidden_biases`` (H,),
+``k/output_weights`` (H,), ``k/output_bias`` (1,). Anything else, a missing array, a bad shape
+or another format version raises :class:`~mocapqa.errors.LimitsFileError`.
+
+A model applies to a skeleton only when the skeleton matches its fingerprint
+(:mod:`mocapqa.limits.rig`); :func:`check_rig` refuses any other rig.
+"""
+
+from __future__ import annotations
+
+import functools
+import io
+import json
+import zipfile
+from collections.abc import Iterator
+from dataclasses import asdict, dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mocapqa import __version__
+from mocapqa.core.arrays import FloatArray
+from mocapqa.core.motion import Skeleton
+from mocapqa.errors import LimitsFileError, MocapQAError
+from mocapqa.limits.discriminator import DiscriminatorScores, Network
+from mocapqa.limits.occupancy import OccupancyMap, OccupancyParams
+from mocapqa.limits.rig import fingerprint_mismatches, rig_family
+
+__all__ = [
+    "FORMAT_VERSION",
+    "JointLimits",
+    "LimitsModel",
+    "check_rig",
+    "default_model_paths",
+    "load_default_model",
+    "load_model",
+    "model_bytes",
+    "save_model",
+]
+
+FORMAT_VERSION = 1
+_FORMAT = "mocapqa-limits"
+
+
+@dataclass(frozen=True, slots=True)
+class JointLimits:
+    """The limits of one joint.
+
+    Parameters
+    ----------
+    role : str
+        Role key, e.g. ``"left_upper_arm"``.
+    name : str
+        Joint name on the rig.
+    axis : ndarray, shape (3,)
+        Unit bone (twist) axis in the joint's frame.
+    reference : ndarray, shape (4,)
+        Reference rotation (mean pose) the parameters are taken relative to.
+    occupancy : OccupancyMap
+    network : Network or None
+        The discriminator, when one was trained.
+    scores : DiscriminatorScores or None
+        Its held-out synthetic test scores.
+    n_samples : int
+        Corpus frames the map was built from.
+    """
+
+    role: str
+    name: str
+    axis: FloatArray
+    reference: FloatArray
+    occupancy: OccupancyMap
+    network: Network | None
+    scores: DiscriminatorScores | None
+    n_samples: int
+
+
+@dataclass(frozen=True, slots=True)
+class LimitsModel:
+    """Learned joint limits for one rig family.
+
+    Parameters
+    ----------
+    rig_family : str
+        Readable family label (``"cmu"``, ``"character_creator"``, ``"bandai"``).
+    fingerprint : dict
+        Role key → (joint name, bone-axis label) that a skeleton must match.
+    joints : tuple of JointLimits
+    occupancy_params : OccupancyParams
+        The map settings the model was built with.
+    reference : str
+        ``"mean"`` or ``"identity"``: how the per-joint reference rotations were chosen.
+    corpus_hash : str
+        sha256 of the build takes' names and modelled rotations.
+    takes : tuple of str
+        Names of the build takes.
+    n_frames : int
+        Frames in the build corpus.
+    version : str
+        mocapqa version that built the model.
+    """
+
+    rig_family: str
+    fingerprint: dict[str, tuple[str, str]]
+    joints: tuple[JointLimits, ...]
+    occupancy_params: OccupancyParams
+    reference: str
+    corpus_hash: str
+    takes: tuple[str, ...]
+    n_frames: int
+    version: str = __version__
+
+    def joint(self, name_or_role: str) -> JointLimits:
+        """The joint with this name or role key.
+
+        Raises
+        ------
+        LimitsFileError
+            If the model has no such joint.
+        """
+        for joint in self.joints:
+            if name_or_role in (joint.name, joint.role):
+                return joint
+        names = [j.name for j in self.joints]
+        raise LimitsFileError(f"Expected a joint of the model {names}, got {name_or_role!r}")
+
+
+def check_rig(model: LimitsModel, skeleton: Skeleton) -> None:
+    """Raise LimitsFileError unless ``model`` applies to ``skeleton``.
+
+    Raises
+    ------
+    LimitsFileError
+        Naming the model's rig family, the skeleton's and the first differences.
+    """
+    problems = fingerprint_mismatches(model.fingerprint, skeleton)
+    if problems:
+        shown = "; ".join(problems[:3]) + (
+            f"; and {len(problems) - 3} more" if len(problems) > 3 else ""
+        )
+        raise LimitsFileError(
+            f"Expected a skeleton of the {model.rig_family!r} rig this limits model covers, got a "
+            f"{rig_family(skeleton)!r} skeleton ({shown})"
+        )
+
+
+def _meta(model: LimitsModel) -> dict[str, Any]:
+    return {
+        "format": _FORMAT,
+        "format_version": FORMAT_VERSION,
+        "mocapqa_version": model.version,
+        "rig_family": model.rig_family,
+        "fingerprint": {k: list(v) for k, v in model.fingerprint.items()},
+        "bin_deg": model.occupancy_params.bin_deg,
+        "occupancy": asdict(model.occupancy_params),
+        "reference": model.reference,
+        "corpus_hash": model.corpus_hash,
+        "takes": list(model.takes),
+        "n_frames": model.n_frames,
+        "joints": [
+            {
+                "role": j.role,
+                "name": j.name,
+                "n_samples": j.n_samples,
+                "activation": j.network.activation if j.network else None,
+                "scores": asdict(j.scores) if j.scores else None,
+            }
+            for j in model.joints
+        ],
+    }
+
+
+def model_bytes(model: LimitsModel) -> bytes:
+    """The ``.npz`` file content of ``model`` (see the module notes for the layout)."""
+    arrays: dict[str, Any] = {
+        "meta": np.frombuffer(json.dumps(_meta(model)).encode("utf-8"), dtype=np.uint8)
+    }
+    for k, j in enumerate(model.joints):
+        arrays[f"{k}/axis"] = j.axis
+        arrays[f"{k}/reference"] = j.reference
+        arrays[f"{k}/occupied"] = j.occupancy.occupied
+        arrays[f"{k}/tau_min"] = j.occupancy.tau_min.astype(np.float32)
+        arrays[f"{k}/tau_max"] = j.occupancy.tau_max.astype(np.float32)
+        if j.network is not None:
+            arrays[f"{k}/hidden_weights"] = j.network.hidden_weights
+            arrays[f"{k}/hidden_biases"] = j.network.hidden_biases
+            arrays[f"{k}/output_weights"] = j.network.output_weights
+            arrays[f"{k}/output_bias"] = np.array([j.network.output_bias])
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, **arrays)
+    return buffer.getvalue()
+
+
+def save_model(model: LimitsModel, path: str | Path) -> None:
+    """Write ``model`` to ``path`` as a ``.npz`` limits file."""
+    Path(path).write_bytes(model_bytes(model))
+
+
+def _joint_from_file(k: int, entry: dict[str, Any], data: Any, bin_deg: float) -> JointLimits:
+    network = None
+    if f"{k}/hidden_weights" in data.files:
+        network = Network(
+            hidden_weights=data[f"{k}/hidden_weights"],
+            hidden_biases=data[f"{k}/hidden_biases"],
+            output_weights=data[f"{k}/output_weights"],
+            output_bias=float(data[f"{k}/output_bias"][0]),
+            activation=str(entry["activation"]),
+        )
+    scores = DiscriminatorScores(**entry["scores"]) if entry.get("scores") else None
+    axis = np.asarray(data[f"{k}/axis"], dtype=np.float64)
+    reference = np.asarray(data[f"{k}/reference"], dtype=np.float64)
+    if axis.shape != (3,) or reference.shape != (4,):
+        raise LimitsFileError(
+            f"Expected joint {k} axis (3,) and reference (4,), got {axis.shape} and "
+            f"{reference.shape}"
+        )
+    occupancy = OccupancyMap(
+        bin_deg,
+        np.asarray(data[f"{k}/occupied"], dtype=bool),
+        np.asarray(data[f"{k}/tau_min"], dtype=np.float64),
+        np.asarray(data[f"{k}/tau_max"], dtype=np.float64),
+    )
+    return JointLimits(
+        role=str(entry["role"]),
+        name=str(entry["name"]),
+        axis=axis,
+        reference=reference,
+        occupancy=occupancy,
+        network=network,
+        scores=scores,
+        n_samples=int(entry["n_samples"]),
+    )
+
+
+def _model_from_npz(data: Any, where: str) -> LimitsModel:
+    if "meta" not in data.files:
+        raise LimitsFileError(
+            f"{where}: Expected a mocapqa limits model with a 'meta' entry, got none"
+        )
+    meta = json.loads(bytes(np.asarray(data["meta"], dtype=np.uint8)).decode("utf-8"))
+    if not isinstance(meta, dict) or meta.get("format") != _FORMAT:
+        raise LimitsFileError(f"{where}: Expected format {_FORMAT!r}, got {meta.get('format')!r}")
+    if meta.get("format_version") != FORMAT_VERSION:
+        raise LimitsFileError(
+            f"{where}: Expected format_version {FORMAT_VERSION}, got {meta.get('format_version')!r}"
+        )
+    params = OccupancyParams(**meta["occupancy"])
+    joints = tuple(
+        _joint_from_file(k, entry, data, params.bin_deg) for k, entry in enumerate(meta["joints"])
+    )
+    return LimitsModel(
+        rig_family=str(meta["rig_family"]),
+        fingerprint={k: (str(v[0]), str(v[1])) for k, v in meta["fingerprint"].items()},
+        joints=joints,
+        occupancy_params=params,
+        reference=str(meta["reference"]),
+        corpus_hash=str(meta["corpus_hash"]),
+        takes=tuple(str(t) for t in meta["takes"]),
+        n_frames=int(meta["n_frames"]),
+        version=str(meta["mocapqa_version"]),
+    )
+
+
+def load_model(path: str | Path) -> LimitsModel:
+    """Read a limits model file (``.npz``, never unpickled).
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    LimitsModel
+
+    Raises
+    ------
+    LimitsFileError
+        If the file is missing, not an ``.npz``, or its content is not a valid limits model.
+    """
+    where = str(path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            return _model_from_npz(data, where)
+    except LimitsFileError:
+        raise
+    except (
+        OSError, ValueError, KeyError, TypeError, IndexError, EOFError, zipfile.BadZipFile,
+        MocapQAError,
+    ) as e:  # fmt: skip
+        raise LimitsFileError(
+            f"{where}: Expected a mocapqa limits model (.npz, format {_FORMAT!r} "
+            f"v{FORMAT_VERSION}), got an unreadable or corrupt file ({type(e).__name__}: {e})"
+        ) from e
+
+
+def default_model_paths() -> Iterator[Path]:
+    """Paths of the models shipped in ``mocapqa/data/limits``, sorted by name."""
+    folder = resources.files("mocapqa") / "data" / "limits"
+    for entry in sorted(folder.iterdir(), key=lambda e: e.name):
+        if entry.name.endswith(".npz"):
+            yield Path(str(entry))
+
+
+@functools.cache
+def _shipped_models() -> tuple[LimitsModel, ...]:
+    # Read once per process: the shipped files do not change while it runs.
+    return tuple(load_model(path) for path in default_model_paths())
+
+
+def load_default_model(skeleton: Skeleton) -> LimitsModel:
+    """The shipped limits model that covers ``skeleton``'s rig.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+
+    Returns
+    -------
+    LimitsModel
+
+    Raises
+    ------
+    LimitsFileError
+        If no shipped model covers the rig (the message lists the families that are covered).
+    """
+    families = []
+    for model in _shipped_models():
+        families.append(model.rig_family)
+        if not fingerprint_mismatches(model.fingerprint, skeleton):
+            return model
+    covered = ", ".join(families) or "none"
+    raise LimitsFileError(
+        f"Expected a skeleton of a rig with a shipped limits model ({covered}), "
+        f"got a {rig_family(skeleton)!r} skeleton that matches none; build one with "
+        "`mocapqa limits build`"
+    )

@@ -1,0 +1,47 @@
+"""``mocapqa limits build|check|show`` on real takes."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from mocapqa.cli.main import main
+from mocapqa.limits.model import load_model
+
+
+def test_check_prints_json_with_the_flagged_fraction(
+    corpus_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    take = corpus_dir / "bvh" / "bandai" / "dataset-1_kick_normal_001.bvh"
+    assert main(["limits", "check", str(take), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert 0.0 <= data["flagged_fraction"] <= 1.0
+    assert {j["name"] for j in data["joints"]} >= {"UpperArm_L", "LowerLeg_R"}
+    assert all("worst_frames" in j for j in data["joints"])
+
+
+def test_build_then_show_writes_a_model_and_an_image(corpus_dir: Path, tmp_path: Path) -> None:
+    corpus = tmp_path / "corpus"
+    corpus.mkdir()
+    for name in ("dataset-1_walk_normal_001.bvh", "dataset-1_kick_normal_001.bvh"):
+        (corpus / name).symlink_to(corpus_dir / "bvh" / "bandai" / name)
+    model = tmp_path / "model.npz"
+    assert main(["limits", "build", str(corpus), "-o", str(model), "--no-networks"]) == 0
+    assert load_model(model).takes == ("dataset-1_kick_normal_001.bvh",)
+    image = tmp_path / "map.png"
+    assert main(["limits", "show", str(model), "--joint", "left_forearm", "-o", str(image)]) == 0
+    assert image.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_check_with_a_model_of_another_rig_exits_with_the_limits_code(
+    corpus_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mocapqa.limits.model import default_model_paths
+
+    bandai = next(p for p in default_model_paths() if p.name == "bandai.npz")
+    code = main(["limits", "check", str(corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh"),
+                 "--model", str(bandai)])  # fmt: skip
+    assert code == 6
+    assert "Expected a skeleton of the 'bandai' rig" in capsys.readouterr().err

@@ -1,0 +1,79 @@
+"""The lookup map: occupancy, twist bounds, smoothing, widening, validity and distances.
+
+Expected values here are worked out by hand from the map's definition (methods §2).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mocapqa.errors import InputError, ShapeError
+from mocapqa.limits.occupancy import (
+    OccupancyParams,
+    build_occupancy,
+    is_valid,
+    limit_distances,
+    swing_bins,
+)
+
+D = np.deg2rad
+
+
+def _samples(rows: list[tuple[float, float, float]]) -> np.ndarray:
+    return np.asarray(D(np.array(rows, dtype=float)), dtype=np.float64)
+
+
+def test_a_bin_keeps_the_twist_range_of_its_samples() -> None:
+    samples = _samples([(0.5, 0.5, -10.0), (0.2, 0.7, 25.0)])
+    occupancy = build_occupancy(samples, OccupancyParams(bin_deg=1.0, smooth=False))
+    i1, i2 = swing_bins(samples[:1], 1.0)
+    assert (int(i1[0]), int(i2[0])) == (180, 180)
+    assert occupancy.occupied.sum() == 1
+    np.testing.assert_allclose(np.rad2deg(occupancy.tau_min[180, 180]), -10.0)
+    np.testing.assert_allclose(np.rad2deg(occupancy.tau_max[180, 180]), 25.0)
+
+
+def test_validity_needs_an_occupied_bin_and_a_twist_inside_its_bounds() -> None:
+    occupancy = build_occupancy(
+        _samples([(0.5, 0.5, -10.0), (0.5, 0.5, 20.0)]), OccupancyParams(bin_deg=1.0)
+    )
+    queries = _samples([(0.9, 0.1, 0.0), (0.9, 0.1, 30.0), (1.5, 0.5, 0.0)])
+    np.testing.assert_array_equal(is_valid(occupancy, queries), [True, False, False])
+
+
+def test_smoothing_averages_bounds_over_occupied_neighbours_only() -> None:
+    # Two side-by-side bins with twist maxima 0° and 16°: the 3×3 kernel weighs the centre 4
+    # and the side neighbour 2, so the smoothed maxima are (4·0 + 2·16)/6 and (2·0 + 4·16)/6.
+    samples = _samples([(0.5, 0.5, 0.0), (1.5, 0.5, 16.0)])
+    occupancy = build_occupancy(samples, OccupancyParams(bin_deg=1.0))
+    np.testing.assert_allclose(np.rad2deg(occupancy.tau_max[180, 180]), 32.0 / 6.0)
+    np.testing.assert_allclose(np.rad2deg(occupancy.tau_max[181, 180]), 64.0 / 6.0)
+
+
+def test_dilation_and_margin_widen_the_map() -> None:
+    samples = _samples([(2.5, 2.5, 0.0), (2.5, 2.5, 10.0)])
+    occupancy = build_occupancy(
+        samples, OccupancyParams(bin_deg=5.0, dilation_bins=1, tau_margin_deg=5.0)
+    )
+    assert occupancy.occupied.sum() == 9
+    np.testing.assert_allclose(np.rad2deg(occupancy.tau_min[occupancy.occupied]), -5.0)
+    np.testing.assert_allclose(np.rad2deg(occupancy.tau_max[occupancy.occupied]), 15.0)
+
+
+def test_distances_are_zero_inside_and_measure_swing_and_twist_outside() -> None:
+    occupancy = build_occupancy(
+        _samples([(0.5, 0.5, 0.0), (0.5, 0.5, 10.0)]), OccupancyParams(bin_deg=1.0)
+    )
+    queries = _samples([(0.5, 0.5, 5.0), (0.5, 0.5, 30.0), (4.0, 0.5, 5.0), (4.0, 5.0, -5.0)])
+    swing, twist = limit_distances(occupancy, queries)
+    # Bin [0°, 1°]²: (4, 0.5) is 3° right of it; (4, 5) is 3° right and 4° above, 5° away.
+    np.testing.assert_allclose(swing, [0.0, 0.0, 3.0, 5.0], atol=1e-9)
+    np.testing.assert_allclose(twist, [0.0, 20.0, 0.0, 5.0], atol=1e-9)
+
+
+def test_bad_settings_and_samples_are_refused() -> None:
+    with pytest.raises(InputError, match="Expected `bin_deg` dividing 360"):
+        OccupancyParams(bin_deg=7.0)
+    with pytest.raises(ShapeError, match=r"Expected `params` to have shape \(N, 3\)"):
+        build_occupancy(np.zeros((4, 2)), OccupancyParams())
