@@ -1,0 +1,127 @@
+"""``create_app(settings)``: the FastAPI application, its services and the static frontend.
+
+Routes live under ``/api/v1`` (OpenAPI at ``/docs``). The frontend is served from the
+repository's ``frontend/`` folder when running from a checkout, else from the package's
+``mocapqa/static/frontend`` copy; Plotly comes from the installed plotly wheel
+(``package_data/plotly.min.js``) under a versioned name, so the UI works offline.
+"""
+
+from __future__ import annotations
+
+import gzip
+import logging
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
+from pathlib import Path
+
+import plotly
+from fastapi import FastAPI, Request, Response
+from fastapi.middleware.gzip import GZipMiddleware
+from fastapi.responses import FileResponse, HTMLResponse, RedirectResponse
+from fastapi.staticfiles import StaticFiles
+
+from mocapqa import __version__
+from mocapqa.api.deps import Services
+from mocapqa.api.errors import install_error_handlers
+from mocapqa.api.routes import filters, health, reviews, runs, stream, takes
+from mocapqa.config import Settings
+from mocapqa.jobs.demo import load_demo
+from mocapqa.jobs.runner import JobRunner
+from mocapqa.store.files import FileStore
+from mocapqa.store.repository import Repository
+
+__all__ = ["API_PREFIX", "create_app", "frontend_dir", "plotly_js_path"]
+
+API_PREFIX = "/api/v1"
+"""Path prefix of every API route."""
+log = logging.getLogger(__name__)
+
+
+def frontend_dir() -> Path:
+    """The folder holding ``index.html``: the checkout's ``frontend/`` or the packaged copy."""
+    package = Path(__file__).resolve().parents[1]
+    for candidate in (package.parents[1] / "frontend", package / "static" / "frontend"):
+        if (candidate / "index.html").is_file():
+            return candidate
+    raise FileNotFoundError("frontend/index.html not found in the checkout or the package")
+
+
+def plotly_js_path() -> Path:
+    """``plotly.min.js`` shipped inside the installed plotly wheel."""
+    return Path(plotly.__file__).resolve().parent / "package_data" / "plotly.min.js"
+
+
+def create_app(settings: Settings, demo: bool = False) -> FastAPI:
+    """Build the application.
+
+    Parameters
+    ----------
+    settings : Settings
+        Data folder, database URL, upload limit, worker count.
+    demo : bool
+        Load the bundled demo takes (analysed) when the database has no takes.
+    """
+    settings.data_dir.mkdir(parents=True, exist_ok=True)
+    repository = Repository(settings.resolved_database_url)
+    files = FileStore(settings.data_dir)
+    runner = JobRunner(repository, files, settings.job_workers)
+    services = Services(settings, repository, files, runner)
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        requeued = runner.start()
+        if requeued:
+            log.info("re-queued %d interrupted run(s)", len(requeued))
+        if demo:
+            load_demo(repository, files, runner)
+        try:
+            yield
+        finally:
+            runner.shutdown()
+            repository.close()
+
+    app = FastAPI(
+        title="mocapqa",
+        version=__version__,
+        description="Motion-capture QA: twist errors, joint limits and keypoint filtering.",
+        lifespan=lifespan,
+    )
+    app.state.services = services
+    app.add_middleware(GZipMiddleware, minimum_size=2048, compresslevel=5)
+    install_error_handlers(app)
+    for module in (health, takes, runs, reviews, filters, stream):
+        app.include_router(module.router, prefix=API_PREFIX)
+
+    plotly_name = f"plotly-{plotly.__version__}.min.js"
+
+    compressed: list[bytes] = []
+
+    @app.get(f"/vendor/{plotly_name}", include_in_schema=False)
+    def plotly_js(request: Request) -> Response:
+        headers = {
+            "Cache-Control": "public, max-age=31536000, immutable",
+            "Vary": "Accept-Encoding",
+        }
+        if "gzip" not in request.headers.get("accept-encoding", ""):
+            return FileResponse(plotly_js_path(), media_type="text/javascript", headers=headers)
+        if not compressed:  # 4.8 MB compressed once, not on every request
+            compressed.append(gzip.compress(plotly_js_path().read_bytes(), compresslevel=6))
+        headers["Content-Encoding"] = "gzip"
+        return Response(compressed[0], media_type="text/javascript", headers=headers)
+
+    static = frontend_dir()
+
+    index_html = (
+        (static / "index.html").read_text().replace("{{PLOTLY_JS}}", f"/vendor/{plotly_name}")
+    )
+
+    @app.get("/", include_in_schema=False)
+    def index() -> HTMLResponse:
+        return HTMLResponse(index_html, headers={"Cache-Control": "no-cache"})
+
+    @app.get("/take/{take_id}", include_in_schema=False)
+    def take_page(take_id: str) -> RedirectResponse:
+        return RedirectResponse(f"/#/take/{take_id}")
+
+    app.mount("/static", StaticFiles(directory=static), name="static")
+    return app

@@ -1,0 +1,46 @@
+"""Typed dependencies: the services held on ``app.state``, and repeated lookups."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Annotated, Any
+
+from fastapi import Depends, Request
+
+from mocapqa.config import Settings
+from mocapqa.jobs.runner import JobRunner
+from mocapqa.store.files import FileStore
+from mocapqa.store.repository import Repository
+
+__all__ = ["Services", "ServicesDep", "TakeDep", "get_services", "get_take"]
+
+
+@dataclass(frozen=True, slots=True)
+class Services:
+    """What the routes use: settings, repository, files and the job runner."""
+
+    settings: Settings
+    repository: Repository
+    files: FileStore
+    runner: JobRunner
+
+
+def get_services(request: Request) -> Services:
+    """The app's services."""
+    services = request.app.state.services
+    if not isinstance(services, Services):  # pragma: no cover - set by create_app
+        raise RuntimeError("app.state.services is not set")
+    return services
+
+
+ServicesDep = Annotated[Services, Depends(get_services)]
+"""Route parameter type that receives the app's :class:`Services`."""
+
+
+def get_take(take_id: str, services: ServicesDep) -> dict[str, Any]:
+    """The take named in the path (404 when missing)."""
+    return services.repository.get_take(take_id)
+
+
+TakeDep = Annotated[dict[str, Any], Depends(get_take)]
+"""Route parameter type that receives the take row named by ``take_id`` (404 when missing)."""

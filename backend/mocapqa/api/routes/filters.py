@@ -1,0 +1,19 @@
+"""The filter registry (names, parameters, defaults, units) for the UI forms."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from mocapqa.api.schemas import FilterInfo
+from mocapqa.pipeline.filtering import filter_catalog
+
+__all__ = ["router"]
+
+router = APIRouter(tags=["filters"])
+"""Routes of this resource, included under ``/api/v1``."""
+
+
+@router.get("/filters")
+def list_filters() -> list[FilterInfo]:
+    """Every registered filter (empty while the filters package is not installed)."""
+    return [FilterInfo(**item) for item in filter_catalog()]

@@ -1,0 +1,20 @@
+"""``GET /health``."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from mocapqa import __version__
+from mocapqa.api.deps import ServicesDep
+from mocapqa.api.schemas import HealthOut
+
+__all__ = ["router"]
+
+router = APIRouter(tags=["health"])
+"""Routes of this resource, included under ``/api/v1``."""
+
+
+@router.get("/health")
+def health(services: ServicesDep) -> HealthOut:
+    """The server is up; which version and database dialect it uses."""
+    return HealthOut(version=__version__, database=services.repository.engine.dialect.name)

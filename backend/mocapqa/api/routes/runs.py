@@ -1,0 +1,110 @@
+"""Analysis runs: start with options, status, result, point windows and downloads."""
+
+from __future__ import annotations
+
+import json
+from typing import Annotated, Literal
+
+import numpy as np
+from fastapi import APIRouter, Query
+from fastapi.responses import FileResponse, Response
+
+from mocapqa.api.deps import ServicesDep, TakeDep
+from mocapqa.api.schemas import AnalysisOptionsIn, RunOut
+from mocapqa.api.views import run_out
+from mocapqa.errors import InputError, NotFoundError
+from mocapqa.pipeline.options import AnalysisOptions
+
+__all__ = ["router"]
+
+router = APIRouter(tags=["runs"])
+"""Routes of this resource, included under ``/api/v1``."""
+
+DOWNLOADS = {
+    "bvh": ("corrected.bvh", "text/plain", "corrected.bvh"),
+    "csv": ("filtered.csv", "text/csv", "filtered.csv"),
+    "trc": ("filtered.trc", "text/plain", "filtered.trc"),
+    "report": ("report.json", "application/json", "report.json"),
+}
+MAX_WINDOW_VALUES = 3_000_000
+
+
+@router.post("/takes/{take_id}/runs", status_code=201)
+def start_run(
+    take: TakeDep, services: ServicesDep, options: AnalysisOptionsIn | None = None
+) -> RunOut:
+    """Start another analysis of a take with these options; earlier runs are kept."""
+    parsed = AnalysisOptions.from_json((options or AnalysisOptionsIn()).model_dump())
+    run_id = services.repository.add_run(str(take["id"]), parsed.to_json())
+    services.runner.submit(run_id)
+    return run_out(services.repository.get_run(run_id))
+
+
+@router.get("/runs/{run_id}")
+def get_run(run_id: str, services: ServicesDep) -> RunOut:
+    """A run's status (queued | running | done | failed), progress (0–100 %) and step."""
+    return run_out(services.repository.get_run(run_id))
+
+
+@router.get("/runs/{run_id}/result")
+def get_result(run_id: str, services: ServicesDep) -> Response:
+    """The report: summary, steps, findings and the plotted series (409 until done)."""
+    services.repository.require_done(run_id)
+    path = services.files.existing(services.files.run_dir(run_id) / "report.json", "the report")
+    return Response(path.read_bytes(), media_type="application/json")
+
+
+@router.get("/runs/{run_id}/frames")
+def get_frames(
+    run_id: str,
+    services: ServicesDep,
+    start: Annotated[int, Query(ge=0)] = 0,
+    stop: Annotated[int | None, Query(ge=1)] = None,
+    step: Annotated[int, Query(ge=1)] = 1,
+    max_frames: Annotated[int, Query(ge=1, le=20_000)] = 1500,
+) -> Response:
+    """Raw and corrected point positions for frames ``start:stop:step`` (file units).
+
+    The step grows so that at most ``max_frames`` frames come back; the answer states the
+    frame indices it holds.
+    """
+    services.repository.require_done(run_id)
+    path = services.files.existing(services.files.run_dir(run_id) / "points.npz", "the points")
+    with np.load(path) as data:
+        raw, corrected = data["raw"], data["corrected"]
+    n_frames = int(raw.shape[0])
+    stop = n_frames if stop is None else min(stop, n_frames)
+    if start >= stop:
+        raise InputError(f"Expected start < stop ≤ {n_frames}, got start={start}, stop={stop}")
+    count = -(-(stop - start) // step)
+    if count > max_frames:
+        step = -(-(stop - start) // max_frames)
+    frames = np.arange(start, stop, step)
+    if frames.size * raw.shape[1] * 6 > MAX_WINDOW_VALUES:
+        raise InputError(
+            f"Expected a window of at most {MAX_WINDOW_VALUES} values, got {frames.size} frames"
+        )
+    payload = {
+        "frames": frames.tolist(),
+        "n_frames": n_frames,
+        "step": step,
+        "raw": np.round(raw[frames].astype(np.float64), 3).tolist(),
+        "corrected": np.round(corrected[frames].astype(np.float64), 3).tolist(),
+    }
+    # Plain json.dumps: FastAPI's encoder would walk each of the ~10^5 numbers in Python.
+    return Response(json.dumps(payload, separators=(",", ":")), media_type="application/json")
+
+
+@router.get("/runs/{run_id}/download/{kind}", response_class=FileResponse)
+def download(
+    run_id: str, kind: Literal["bvh", "csv", "trc", "report"], services: ServicesDep
+) -> FileResponse:
+    """A run's output: ``bvh`` (corrected), ``csv``/``trc`` (filtered keypoints), ``report``."""
+    run = services.repository.require_done(run_id)
+    file_name, media_type, suffix = DOWNLOADS[kind]
+    path = services.files.run_dir(run_id) / file_name
+    if not path.is_file():
+        raise NotFoundError(f"Expected a {kind} output for run {run_id}, got none for this take")
+    take = services.repository.get_take(str(run["take_id"]))
+    stem = str(take["file_name"]).rsplit(".", 1)[0]
+    return FileResponse(path, media_type=media_type, filename=f"{stem}.{suffix}")

@@ -1,0 +1,82 @@
+"""Takes: upload, list (paged, filtered), get, delete, thumbnail."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from fastapi import APIRouter, File, Query, Request, Response, UploadFile
+
+from mocapqa.api.deps import ServicesDep, TakeDep
+from mocapqa.api.schemas import TakeCreatedOut, TakeDetailOut, TakeOut, TakePageOut
+from mocapqa.api.views import review_out, run_out, take_fields
+from mocapqa.errors import TooLargeError
+from mocapqa.jobs.intake import ingest_take
+from mocapqa.jobs.thumbnails import thumbnail_svg
+
+__all__ = ["router"]
+
+router = APIRouter(prefix="/takes", tags=["takes"])
+"""Routes of this resource, included under ``/api/v1``."""
+
+
+@router.post("", status_code=201)
+def upload_take(
+    request: Request, services: ServicesDep, file: Annotated[UploadFile, File()]
+) -> TakeCreatedOut:
+    """Upload a take (multipart field ``file``); its analysis starts with default options."""
+    max_bytes = int(services.settings.max_upload_mb * 1_000_000)
+    length = request.headers.get("content-length")
+    if length and length.isdigit() and int(length) > max_bytes + 64_000:
+        raise TooLargeError(f"Expected an upload of at most {max_bytes} bytes, got {length}")
+    take_id, run_id = ingest_take(
+        file.file,
+        file.filename or "take",
+        services.repository,
+        services.files,
+        services.runner,
+        max_bytes,
+    )
+    row = services.repository.get_take(take_id)
+    return TakeCreatedOut(**take_fields(row), run_id=run_id)
+
+
+@router.get("")
+def list_takes(
+    services: ServicesDep,
+    limit: Annotated[int, Query(ge=1, le=500)] = 50,
+    offset: Annotated[int, Query(ge=0)] = 0,
+    status: str | None = None,
+    review_status: str | None = None,
+) -> TakePageOut:
+    """A page of takes, newest first, optionally filtered by run or review status."""
+    rows, total = services.repository.list_takes(limit, offset, status, review_status)
+    items = [TakeOut(**take_fields(r)) for r in rows]
+    return TakePageOut(items=items, total=total, limit=limit, offset=offset)
+
+
+@router.get("/{take_id}")
+def get_take(take: TakeDep, services: ServicesDep) -> TakeDetailOut:
+    """One take with its runs (oldest first) and its review history (newest first)."""
+    take_id = str(take["id"])
+    return TakeDetailOut(
+        **take_fields(take),
+        runs=[run_out(r) for r in services.repository.list_runs(take_id)],
+        reviews=[review_out(r) for r in services.repository.list_reviews(take_id)],
+    )
+
+
+@router.delete("/{take_id}", status_code=204)
+def delete_take(take: TakeDep, services: ServicesDep) -> Response:
+    """Delete a take, its runs, reviews and files."""
+    take_id = str(take["id"])
+    run_ids = services.repository.delete_take(take_id)
+    services.files.remove_take(take_id, run_ids)
+    return Response(status_code=204)
+
+
+@router.get("/{take_id}/thumbnail", response_class=Response)
+def thumbnail(take: TakeDep, services: ServicesDep) -> Response:
+    """A small picture of the take (SVG; a placeholder until a run has points)."""
+    run_id = take.get("latest_run_id")
+    body = thumbnail_svg(services.files, str(run_id) if run_id else None, str(take["name"]))
+    return Response(body, media_type="image/svg+xml", headers={"Cache-Control": "max-age=60"})

@@ -1,0 +1,138 @@
+"""Request and response models of the REST API (pydantic), separate from the store's rows."""
+
+from __future__ import annotations
+
+from datetime import datetime
+from typing import Any, Literal
+
+from pydantic import BaseModel, Field
+
+__all__ = [
+    "AnalysisOptionsIn",
+    "FilterInfo",
+    "HealthOut",
+    "ReviewIn",
+    "ReviewOut",
+    "RunOut",
+    "TakeCreatedOut",
+    "TakeDetailOut",
+    "TakeOut",
+    "TakePageOut",
+]
+
+RunStatus = Literal["queued", "running", "done", "failed"]
+ReviewStatus = Literal["unreviewed", "approved", "needs_fix", "rejected"]
+
+
+class HealthOut(BaseModel):
+    """Server health."""
+
+    status: Literal["ok"] = "ok"
+    version: str
+    database: str
+
+
+class AnalysisOptionsIn(BaseModel):
+    """Options of a new run; omitted fields take their defaults."""
+
+    model_config = {"extra": "forbid"}
+
+    checks: list[Literal["twist", "limits", "filter"]] = ["twist", "limits", "filter"]
+    twist_method: Literal["robust", "paper"] = "robust"
+    filter_method: str | None = None
+    filter_preset: str | None = None
+    filter_params: dict[str, float | int | bool | str] = Field(default_factory=dict)
+    max_points: int = Field(2000, ge=10, le=100_000)
+
+
+class RunOut(BaseModel):
+    """One analysis run."""
+
+    id: str
+    take_id: str
+    status: RunStatus
+    progress: int = Field(description="Percent complete, 0–100")
+    step: str
+    options: dict[str, Any]
+    input_sha256: str
+    version: str
+    error: str | None
+    summary: dict[str, Any] | None
+    server_time_s: float | None
+    created_at: datetime
+    started_at: datetime | None
+    finished_at: datetime | None
+
+
+class TakeOut(BaseModel):
+    """A take in the list."""
+
+    id: str
+    name: str
+    format: str
+    kind: Literal["motion", "keypoints"]
+    size_bytes: int
+    sha256: str
+    n_frames: int
+    fps: float
+    n_joints: int
+    created_at: datetime
+    latest_run_id: str | None
+    status: RunStatus | None
+    review_status: ReviewStatus
+    n_findings: int | None
+
+
+class TakeCreatedOut(TakeOut):
+    """The answer to an upload: the take and the run that started."""
+
+    run_id: str
+
+
+class TakeDetailOut(TakeOut):
+    """One take with its runs and review history."""
+
+    runs: list[RunOut]
+    reviews: list[ReviewOut]
+
+
+class TakePageOut(BaseModel):
+    """A page of takes."""
+
+    items: list[TakeOut]
+    total: int
+    limit: int
+    offset: int
+
+
+class ReviewIn(BaseModel):
+    """A review decision."""
+
+    status: ReviewStatus
+    notes: str = Field("", max_length=10_000)
+    reviewer: str = Field("anonymous", min_length=1, max_length=255)
+
+
+class ReviewOut(BaseModel):
+    """One entry of a take's review history."""
+
+    id: int
+    take_id: str
+    status: ReviewStatus
+    notes: str
+    reviewer: str
+    created_at: datetime
+
+
+class FilterInfo(BaseModel):
+    """One filter of the registry, for the UI forms."""
+
+    name: str
+    label: str
+    description: str
+    parameters: list[dict[str, Any]]
+    presets: list[str]
+    applies_to: list[str]
+
+
+TakeDetailOut.model_rebuild()

@@ -1,0 +1,120 @@
+"""Receiving a take: stream to disk with a size limit, detect, parse, store, queue its first run.
+
+Nothing is stored when any step fails: the partial file is removed and no row is written.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from pathlib import Path
+from typing import BinaryIO
+
+from mocapqa.core.motion import Motion
+from mocapqa.errors import InputError, MocapQAError, ParseError, TooLargeError
+from mocapqa.jobs.runner import JobRunner
+from mocapqa.pipeline.loading import detect_take_format, read_take_file
+from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.store.files import FileStore
+from mocapqa.store.repository import Repository, new_id
+
+__all__ = ["CHUNK_BYTES", "ingest_take", "safe_file_name"]
+
+CHUNK_BYTES = 1 << 20
+"""Bytes read from an upload at a time while streaming it to disk."""
+
+
+def safe_file_name(name: str) -> str:
+    """A file name safe to store: the base name, with unusual characters replaced."""
+    base = Path(name.replace("\\", "/")).name.strip() or "take"
+    cleaned = re.sub(r"[^A-Za-z0-9._-]+", "_", base)[:200].lstrip(".")
+    return cleaned or "take"
+
+
+def ingest_take(
+    source: BinaryIO,
+    name: str,
+    repository: Repository,
+    files: FileStore,
+    runner: JobRunner,
+    max_bytes: int,
+    options: AnalysisOptions | None = None,
+) -> tuple[str, str]:
+    """Store an uploaded take and queue its analysis.
+
+    Parameters
+    ----------
+    source : binary file
+        The upload, read in chunks.
+    name : str
+        The client's file name.
+    max_bytes : int
+        Largest accepted size, bytes.
+    options : AnalysisOptions, optional
+        Options of the first run (defaults when None).
+
+    Returns
+    -------
+    take_id, run_id : str
+
+    Raises
+    ------
+    TooLargeError, FormatError, ParseError, InputError
+    """
+    file_name = safe_file_name(name)
+    incoming = files.incoming_path(Path(file_name).suffix.lower())
+    digest = hashlib.sha256()
+    size = 0
+    try:
+        with incoming.open("wb") as out:
+            while chunk := source.read(CHUNK_BYTES):
+                size += len(chunk)
+                if size > max_bytes:
+                    raise TooLargeError(
+                        f"Expected an upload of at most {max_bytes} bytes, got more ({name!r})"
+                    )
+                digest.update(chunk)
+                out.write(chunk)
+        if size == 0:
+            raise InputError(f"Expected a non-empty file, got 0 bytes ({name!r})")
+        format_name = detect_take_format(incoming)
+        try:
+            take = read_take_file(incoming, format_name, file_name)
+        except MocapQAError:
+            raise
+        except (ValueError, LookupError, TypeError, OverflowError, EOFError, OSError) as e:
+            # A reader tripping over bytes it did not foresee is still the input's fault.
+            raise ParseError(
+                f"Expected a readable {format_name} file, got {type(e).__name__}: {e}", file_name
+            ) from e
+        if take.n_frames == 0:
+            raise InputError(f"Expected at least one frame, got 0 ({name!r})")
+        if isinstance(take, Motion):
+            kind, n_points, fps = "motion", take.skeleton.n_joints, take.fps
+        else:
+            kind, n_points, fps = "keypoints", take.n_keypoints, take.fps
+        take_id = new_id()
+        files.adopt(incoming, take_id, file_name)
+        try:
+            _, run_id = repository.add_take(
+                {
+                    "id": take_id,
+                    "name": Path(name.replace("\\", "/")).name[:255] or file_name,
+                    "format": format_name,
+                    "kind": kind,
+                    "size_bytes": size,
+                    "sha256": digest.hexdigest(),
+                    "n_frames": take.n_frames,
+                    "fps": fps,
+                    "n_joints": n_points,
+                    "file_name": file_name,
+                },
+                (options or AnalysisOptions()).to_json(),
+            )
+        except Exception:
+            files.remove_take(take_id, [])
+            raise
+    finally:
+        incoming.unlink(missing_ok=True)
+    runner.submit(run_id, take)
+    return take_id, run_id

@@ -1,0 +1,159 @@
+"""Background analysis runs: a thread pool outside the request, with progress in the database.
+
+A run's outputs are written to its folder (each file atomically) *before* the run is marked
+done, so a run seen as done always has complete files; a server that stops mid-run leaves the
+run queued or running, and :meth:`JobRunner.start` re-queues it on the next start. numpy and the
+file I/O release the GIL for most of the work, so the event loop stays responsive.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import logging
+import threading
+import time
+from concurrent.futures import Future, ThreadPoolExecutor
+from typing import Any
+
+import numpy as np
+
+from mocapqa.errors import MocapQAError
+from mocapqa.io.bvh import format_bvh
+from mocapqa.pipeline.analyze import AnalysisResult, analyze
+from mocapqa.pipeline.loading import Take, read_take_file, write_keypoints_file
+from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.store.files import FileStore
+from mocapqa.store.repository import Repository
+
+__all__ = ["JobRunner", "write_outputs"]
+
+log = logging.getLogger(__name__)
+
+
+def write_outputs(files: FileStore, run_id: str, result: AnalysisResult) -> list[str]:
+    """Write a run's files (report, points, corrected BVH or filtered keypoints).
+
+    Returns
+    -------
+    list of str
+        The download kinds written (``"report"``, ``"bvh"``, ``"csv"``, ``"trc"``).
+    """
+    folder = files.run_dir(run_id)
+    kinds = ["report"]
+    buffer = io.BytesIO()
+    np.savez(
+        buffer,
+        raw=result.raw_points.astype(np.float32),
+        corrected=result.corrected_points.astype(np.float32),
+    )
+    files.write_bytes(folder / "points.npz", buffer.getvalue())
+    if result.corrected_motion is not None:
+        files.write_bytes(folder / "corrected.bvh", format_bvh(result.corrected_motion).encode())
+        kinds.append("bvh")
+    if result.filtered_keypoints is not None:
+        for suffix in ("csv", "trc"):
+            try:
+                target = folder / f"filtered.{suffix}"
+                temporary = folder / f".filtered.{run_id}.{suffix}"
+                write_keypoints_file(temporary, result.filtered_keypoints)
+                temporary.replace(target)
+                kinds.append(suffix)
+            except MocapQAError as e:
+                log.info("no %s output for run %s: %s", suffix, run_id, e)
+    report = {**result.report, "downloads": kinds}
+    files.write_bytes(folder / "report.json", json.dumps(report, allow_nan=False).encode())
+    return kinds
+
+
+class JobRunner:
+    """Runs analyses on worker threads.
+
+    Parameters
+    ----------
+    repository : Repository
+        Where runs are recorded.
+    files : FileStore
+        Where takes and outputs live.
+    workers : int
+        Worker threads.
+    """
+
+    def __init__(self, repository: Repository, files: FileStore, workers: int = 2) -> None:
+        self.repository = repository
+        self.files = files
+        self._pool = ThreadPoolExecutor(max_workers=max(1, workers), thread_name_prefix="run")
+        self._futures: dict[str, Future[None]] = {}
+        self._preloaded: dict[str, Take] = {}
+        self._lock = threading.Lock()
+
+    def start(self) -> list[str]:
+        """Re-queue runs left by a stopped server and submit them; returns their ids."""
+        ids = self.repository.recover_interrupted()
+        for run_id in ids:
+            self.submit(run_id)
+        return ids
+
+    def submit(self, run_id: str, take: Take | None = None) -> None:
+        """Queue a run (already recorded as queued) for a worker.
+
+        ``take`` is the take as already read by the upload, which spares the worker a second
+        parse of the same bytes.
+        """
+        if take is not None:
+            with self._lock:
+                self._preloaded[run_id] = take
+        future = self._pool.submit(self._execute, run_id)
+        with self._lock:
+            self._futures[run_id] = future
+
+    def wait(self, run_id: str, timeout_s: float = 60.0) -> None:
+        """Block until a submitted run has finished (for tests and the demo loader)."""
+        with self._lock:
+            future = self._futures.get(run_id)
+        if future is not None:
+            future.result(timeout=timeout_s)
+
+    def shutdown(self) -> None:
+        """Stop taking runs; running ones finish, queued ones stay queued for the next start."""
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+    def _execute(self, run_id: str) -> None:
+        started = time.perf_counter()
+        try:
+            self.repository.mark_running(run_id)
+            run = self.repository.get_run(run_id)
+            take = self.repository.get_take(str(run["take_id"]))
+            path = self.files.take_dir(str(take["id"])) / str(take["file_name"])
+            options = AnalysisOptions.from_json(run["options"])
+            with self._lock:
+                preloaded = self._preloaded.pop(run_id, None)
+            motion_or_keypoints = preloaded or read_take_file(
+                path, str(take["format"]), str(take["name"])
+            )
+            last = [0.0]
+
+            def progress(percent: int, step: str) -> None:
+                now = time.perf_counter()
+                if now - last[0] > 0.2 or percent >= 95:
+                    last[0] = now
+                    self.repository.set_progress(run_id, percent, step)
+
+            result = analyze(motion_or_keypoints, options, progress)
+            write_outputs(self.files, run_id, result)
+            summary: dict[str, Any] = {
+                **result.report["summary"],
+                "steps": {k: v["state"] for k, v in result.report["steps"].items()},
+            }
+            self.repository.finish_run(run_id, summary, None, time.perf_counter() - started)
+        except MocapQAError as e:
+            self._fail(run_id, str(e), started)
+        except Exception as e:  # a bug must not leave the run "running" forever
+            log.exception("run %s failed", run_id)
+            self._fail(run_id, f"internal error: {type(e).__name__}: {e}", started)
+
+    def _fail(self, run_id: str, message: str, started: float) -> None:
+        try:
+            self.repository.finish_run(run_id, None, message, time.perf_counter() - started)
+        except Exception:
+            log.exception("could not record the failure of run %s", run_id)

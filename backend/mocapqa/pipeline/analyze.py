@@ -1,0 +1,243 @@
+"""One analysis of a take: twist refinement, joint limits and filtering, with progress.
+
+``analyze(take, options, progress)`` calls the algorithm entry points and gathers what the UI
+and the downloads need into an :class:`AnalysisResult`:
+
+* ``report`` — JSON-ready: summary, per-step state, findings, and the plotted time series
+  (decimated to ``options.max_points`` samples);
+* the corrected motion (twist-refined, optionally filtered) or the filtered keypoints;
+* raw and corrected point positions ``(F, P, 3)`` for the 3D view (served in windows).
+
+Each algorithm step lives in :mod:`mocapqa.pipeline.steps`; a step that does not apply (a rig
+without a limits model, a keypoint take for twist) reports why, and the take passes through.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from mocapqa import __version__
+from mocapqa.core.arrays import FloatArray
+from mocapqa.core.keypoints import KeypointSequence
+from mocapqa.core.motion import Motion
+from mocapqa.pipeline.frames import motion_points, sample_frames
+from mocapqa.pipeline.loading import Take
+from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.pipeline.steps import (
+    StepOutcome,
+    run_filter_keypoints,
+    run_filter_motion,
+    run_limits,
+    run_twist,
+)
+
+__all__ = ["AnalysisResult", "ProgressCallback", "analyze"]
+
+ProgressCallback = Callable[[int, str], None]
+"""Called as ``progress(percent, step)`` with percent in 0–100."""
+
+
+@dataclass(frozen=True, slots=True)
+class AnalysisResult:
+    """Everything one run produces.
+
+    Parameters
+    ----------
+    report : dict
+        JSON-ready report (summary, steps, findings, series).
+    corrected_motion : Motion, optional
+        Twist-refined (and optionally filtered) motion, for BVH takes.
+    filtered_keypoints : KeypointSequence, optional
+        Filtered keypoints, for keypoint takes.
+    raw_points : ndarray, shape (F, P, 3)
+        Positions drawn in the raw 3D view, file units.
+    corrected_points : ndarray, shape (F, P, 3)
+        Positions drawn in the corrected 3D view, file units.
+    """
+
+    report: dict[str, Any]
+    corrected_motion: Motion | None
+    filtered_keypoints: KeypointSequence | None
+    raw_points: FloatArray
+    corrected_points: FloatArray
+
+
+def _no_progress(percent: int, step: str) -> None:
+    del percent, step
+
+
+def _steps_json(outcomes: dict[str, StepOutcome]) -> dict[str, dict[str, str]]:
+    return {name: {"state": o.state, "message": o.message} for name, o in outcomes.items()}
+
+
+def _analyze_motion(
+    motion: Motion, options: AnalysisOptions, progress: ProgressCallback
+) -> AnalysisResult:
+    outcomes: dict[str, StepOutcome] = {}
+    series: dict[str, Any] = {}
+    findings: list[dict[str, Any]] = []
+    timings: dict[str, float] = {}
+    frames = sample_frames(motion.n_frames, options.max_points)
+
+    progress(10, "forward kinematics (raw)")
+    clock = time.perf_counter()
+    names, parents, raw_points = motion_points(motion)
+    timings["fk_raw_s"] = time.perf_counter() - clock
+
+    corrected = motion
+    if "twist" in options.checks:
+        progress(25, "twist analysis")
+        clock = time.perf_counter()
+        outcome = run_twist(motion, options.twist_method, frames)
+        timings["twist_s"] = time.perf_counter() - clock
+        outcomes["twist"] = outcome
+        if outcome.motion is not None:
+            corrected = outcome.motion
+        series["twist"] = outcome.series
+        findings += outcome.findings
+    else:
+        outcomes["twist"] = StepOutcome("skipped", "not requested")
+
+    if "limits" in options.checks:
+        progress(55, "joint-limit check")
+        clock = time.perf_counter()
+        outcome = run_limits(motion, frames)
+        timings["limits_s"] = time.perf_counter() - clock
+        outcomes["limits"] = outcome
+        series["limits"] = outcome.series
+        findings += outcome.findings
+    else:
+        outcomes["limits"] = StepOutcome("skipped", "not requested")
+
+    if "filter" in options.checks and options.filter_method:
+        progress(75, "filtering the corrected motion")
+        clock = time.perf_counter()
+        outcome = run_filter_motion(corrected, options.filter_method, options.filter_params)
+        timings["filter_s"] = time.perf_counter() - clock
+        outcomes["filter"] = outcome
+        if outcome.motion is not None:
+            corrected = outcome.motion
+    else:
+        outcomes["filter"] = StepOutcome("skipped", "no filter chosen for motion takes")
+
+    progress(85, "forward kinematics (corrected)")
+    clock = time.perf_counter()
+    _, _, corrected_points = motion_points(corrected)
+    timings["fk_corrected_s"] = time.perf_counter() - clock
+    skeleton = motion.skeleton
+    report = {
+        "kind": "motion",
+        "version": __version__,
+        "summary": {
+            "n_frames": motion.n_frames,
+            "fps": motion.fps,
+            "duration_s": motion.n_frames / motion.fps,
+            "n_joints": skeleton.n_joints,
+            "length_unit": skeleton.length_unit,
+            "n_findings": len(findings),
+            "findings_by_kind": _count_by_kind(findings),
+        },
+        "options": options.to_json(),
+        "steps": _steps_json(outcomes),
+        "timings_s": {k: round(v, 4) for k, v in timings.items()},
+        "findings": findings,
+        "points": {"names": names, "parents": parents, "n_joints": skeleton.n_joints},
+        "series": {"frames": frames.tolist(), "fps": motion.fps, **series},
+    }
+    return AnalysisResult(report, corrected, None, raw_points, corrected_points)
+
+
+def _analyze_keypoints(
+    sequence: KeypointSequence, options: AnalysisOptions, progress: ProgressCallback
+) -> AnalysisResult:
+    outcomes: dict[str, StepOutcome] = {
+        "twist": StepOutcome("skipped", "keypoint takes have no joint rotations"),
+        "limits": StepOutcome("skipped", "keypoint takes have no joint rotations"),
+    }
+    frames = sample_frames(sequence.n_frames, options.max_points)
+    filtered = sequence
+    series: dict[str, Any] = {}
+    findings: list[dict[str, Any]] = []
+    if "filter" in options.checks:
+        progress(30, "filtering keypoints")
+        outcome = run_filter_keypoints(
+            sequence,
+            options.filter_method or "adaptive",
+            options.filter_preset,
+            options.filter_params,
+            frames,
+        )
+        outcomes["filter"] = outcome
+        if outcome.keypoints is not None:
+            filtered = outcome.keypoints
+        series["filter"] = outcome.series
+        findings += outcome.findings
+    else:
+        outcomes["filter"] = StepOutcome("skipped", "not requested")
+    progress(85, "collecting results")
+    raw_points = np.nan_to_num(sequence.positions)
+    corrected_points = np.nan_to_num(filtered.positions)
+    report = {
+        "kind": "keypoints",
+        "version": __version__,
+        "summary": {
+            "n_frames": sequence.n_frames,
+            "fps": sequence.fps,
+            "duration_s": sequence.n_frames / sequence.fps,
+            "n_keypoints": sequence.n_keypoints,
+            "length_unit": sequence.length_unit,
+            "missing_fraction": sequence.missing_fraction,
+            "n_findings": len(findings),
+            "findings_by_kind": _count_by_kind(findings),
+        },
+        "options": options.to_json(),
+        "steps": _steps_json(outcomes),
+        "findings": findings,
+        "points": {
+            "names": list(sequence.names),
+            "parents": [-1] * sequence.n_keypoints,
+            "n_joints": sequence.n_keypoints,
+        },
+        "series": {"frames": frames.tolist(), "fps": sequence.fps, **series},
+    }
+    return AnalysisResult(report, None, filtered, raw_points, corrected_points)
+
+
+def _count_by_kind(findings: list[dict[str, Any]]) -> dict[str, int]:
+    counts: dict[str, int] = {}
+    for finding in findings:
+        kind = str(finding.get("kind", "other"))
+        counts[kind] = counts.get(kind, 0) + 1
+    return counts
+
+
+def analyze(
+    take: Take, options: AnalysisOptions, progress: ProgressCallback | None = None
+) -> AnalysisResult:
+    """Analyse a take.
+
+    Parameters
+    ----------
+    take : Motion or KeypointSequence
+        The take as read.
+    options : AnalysisOptions
+        What to run.
+    progress : callable, optional
+        Called as ``progress(percent, step)`` with percent in 0–100.
+
+    Returns
+    -------
+    AnalysisResult
+    """
+    report_progress = progress or _no_progress
+    if isinstance(take, Motion):
+        result = _analyze_motion(take, options, report_progress)
+    else:
+        result = _analyze_keypoints(take, options, report_progress)
+    report_progress(95, "analysis finished")
+    return result

@@ -1,0 +1,55 @@
+"""Point positions for the 3D view and the sample grid of plotted series.
+
+The 3D view draws joints and End Sites as points joined to their parents. Positions are
+``(F, P, 3)`` in file units, with the P points in skeleton order followed by the End Sites.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mocapqa.core.arrays import FloatArray, IntArray
+from mocapqa.core.motion import Motion
+from mocapqa.kinematics.forward import end_site_positions, forward_kinematics
+
+__all__ = ["motion_points", "sample_frames"]
+
+
+def motion_points(motion: Motion) -> tuple[list[str], list[int], FloatArray]:
+    """Names, parents and world positions of the joints and End Sites of a motion.
+
+    Returns
+    -------
+    names : list of str
+        Joint names, then ``"<parent> end"`` per End Site.
+    parents : list of int
+        Parent point index per point (-1 for roots).
+    positions : ndarray, shape (F, P, 3)
+        World positions, file units.
+    """
+    world_quats, world_positions = forward_kinematics(motion)
+    ends = end_site_positions(motion, world_quats, world_positions)
+    skeleton = motion.skeleton
+    names = list(skeleton.names) + [f"{skeleton.names[e.parent]} end" for e in skeleton.end_sites]
+    parents = [int(p) for p in skeleton.parents] + [int(e.parent) for e in skeleton.end_sites]
+    return names, parents, np.concatenate([world_positions, ends], axis=1)
+
+
+def sample_frames(n_frames: int, max_points: int) -> IntArray:
+    """Evenly spaced frame indices, at most ``max_points`` of them, always the first and last.
+
+    Parameters
+    ----------
+    n_frames : int
+        Frames in the take.
+    max_points : int
+        Largest number of samples.
+
+    Returns
+    -------
+    ndarray, shape (S,)
+        Increasing frame indices.
+    """
+    if n_frames <= max_points:
+        return np.arange(n_frames, dtype=np.intp)
+    return np.unique(np.linspace(0, n_frames - 1, max_points).round().astype(np.intp))

@@ -1,0 +1,121 @@
+"""Options of one analysis run: which checks, which twist and filter methods, with parameters.
+
+The options travel as JSON (stored with each run, sent by the UI), so they are one frozen
+dataclass with a strict ``from_json`` that names the offending field, and a ``to_json`` that
+round-trips. Angles are degrees only at this edge (names end in ``_deg``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from mocapqa.errors import InputError
+from mocapqa.filters.registry import FILTERS
+from mocapqa.twist.analysis import METHODS
+
+__all__ = ["CHECKS", "TWIST_METHODS", "AnalysisOptions", "ParamValue"]
+
+ParamValue = float | int | bool | str
+"""Value of one filter parameter override."""
+
+CHECKS = ("twist", "limits", "filter")
+"""The checks a run can do."""
+TWIST_METHODS = METHODS
+"""Twist detection methods (those of :mod:`mocapqa.twist.analysis`)."""
+
+
+@dataclass(frozen=True, slots=True)
+class AnalysisOptions:
+    """What one analysis run does.
+
+    Parameters
+    ----------
+    checks : tuple of str
+        Subset of :data:`CHECKS` to run.
+    twist_method : str
+        One of :data:`TWIST_METHODS`.
+    filter_method : str, optional
+        A name from the filter registry; ``None`` means "adaptive" for keypoint takes and no
+        filtering of the corrected BVH.
+    filter_preset : str, optional
+        A preset name of the filter registry, for keypoint filters.
+    filter_params : dict of str to float, int, bool or str
+        Parameter overrides for the filter by dotted name, in the registry's units.
+    max_points : int
+        Largest number of time samples per plotted series (the result is decimated to it).
+    """
+
+    checks: tuple[str, ...] = CHECKS
+    twist_method: str = "robust"
+    filter_method: str | None = None
+    filter_preset: str | None = None
+    filter_params: dict[str, ParamValue] = field(default_factory=dict)
+    max_points: int = 2000
+
+    def __post_init__(self) -> None:
+        unknown = [c for c in self.checks if c not in CHECKS]
+        if unknown:
+            raise InputError(f"Expected checks among {list(CHECKS)}, got {unknown}")
+        if self.twist_method not in TWIST_METHODS:
+            raise InputError(
+                f"Expected twist_method in {list(TWIST_METHODS)}, got {self.twist_method!r}"
+            )
+        if self.filter_method is not None and self.filter_method not in FILTERS:
+            raise InputError(
+                f"Expected filter_method in {sorted(FILTERS)}, got {self.filter_method!r}"
+            )
+        if not 10 <= self.max_points <= 100_000:
+            raise InputError(f"Expected max_points in [10, 100000], got {self.max_points}")
+        object.__setattr__(self, "checks", tuple(self.checks))
+
+    def to_json(self) -> dict[str, Any]:
+        """The options as a JSON-ready dict."""
+        return {
+            "checks": list(self.checks),
+            "twist_method": self.twist_method,
+            "filter_method": self.filter_method,
+            "filter_preset": self.filter_preset,
+            "filter_params": dict(self.filter_params),
+            "max_points": self.max_points,
+        }
+
+    @classmethod
+    def from_json(cls, data: dict[str, Any] | None) -> AnalysisOptions:
+        """Options from a JSON dict; missing fields take their defaults.
+
+        Raises
+        ------
+        InputError
+            On an unknown field or a value of the wrong type.
+        """
+        if not data:
+            return cls()
+        known = {"checks", "twist_method", "filter_method", "filter_preset", "filter_params"}
+        known |= {"max_points"}
+        extra = sorted(set(data) - known)
+        if extra:
+            raise InputError(f"Expected option fields among {sorted(known)}, got {extra}")
+        params = data.get("filter_params") or {}
+        if not isinstance(params, dict) or not all(
+            isinstance(v, int | float | str) for v in params.values()
+        ):
+            raise InputError(f"Expected filter_params to map names to values, got {params!r}")
+        checks = data.get("checks", list(CHECKS))
+        if not isinstance(checks, list | tuple) or not all(isinstance(c, str) for c in checks):
+            raise InputError(f"Expected checks to be a list of names, got {checks!r}")
+        max_points = data.get("max_points", 2000)
+        if not isinstance(max_points, int) or isinstance(max_points, bool):
+            raise InputError(f"Expected max_points to be an integer, got {max_points!r}")
+        for name in ("twist_method", "filter_method", "filter_preset"):
+            value = data.get(name)
+            if value is not None and not isinstance(value, str):
+                raise InputError(f"Expected {name} to be a string, got {value!r}")
+        return cls(
+            checks=tuple(checks),
+            twist_method=data.get("twist_method") or "robust",
+            filter_method=data.get("filter_method"),
+            filter_preset=data.get("filter_preset"),
+            filter_params={str(k): v for k, v in params.items()},
+            max_points=max_points,
+        )

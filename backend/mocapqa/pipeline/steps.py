@@ -1,0 +1,215 @@
+"""The pipeline's steps: each calls one algorithm entry point and normalises its output.
+
+* twist — :func:`mocapqa.twist.analysis.analyze_twist`
+* limits — :func:`mocapqa.limits.model.load_default_model` and
+  :func:`mocapqa.limits.analysis.check_limits`; a rig without a shipped model reports
+  ``"no_model"`` ("no model for this rig") instead of failing the run
+* filters — :func:`mocapqa.filters.apply.filter_keypoints` and
+  :func:`~mocapqa.filters.apply.filter_motion`
+
+Every step returns a :class:`StepOutcome` whose ``findings`` share one shape
+(``kind, joint, start_frame, end_frame, value, unit, confidence``; frames inclusive) and whose
+``series`` is the JSON the UI plots, sampled at the run's frame grid. Angles are in degrees.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.core.keypoints import KeypointSequence
+from mocapqa.core.motion import Motion, Skeleton
+from mocapqa.errors import LimitsFileError
+from mocapqa.filters.apply import filter_keypoints, filter_motion
+from mocapqa.limits.analysis import check_limits
+from mocapqa.limits.model import LimitsModel, load_default_model
+from mocapqa.pipeline.options import ParamValue
+from mocapqa.twist.analysis import analyze_twist
+
+__all__ = [
+    "StepOutcome",
+    "run_filter_keypoints",
+    "run_filter_motion",
+    "run_limits",
+    "run_twist",
+    "violation_findings",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class StepOutcome:
+    """What one step produced.
+
+    Parameters
+    ----------
+    state : str
+        ``"done"``, ``"skipped"`` or ``"no_model"``.
+    message : str
+        One line for the UI.
+    findings : list of dict
+        Normalised findings.
+    series : dict, optional
+        Plotted series (JSON-ready).
+    motion : Motion, optional
+        A corrected motion, when the step makes one.
+    keypoints : KeypointSequence, optional
+        Filtered keypoints, when the step makes them.
+    """
+
+    state: str
+    message: str = ""
+    findings: list[dict[str, Any]] = field(default_factory=list)
+    series: dict[str, Any] | None = None
+    motion: Motion | None = None
+    keypoints: KeypointSequence | None = None
+
+
+def run_twist(motion: Motion, method: str, frames: IntArray) -> StepOutcome:
+    """Detect and remove twist offsets (θP level shifts) on every limb chain."""
+    analysis = analyze_twist(motion, method=method)
+    findings = [
+        {
+            "kind": "twist",
+            "joint": interval.joint,
+            "start_frame": int(interval.start_frame),
+            "end_frame": int(interval.end_frame),
+            "value": round(float(interval.offset_deg), 3),
+            "unit": "deg",
+            "confidence": round(float(interval.confidence), 3),
+        }
+        for interval in analysis.intervals
+    ]
+    series = analysis.to_json(max_points=int(frames.size))
+    return StepOutcome(
+        "done",
+        f"{len(findings)} twist interval(s) on {len(analysis.chains)} chain(s)",
+        findings,
+        series,
+        analysis.refined,
+    )
+
+
+def violation_findings(
+    valid: BoolArray, score_deg: FloatArray, joints: list[str]
+) -> list[dict[str, Any]]:
+    """One finding per joint and run of consecutive frames outside the limits.
+
+    Parameters
+    ----------
+    valid : ndarray of bool, shape (F, J)
+        Inside the limits.
+    score_deg : ndarray, shape (F, J)
+        Distance outside the limits, degrees.
+    joints : list of str
+        Joint names of the J columns.
+    """
+    findings: list[dict[str, Any]] = []
+    for j, joint in enumerate(joints):
+        bad = ~valid[:, j]
+        if not bad.any():
+            continue
+        edges = np.diff(np.concatenate(([0], bad.astype(np.int8), [0])))
+        starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+        for start, stop in zip(starts, stops, strict=True):
+            findings.append(
+                {
+                    "kind": "limits",
+                    "joint": joint,
+                    "start_frame": int(start),
+                    "end_frame": int(stop - 1),
+                    "value": round(float(score_deg[start:stop, j].max()), 3),
+                    "unit": "deg",
+                    "confidence": None,
+                }
+            )
+    return findings
+
+
+RigKey = tuple[tuple[str, ...], bytes, bytes]
+_RIGS: dict[RigKey, Skeleton] = {}
+
+
+@functools.lru_cache(maxsize=16)
+def _model_for_rig(key: RigKey) -> LimitsModel | str:
+    # The shipped models are read-only package data: load them once per rig layout (names,
+    # parents and rest offsets, which decide the fingerprint), not once per run.
+    try:
+        return load_default_model(_RIGS[key])
+    except LimitsFileError as e:
+        return str(e)
+
+
+def run_limits(motion: Motion, frames: IntArray) -> StepOutcome:
+    """Check joint limits with the shipped model of the rig (loaded once per rig layout)."""
+    skeleton = motion.skeleton
+    key = (skeleton.names, skeleton.parents.tobytes(), skeleton.offsets.tobytes())
+    _RIGS.setdefault(key, skeleton)
+    model = _model_for_rig(key)
+    if isinstance(model, str):
+        return StepOutcome("no_model", f"no model for this rig ({model})")
+    report = check_limits(motion, model)
+    joints = list(report.joint_names)
+    findings = violation_findings(report.valid, report.score_deg, joints)
+    sampled = frames[frames < report.valid.shape[0]]
+    heat = np.where(report.valid[sampled].T, 0.0, np.round(report.score_deg[sampled].T, 2))
+    summary = report.to_json(max_points=1)
+    for joint in summary["joints"]:
+        joint.pop("frames", None)  # the heat map carries the per-frame values
+    return StepOutcome(
+        "done",
+        f"{len(findings)} violation interval(s), rig {report.rig_family}",
+        findings,
+        {
+            "joints": joints,
+            "frames": sampled.tolist(),
+            "score_deg": heat.tolist(),
+            "summary": summary,
+        },
+    )
+
+
+def run_filter_motion(motion: Motion, method: str, params: dict[str, ParamValue]) -> StepOutcome:
+    """Filter a (corrected) motion's rotations and root translation."""
+    filtered = filter_motion(motion, method, dict(params))
+    return StepOutcome("done", f"filtered with {method}", motion=filtered)
+
+
+def run_filter_keypoints(
+    sequence: KeypointSequence,
+    method: str,
+    preset: str | None,
+    params: dict[str, ParamValue],
+    frames: IntArray,
+) -> StepOutcome:
+    """Filter keypoints; the series holds the filter weight timeline (mean over keypoints)."""
+    result = filter_keypoints(sequence, method, preset or "default", dict(params))
+    weights: dict[str, Any] = {}
+    if result.weights is not None:
+        sampled = np.nan_to_num(result.weights[frames])
+        mean = sampled.mean(axis=1)
+        for i, name in enumerate(result.weight_names):
+            weights[name] = {
+                "mean": np.round(mean[:, i], 4).tolist(),
+                "per_keypoint": np.round(sampled[:, :, i].T, 3).tolist(),
+            }
+    detail = result.to_json(max_points=1)
+    for key in ("weights", "weights_mean", "timeline_frames"):
+        detail.pop(key, None)
+    bridged = int(result.bridged.sum())
+    return StepOutcome(
+        "done",
+        f"filtered with {method} ({bridged} bridged samples)",
+        [],
+        {
+            "method": method,
+            "names": list(sequence.names),
+            "length_unit": sequence.length_unit,
+            "weights": weights,
+            "summary": detail,
+        },
+        keypoints=result.sequence,
+    )

@@ -1,0 +1,341 @@
+"""The repository: every read and write of takes, runs and reviews goes through here.
+
+Rows come back as plain dicts (JSON-ready apart from datetimes). A run's life is
+``queued → running → done | failed``; :meth:`Repository.recover_interrupted` puts runs that a
+stopped server left queued or running back in the queue (their outputs are only published
+after they are complete, so nothing half-written is ever marked done).
+"""
+
+from __future__ import annotations
+
+import uuid
+from datetime import UTC, datetime
+from typing import Any
+
+from sqlalchemy import Engine, create_engine, delete, event, func, insert, select, update
+from sqlalchemy.engine import Connection
+
+from mocapqa import __version__
+from mocapqa.errors import ConflictError, InputError, NotFoundError
+from mocapqa.store.tables import metadata, reviews, runs, takes
+
+__all__ = ["REVIEW_STATUSES", "RUN_STATUSES", "Repository", "new_id", "utc_now"]
+
+RUN_STATUSES = ("queued", "running", "done", "failed")
+"""A run's states, in life order."""
+REVIEW_STATUSES = ("unreviewed", "approved", "needs_fix", "rejected")
+"""The review decisions a take can have."""
+
+
+def new_id() -> str:
+    """A new 32-character hex id."""
+    return uuid.uuid4().hex
+
+
+def utc_now() -> datetime:
+    """The current time, UTC."""
+    return datetime.now(UTC)
+
+
+def _sqlite_pragmas(dbapi_connection: Any, connection_record: Any) -> None:
+    del connection_record
+    cursor = dbapi_connection.cursor()
+    cursor.execute("PRAGMA foreign_keys=ON")
+    cursor.execute("PRAGMA journal_mode=WAL")
+    cursor.execute("PRAGMA busy_timeout=10000")
+    cursor.close()
+
+
+def _aware(value: Any) -> Any:
+    # SQLite hands back naive datetimes; every stored time is UTC.
+    if isinstance(value, datetime) and value.tzinfo is None:
+        return value.replace(tzinfo=UTC)
+    return value
+
+
+def _row(mapping: Any) -> dict[str, Any]:
+    return {key: _aware(value) for key, value in dict(mapping).items()}
+
+
+class Repository:
+    """Database access for takes, runs and reviews.
+
+    Parameters
+    ----------
+    database_url : str
+        SQLAlchemy URL (``sqlite:///...`` or ``postgresql+psycopg://...``).
+    """
+
+    def __init__(self, database_url: str) -> None:
+        self.database_url = database_url
+        self.engine: Engine = create_engine(database_url, pool_pre_ping=True)
+        if self.engine.dialect.name == "sqlite":
+            event.listen(self.engine, "connect", _sqlite_pragmas)
+        metadata.create_all(self.engine)
+
+    def close(self) -> None:
+        """Release the connection pool."""
+        self.engine.dispose()
+
+    # takes -----------------------------------------------------------------------------
+    def add_take(self, values: dict[str, Any], options: dict[str, Any]) -> tuple[str, str]:
+        """Insert a take and its first (queued) run in one transaction.
+
+        Returns
+        -------
+        take_id, run_id : str
+        """
+        take_id = str(values.get("id") or new_id())
+        with self.engine.begin() as conn:
+            conn.execute(insert(takes).values(**{**values, "id": take_id, "created_at": utc_now()}))
+            run_id = self._insert_run(conn, take_id, str(values["sha256"]), options)
+        return take_id, run_id
+
+    def get_take(self, take_id: str) -> dict[str, Any]:
+        """One take with its latest run and review fields.
+
+        Raises
+        ------
+        NotFoundError
+        """
+        items, _ = self._query_takes(take_id=take_id)
+        if not items:
+            raise NotFoundError(f"Expected take {take_id!r} to exist, got none")
+        return items[0]
+
+    def list_takes(
+        self,
+        limit: int = 50,
+        offset: int = 0,
+        status: str | None = None,
+        review_status: str | None = None,
+    ) -> tuple[list[dict[str, Any]], int]:
+        """A page of takes, newest first, and the total count after filtering."""
+        if status is not None and status not in RUN_STATUSES:
+            raise InputError(f"Expected status in {list(RUN_STATUSES)}, got {status!r}")
+        if review_status is not None and review_status not in REVIEW_STATUSES:
+            raise InputError(
+                f"Expected review_status in {list(REVIEW_STATUSES)}, got {review_status!r}"
+            )
+        return self._query_takes(limit, offset, status, review_status)
+
+    def _query_takes(
+        self,
+        limit: int = 50,
+        offset: int = 0,
+        status: str | None = None,
+        review_status: str | None = None,
+        take_id: str | None = None,
+    ) -> tuple[list[dict[str, Any]], int]:
+        latest_run = (
+            select(runs.c.take_id, func.max(runs.c.created_at).label("created_at"))
+            .group_by(runs.c.take_id)
+            .subquery()
+        )
+        run_row = (
+            select(
+                runs.c.take_id,
+                runs.c.id.label("latest_run_id"),
+                runs.c.status.label("status"),
+                runs.c.summary.label("summary"),
+            )
+            .join(
+                latest_run,
+                (runs.c.take_id == latest_run.c.take_id)
+                & (runs.c.created_at == latest_run.c.created_at),
+            )
+            .subquery()
+        )
+        latest_review = (
+            select(reviews.c.take_id, func.max(reviews.c.id).label("id"))
+            .group_by(reviews.c.take_id)
+            .subquery()
+        )
+        review_row = (
+            select(reviews.c.take_id, reviews.c.status.label("review_status"))
+            .join(latest_review, reviews.c.id == latest_review.c.id)
+            .subquery()
+        )
+        review_status_col = func.coalesce(review_row.c.review_status, "unreviewed")
+        query = (
+            select(
+                takes,
+                run_row.c.latest_run_id,
+                run_row.c.status,
+                run_row.c.summary,
+                review_status_col.label("review_status"),
+            )
+            .outerjoin(run_row, run_row.c.take_id == takes.c.id)
+            .outerjoin(review_row, review_row.c.take_id == takes.c.id)
+        )
+        if take_id is not None:
+            query = query.where(takes.c.id == take_id)
+        if status is not None:
+            query = query.where(run_row.c.status == status)
+        if review_status is not None:
+            query = query.where(review_status_col == review_status)
+        with self.engine.connect() as conn:
+            total = int(
+                conn.execute(select(func.count()).select_from(query.subquery())).scalar_one()
+            )
+            page = query.order_by(takes.c.created_at.desc(), takes.c.id).limit(limit).offset(offset)
+            rows = [_row(r) for r in conn.execute(page).mappings()]
+        return rows, total
+
+    def delete_take(self, take_id: str) -> list[str]:
+        """Delete a take with its runs and reviews; returns the deleted run ids."""
+        with self.engine.begin() as conn:
+            found = conn.execute(select(takes.c.id).where(takes.c.id == take_id)).first()
+            if found is None:
+                raise NotFoundError(f"Expected take {take_id!r} to exist, got none")
+            run_ids = [
+                str(r)
+                for r in conn.execute(select(runs.c.id).where(runs.c.take_id == take_id)).scalars()
+            ]
+            conn.execute(delete(reviews).where(reviews.c.take_id == take_id))
+            conn.execute(delete(runs).where(runs.c.take_id == take_id))
+            conn.execute(delete(takes).where(takes.c.id == take_id))
+        return run_ids
+
+    # runs ------------------------------------------------------------------------------
+    def _insert_run(
+        self, conn: Connection, take_id: str, sha256: str, options: dict[str, Any]
+    ) -> str:
+        run_id = new_id()
+        conn.execute(
+            insert(runs).values(
+                id=run_id,
+                take_id=take_id,
+                status="queued",
+                progress=0,
+                step="queued",
+                options=options,
+                input_sha256=sha256,
+                version=__version__,
+                created_at=utc_now(),
+            )
+        )
+        return run_id
+
+    def add_run(self, take_id: str, options: dict[str, Any]) -> str:
+        """Queue a new run of a take with the given options; earlier runs are kept."""
+        take = self.get_take(take_id)
+        with self.engine.begin() as conn:
+            return self._insert_run(conn, take_id, str(take["sha256"]), options)
+
+    def get_run(self, run_id: str) -> dict[str, Any]:
+        """One run.
+
+        Raises
+        ------
+        NotFoundError
+        """
+        with self.engine.connect() as conn:
+            row = conn.execute(select(runs).where(runs.c.id == run_id)).mappings().first()
+        if row is None:
+            raise NotFoundError(f"Expected run {run_id!r} to exist, got none")
+        return _row(row)
+
+    def list_runs(self, take_id: str) -> list[dict[str, Any]]:
+        """All runs of a take, oldest first."""
+        with self.engine.connect() as conn:
+            rows = conn.execute(
+                select(runs).where(runs.c.take_id == take_id).order_by(runs.c.created_at)
+            ).mappings()
+            return [_row(r) for r in rows]
+
+    def require_done(self, run_id: str) -> dict[str, Any]:
+        """The run, if it finished; :class:`ConflictError` otherwise."""
+        run = self.get_run(run_id)
+        if run["status"] != "done":
+            raise ConflictError(f"Expected run {run_id} to be done, got {run['status']!r}")
+        return run
+
+    def mark_running(self, run_id: str) -> None:
+        """Move a run from queued to running."""
+        with self.engine.begin() as conn:
+            conn.execute(
+                update(runs)
+                .where(runs.c.id == run_id)
+                .values(status="running", progress=1, step="starting", started_at=utc_now())
+            )
+
+    def set_progress(self, run_id: str, percent: int, step: str) -> None:
+        """Record a running run's progress (0–100) and current step."""
+        with self.engine.begin() as conn:
+            conn.execute(
+                update(runs)
+                .where(runs.c.id == run_id)
+                .values(progress=max(0, min(100, int(percent))), step=step[:255])
+            )
+
+    def finish_run(
+        self,
+        run_id: str,
+        summary: dict[str, Any] | None,
+        error: str | None,
+        server_time_s: float,
+    ) -> None:
+        """Mark a run done (``error`` None) or failed."""
+        with self.engine.begin() as conn:
+            conn.execute(
+                update(runs)
+                .where(runs.c.id == run_id)
+                .values(
+                    status="failed" if error else "done",
+                    progress=100,
+                    step="failed" if error else "done",
+                    error=error,
+                    summary=summary,
+                    server_time_s=server_time_s,
+                    finished_at=utc_now(),
+                )
+            )
+
+    def recover_interrupted(self) -> list[str]:
+        """Re-queue the runs a stopped server left queued or running; returns their ids."""
+        with self.engine.begin() as conn:
+            ids = [
+                str(r)
+                for r in conn.execute(
+                    select(runs.c.id)
+                    .where(runs.c.status.in_(("queued", "running")))
+                    .order_by(runs.c.created_at)
+                ).scalars()
+            ]
+            if ids:
+                conn.execute(
+                    update(runs)
+                    .where(runs.c.id.in_(ids))
+                    .values(status="queued", progress=0, step="re-queued after a restart")
+                )
+        return ids
+
+    # reviews ---------------------------------------------------------------------------
+    def add_review(self, take_id: str, status: str, notes: str, reviewer: str) -> dict[str, Any]:
+        """Append a review entry to a take's history."""
+        if status not in REVIEW_STATUSES:
+            raise InputError(f"Expected review status in {list(REVIEW_STATUSES)}, got {status!r}")
+        self.get_take(take_id)
+        with self.engine.begin() as conn:
+            result = conn.execute(
+                insert(reviews)
+                .values(
+                    take_id=take_id,
+                    status=status,
+                    notes=notes,
+                    reviewer=reviewer or "anonymous",
+                    created_at=utc_now(),
+                )
+                .returning(reviews)
+            )
+            return _row(result.mappings().one())
+
+    def list_reviews(self, take_id: str) -> list[dict[str, Any]]:
+        """A take's review history, newest first."""
+        self.get_take(take_id)
+        with self.engine.connect() as conn:
+            rows = conn.execute(
+                select(reviews).where(reviews.c.take_id == take_id).order_by(reviews.c.id.desc())
+            ).mappings()
+            return [_row(r) for r in rows]

@@ -1,0 +1,75 @@
+// The only module that knows the server's URLs. Every function returns parsed JSON or throws
+// an Error whose message is the API's own "detail" (with the file's line for parse errors).
+
+const BASE = "/api/v1";
+
+async function request(method, path, body) {
+  const init = { method, headers: {} };
+  if (body !== undefined) {
+    init.headers["Content-Type"] = "application/json";
+    init.body = JSON.stringify(body);
+  }
+  const response = await fetch(BASE + path, init);
+  if (!response.ok) throw await apiError(response.status, await response.text());
+  if (response.status === 204) return null;
+  return response.json();
+}
+
+function apiError(status, text) {
+  let message = `HTTP ${status}`;
+  try {
+    const body = JSON.parse(text);
+    if (typeof body.detail === "string") message = body.detail;
+    else if (Array.isArray(body.detail)) message = body.detail.map((d) => `${d.loc.join(".")}: ${d.msg}`).join("; ");
+  } catch { /* not JSON */ }
+  const error = new Error(message);
+  error.status = status;
+  return error;
+}
+
+export const health = () => request("GET", "/health");
+export const listTakes = (params = {}) => {
+  const query = new URLSearchParams(Object.entries(params).filter(([, v]) => v !== "" && v != null));
+  return request("GET", `/takes?${query}`);
+};
+export const getTake = (id) => request("GET", `/takes/${id}`);
+export const deleteTake = (id) => request("DELETE", `/takes/${id}`);
+export const getRun = (id) => request("GET", `/runs/${id}`);
+export const getResult = (id) => request("GET", `/runs/${id}/result`);
+export const getFrames = (id, { start = 0, stop = null, step = 1, maxFrames = 800 } = {}) => {
+  const query = new URLSearchParams({ start, step, max_frames: maxFrames });
+  if (stop != null) query.set("stop", stop);
+  return request("GET", `/runs/${id}/frames?${query}`);
+};
+export const startRun = (takeId, options) => request("POST", `/takes/${takeId}/runs`, options);
+export const addReview = (takeId, review) => request("POST", `/takes/${takeId}/reviews`, review);
+export const listFilters = () => request("GET", "/filters");
+export const downloadUrl = (runId, kind) => `${BASE}/runs/${runId}/download/${kind}`;
+export const thumbnailUrl = (takeId, runId) => `${BASE}/takes/${takeId}/thumbnail?run=${runId || ""}`;
+export const takeLink = (takeId, runId) => `#/take/${takeId}${runId ? `?run=${runId}` : ""}`;
+
+// Upload with progress (fetch cannot report upload progress; XMLHttpRequest can).
+export function uploadTake(file, onProgress) {
+  return new Promise((resolve, reject) => {
+    const xhr = new XMLHttpRequest();
+    xhr.open("POST", `${BASE}/takes`);
+    xhr.upload.onprogress = (e) => { if (e.lengthComputable) onProgress(e.loaded / e.total); };
+    xhr.onload = () => {
+      if (xhr.status === 201) resolve(JSON.parse(xhr.responseText));
+      else reject(apiError(xhr.status, xhr.responseText));
+    };
+    xhr.onerror = () => reject(new Error("network error during upload"));
+    const form = new FormData();
+    form.append("file", file);
+    xhr.send(form);
+  });
+}
+
+export async function waitForRun(runId, onProgress, intervalMs = 300) {
+  for (;;) {
+    const run = await getRun(runId);
+    onProgress(run);
+    if (run.status === "done" || run.status === "failed") return run;
+    await new Promise((r) => setTimeout(r, intervalMs));
+  }
+}

@@ -1,0 +1,79 @@
+"""API fixtures: ``TestClient(create_app(settings))`` on a temporary SQLite and on PostgreSQL."""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from mocapqa.api.app import create_app
+from mocapqa.config import Settings
+from mocapqa.store.repository import Repository
+from mocapqa.store.tables import metadata
+
+
+def make_settings(kind: str, tmp_path: Path, **changes: Any) -> Settings:
+    """Settings with a fresh data folder and a clean database of ``kind``."""
+    url = None
+    if kind == "postgres":
+        url = os.environ.get("MOCAPQA_TEST_POSTGRES_URL")
+        if not url:
+            pytest.skip("MOCAPQA_TEST_POSTGRES_URL is not set (scripts/with-postgres.sh sets it)")
+        cleaner = Repository(url)
+        metadata.drop_all(cleaner.engine)
+        cleaner.close()
+    return Settings(data_dir=tmp_path / "data", database_url=url, **changes)
+
+
+@pytest.fixture(params=["sqlite", pytest.param("postgres", marks=pytest.mark.postgres)])
+def settings(request: pytest.FixtureRequest, tmp_path: Path) -> Settings:
+    """Settings for one database kind."""
+    return make_settings(str(request.param), tmp_path)
+
+
+@pytest.fixture
+def client(settings: Settings) -> Iterator[TestClient]:
+    """A client of a freshly created app."""
+    with TestClient(create_app(settings)) as test_client:
+        yield test_client
+
+
+def poll_run(client: TestClient, run_id: str, timeout_s: float = 60.0) -> dict[str, Any]:
+    """Poll a run until it is done or failed."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        run: dict[str, Any] = client.get(f"/api/v1/runs/{run_id}").json()
+        if run["status"] in ("done", "failed"):
+            return run
+        time.sleep(0.05)
+    raise TimeoutError(f"run {run_id} did not finish in {timeout_s} s")
+
+
+def post_file(client: TestClient, path: Path, name: str | None = None) -> dict[str, Any]:
+    """Upload a file and return the 201 body."""
+    with path.open("rb") as handle:
+        response = client.post("/api/v1/takes", files={"file": (name or path.name, handle)})
+    assert response.status_code == 201, response.text
+    body: dict[str, Any] = response.json()
+    return body
+
+
+Waiter = Callable[[TestClient, str], dict[str, Any]]
+Uploader = Callable[[TestClient, Path], dict[str, Any]]
+
+
+@pytest.fixture
+def wait_for_run() -> Waiter:
+    """``wait_for_run(client, run_id)`` polls until the run is done or failed."""
+    return poll_run
+
+
+@pytest.fixture
+def upload() -> Uploader:
+    """``upload(client, path)`` posts a file and returns the 201 body."""
+    return post_file

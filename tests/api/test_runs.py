@@ -1,0 +1,164 @@
+"""Runs with options, results, point windows, reviews, the filter registry and the stream."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from mocapqa.api.app import create_app
+from mocapqa.config import Settings
+from mocapqa.io.bvh import read_bvh
+from mocapqa.kinematics.forward import forward_kinematics
+
+Waiter = Callable[[TestClient, str], dict[str, Any]]
+Uploader = Callable[[TestClient, Path], dict[str, Any]]
+
+
+@pytest.fixture
+def analysed(
+    client: TestClient, cmu_walk: Path, upload: Uploader, wait_for_run: Waiter
+) -> dict[str, Any]:
+    """The CMU walk, uploaded and analysed."""
+    created = upload(client, cmu_walk)
+    assert wait_for_run(client, created["run_id"])["status"] == "done"
+    return created
+
+
+def test_rerun_with_other_options_keeps_earlier_runs(
+    client: TestClient, analysed: dict[str, Any], wait_for_run: Waiter, cmu_walk: Path
+) -> None:
+    options = {"checks": ["twist", "filter"], "filter_method": "quat-pd", "max_points": 100}
+    response = client.post(f"/api/v1/takes/{analysed['id']}/runs", json=options)
+    assert response.status_code == 201, response.text
+    run = wait_for_run(client, response.json()["id"])
+    assert run["status"] == "done", run["error"]
+    assert run["options"]["filter_method"] == "quat-pd"
+    result = client.get(f"/api/v1/runs/{run['id']}/result").json()
+    assert result["steps"]["filter"]["state"] == "done"
+    assert result["steps"]["limits"]["state"] == "skipped"
+    assert len(result["series"]["frames"]) == 100
+    detail = client.get(f"/api/v1/takes/{analysed['id']}").json()
+    assert [r["id"] for r in detail["runs"]] == [analysed["run_id"], run["id"]]
+    filtered = client.get(f"/api/v1/runs/{run['id']}/download/bvh").content
+    first = client.get(f"/api/v1/runs/{analysed['run_id']}/download/bvh").content
+    assert filtered != first
+
+
+def test_bad_run_options_are_refused(client: TestClient, analysed: dict[str, Any]) -> None:
+    bad_options: list[dict[str, Any]] = [
+        {"checks": ["spelling"]},
+        {"twist_method": "magic"},
+        {"max_points": 1},
+        {"unknown": 1},
+        {"checks": ["filter"], "filter_method": "no-such-filter"},
+    ]
+    for options in bad_options:
+        response = client.post(f"/api/v1/takes/{analysed['id']}/runs", json=options)
+        assert response.status_code == 422, options
+    detail = client.get(f"/api/v1/takes/{analysed['id']}").json()
+    assert len(detail["runs"]) == 1
+
+
+def test_frames_come_in_windows_matching_forward_kinematics(
+    client: TestClient, analysed: dict[str, Any], cmu_walk: Path
+) -> None:
+    run_id = analysed["run_id"]
+    window = client.get(f"/api/v1/runs/{run_id}/frames?start=100&stop=110").json()
+    assert window["frames"] == list(range(100, 110))
+    _, positions = forward_kinematics(read_bvh(cmu_walk))
+    raw = np.asarray(window["raw"])
+    np.testing.assert_allclose(raw[:, :31], positions[100:110], atol=2e-3)
+    overview = client.get(f"/api/v1/runs/{run_id}/frames?max_frames=50").json()
+    assert len(overview["frames"]) <= 50
+    assert overview["step"] == 11
+    bad = client.get(f"/api/v1/runs/{run_id}/frames?start=600")
+    assert bad.status_code == 422
+
+
+def test_unfinished_runs_answer_409(client: TestClient, analysed: dict[str, Any]) -> None:
+    services = client.app.state.services  # type: ignore[attr-defined]
+    run_id = services.repository.add_run(analysed["id"], {})
+    assert client.get(f"/api/v1/runs/{run_id}/result").status_code == 409
+    assert client.get(f"/api/v1/runs/{run_id}/download/bvh").status_code == 409
+    assert client.get(f"/api/v1/runs/{run_id}").json()["status"] == "queued"
+
+
+def test_reviews_are_history_and_filter_the_list(
+    client: TestClient, analysed: dict[str, Any]
+) -> None:
+    take_id = analysed["id"]
+    first = {"status": "needs_fix", "notes": "left arm", "reviewer": "ann"}
+    assert client.post(f"/api/v1/takes/{take_id}/reviews", json=first).status_code == 201
+    second = {"status": "approved", "notes": "fixed", "reviewer": "bob"}
+    assert client.post(f"/api/v1/takes/{take_id}/reviews", json=second).status_code == 201
+    history = client.get(f"/api/v1/takes/{take_id}/reviews").json()
+    assert [h["status"] for h in history] == ["approved", "needs_fix"]
+    assert client.get("/api/v1/takes?review_status=approved").json()["total"] == 1
+    assert client.get("/api/v1/takes?review_status=rejected").json()["total"] == 0
+    bad = client.post(f"/api/v1/takes/{take_id}/reviews", json={"status": "great"})
+    assert bad.status_code == 422
+    assert client.get("/api/v1/takes?status=bogus").status_code == 422
+
+
+def test_filter_registry_lists_parameters_with_units(client: TestClient) -> None:
+    filters = {f["name"]: f for f in client.get("/api/v1/filters").json()}
+    assert {"adaptive", "kalman", "one-euro", "ema"} <= set(filters)
+    one_euro = {p["name"]: p for p in filters["one-euro"]["parameters"]}
+    assert one_euro["min_cutoff_hz"]["unit"] == "Hz"
+    assert "keypoints" in filters["adaptive"]["applies_to"]
+
+
+def test_stream_filters_frames_and_returns_weights(client: TestClient) -> None:
+    rng = np.random.default_rng(3)
+    with client.websocket_connect("/api/v1/stream/filter") as socket:
+        socket.send_json({"fps": 30, "n_keypoints": 4})
+        assert socket.receive_json()["ready"] is True
+        for i in range(10):
+            frame = (np.ones((4, 3)) + 0.01 * rng.standard_normal((4, 3))).tolist()
+            socket.send_json({"positions": frame, "confidence": [1.0] * 4})
+            answer = socket.receive_json()
+            assert answer["frame"] == i
+            assert np.asarray(answer["positions"]).shape == (4, 3)
+            total = sum(answer["weights"][k]["mean"] for k in ("kalman", "one_euro", "ema"))
+            assert total == pytest.approx(1.0, abs=1e-3)
+        socket.send_json({"positions": [[1, 2]]})
+        assert "Expected positions" in socket.receive_json()["error"]
+
+
+def test_stream_refuses_a_bad_opening(client: TestClient) -> None:
+    with client.websocket_connect("/api/v1/stream/filter") as socket:
+        socket.send_json({"fps": "fast"})
+        assert "Expected a number" in socket.receive_json()["error"]
+
+
+def test_runs_left_by_a_stopped_server_finish_after_restart(
+    settings: Settings, cmu_walk: Path, wait_for_run: Waiter, upload: Uploader
+) -> None:
+    with TestClient(create_app(settings)) as client:
+        created = upload(client, cmu_walk)
+        wait_for_run(client, created["run_id"])
+        services = client.app.state.services  # type: ignore[attr-defined]
+        orphan = services.repository.add_run(created["id"], {})
+        services.repository.mark_running(orphan)  # as if the server died mid-run
+    with TestClient(create_app(settings)) as client:
+        run = wait_for_run(client, orphan)
+        assert run["status"] == "done"
+        assert client.get(f"/api/v1/runs/{orphan}/download/bvh").status_code == 200
+
+
+def test_frontend_and_plotly_are_served(client: TestClient) -> None:
+    page = client.get("/")
+    assert page.status_code == 200
+    assert "/vendor/plotly-" in page.text
+    script = page.text.split('src="')[1].split('"')[0]
+    plotly = client.get(script, headers={"Accept-Encoding": "gzip"})
+    assert plotly.status_code == 200
+    assert plotly.headers["content-encoding"] == "gzip"
+    for path in ("/static/js/app.js", "/static/js/api.js", "/static/js/charts.js"):
+        assert client.get(path).status_code == 200
+    assert client.get("/docs").status_code == 200

@@ -1,0 +1,109 @@
+"""The pipeline on real takes: options, frame grid, points, and each step's output."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mocapqa.errors import InputError
+from mocapqa.io.bvh import read_bvh
+from mocapqa.io.formats import read_take
+from mocapqa.jobs.demo import demo_paths
+from mocapqa.kinematics.forward import forward_kinematics
+from mocapqa.pipeline.analyze import analyze
+from mocapqa.pipeline.frames import motion_points, sample_frames
+from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.pipeline.steps import violation_findings
+
+
+def test_options_round_trip_and_name_bad_fields() -> None:
+    options = AnalysisOptions.from_json(
+        {"checks": ["twist"], "filter_method": "kalman", "filter_params": {"gate_sigma": 3}}
+    )
+    assert AnalysisOptions.from_json(options.to_json()) == options
+    assert AnalysisOptions.from_json(None) == AnalysisOptions()
+    with pytest.raises(InputError, match="Expected option fields among"):
+        AnalysisOptions.from_json({"speed": 1})
+    with pytest.raises(InputError, match="Expected checks among"):
+        AnalysisOptions(checks=("twist", "colour"))
+    with pytest.raises(InputError, match="Expected twist_method in"):
+        AnalysisOptions(twist_method="guess")
+    with pytest.raises(InputError, match="Expected filter_method in"):
+        AnalysisOptions(filter_method="median")
+    with pytest.raises(InputError, match="Expected max_points to be an integer"):
+        AnalysisOptions.from_json({"max_points": "many"})
+
+
+@pytest.mark.parametrize(("n_frames", "max_points"), [(5, 10), (10_000, 2000), (2001, 2000)])
+def test_sample_frames_keeps_ends_and_the_limit(n_frames: int, max_points: int) -> None:
+    frames = sample_frames(n_frames, max_points)
+    assert frames[0] == 0
+    assert frames[-1] == n_frames - 1
+    assert len(frames) <= max_points
+    assert np.all(np.diff(frames) > 0)
+
+
+def test_motion_points_are_fk_joints_then_end_sites(cmu_walk: Path) -> None:
+    motion = read_bvh(cmu_walk)
+    names, parents, points = motion_points(motion)
+    _, positions = forward_kinematics(motion)
+    n_joints, n_sites = motion.skeleton.n_joints, len(motion.skeleton.end_sites)
+    assert points.shape == (motion.n_frames, n_joints + n_sites, 3)
+    np.testing.assert_array_equal(points[:, :n_joints], positions)
+    assert names[n_joints] == f"{motion.skeleton.names[parents[n_joints]]} end"
+
+
+def test_violation_findings_cover_each_run_of_bad_frames() -> None:
+    valid = np.ones((10, 2), dtype=bool)
+    valid[2:5, 0] = False
+    valid[9, 1] = False
+    score = np.zeros((10, 2))
+    score[3, 0] = 12.5
+    score[9, 1] = 4.0
+    findings = violation_findings(valid, score, ["elbow", "knee"])
+    assert [(f["joint"], f["start_frame"], f["end_frame"], f["value"]) for f in findings] == [
+        ("elbow", 2, 4, 12.5),
+        ("knee", 9, 9, 4.0),
+    ]
+
+
+def test_analyze_motion_reports_steps_and_progress() -> None:
+    motion = read_bvh(demo_paths()[0])
+    calls: list[tuple[int, str]] = []
+    result = analyze(motion, AnalysisOptions(max_points=200), lambda p, s: calls.append((p, s)))
+    percents = [p for p, _ in calls]
+    assert percents == sorted(percents)
+    assert percents[0] > 0
+    assert percents[-1] <= 100
+    report = result.report
+    assert report["kind"] == "motion"
+    assert report["steps"]["twist"]["state"] == "done"
+    limits = report["steps"]["limits"]
+    if limits["state"] == "done":
+        heat = np.asarray(report["series"]["limits"]["score_deg"])
+        assert heat.shape == (len(report["series"]["limits"]["joints"]), 200)
+        assert np.all(heat >= 0)
+    else:
+        assert limits["state"] == "no_model"
+        assert "no model for this rig" in limits["message"]
+    assert len(report["series"]["frames"]) == 200
+    assert result.corrected_motion is not None
+    assert result.raw_points.shape == result.corrected_points.shape
+    twist_joints = {f["joint"] for f in report["findings"] if f["kind"] == "twist"}
+    assert twist_joints == {"LeftArm", "LeftLeg"}  # the demo README's injected joints
+
+
+def test_analyze_keypoints_filters_and_keeps_the_input(corpus_dir: Path) -> None:
+    path = corpus_dir / (
+        "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d/S00_P00_T01_BalancingTrial_0-100.trc"
+    )
+    sequence = read_take(path)
+    before = np.array(sequence.positions, copy=True)
+    result = analyze(sequence, AnalysisOptions())
+    np.testing.assert_array_equal(sequence.positions, before)
+    assert result.filtered_keypoints is not None
+    assert result.corrected_motion is None
+    assert result.report["steps"]["filter"]["state"] == "done"
+    assert not np.allclose(result.filtered_keypoints.positions, sequence.positions, equal_nan=True)
