@@ -7,3 +7,4 @@ noisy keypoint and rotation streams.
 __all__ = ["__version__"]
 
 __version__ = "0.1.0"
+"""The package version, stored with every run for reproducibility."""

@@ -52,6 +52,7 @@ __all__ = [
     "speed_frames_per_s",
 ]
 
+# Rig families reported separately, by corpus folder.
 RIGS = ("cmu", "iclone", "bandai")
 
 

@@ -27,12 +27,16 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     add_completion=False,
 )
+"""The ``mocapqa`` command; command modules register on it."""
 bench_app = typer.Typer(help="Benchmarks that print tables of figures.", no_args_is_help=True)
+"""The ``mocapqa bench`` group."""
 limits_app = typer.Typer(help="Build, check and show joint-limit models.", no_args_is_help=True)
+"""The ``mocapqa limits`` group."""
 app.add_typer(bench_app, name="bench")
 app.add_typer(limits_app, name="limits")
 
 err_console = Console(stderr=True, highlight=False)
+"""Console on stderr for one-line error messages."""
 
 # Most specific class first: the first match wins.
 EXIT_CODES: tuple[tuple[type[MocapQAError], int], ...] = (

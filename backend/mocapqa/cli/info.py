@@ -1,3 +1,225 @@
-"""``mocapqa info``: what a file holds."""
+"""``mocapqa info`` (what a file holds) and ``mocapqa convert`` (between formats).
+
+Reading goes through :mod:`mocapqa.io.formats` (imported inside the commands, so that the CLI
+starts fast); ``info`` prints a Rich table, or JSON with ``--json``. For BVH it lists the rig
+roles found by :func:`mocapqa.core.rig.find_roles` and, as plainly, the roles it could not map.
+"""
 
 from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import typer
+
+from mocapqa.cli.app import app
+from mocapqa.errors import InputError, ParseError, UnsupportedFormatError
+
+if TYPE_CHECKING:
+    from mocapqa.core.keypoints import KeypointSequence
+    from mocapqa.core.motion import Motion
+
+__all__ = ["convert_command", "info_command", "keypoints_summary", "motion_summary", "read_mapping"]
+
+
+def read_mapping(path: Path) -> dict[str, str]:
+    """Read a rig mapping file: JSON ``{"joint name": "left_upper_arm", ...}``.
+
+    Raises
+    ------
+    ParseError
+        If the file cannot be read or is not a JSON object of strings.
+    """
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as e:
+        raise ParseError(f"Expected a readable UTF-8 mapping file, got {e}", path) from e
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise ParseError(f"Expected JSON, got {e.msg}", path, e.lineno) from e
+    if not isinstance(data, dict) or not all(
+        isinstance(k, str) and isinstance(v, str) for k, v in data.items()
+    ):
+        raise ParseError(
+            'Expected a JSON object {"joint name": "left_upper_arm", ...}, '
+            f"got {type(data).__name__}",
+            path,
+        )
+    return data
+
+
+def motion_summary(motion: Motion, mapping: dict[str, str] | None = None) -> dict[str, Any]:
+    """What a BVH take holds, as a JSON-ready dict.
+
+    Parameters
+    ----------
+    motion : Motion
+        The take.
+    mapping : dict, optional
+        Joint name → role key, overriding the automatic role guesses.
+
+    Returns
+    -------
+    dict
+        Frames, fps, duration (s), joints, length unit, rotation orders (order → joint
+        count), root translation mode, roles found (role key → joint name), roles not
+        mapped, and limb chains (``"left upper_arm: A > B > C"``).
+    """
+    from mocapqa.core.rig import find_roles, limb_chains
+
+    sk = motion.skeleton
+    rig = find_roles(sk, mapping)
+    orders: dict[str, int] = {}
+    for j in range(sk.n_joints):
+        order = sk.rotation_order(j)
+        if order:
+            orders[order] = orders.get(order, 0) + 1
+    chains = []
+    for chain in limb_chains(rig):
+        names = [sk.names[chain.parent], sk.names[chain.child]]
+        if chain.grandchild is not None:
+            names.append(sk.names[chain.grandchild])
+        chains.append(f"{chain.side} {chain.segment}: {' > '.join(names)}")
+    return {
+        "format": "bvh",
+        "frames": motion.n_frames,
+        "fps": motion.fps,
+        "duration_s": motion.duration_s,
+        "joints": sk.n_joints,
+        "end_sites": len(sk.end_sites),
+        "channels": sum(len(c) for c in sk.channels),
+        "length_unit": sk.length_unit,
+        "rotation_orders": orders,
+        "root_translation": sk.root_translation,
+        "roles": {key: sk.names[j] for key, j in sorted(rig.roles.items())},
+        "unmapped_roles": list(rig.unmapped),
+        "limb_chains": chains,
+        "joint_names": list(sk.names),
+    }
+
+
+def keypoints_summary(seq: KeypointSequence, format_name: str) -> dict[str, Any]:
+    """What a keypoint take holds, as a JSON-ready dict.
+
+    Returns
+    -------
+    dict
+        Format, frames, fps, duration (s), keypoints, dimensions, length unit, the share
+        of missing frame × keypoint values (0–1) and the keypoint names.
+    """
+    return {
+        "format": format_name,
+        "frames": seq.n_frames,
+        "fps": seq.fps,
+        "duration_s": seq.duration_s,
+        "keypoints": seq.n_keypoints,
+        "dimensions": seq.n_dims,
+        "length_unit": seq.length_unit,
+        "missing_fraction": seq.missing_fraction,
+        "keypoint_names": list(seq.names),
+    }
+
+
+def _print_table(path: Path, summary: dict[str, Any]) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(show_header=False)
+    table.add_column("field", style="bold")
+    table.add_column("value", overflow="fold")
+    table.add_row("file", str(path))
+    for key, value in summary.items():
+        if key in ("joint_names", "keypoint_names"):
+            continue
+        if key == "fps" or key == "duration_s":
+            text = f"{value:.6g}"
+        elif key == "missing_fraction":
+            text = f"{100 * value:.2f} %"
+        elif key == "rotation_orders":
+            text = ", ".join(f"{order} ×{count}" for order, count in value.items()) or "none"
+        elif key == "roles":
+            text = "\n".join(f"{role}: {joint}" for role, joint in value.items()) or "none"
+        elif key == "unmapped_roles":
+            text = f"[yellow]{', '.join(value)}[/]" if value else "none (all roles mapped)"
+        elif key == "limb_chains":
+            text = "\n".join(value) or "none"
+        else:
+            text = str(value)
+        table.add_row(key.replace("_", " "), text)
+    Console().print(table)
+
+
+@app.command("info")
+def info_command(
+    file: Annotated[Path, typer.Argument(help="A BVH or keypoint file (or OpenPose folder).")],
+    json_output: Annotated[bool, typer.Option("--json", help="Print JSON instead.")] = False,
+    fps: Annotated[
+        float | None, typer.Option(help="Frames per second, for formats that do not store it.")
+    ] = None,
+    mapping: Annotated[
+        Path | None,
+        typer.Option(help='Rig roles as JSON {"joint": "left_upper_arm"} (BVH only).'),
+    ] = None,
+) -> None:
+    """Show what a take holds: frames, rate, joints or keypoints, units, rig roles."""
+    from mocapqa.core.motion import Motion
+    from mocapqa.io.formats import detect_format, read_take
+
+    if fps is not None and not fps > 0:
+        raise InputError(f"Expected --fps > 0, got {fps}")
+    roles = read_mapping(mapping) if mapping is not None else None
+    format_name = detect_format(file)
+    take = read_take(file, fps=fps)
+    if isinstance(take, Motion):
+        summary = motion_summary(take, roles)
+    else:
+        if roles is not None:
+            raise InputError(f"Expected --mapping only for BVH input, got a {format_name} file")
+        summary = keypoints_summary(take, format_name)
+    if json_output:
+        typer.echo(json.dumps({"path": str(file), **summary}, indent=2))
+    else:
+        _print_table(file, summary)
+
+
+@app.command("convert")
+def convert_command(
+    source: Annotated[Path, typer.Argument(help="Input take (BVH or keypoints).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Output file.")],
+    fps: Annotated[
+        float | None, typer.Option(help="Frames per second, for inputs that do not store it.")
+    ] = None,
+    precision: Annotated[int, typer.Option(help="Decimal places of BVH channel values.")] = 6,
+) -> None:
+    """Convert a take: BVH to BVH, keypoints between TRC, CSV, NPY, NPZ and JSON."""
+    from mocapqa.core.motion import Motion
+    from mocapqa.io.bvh import write_bvh
+    from mocapqa.io.formats import KEYPOINT_WRITE_FORMATS, read_take, write_keypoints
+
+    if fps is not None and not fps > 0:
+        raise InputError(f"Expected --fps > 0, got {fps}")
+    if not 0 <= precision <= 15:
+        raise InputError(f"Expected --precision between 0 and 15, got {precision}")
+    suffix = output.suffix.lower().lstrip(".")
+    take = read_take(source, fps=fps)
+    if isinstance(take, Motion):
+        if suffix != "bvh":
+            raise UnsupportedFormatError(
+                f"Expected a .bvh output for a BVH input, got {output.name!r}"
+            )
+        writer: Callable[[], None] = lambda: write_bvh(output, take, precision=precision)  # noqa: E731
+    else:
+        if suffix not in KEYPOINT_WRITE_FORMATS:
+            raise UnsupportedFormatError(
+                f"Expected a keypoint output among {', '.join(KEYPOINT_WRITE_FORMATS)}, "
+                f"got {output.name!r}"
+            )
+        writer = lambda: write_keypoints(output, take)  # noqa: E731
+    try:
+        writer()
+    except OSError as e:
+        raise InputError(f"Expected a writable output path, got {e.strerror}: {output}") from e
+    typer.echo(f"wrote {output} ({suffix}, {take.n_frames} frames)")

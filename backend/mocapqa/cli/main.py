@@ -5,8 +5,18 @@ from __future__ import annotations
 import sys
 
 import click
+from rich.markup import escape
 
-from mocapqa.cli import info  # noqa: F401  (registers commands)
+from mocapqa.cli import (
+    bench_io,  # noqa: F401  (registers commands)
+    info,  # noqa: F401  (registers commands)
+    limits,  # noqa: F401  (registers commands)
+    render,  # noqa: F401  (registers commands)
+    report,  # noqa: F401  (registers commands)
+    serve,  # noqa: F401  (registers commands)
+)
+from mocapqa.cli import filters as filter_commands  # noqa: F401  (registers commands)
+from mocapqa.cli import twist as twist_commands  # noqa: F401  (registers commands)
 from mocapqa.cli.app import app, err_console, exit_code_for
 from mocapqa.errors import MocapQAError
 
@@ -26,7 +36,8 @@ def main(argv: list[str] | None = None) -> int:
         e.show()
         return int(e.exit_code)
     except MocapQAError as e:
-        err_console.print(f"[bold red]error:[/] {e}")
+        # One line, never wrapped, and the message is not read as Rich markup.
+        err_console.print(f"[bold red]error:[/] {escape(str(e))}", soft_wrap=True)
         return exit_code_for(e)
     return int(result) if isinstance(result, int) else 0
 

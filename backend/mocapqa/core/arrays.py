@@ -18,8 +18,11 @@ from mocapqa.errors import ShapeError
 __all__ = ["BoolArray", "FloatArray", "IntArray", "as_float_array", "check_shape"]
 
 FloatArray = NDArray[np.float64]
+"""float64 array of any shape (positions, quaternions, angles)."""
 IntArray = NDArray[np.intp]
+"""Platform-integer array (indices such as ``parents``)."""
 BoolArray = NDArray[np.bool_]
+"""Boolean mask array."""
 
 
 def check_shape(array: NDArray[Any], name: str, pattern: tuple[int | str, ...]) -> None:
@@ -43,7 +46,9 @@ def check_shape(array: NDArray[Any], name: str, pattern: tuple[int | str, ...]) 
         isinstance(p, str) or array.shape[i] == p for i, p in enumerate(pattern)
     )
     if not ok:
-        expected = "(" + ", ".join(str(p) for p in pattern) + ("," if len(pattern) == 1 else "") + ")"
+        expected = (
+            "(" + ", ".join(str(p) for p in pattern) + ("," if len(pattern) == 1 else "") + ")"
+        )
         raise ShapeError(f"Expected `{name}` to have shape {expected}, got {tuple(array.shape)}")
 
 

@@ -24,6 +24,7 @@ from mocapqa.errors import ShapeError
 __all__ = ["LENGTH_UNITS", "KeypointSequence"]
 
 LENGTH_UNITS = ("m", "cm", "mm", "in", "px", "normalized", "unknown")
+"""Length units a keypoint sequence may record."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -96,7 +97,8 @@ class KeypointSequence:
     @property
     def missing(self) -> np.ndarray:
         """Boolean ``(F, K)``: True where a keypoint has no value."""
-        return np.any(np.isnan(self.positions), axis=-1)
+        mask: np.ndarray = np.any(np.isnan(self.positions), axis=-1)
+        return mask
 
     @property
     def missing_fraction(self) -> float:

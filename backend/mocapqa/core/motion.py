@@ -25,7 +25,9 @@ from mocapqa.errors import ShapeError
 __all__ = ["POSITION_CHANNELS", "ROTATION_CHANNELS", "EndSite", "Motion", "Skeleton"]
 
 POSITION_CHANNELS = ("Xposition", "Yposition", "Zposition")
+"""BVH position channel names, in x, y, z order."""
 ROTATION_CHANNELS = ("Xrotation", "Yrotation", "Zrotation")
+"""BVH rotation channel names, in x, y, z order."""
 
 RootTranslation = Literal["replace", "add"]
 

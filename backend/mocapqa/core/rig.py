@@ -32,7 +32,9 @@ __all__ = [
 
 Side = Literal["left", "right"]
 SIDES: tuple[Side, ...] = ("left", "right")
+"""The two body sides, in the order roles are listed."""
 ROLES = ("clavicle", "upper_arm", "forearm", "hand", "upper_leg", "lower_leg", "foot", "toe")
+"""Limb roles, arm then leg, proximal to distal."""
 # The limb segments whose twist the twist detector checks (parent role of a chain).
 SEGMENTS = ("clavicle", "upper_arm", "forearm", "upper_leg", "lower_leg")
 

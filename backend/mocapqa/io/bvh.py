@@ -17,8 +17,8 @@ Conventions
 
 from __future__ import annotations
 
-import io
 import math
+import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,12 +35,13 @@ from mocapqa.core.motion import (
     Skeleton,
 )
 from mocapqa.errors import ParseError
+from mocapqa.io.bvh_frames import frames_by_arrow, frames_by_line
 from mocapqa.kinematics.euler import euler_from_quats, quats_from_euler
-from mocapqa.kinematics.quaternion import geodesic_angle
 
 __all__ = [
     "MAX_JOINTS",
     "BvhParseError",
+    "NumberReader",
     "channel_values",
     "format_bvh",
     "parse_bvh",
@@ -49,8 +50,13 @@ __all__ = [
 ]
 
 BvhParseError = ParseError
+"""Alias of :class:`~mocapqa.errors.ParseError`, the error every malformed BVH raises."""
+NumberReader = Literal["arrow", "python"]
+"""How the frame block's numbers are read (see :func:`parse_bvh`)."""
 MAX_JOINTS = 1000
+"""Largest joint count accepted; more means a corrupt or hostile file."""
 _KNOWN_CHANNELS = set(POSITION_CHANNELS) | set(ROTATION_CHANNELS)
+_SAME_ROTATION = 1e-12  # quaternion component gap under which the Euler hint is written
 
 
 @dataclass(slots=True)
@@ -82,6 +88,7 @@ class _HierarchyParser:
         self.pos = 0
         self.path = path
         self.names: list[str] = []
+        self.name_set: set[str] = set()
         self.parents: list[int] = []
         self.offsets: list[tuple[float, float, float]] = []
         self.channels: list[tuple[str, ...]] = []
@@ -111,7 +118,9 @@ class _HierarchyParser:
         try:
             value = float(token.text)
         except ValueError:
-            raise self._fail(f"Expected a number for {what}, got {token.text!r}", token.line) from None
+            raise self._fail(
+                f"Expected a number for {what}, got {token.text!r}", token.line
+            ) from None
         if not math.isfinite(value):
             raise self._fail(f"Expected a finite number for {what}, got {token.text!r}", token.line)
         return value
@@ -129,23 +138,29 @@ class _HierarchyParser:
             token = self.tokens[self.pos]
             raise self._fail(f"Expected 'ROOT' or 'MOTION', got {token.text!r}", token.line)
 
-    def _joint(self, parent: int) -> None:
+    def _open_joint(self, parent: int) -> tuple[int, _Token]:
         name_token = self._next("a joint name")
         name = name_token.text
         if name == "{":
             raise self._fail("Expected a joint name, got '{'", name_token.line)
-        if name in self.names:
+        if name in self.name_set:
             raise self._fail(f"Expected unique joint names, got {name!r} twice", name_token.line)
         if len(self.names) >= MAX_JOINTS:
             raise self._fail(f"Expected at most {MAX_JOINTS} joints, got more", name_token.line)
         index = len(self.names)
         self.names.append(name)
+        self.name_set.add(name)
         self.parents.append(parent)
         self.offsets.append((0.0, 0.0, 0.0))
         self.channels.append(())
         self._expect("{")
-        seen_offset = False
-        while True:
+        return index, name_token
+
+    def _joint(self, parent: int) -> None:
+        """Parse a joint and its descendants; iterative, so deep chains cannot overflow."""
+        stack: list[tuple[int, _Token, bool]] = [(*self._open_joint(parent), False)]
+        while stack:
+            index, name_token, seen_offset = stack[-1]
             token = self._next("'OFFSET', 'CHANNELS', 'JOINT', 'End' or '}'")
             if token.text == "OFFSET":
                 self.offsets[index] = (
@@ -153,7 +168,7 @@ class _HierarchyParser:
                     self._number("OFFSET y"),
                     self._number("OFFSET z"),
                 )
-                seen_offset = True
+                stack[-1] = (index, name_token, True)
             elif token.text == "CHANNELS":
                 count_token = self._next("a channel count")
                 try:
@@ -179,7 +194,7 @@ class _HierarchyParser:
                     )
                 self.channels[index] = names
             elif token.text == "JOINT":
-                self._joint(parent=index)
+                stack.append((*self._open_joint(index), False))
             elif token.text == "End":
                 self._expect("Site")
                 self._expect("{")
@@ -192,14 +207,44 @@ class _HierarchyParser:
                 self._expect("}")
                 self.end_sites.append(EndSite(index, offset))
             elif token.text == "}":
-                break
+                if not seen_offset:
+                    name = self.names[index]
+                    raise self._fail(f"Expected an OFFSET for joint {name!r}", name_token.line)
+                stack.pop()
             else:
                 raise self._fail(
                     f"Expected 'OFFSET', 'CHANNELS', 'JOINT', 'End' or '}}', got {token.text!r}",
                     token.line,
                 )
-        if not seen_offset:
-            raise self._fail(f"Expected an OFFSET for joint {name!r}", name_token.line)
+
+
+_MOTION = re.compile(r"^[^\S\n]*MOTION[^\S\n]*$", re.MULTILINE)
+
+
+class _LineCursor:
+    """Walks LF-separated lines of ``text`` from ``position`` (the end of line ``number``)."""
+
+    def __init__(self, text: str, position: int, number: int) -> None:
+        self.text = text
+        self.number = number  # 0-based index of the line last returned
+        end = text.find("\n", position)
+        self.position = len(text) if end < 0 else end + 1
+
+    def next_line(self) -> str | None:
+        if self.position >= len(self.text):
+            return None
+        end = self.text.find("\n", self.position)
+        end = len(self.text) if end < 0 else end
+        line = self.text[self.position : end]
+        self.position = end + 1
+        self.number += 1
+        return line
+
+    def next_nonblank(self) -> str | None:
+        line = self.next_line()
+        while line is not None and not line.strip():
+            line = self.next_line()
+        return line
 
 
 def _header_value(line: str, key: str, path: str, number: int) -> str:
@@ -209,82 +254,12 @@ def _header_value(line: str, key: str, path: str, number: int) -> str:
     return stripped[len(key) :].strip()
 
 
-def _parse_frames_fast(data: str, n_frames: int, n_channels: int) -> FloatArray | None:
-    """Parse the frame block with pandas' C reader; None when the text needs the careful path."""
-    if n_frames == 0 or n_channels == 0:
-        return None
-    try:
-        import pandas as pd
-
-        table = pd.read_csv(
-            io.StringIO(data.replace("\t", " ")),
-            sep=" ",
-            header=None,
-            engine="c",
-            dtype=np.float64,
-            skip_blank_lines=True,
-            na_filter=True,
-        ).to_numpy()
-    except Exception:  # noqa: BLE001 - any pandas complaint means "use the careful path"
-        return None
-    if table.shape[0] != n_frames or table.shape[1] < n_channels:
-        return None
-    values = table[:, :n_channels]
-    if table.shape[1] > n_channels and not np.all(np.isnan(table[:, n_channels:])):
-        return None
-    if not np.all(np.isfinite(values)):
-        return None
-    return np.ascontiguousarray(values)
-
-
-def _parse_frames_careful(
-    lines: list[str], first: int, n_frames: int, n_channels: int, path: str
-) -> FloatArray:
-    values = np.empty((n_frames, n_channels), dtype=np.float64)
-    row = 0
-    for number in range(first, len(lines)):
-        tokens = lines[number].split()
-        if not tokens:
-            continue
-        if row >= n_frames:
-            raise ParseError(
-                f"Expected {n_frames} frame lines (Frames:), got more", path, number + 1
-            )
-        if len(tokens) != n_channels:
-            raise ParseError(
-                f"Expected {n_channels} values on a frame line, got {len(tokens)}", path, number + 1
-            )
-        try:
-            parsed = [float(t) for t in tokens]
-        except ValueError:
-            bad = next(t for t in tokens if not _is_float(t))
-            raise ParseError(f"Expected a number, got {bad!r}", path, number + 1) from None
-        if not all(math.isfinite(v) for v in parsed):
-            raise ParseError("Expected finite numbers, got NaN or infinity", path, number + 1)
-        values[row] = parsed
-        row += 1
-    if row != n_frames:
-        raise ParseError(
-            f"Expected {n_frames} frame lines (Frames:), got {row} (truncated file?)",
-            path,
-            len(lines),
-        )
-    return values
-
-
-def _is_float(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
 def parse_bvh(
     data: bytes | str,
     path: str | Path = "<bvh>",
     root_translation: Literal["auto", "replace", "add"] = "auto",
     length_unit: str = "unknown",
+    number_reader: NumberReader = "arrow",
 ) -> Motion:
     """Parse BVH text into a :class:`~mocapqa.core.motion.Motion`.
 
@@ -298,6 +273,11 @@ def parse_bvh(
         How root position channels combine with the root OFFSET (see module notes).
     length_unit : str
         Unit of lengths in the file, when the caller knows it.
+    number_reader : {"arrow", "python"}
+        How the frame block's numbers are read: "arrow" with pyarrow's CSV reader (~5×
+        faster), "python" line by line with ``float``. The numbers are the same; malformed
+        input, or a machine without pyarrow, always ends on the line-by-line path, which
+        reports the line.
 
     Returns
     -------
@@ -310,45 +290,53 @@ def parse_bvh(
     """
     path = str(path)
     text = _decode(data, path) if isinstance(data, bytes) else data
-    lines = text.splitlines()
-    motion_line = next(
-        (i for i, line in enumerate(lines) if line.strip() == "MOTION"), None
-    )
-    if motion_line is None:
-        raise ParseError("Expected a 'MOTION' section, got none", path, len(lines) or 1)
-    tokens = list(_tokens(lines, motion_line))
+    if "\r" in text and "\n" not in text:
+        text = text.replace("\r", "\n")  # classic Mac line endings
+    # Lines are counted by LF everywhere (CR is whitespace), so error line numbers agree with
+    # editors for LF, CRLF and mixed files.
+    match = _MOTION.search(text)
+    if match is None:
+        last_line = text.count("\n", 0, len(text.rstrip())) + 1
+        raise ParseError("Expected a 'MOTION' section, got none", path, last_line)
+    header_lines = text[: match.start()].split("\n")
+    motion_line = len(header_lines) - 1  # 0-based index of the MOTION line
+    tokens = list(_tokens(header_lines, motion_line))
     if not tokens:
         raise ParseError("Expected 'HIERARCHY', got an empty header", path, 1)
     parser = _HierarchyParser(tokens, path)
     parser.parse()
-    idx = motion_line + 1
-    while idx < len(lines) and not lines[idx].strip():
-        idx += 1
-    if idx >= len(lines):
-        raise ParseError("Expected 'Frames:', got end of file", path, idx)
-    frames_text = _header_value(lines[idx], "Frames:", path, idx + 1)
+    cursor = _LineCursor(text, match.end(), motion_line)
+    line = cursor.next_nonblank()
+    if line is None:
+        raise ParseError("Expected 'Frames:', got end of file", path, cursor.number + 1)
+    frames_text = _header_value(line, "Frames:", path, cursor.number + 1)
     try:
         n_frames = int(frames_text)
     except ValueError:
-        raise ParseError(f"Expected a frame count, got {frames_text!r}", path, idx + 1) from None
+        raise ParseError(
+            f"Expected a frame count, got {frames_text!r}", path, cursor.number + 1
+        ) from None
     if n_frames < 0:
-        raise ParseError(f"Expected a frame count >= 0, got {n_frames}", path, idx + 1)
-    idx += 1
-    if idx >= len(lines):
-        raise ParseError("Expected 'Frame Time:', got end of file", path, idx)
-    time_text = _header_value(lines[idx], "Frame Time:", path, idx + 1)
+        raise ParseError(f"Expected a frame count >= 0, got {n_frames}", path, cursor.number + 1)
+    line = cursor.next_line()
+    if line is None:
+        raise ParseError("Expected 'Frame Time:', got end of file", path, cursor.number + 1)
+    time_text = _header_value(line, "Frame Time:", path, cursor.number + 1)
     try:
         frame_time = float(time_text)
     except ValueError:
-        raise ParseError(f"Expected a frame time in seconds, got {time_text!r}", path, idx + 1) from None
+        raise ParseError(
+            f"Expected a frame time in seconds, got {time_text!r}", path, cursor.number + 1
+        ) from None
     if not (math.isfinite(frame_time) and frame_time > 0):
-        raise ParseError(f"Expected a frame time > 0 s, got {time_text!r}", path, idx + 1)
-    first_data = idx + 1
+        raise ParseError(f"Expected a frame time > 0 s, got {time_text!r}", path, cursor.number + 1)
     n_channels = sum(len(c) for c in parser.channels)
-    data_text = "\n".join(lines[first_data:])
-    values = _parse_frames_fast(data_text, n_frames, n_channels)
+    block = text[cursor.position :]
+    values = None
+    if number_reader == "arrow":
+        values = frames_by_arrow(block, n_frames, n_channels)
     if values is None:
-        values = _parse_frames_careful(lines, first_data, n_frames, n_channels, path)
+        values = frames_by_line(text.split("\n"), cursor.number + 1, n_frames, n_channels, path)
     return _motion_from_channels(parser, values, 1.0 / frame_time, root_translation, length_unit)
 
 
@@ -419,6 +407,7 @@ def read_bvh(
     path: str | Path,
     root_translation: Literal["auto", "replace", "add"] = "auto",
     length_unit: str = "unknown",
+    number_reader: NumberReader = "arrow",
 ) -> Motion:
     """Read a BVH file. See :func:`parse_bvh` for parameters and errors."""
     path = Path(path)
@@ -426,7 +415,13 @@ def read_bvh(
         data = path.read_bytes()
     except OSError as e:
         raise ParseError(f"Expected a readable file, got {e.strerror}", path) from e
-    return parse_bvh(data, path, root_translation=root_translation, length_unit=length_unit)
+    return parse_bvh(
+        data,
+        path,
+        root_translation=root_translation,
+        length_unit=length_unit,
+        number_reader=number_reader,
+    )
 
 
 def _format_number(value: float) -> str:
@@ -484,8 +479,10 @@ def format_bvh(motion: Motion, precision: int = 6) -> str:
     out.append(f"Frame Time: {1.0 / motion.fps:.7g}")
     values = channel_values(motion)
     if values.size:
-        body = np.char.mod(f"%.{precision}f", np.round(values, precision) + 0.0)
-        out.extend(" ".join(row) for row in body)
+        # Rounding first and adding 0.0 turns -0.0 (and tiny negatives) into "0.000000".
+        rows = (np.round(values, precision) + 0.0).tolist()
+        line = " ".join([f"%.{precision}f"] * values.shape[1])
+        out.extend(line % tuple(row) for row in rows)
     return "\n".join(out) + "\n"
 
 
@@ -506,11 +503,21 @@ def channel_values(motion: Motion) -> FloatArray:
             euler[:, joints] = np.rad2deg(euler_from_quats(quats, order))
             continue
         hint_deg = motion.euler_hint_deg[:, joints]
-        angles = np.rad2deg(euler_from_quats(quats, order, np.deg2rad(hint_deg)))
         # Where the hint still describes the rotation, write it verbatim: near gimbal lock the
-        # quaternion → Euler step loses digits that the file had.
-        same = geodesic_angle(quats_from_euler(np.deg2rad(hint_deg), order), quats) < 1e-9
-        euler[:, joints] = np.where(same[..., None], hint_deg, angles)
+        # quaternion → Euler step loses digits that the file had. Compared by components, not
+        # by angle: arccos near 1 turns a 1e-16 difference in the dot product into 1e-8 rad.
+        from_hint = quats_from_euler(np.deg2rad(hint_deg), order)
+        gap = np.minimum(
+            np.max(np.abs(from_hint - quats), axis=-1), np.max(np.abs(from_hint + quats), axis=-1)
+        )
+        changed = gap >= _SAME_ROTATION
+        chosen = hint_deg.copy()
+        if np.any(changed):
+            # Elementwise with a reference, so only the changed rotations are converted.
+            chosen[changed] = np.rad2deg(
+                euler_from_quats(quats[changed], order, np.deg2rad(hint_deg[changed]))
+            )
+        euler[:, joints] = chosen
     column = 0
     for j, chans in enumerate(sk.channels):
         k_rot = 0

@@ -44,6 +44,7 @@ __all__ = [
     "write_keypoints",
 ]
 
+# Names of the keypoint formats that detect_format can return.
 KEYPOINT_FORMATS: tuple[str, ...] = (
     "trc",
     "openpose",
@@ -55,7 +56,9 @@ KEYPOINT_FORMATS: tuple[str, ...] = (
     "npz",
     "json",
 )
+# Every format read_take accepts.
 TAKE_FORMATS: tuple[str, ...] = ("bvh", *KEYPOINT_FORMATS)
+# Formats write_keypoints can write, by file extension.
 KEYPOINT_WRITE_FORMATS: tuple[str, ...] = ("trc", "csv", "npy", "npz", "json")
 
 _SNIFF_BYTES = 4096

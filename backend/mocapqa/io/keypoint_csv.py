@@ -45,6 +45,7 @@ __all__ = [
     "write_keypoint_csv",
 ]
 
+# Columns of the long CSV format; time, z and confidence are optional on read.
 KEYPOINT_CSV_COLUMNS = ("frame", "time", "keypoint", "x", "y", "z", "confidence")
 _REQUIRED = ("frame", "keypoint", "x", "y")
 _MAX_FRAME_GAP_FACTOR = 4

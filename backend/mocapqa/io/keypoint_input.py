@@ -32,6 +32,7 @@ __all__ = [
     "resolve_length_unit",
 ]
 
+# Largest keypoint file read into memory, bytes.
 MAX_FILE_BYTES = 2**31
 
 

@@ -50,6 +50,7 @@ __all__ = [
     "read_mediapipe_pbtxt",
 ]
 
+# Frame rate assumed (and recorded) when the caller gives none.
 MEDIAPIPE_DEFAULT_FPS = 30.0
 _N = len(MEDIAPIPE_33_NAMES)
 _INDEX = {name: i for i, name in enumerate(MEDIAPIPE_33_NAMES)}

@@ -51,7 +51,9 @@ __all__ = [
     "read_openpose",
 ]
 
+# Frame rate assumed (and recorded) when the caller gives none: OpenPose JSON stores none.
 OPENPOSE_DEFAULT_FPS = 30.0
+# Keypoint layouts the reader knows; "auto" chooses by count and geometry.
 OPENPOSE_LAYOUTS = ("auto", "BODY_25B", "BODY_25", "COCO_18")
 _DIGITS = re.compile(r"\d+")
 _MIDPOINT_TOLERANCE = 0.15

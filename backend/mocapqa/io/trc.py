@@ -36,6 +36,7 @@ from mocapqa.io.keypoint_input import (
 
 __all__ = ["TRC_UNIT_ALIASES", "format_trc", "parse_trc", "read_trc", "write_trc"]
 
+# Spellings of TRC "Units" values mapped to our length units.
 TRC_UNIT_ALIASES: dict[str, str] = {
     "m": "m",
     "meter": "m",

@@ -62,12 +62,12 @@ def world_from_local(
 
 def forward_kinematics(motion: Motion) -> tuple[FloatArray, FloatArray]:
     """World rotations ``(F, J, 4)`` and positions ``(F, J, 3)`` of a motion, file units."""
-    return world_from_local(
-        motion.skeleton.parents, motion.quats, motion.local_translations()
-    )
+    return world_from_local(motion.skeleton.parents, motion.quats, motion.local_translations())
 
 
-def end_site_positions(motion: Motion, world_quats: FloatArray, world_positions: FloatArray) -> FloatArray:
+def end_site_positions(
+    motion: Motion, world_quats: FloatArray, world_positions: FloatArray
+) -> FloatArray:
     """World positions of the End Sites, shape (F, E, 3), in ``skeleton.end_sites`` order."""
     sites = motion.skeleton.end_sites
     if not sites:

@@ -20,9 +20,9 @@ __all__ = [
     "axis_angle_from_quats",
     "canonical",
     "conjugate",
+    "exp_map",
     "geodesic_angle",
     "log_map",
-    "exp_map",
     "multiply",
     "normalize",
     "quats_from_axis_angle",
@@ -35,6 +35,7 @@ __all__ = [
 ]
 
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
+"""The identity rotation, scalar-last ``(0, 0, 0, 1)``."""
 
 
 def scalar_part(quats: FloatArray) -> FloatArray:
@@ -81,7 +82,8 @@ def conjugate(quats: FloatArray) -> FloatArray:
 
 def normalize(quats: FloatArray) -> FloatArray:
     """Scale quaternions ``(..., 4)`` to unit norm."""
-    return quats / np.linalg.norm(quats, axis=-1, keepdims=True)
+    unit: FloatArray = quats / np.linalg.norm(quats, axis=-1, keepdims=True)
+    return unit
 
 
 def rotate(quats: FloatArray, vectors: FloatArray) -> FloatArray:
@@ -97,7 +99,7 @@ def quats_from_axis_angle(axes: FloatArray, angles_rad: FloatArray | float) -> F
     half = 0.5 * np.asarray(angles_rad, dtype=np.float64)[..., None]
     axes = np.asarray(axes, dtype=np.float64)
     vec = axes * np.sin(half)
-    w = np.broadcast_to(np.cos(half), vec.shape[:-1] + (1,))
+    w = np.broadcast_to(np.cos(half), (*vec.shape[:-1], 1))
     return np.concatenate((vec, w), axis=-1)
 
 
@@ -124,7 +126,9 @@ def log_map(quats: FloatArray) -> FloatArray:
     small = sin_half < 1e-12
     # angle / sin(angle/2) → 2 / w as the vector part vanishes (w = ±1 there).
     w = quats[..., 3:4]
-    scale = np.where(small, 2.0 / np.where(w == 0.0, 1.0, w), angle / np.where(small, 1.0, sin_half))
+    scale = np.where(
+        small, 2.0 / np.where(w == 0.0, 1.0, w), angle / np.where(small, 1.0, sin_half)
+    )
     return vec * scale
 
 
@@ -159,15 +163,22 @@ def unwrap(quats: FloatArray, axis: int = 0) -> FloatArray:
     if q.shape[0] < 2:
         return quats.copy()
     dots = np.sum(q[1:] * q[:-1], axis=-1)
-    flips = np.concatenate((np.zeros((1,) + dots.shape[1:], dtype=bool), dots < 0.0), axis=0)
+    flips = np.concatenate((np.zeros((1, *dots.shape[1:]), dtype=bool), dots < 0.0), axis=0)
     sign = np.where(np.cumsum(flips, axis=0) % 2 == 1, -1.0, 1.0)
     return np.moveaxis(q * sign[..., None], 0, axis)
 
 
 def geodesic_angle(p: FloatArray, q: FloatArray) -> FloatArray:
-    """Angle in radians [0, π] of the rotation between ``p`` and ``q`` (sign-insensitive)."""
-    dot = np.abs(np.sum(p * q, axis=-1))
-    return 2.0 * np.arccos(np.clip(dot, 0.0, 1.0))
+    """Angle in radians [0, π] of the rotation between ``p`` and ``q`` (sign-insensitive).
+
+    Computed as ``2·atan2(|v|, |w|)`` of ``conj(p) ⊗ q``, which keeps full precision for
+    nearly equal rotations, where ``2·arccos(|p·q|)`` turns a 1e-16 rounding into 1e-8 rad.
+    """
+    relative = multiply(conjugate(p), q)
+    angle: FloatArray = 2.0 * np.arctan2(
+        np.linalg.norm(relative[..., :3], axis=-1), np.abs(relative[..., 3])
+    )
+    return angle
 
 
 def quats_xyzw_from_wxyz(quats: FloatArray) -> FloatArray:

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from mocapqa.core.arrays import FloatArray
-from mocapqa.kinematics.quaternion import multiply, conjugate
+from mocapqa.kinematics.quaternion import conjugate, multiply
 
 __all__ = ["swing_twist", "twist_angle", "twist_swing"]
 

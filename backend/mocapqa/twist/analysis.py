@@ -40,6 +40,7 @@ from mocapqa.twist.refine import refine_quats
 
 __all__ = ["METHODS", "TwistAnalysis", "TwistInterval", "analyze_twist", "detect_chains"]
 
+# Detection methods: the robust default and the paper as written.
 METHODS = ("robust", "paper")
 
 

@@ -1,0 +1,104 @@
+"""``mocapqa bench io``: BVH read, read + FK and write throughput over the corpus."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from mocapqa.cli.app import bench_app
+
+__all__ = ["bench_io"]
+
+
+@bench_app.command("io")
+def bench_io(
+    data: Annotated[
+        Path | None,
+        typer.Option(help="Corpus folder (default: $MOCAPQA_CORPUS_DIR or ../shared/data)."),
+    ] = None,
+    repeats: Annotated[int, typer.Option(help="Timed runs per figure; the best is kept.")] = 3,
+    files: Annotated[
+        int | None, typer.Option(help="Only the first N BVH files (sorted by path).")
+    ] = None,
+    info_runs: Annotated[int, typer.Option(help="Runs of the `mocapqa info` process.")] = 3,
+) -> None:
+    """Read, read + FK and write throughput (frames/s, MB/s); pybvh on the CMU walk."""
+    from rich.console import Console
+    from rich.progress import Progress
+    from rich.table import Table
+
+    from mocapqa.bench.corpus import corpus_bvh_files, require_corpus
+    from mocapqa.bench.io import (
+        IoBenchParams,
+        Throughput,
+        info_process_time_s,
+        pybvh_comparison,
+        scratch_folder,
+        time_file,
+        total_throughput,
+        warm_up,
+    )
+    from mocapqa.errors import NotFoundError
+
+    params = IoBenchParams(repeats=repeats, max_files=files, info_runs=info_runs)
+    root = require_corpus(data)
+    paths = corpus_bvh_files(root)
+    if not paths:
+        raise NotFoundError(f"Expected BVH files under {root}, got none")
+    if params.max_files is not None:
+        paths = paths[: params.max_files]
+    console = Console()
+    timings = []
+    with Progress(console=console, transient=True) as progress:
+        task = progress.add_task("warming up", total=2 * len(paths))
+        for path in paths:
+            warm_up([path])
+            progress.advance(task)
+        with scratch_folder() as scratch:
+            for path in paths:
+                progress.update(task, description=f"timing {path.name}")
+                timings.append(time_file(path, params.repeats, Path(scratch)))
+                progress.advance(task)
+
+    table = Table(title=f"BVH I/O over {len(paths)} files ({root})", title_justify="left")
+    for column in ("measure", "files", "frames", "MB", "seconds", "frames/s", "MB/s"):
+        table.add_column(column, justify="left" if column == "measure" else "right")
+
+    def add(row: Throughput, n_files: int) -> None:
+        table.add_row(
+            row.label, str(n_files), str(row.n_frames), f"{row.n_bytes / 1e6:.2f}",
+            f"{row.seconds:.4f}", f"{row.frames_per_s:,.0f}", f"{row.mb_per_s:.1f}",
+        )  # fmt: skip
+
+    for row in total_throughput(timings):
+        add(row, len(timings))
+    bandai = [t for t in timings if "bandai" in t.path.parts]
+    if bandai:
+        big = max(bandai, key=lambda t: t.n_bytes)
+        add(Throughput("read, largest Bandai", big.n_bytes, big.n_frames, big.read_s), 1)
+        table.caption = f"largest Bandai file: {big.path.name}"
+    console.print(table)
+
+    walk = next((p for p in paths if p.name == "cmu_12_01_walk.bvh"), None)
+    if walk is None:
+        console.print("CMU walk (cmu_12_01_walk.bvh) not among the files: no pybvh comparison")
+        return
+    compare = Table(title=f"Read + joint and End Site positions, {walk.name}", title_justify="left")
+    for column in ("reader", "seconds", "frames/s", "MB/s"):
+        compare.add_column(column, justify="left" if column == "reader" else "right")
+    walk_timing = next(t for t in timings if t.path == walk)
+    pair = pybvh_comparison(walk, params.repeats)
+    if pair is None:
+        console.print("pybvh is not installed (pip install '.[bench]'): no comparison")
+    else:
+        for name, seconds in (("mocapqa", pair[0]), ("pybvh 0.9", pair[1])):
+            row = Throughput(name, walk_timing.n_bytes, walk_timing.n_frames, seconds)
+            compare.add_row(
+                name, f"{seconds:.4f}", f"{row.frames_per_s:,.0f}", f"{row.mb_per_s:.1f}"
+            )
+        compare.caption = f"pybvh / mocapqa time ratio: {pair[1] / pair[0]:.2f}×"
+    info_s = info_process_time_s(walk, params.info_runs)
+    compare.add_row("`mocapqa info` process (cold)", f"{info_s:.3f}", "", "")
+    console.print(compare)

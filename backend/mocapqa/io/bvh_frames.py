@@ -1,0 +1,174 @@
+"""Reading the frame block of a BVH file: a fast path and a line-by-line path.
+
+Conventions
+-----------
+* :func:`frames_by_arrow` reads the whole block with pyarrow's CSV reader (correctly rounded,
+  like ``float``) and returns None on anything unexpected, never raising.
+* :func:`frames_by_line` is the reference path: ``float`` per token, one line at a time, and
+  the only one that raises, with the 1-based line.
+* Lines are counted by LF; CR is whitespace.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from itertools import repeat
+from operator import add
+from typing import Any
+
+import numpy as np
+
+from mocapqa.core.arrays import FloatArray
+from mocapqa.errors import ParseError
+
+__all__ = ["frames_by_arrow", "frames_by_line"]
+
+_TOKEN_SHAPES = bytes(
+    byte if byte == 10 else 32 if byte in b" \t\r" else ord("x") for byte in range(256)
+)
+_SPACES_TO_NEWLINES = bytes.maketrans(b" \t\r", b"\n\n\n")
+
+
+def frames_by_arrow(block: str, n_frames: int, n_channels: int) -> FloatArray | None:
+    """Parse the frame block with Arrow's CSV reader; None when it needs the careful path.
+
+    Parameters
+    ----------
+    block : str
+        The text after the ``Frame Time:`` line.
+    n_frames, n_channels : int
+        The counts the header announced.
+
+    Returns
+    -------
+    ndarray, shape (n_frames, n_channels), or None
+        None when pyarrow is missing or anything is off (then :func:`frames_by_line`
+        reports the problem with its line).
+
+    Every whitespace becomes a line break, so Arrow reads one float column (its parser is
+    correctly rounded, like ``float``); the line structure is checked separately. Arrow's
+    CSV module imports in ~0.04 s, unlike pandas (~0.3 s), so even one small file gains.
+    """
+    if n_frames == 0 or n_channels == 0:
+        return None
+    try:
+        raw = block.encode("ascii")
+    except UnicodeEncodeError:
+        return None
+    # Every non-blank line must hold exactly n_channels values: count token starts per line
+    # on a copy where whitespace is " " and anything else "x".
+    # A value starts at each " x" and at an "x" opening a line.
+    lines = raw.translate(_TOKEN_SHAPES).split(b"\n")
+    counts = list(
+        map(add, map(bytes.count, lines, repeat(b" x")), map(bytes.startswith, lines, repeat(b"x")))
+    )
+    if not set(counts) <= {0, n_channels}:
+        return None
+    n_tokens = sum(counts)
+    if n_tokens != n_frames * n_channels:
+        return None
+    try:
+        arrow: Any = importlib.import_module("pyarrow")
+        arrow_csv: Any = importlib.import_module("pyarrow.csv")
+    except ImportError:
+        return None
+    try:
+        table = arrow_csv.read_csv(
+            arrow.BufferReader(raw.translate(_SPACES_TO_NEWLINES)),
+            read_options=arrow_csv.ReadOptions(column_names=["value"], use_threads=False),
+            parse_options=arrow_csv.ParseOptions(
+                quote_char=False, escape_char=False, ignore_empty_lines=True
+            ),
+            convert_options=arrow_csv.ConvertOptions(
+                column_types={"value": arrow.float64()},
+                null_values=[],
+                strings_can_be_null=False,
+                quoted_strings_can_be_null=False,
+            ),
+        )
+        # Straight from the buffers: Arrow's to_numpy() imports pandas (~0.3 s).
+        parts = []
+        for chunk in table.column(0).chunks:
+            if chunk.null_count:
+                return None
+            data = chunk.buffers()[1]
+            parts.append(np.frombuffer(data, np.float64, count=len(chunk), offset=8 * chunk.offset))
+    except (arrow.ArrowException, ValueError):
+        return None
+    column: FloatArray = np.concatenate(parts) if parts else np.zeros(0)
+    if column.shape != (n_tokens,) or not np.all(np.isfinite(column)):
+        return None
+    return column.reshape(n_frames, n_channels)
+
+
+def frames_by_line(
+    lines: list[str], first: int, n_frames: int, n_channels: int, path: str
+) -> FloatArray:
+    """Parse frame lines one by one with ``float``, raising on the first bad line.
+
+    Parameters
+    ----------
+    lines : list of str
+        The file's lines (split on LF).
+    first : int
+        0-based index of the first frame line.
+    n_frames, n_channels : int
+        The counts the header announced.
+    path : str
+        File name for error messages.
+
+    Returns
+    -------
+    ndarray, shape (n_frames, n_channels)
+
+    Raises
+    ------
+    ParseError
+        On a wrong value count, a non-number, NaN or infinity, or too few or too many lines,
+        with the 1-based line.
+    """
+    # Rows are collected, not preallocated: a corrupt "Frames:" count must not allocate.
+    rows: list[list[float]] = []
+    row = 0
+    last = first - 1  # 0-based index of the last frame line read
+    for number in range(first, len(lines)):
+        tokens = lines[number].split()
+        if not tokens:
+            continue
+        last = number
+        if row >= n_frames:
+            raise ParseError(
+                f"Expected {n_frames} frame lines (Frames:), got more", path, number + 1
+            )
+        if len(tokens) != n_channels:
+            raise ParseError(
+                f"Expected {n_channels} values on a frame line, got {len(tokens)}",
+                path,
+                number + 1,
+            )
+        try:
+            parsed = list(map(float, tokens))
+        except ValueError:
+            bad = next(t for t in tokens if not _is_float(t))
+            raise ParseError(f"Expected a number, got {bad!r}", path, number + 1) from None
+        if not all(map(math.isfinite, parsed)):
+            raise ParseError("Expected finite numbers, got NaN or infinity", path, number + 1)
+        rows.append(parsed)
+        row += 1
+    if row != n_frames:
+        # Reported at the line where the next frame was expected.
+        raise ParseError(
+            f"Expected {n_frames} frame lines (Frames:), got {row} (truncated file?)",
+            path,
+            last + 2,
+        )
+    return np.array(rows, dtype=np.float64).reshape(n_frames, n_channels)
+
+
+def _is_float(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
