@@ -310,9 +310,10 @@ function reviewPanel(take) {
 }
 
 function downloadsPanel(run, result) {
-  const labels = { bvh: "corrected BVH", csv: "filtered keypoints (CSV)", trc: "filtered keypoints (TRC)", report: "JSON report" };
+  const labels = { bvh: "corrected BVH", csv: "filtered keypoints (CSV)", trc: "filtered keypoints (TRC)", report: "JSON report", "report.html": "HTML report" };
+  const kinds = [...(result.downloads || ["report"]), "report.html"];
   return h("div", { class: "panel" }, h("h2", {}, "Downloads"),
-    (result.downloads || ["report"]).map((k) => h("a", { href: api.downloadUrl(run.id, k), download: "", id: `download-${k}`, style: "margin-right:12px" }, labels[k] || k)));
+    kinds.map((k) => h("a", { href: api.downloadUrl(run.id, k), download: "", id: `download-${k.replace(".", "-")}`, style: "margin-right:12px" }, labels[k] || k)));
 }
 
 function stepsPanel(result) {

@@ -5,6 +5,10 @@ const BONE = "#1f4e79";
 const JOINT = "#2b6cb0";
 const COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
 
+// A missing point (keypoint not detected) arrives as [null, null, null]; it is left out of the
+// drawing (Plotly draws null coordinates as gaps) and of the bounds.
+const present = (p) => p != null && p[0] != null && p[1] != null && p[2] != null;
+
 // Data are Y-up; Plotly's scene is Z-up: plot (x, z, y).
 // The box follows the body: a fixed size (the largest body extent over the take, so the scale
 // never changes) centred on the current frame's centre of the points, floor height fixed.
@@ -13,17 +17,19 @@ export function bodyExtent(frameSets) {
   for (const frames of frameSets) {
     for (const points of frames) {
       const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
-      for (const p of points) for (let a = 0; a < 3; a++) { lo[a] = Math.min(lo[a], p[a]); hi[a] = Math.max(hi[a], p[a]); }
+      for (const p of points) if (present(p)) for (let a = 0; a < 3; a++) { lo[a] = Math.min(lo[a], p[a]); hi[a] = Math.max(hi[a], p[a]); }
       extent = Math.max(extent, ...hi.map((v, a) => v - lo[a]));
       floor = Math.min(floor, lo[1]); ceiling = Math.max(ceiling, hi[1]);
     }
   }
+  if (!Number.isFinite(floor)) { floor = 0; ceiling = 1; }
   return { half: (extent || 1) * 0.6, floor, ceiling };
 }
 
 export function sceneBounds(points, extent) {
-  const n = points.length || 1;
-  const mid = [0, 1, 2].map((a) => points.reduce((s, p) => s + p[a], 0) / n);
+  const shown = points.filter(present);
+  const n = shown.length || 1;
+  const mid = [0, 1, 2].map((a) => shown.reduce((s, p) => s + p[a], 0) / n);
   const half = Math.max(extent.half, (extent.ceiling - extent.floor) / 2);
   const yMid = (extent.floor + extent.ceiling) / 2;
   return [[mid[0] - half, mid[0] + half], [yMid - half, yMid + half], [mid[2] - half, mid[2] + half]];
@@ -34,6 +40,7 @@ export function skeletonFigure(points, parents, flagged, bounds, title, camera) 
   parents.forEach((parent, child) => {
     if (parent < 0) return;
     const a = points[parent], b = points[child];
+    if (!present(a) || !present(b)) return;
     xs.push(a[0], b[0], null); ys.push(a[2], b[2], null); zs.push(a[1], b[1], null);
   });
   const colors = points.map((_, i) => (flagged.has(i) ? FLAG : JOINT));

@@ -13,6 +13,7 @@ from fastapi.testclient import TestClient
 
 from mocapqa.api.app import create_app
 from mocapqa.config import Settings
+from mocapqa.render.service import RenderService
 from mocapqa.store.repository import Repository
 from mocapqa.store.tables import metadata
 
@@ -36,10 +37,17 @@ def settings(request: pytest.FixtureRequest, tmp_path: Path) -> Settings:
     return make_settings(str(request.param), tmp_path)
 
 
+@pytest.fixture(scope="session")
+def renderer() -> Iterator[RenderService]:
+    """One render thread for every app of the session (VTK starts once)."""
+    with RenderService() as service:
+        yield service
+
+
 @pytest.fixture
-def client(settings: Settings) -> Iterator[TestClient]:
+def client(settings: Settings, renderer: RenderService) -> Iterator[TestClient]:
     """A client of a freshly created app."""
-    with TestClient(create_app(settings)) as test_client:
+    with TestClient(create_app(settings, renderer=renderer)) as test_client:
         yield test_client
 
 

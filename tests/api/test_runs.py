@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -12,8 +13,12 @@ from fastapi.testclient import TestClient
 
 from mocapqa.api.app import create_app
 from mocapqa.config import Settings
+from mocapqa.core.keypoints import KeypointSequence
+from mocapqa.filters.apply import filter_keypoints
 from mocapqa.io.bvh import read_bvh
+from mocapqa.io.formats import read_take
 from mocapqa.kinematics.forward import forward_kinematics
+from mocapqa.render.service import RenderService
 
 Waiter = Callable[[TestClient, str], dict[str, Any]]
 Uploader = Callable[[TestClient, Path], dict[str, Any]]
@@ -130,6 +135,29 @@ def test_stream_filters_frames_and_returns_weights(client: TestClient) -> None:
         assert "Expected positions" in socket.receive_json()["error"]
 
 
+def test_stream_in_metres_matches_the_batch_default_preset(
+    client: TestClient, corpus_dir: Path
+) -> None:
+    trc = corpus_dir / "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d"
+    take = read_take(trc / "S00_P00_T01_BalancingTrial_0-100.trc")
+    assert isinstance(take, KeypointSequence)
+    positions = take.positions[:40].copy()
+    positions[5:9, 3] = np.nan  # a keypoint lost for four frames is sent as null
+    seq = dataclasses.replace(take, positions=positions, confidence=take.confidence[:40])
+    batch = filter_keypoints(seq, method="adaptive", preset="default").sequence.positions
+    streamed = []
+    with client.websocket_connect("/api/v1/stream/filter") as socket:
+        socket.send_json({"fps": seq.fps, "n_keypoints": seq.n_keypoints, "length_unit": "m"})
+        ready = socket.receive_json()
+        assert ready["length_unit"] == "m"
+        assert ready["preset"] == "default"
+        for frame in seq.positions:
+            cells = [[None if np.isnan(v) else float(v) for v in row] for row in frame]
+            socket.send_json({"positions": cells})
+            streamed.append(socket.receive_json()["positions"])
+    np.testing.assert_allclose(np.asarray(streamed, dtype=np.float64), batch, atol=6e-6)
+
+
 def test_stream_refuses_a_bad_opening(client: TestClient) -> None:
     with client.websocket_connect("/api/v1/stream/filter") as socket:
         socket.send_json({"fps": "fast"})
@@ -137,15 +165,19 @@ def test_stream_refuses_a_bad_opening(client: TestClient) -> None:
 
 
 def test_runs_left_by_a_stopped_server_finish_after_restart(
-    settings: Settings, cmu_walk: Path, wait_for_run: Waiter, upload: Uploader
+    settings: Settings,
+    cmu_walk: Path,
+    wait_for_run: Waiter,
+    upload: Uploader,
+    renderer: RenderService,
 ) -> None:
-    with TestClient(create_app(settings)) as client:
+    with TestClient(create_app(settings, renderer=renderer)) as client:
         created = upload(client, cmu_walk)
         wait_for_run(client, created["run_id"])
         services = client.app.state.services  # type: ignore[attr-defined]
         orphan = services.repository.add_run(created["id"], {})
         services.repository.mark_running(orphan)  # as if the server died mid-run
-    with TestClient(create_app(settings)) as client:
+    with TestClient(create_app(settings, renderer=renderer)) as client:
         run = wait_for_run(client, orphan)
         assert run["status"] == "done"
         assert client.get(f"/api/v1/runs/{orphan}/download/bvh").status_code == 200

@@ -7,15 +7,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.io.formats import read_take
 from mocapqa.jobs.demo import demo_paths
+from mocapqa.jobs.runner import write_outputs
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.frames import motion_points, sample_frames
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.pipeline.steps import violation_findings
+from mocapqa.store.files import FileStore
 
 
 def test_options_round_trip_and_name_bad_fields() -> None:
@@ -107,3 +110,20 @@ def test_analyze_keypoints_filters_and_keeps_the_input(corpus_dir: Path) -> None
     assert result.corrected_motion is None
     assert result.report["steps"]["filter"]["state"] == "done"
     assert not np.allclose(result.filtered_keypoints.positions, sequence.positions, equal_nan=True)
+
+
+def test_undetected_openpose_keypoints_stay_missing_in_the_stored_points(
+    corpus_dir: Path, tmp_path: Path
+) -> None:
+    folder = corpus_dir / "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-associated"
+    take = read_take(folder / "cam01_json")
+    assert isinstance(take, KeypointSequence)
+    undetected = np.isnan(take.positions).any(axis=-1)
+    assert undetected.sum() == 90  # the corpus README: 90 zeroed keypoints in cam01
+    result = analyze(take, AnalysisOptions())
+    files = FileStore(tmp_path)
+    write_outputs(files, "0123456789abcdef0123456789abcdef", result)
+    with np.load(files.run_dir("0123456789abcdef0123456789abcdef") / "points.npz") as data:
+        raw = data["raw"]
+    np.testing.assert_array_equal(np.isnan(raw).any(axis=-1), undetected)
+    assert not np.any(np.all(raw[~undetected] == 0, axis=-1))

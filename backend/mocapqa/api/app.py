@@ -27,6 +27,7 @@ from mocapqa.api.routes import filters, health, reviews, runs, stream, takes
 from mocapqa.config import Settings
 from mocapqa.jobs.demo import load_demo
 from mocapqa.jobs.runner import JobRunner
+from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
 
@@ -51,7 +52,9 @@ def plotly_js_path() -> Path:
     return Path(plotly.__file__).resolve().parent / "package_data" / "plotly.min.js"
 
 
-def create_app(settings: Settings, demo: bool = False) -> FastAPI:
+def create_app(
+    settings: Settings, demo: bool = False, renderer: RenderService | None = None
+) -> FastAPI:
     """Build the application.
 
     Parameters
@@ -60,12 +63,18 @@ def create_app(settings: Settings, demo: bool = False) -> FastAPI:
         Data folder, database URL, upload limit, worker count.
     demo : bool
         Load the bundled demo takes (analysed) when the database has no takes.
+    renderer : RenderService, optional
+        A render thread to share (the caller closes it). By default the app creates its own
+        (one per app: VTK renders on one thread) and closes it on shutdown. Rendering starts
+        lazily, so an app whose runs never draw pays nothing.
     """
     settings.data_dir.mkdir(parents=True, exist_ok=True)
     repository = Repository(settings.resolved_database_url)
     files = FileStore(settings.data_dir)
-    runner = JobRunner(repository, files, settings.job_workers)
-    services = Services(settings, repository, files, runner)
+    owns_renderer = renderer is None
+    render_service = RenderService() if renderer is None else renderer
+    runner = JobRunner(repository, files, settings.job_workers, render_service)
+    services = Services(settings, repository, files, runner, render_service)
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
@@ -78,6 +87,8 @@ def create_app(settings: Settings, demo: bool = False) -> FastAPI:
             yield
         finally:
             runner.shutdown()
+            if owns_renderer:
+                render_service.close()
             repository.close()
 
     app = FastAPI(

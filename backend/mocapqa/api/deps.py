@@ -9,6 +9,7 @@ from fastapi import Depends, Request
 
 from mocapqa.config import Settings
 from mocapqa.jobs.runner import JobRunner
+from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
 
@@ -17,12 +18,13 @@ __all__ = ["Services", "ServicesDep", "TakeDep", "get_services", "get_take"]
 
 @dataclass(frozen=True, slots=True)
 class Services:
-    """What the routes use: settings, repository, files and the job runner."""
+    """What the routes use: settings, repository, files, the job runner and the render thread."""
 
     settings: Settings
     repository: Repository
     files: FileStore
     runner: JobRunner
+    renderer: RenderService | None = None
 
 
 def get_services(request: Request) -> Services:

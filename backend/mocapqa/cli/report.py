@@ -135,15 +135,10 @@ def sheet_tiles(run: TakeRun, max_tiles: int = MAX_TILES) -> list[SheetTile]:
     """Contact-sheet tiles for a run's findings: twist intervals first, then the largest
     limit violations, at most ``max_tiles``."""
     from mocapqa.render.sheet import tiles_from_intervals
-    from mocapqa.report.findings import normalise_findings
+    from mocapqa.report.findings import sheet_findings
 
-    findings = normalise_findings(list(run.analysis.get("findings", [])))
-    twists = [f for f in findings if f["kind"] == "twist"]
-    others = sorted(
-        (f for f in findings if f["kind"] != "twist"),
-        key=lambda f: -float(f.get("violation_deg", 0)),
-    )
-    return tiles_from_intervals([*twists, *others][:max_tiles], run.raw, run.corrected)
+    chosen = sheet_findings(list(run.analysis.get("findings", [])), max_tiles)
+    return tiles_from_intervals(chosen, run.raw, run.corrected)
 
 
 def build_take_report(

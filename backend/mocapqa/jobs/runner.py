@@ -20,9 +20,11 @@ import numpy as np
 
 from mocapqa.errors import MocapQAError
 from mocapqa.io.bvh import format_bvh
+from mocapqa.jobs.rendered import render_thumbnail
 from mocapqa.pipeline.analyze import AnalysisResult, analyze
 from mocapqa.pipeline.loading import Take, read_take_file, write_keypoints_file
 from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
 
@@ -77,11 +79,21 @@ class JobRunner:
         Where takes and outputs live.
     workers : int
         Worker threads.
+    renderer : RenderService, optional
+        The app's render thread; with it each run gets a rendered ``thumbnail.png`` after the
+        analysis (skipped, with the SVG thumbnail as fallback, when rendering is unavailable).
     """
 
-    def __init__(self, repository: Repository, files: FileStore, workers: int = 2) -> None:
+    def __init__(
+        self,
+        repository: Repository,
+        files: FileStore,
+        workers: int = 2,
+        renderer: RenderService | None = None,
+    ) -> None:
         self.repository = repository
         self.files = files
+        self.renderer = renderer
         self._pool = ThreadPoolExecutor(max_workers=max(1, workers), thread_name_prefix="run")
         self._futures: dict[str, Future[None]] = {}
         self._preloaded: dict[str, Take] = {}
@@ -141,6 +153,11 @@ class JobRunner:
 
             result = analyze(motion_or_keypoints, options, progress)
             write_outputs(self.files, run_id, result)
+            if self.renderer is not None:
+                self.repository.set_progress(run_id, 97, "rendering the thumbnail")
+                render_thumbnail(
+                    self.files, run_id, result.report, result.raw_points, self.renderer
+                )
             summary: dict[str, Any] = {
                 **result.report["summary"],
                 "steps": {k: v["state"] for k, v in result.report["steps"].items()},

@@ -1,5 +1,7 @@
 """Take-list thumbnails: the middle frame's skeleton as a small SVG, drawn from a run's points.
 
+Missing points (NaN in ``points.npz``) and the bones that end at them are left out.
+
 The view is frontal (X to the right, the rig's up axis, Y, upward), scaled to fit. Before a run
 has finished the thumbnail is a neutral placeholder.
 """
@@ -41,9 +43,12 @@ def thumbnail_svg(files: FileStore, run_id: str | None, label: str) -> str:
         return placeholder_svg("analysing…")
     if points.shape[0] == 0:
         return placeholder_svg(label)
-    frame = np.nan_to_num(points[points.shape[0] // 2, :, :2].astype(np.float64))
+    frame = points[points.shape[0] // 2, :, :2].astype(np.float64)
+    seen = np.isfinite(frame).all(axis=1)
+    if not seen.any():
+        return placeholder_svg(label)
     parents = report.get("points", {}).get("parents", [])
-    low, high = frame.min(axis=0), frame.max(axis=0)
+    low, high = frame[seen].min(axis=0), frame[seen].max(axis=0)
     scale = (SIZE_PX - 12) / max(float((high - low).max()), 1e-9)
     xy = (frame - (low + high) / 2) * scale
     xy[:, 1] *= -1
@@ -53,13 +58,15 @@ def thumbnail_svg(files: FileStore, run_id: str | None, label: str) -> str:
         '<rect width="100%" height="100%" fill="#f5f7fa"/>',
     ]
     for child, parent in enumerate(parents):
-        if 0 <= parent < len(xy) and child < len(xy):
+        if 0 <= parent < len(xy) and child < len(xy) and seen[parent] and seen[child]:
             (x1, y1), (x2, y2) = xy[parent], xy[child]
             parts.append(
                 f'<line x1="{x1:.1f}" y1="{y1:.1f}" x2="{x2:.1f}" y2="{y2:.1f}" '
                 'stroke="#1f4e79" stroke-width="2" stroke-linecap="round"/>'
             )
     if not any(p >= 0 for p in parents):
-        parts += [f'<circle cx="{x:.1f}" cy="{y:.1f}" r="1.6" fill="#1f4e79"/>' for x, y in xy]
+        parts += [
+            f'<circle cx="{x:.1f}" cy="{y:.1f}" r="1.6" fill="#1f4e79"/>' for x, y in xy[seen]
+        ]
     parts.append("</svg>")
     return "".join(parts)

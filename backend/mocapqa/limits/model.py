@@ -55,6 +55,7 @@ __all__ = [
     "save_model",
 ]
 
+# Version of the .npz model layout; files of another version are refused.
 FORMAT_VERSION = 1
 _FORMAT = "mocapqa-limits"
 

@@ -19,8 +19,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
 from mocapqa import __version__
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.keypoints import KeypointSequence
@@ -180,8 +178,9 @@ def _analyze_keypoints(
     else:
         outcomes["filter"] = StepOutcome("skipped", "not requested")
     progress(85, "collecting results")
-    raw_points = np.nan_to_num(sequence.positions)
-    corrected_points = np.nan_to_num(filtered.positions)
+    # Missing keypoints stay NaN: drawing them at the origin would show points never seen.
+    raw_points = sequence.positions
+    corrected_points = filtered.positions
     report = {
         "kind": "keypoints",
         "version": __version__,

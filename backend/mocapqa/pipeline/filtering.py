@@ -1,7 +1,11 @@
 """The filter registry as the UI sees it, and a frame-by-frame streaming filter session.
 
 Both wrap the filters package: :data:`mocapqa.filters.registry.FILTERS` and
-:class:`mocapqa.filters.adaptive.AdaptiveFilter` (default parameters, in data units).
+:class:`mocapqa.filters.adaptive.AdaptiveFilter`. The stream takes its parameters the way
+:func:`mocapqa.filters.apply.filter_keypoints` does: a registry preset (``default`` unless the
+client names another) converted to the stream's length unit and frame rate, so streaming a take
+gives the same output as filtering it in batch. For ``px``, ``normalized`` and ``unknown`` units
+the body size is estimated from the first frame (the batch filter uses the whole take).
 """
 
 from __future__ import annotations
@@ -12,11 +16,16 @@ from typing import Any
 
 import numpy as np
 
+from mocapqa.core.arrays import FloatArray
+from mocapqa.core.keypoints import LENGTH_UNITS
 from mocapqa.errors import InputError
-from mocapqa.filters.adaptive import AdaptiveFilter, AdaptiveParams
+from mocapqa.filters.adaptive import AdaptiveFilter
+from mocapqa.filters.apply import data_scale
 from mocapqa.filters.registry import FILTERS, DataScale
 
 __all__ = ["StreamSession", "filter_catalog"]
+
+METRIC_UNITS = ("m", "cm", "mm", "in")
 
 
 def _plain(value: Any) -> Any:
@@ -63,14 +72,46 @@ class StreamSession:
         Frame rate of the stream, Hz.
     n_keypoints : int
         Keypoints per frame.
+    length_unit : str
+        Unit of the positions: "m", "cm", "mm", "in", "px", "normalized" or "unknown". Metric
+        units convert exactly; the others take the body size from the first frame.
+    preset : str
+        A preset of the registry's ``adaptive`` filter ("default" or "note").
+
+    Raises
+    ------
+    InputError
+        On a bad frame rate, keypoint count, unit or preset.
     """
 
-    def __init__(self, fps: float, n_keypoints: int) -> None:
+    def __init__(
+        self,
+        fps: float,
+        n_keypoints: int,
+        length_unit: str = "unknown",
+        preset: str = "default",
+    ) -> None:
         if not (math.isfinite(fps) and fps > 0) or n_keypoints < 1:
             raise InputError(f"Expected fps > 0 and n_keypoints ≥ 1, got {fps}, {n_keypoints}")
+        if length_unit not in LENGTH_UNITS:
+            raise InputError(f"Expected a length unit in {LENGTH_UNITS}, got {length_unit!r}")
+        if preset not in FILTERS["adaptive"].presets:
+            raise InputError(
+                f"Expected a preset in {sorted(FILTERS['adaptive'].presets)}, got {preset!r}"
+            )
         self.n_keypoints = n_keypoints
+        self.fps = fps
+        self.length_unit = length_unit
+        self.preset = preset
         self.frame = 0
-        self._filter = AdaptiveFilter(AdaptiveParams(), n_keypoints, fps)
+        self._filter: AdaptiveFilter | None = None
+        if length_unit in METRIC_UNITS:
+            self._filter = self._make_filter(None)
+
+    def _make_filter(self, first: FloatArray | None) -> AdaptiveFilter:
+        scale = data_scale(self.length_unit, self.fps, first)
+        params = FILTERS["adaptive"].preset(self.preset, scale)
+        return AdaptiveFilter(params, self.n_keypoints, self.fps)
 
     def update(self, positions: Any, confidence: Any | None) -> dict[str, Any]:
         """Filter one frame.
@@ -78,34 +119,50 @@ class StreamSession:
         Parameters
         ----------
         positions : array-like, shape (K, 3)
+            Positions in the stream's unit; ``None`` (or NaN) entries are missing.
         confidence : array-like, shape (K,), optional
+            Confidence in [0, 1]; without it, 1 where a keypoint is present and 0 where missing.
 
         Returns
         -------
         dict
-            ``frame``, ``positions`` (K, 3) and ``weights`` (filter name → weight).
+            ``frame``, ``positions`` (K, 3; ``None`` where the filter has no value yet) and
+            ``weights`` (filter name → weight).
         """
-        try:
-            frame = np.asarray(positions, dtype=np.float64).reshape(self.n_keypoints, 3)
-            conf = (
-                np.ones(self.n_keypoints)
-                if confidence is None
-                else np.asarray(confidence, dtype=np.float64).reshape(self.n_keypoints)
-            )
-        except (TypeError, ValueError) as e:
-            raise InputError(
-                f"Expected positions ({self.n_keypoints}, 3) and confidence "
-                f"({self.n_keypoints},), got {e}"
-            ) from e
-        filtered, weights = self._filter.update(frame, conf)
-        index = self.frame
-        self.frame += 1
-        values = np.asarray(filtered, dtype=np.float64).reshape(self.n_keypoints, 3)
+        values, weights = self.filter(positions, confidence)
+        index = self.frame - 1
+        rounded = np.round(values, 5)
         return {
             "frame": index,
-            "positions": np.where(np.isfinite(values), np.round(values, 5), 0.0).tolist(),
+            "positions": [
+                [float(v) if math.isfinite(v) else None for v in row] for row in rounded.tolist()
+            ],
             "weights": _weights_json(weights),
         }
+
+    def filter(self, positions: Any, confidence: Any | None) -> tuple[FloatArray, FloatArray]:
+        """Filter one frame and return the arrays (unrounded).
+
+        Returns
+        -------
+        filtered : ndarray, shape (K, 3)
+            NaN where the keypoint has had no valid sample yet.
+        weights : ndarray, shape (K, 3)
+            Weights of (Kalman, One Euro, EMA).
+        """
+        k = self.n_keypoints
+        try:
+            frame = np.asarray(positions, dtype=np.float64).reshape(k, 3)
+            conf = (
+                None if confidence is None else np.asarray(confidence, dtype=np.float64).reshape(k)
+            )
+        except (TypeError, ValueError) as e:
+            raise InputError(f"Expected positions ({k}, 3) and confidence ({k},), got {e}") from e
+        if self._filter is None:
+            self._filter = self._make_filter(frame[None])
+        filtered, weights = self._filter.update(frame, conf)
+        self.frame += 1
+        return np.asarray(filtered, dtype=np.float64), np.asarray(weights, dtype=np.float64)
 
 
 def _weights_json(weights: Any) -> dict[str, Any]:

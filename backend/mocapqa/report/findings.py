@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["limit_findings", "normalise_findings", "twist_findings"]
+__all__ = ["limit_findings", "normalise_findings", "sheet_findings", "twist_findings"]
 
 
 def twist_findings(twist: Mapping[str, Any] | None) -> list[dict[str, Any]]:
@@ -107,3 +107,15 @@ def normalise_findings(findings: list[dict[str, Any]]) -> list[dict[str, Any]]:
         item["end_frame"] = int(item.get("end_frame", item["start_frame"]))
         out.append(item)
     return out
+
+
+def sheet_findings(findings: list[dict[str, Any]], max_tiles: int = 8) -> list[dict[str, Any]]:
+    """The findings a contact sheet shows: twist intervals first, then the largest limit
+    violations, at most ``max_tiles`` (normalised as by :func:`normalise_findings`)."""
+    normalised = normalise_findings(findings)
+    twists = [f for f in normalised if f["kind"] == "twist"]
+    others = sorted(
+        (f for f in normalised if f["kind"] != "twist"),
+        key=lambda f: -float(f.get("violation_deg", 0)),
+    )
+    return [*twists, *others][:max_tiles]

@@ -4,7 +4,7 @@ Layout under the data folder::
 
     takes/<take_id>/<file name>        the upload, as received
     runs/<run_id>/report.json          the report
-    runs/<run_id>/points.npz           raw and corrected point positions (float32)
+    runs/<run_id>/points.npz           raw and corrected point positions (float32, NaN = missing)
     runs/<run_id>/corrected.bvh        and filtered.csv / filtered.trc
 
 Every file is written to a temporary name in the same folder and renamed, so a reader never

@@ -13,6 +13,7 @@ from mocapqa.api.deps import ServicesDep, TakeDep
 from mocapqa.api.schemas import AnalysisOptionsIn, RunOut
 from mocapqa.api.views import run_out
 from mocapqa.errors import InputError, NotFoundError
+from mocapqa.jobs.rendered import html_report
 from mocapqa.pipeline.options import AnalysisOptions
 
 __all__ = ["router"]
@@ -65,6 +66,8 @@ def get_frames(
 ) -> Response:
     """Raw and corrected point positions for frames ``start:stop:step`` (file units).
 
+    A missing point (a keypoint not detected in that frame) is ``[null, null, null]``.
+
     The step grows so that at most ``max_frames`` frames come back; the answer states the
     frame indices it holds.
     """
@@ -92,7 +95,24 @@ def get_frames(
         "corrected": np.round(corrected[frames].astype(np.float64), 3).tolist(),
     }
     # Plain json.dumps: FastAPI's encoder would walk each of the ~10^5 numbers in Python.
-    return Response(json.dumps(payload, separators=(",", ":")), media_type="application/json")
+    # Missing points are NaN in the store; JSON has no NaN, so they go out as null (no number
+    # literal contains "NaN", so the replacement touches nothing else).
+    body = json.dumps(payload, separators=(",", ":")).replace("NaN", "null")
+    return Response(body, media_type="application/json")
+
+
+@router.get("/runs/{run_id}/download/report.html", response_class=Response)
+def download_html_report(run_id: str, services: ServicesDep) -> Response:
+    """The self-contained HTML QA report of a finished run (built on first request)."""
+    run = services.repository.require_done(run_id)
+    take = services.repository.get_take(str(run["take_id"]))
+    body = html_report(services.files, run_id, take, services.renderer)
+    stem = str(take["file_name"]).rsplit(".", 1)[0]
+    return Response(
+        body,
+        media_type="text/html",
+        headers={"Content-Disposition": f'attachment; filename="{stem}.report.html"'},
+    )
 
 
 @router.get("/runs/{run_id}/download/{kind}", response_class=FileResponse)

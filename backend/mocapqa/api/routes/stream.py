@@ -1,6 +1,8 @@
 """``WS /stream/filter``: filter a live keypoint stream frame by frame.
 
-Protocol (JSON text messages): the client first sends ``{"fps": 30, "n_keypoints": K}``, then
+Protocol (JSON text messages): the client first sends ``{"fps": 30, "n_keypoints": K}``, with
+optionally ``"length_unit"`` (m, cm, mm, in, px, normalized, unknown; default unknown) and
+``"preset"`` (a preset of the adaptive filter; default ``default``), then
 one ``{"positions": [[x, y, z], ...], "confidence": [...]}`` per frame; the server answers each
 frame with ``{"frame": i, "positions": [...], "weights": {...}}``, or ``{"error": message}``
 and closes (code 1003) on bad input.
@@ -28,14 +30,35 @@ def _number(message: dict[str, Any], key: str) -> float:
     return float(value)
 
 
+def _text(message: dict[str, Any], key: str, default: str) -> str:
+    value = message.get(key, default)
+    if not isinstance(value, str):
+        raise TypeError(f"Expected a string for {key!r}, got {value!r}")
+    return value
+
+
 @router.websocket("/stream/filter")
 async def stream_filter(websocket: WebSocket) -> None:
     """Filter frames as they arrive with the streaming adaptive filter."""
     await websocket.accept()
     try:
         first = await websocket.receive_json()
-        session = StreamSession(_number(first, "fps"), int(_number(first, "n_keypoints")))
-        await websocket.send_json({"ready": True, "n_keypoints": session.n_keypoints})
+        if not isinstance(first, dict):
+            raise TypeError(f"Expected a JSON object first, got {type(first).__name__}")
+        session = StreamSession(
+            _number(first, "fps"),
+            int(_number(first, "n_keypoints")),
+            _text(first, "length_unit", "unknown"),
+            _text(first, "preset", "default"),
+        )
+        await websocket.send_json(
+            {
+                "ready": True,
+                "n_keypoints": session.n_keypoints,
+                "length_unit": session.length_unit,
+                "preset": session.preset,
+            }
+        )
         while True:
             message = await websocket.receive_json()
             if not isinstance(message, dict):

@@ -11,6 +11,7 @@ from mocapqa.api.schemas import TakeCreatedOut, TakeDetailOut, TakeOut, TakePage
 from mocapqa.api.views import review_out, run_out, take_fields
 from mocapqa.errors import TooLargeError
 from mocapqa.jobs.intake import ingest_take
+from mocapqa.jobs.rendered import THUMBNAIL_PNG
 from mocapqa.jobs.thumbnails import thumbnail_svg
 
 __all__ = ["router"]
@@ -76,7 +77,14 @@ def delete_take(take: TakeDep, services: ServicesDep) -> Response:
 
 @router.get("/{take_id}/thumbnail", response_class=Response)
 def thumbnail(take: TakeDep, services: ServicesDep) -> Response:
-    """A small picture of the take (SVG; a placeholder until a run has points)."""
+    """A small picture of the take: the rendered PNG of the latest run, else an SVG (a
+    placeholder until a run has points; a line drawing when rendering is unavailable)."""
     run_id = take.get("latest_run_id")
+    if run_id:
+        png = services.files.run_dir(str(run_id)) / THUMBNAIL_PNG
+        if png.is_file():
+            return Response(
+                png.read_bytes(), media_type="image/png", headers={"Cache-Control": "max-age=60"}
+            )
     body = thumbnail_svg(services.files, str(run_id) if run_id else None, str(take["name"]))
     return Response(body, media_type="image/svg+xml", headers={"Cache-Control": "max-age=60"})
