@@ -88,10 +88,21 @@ def normalize(quats: FloatArray) -> FloatArray:
 
 def rotate(quats: FloatArray, vectors: FloatArray) -> FloatArray:
     """Rotate ``vectors (..., 3)`` by unit ``quats (..., 4)`` (broadcast), shape ``(..., 3)``."""
-    u = quats[..., :3]
-    w = quats[..., 3:4]
-    t = 2.0 * np.cross(u, vectors)
-    return vectors + w * t + np.cross(u, t)
+    # v + w·t + u × t with t = 2 u × v, written per component: np.cross spends most of its
+    # time moving axes (5× slower on (F, J, 3) batches).
+    x, y, z, w = quats[..., 0], quats[..., 1], quats[..., 2], quats[..., 3]
+    vx, vy, vz = vectors[..., 0], vectors[..., 1], vectors[..., 2]
+    tx = 2.0 * (y * vz - z * vy)
+    ty = 2.0 * (z * vx - x * vz)
+    tz = 2.0 * (x * vy - y * vx)
+    return np.stack(
+        (
+            vx + w * tx + (y * tz - z * ty),
+            vy + w * ty + (z * tx - x * tz),
+            vz + w * tz + (x * ty - y * tx),
+        ),
+        axis=-1,
+    )
 
 
 def quats_from_axis_angle(axes: FloatArray, angles_rad: FloatArray | float) -> FloatArray:
