@@ -50,3 +50,19 @@ def test_bad_training_settings_are_refused() -> None:
         DiscriminatorParams(hidden_sizes=(0,))
     with pytest.raises(InputError, match="Expected `activation`"):
         DiscriminatorParams(activation="sigmoid")
+    with pytest.raises(InputError, match="Expected `solver`"):
+        DiscriminatorParams(solver="sgd")
+
+
+def test_both_solvers_store_a_network_that_reproduces_its_scores() -> None:
+    from mocapqa.limits.occupancy import is_valid
+
+    occupancy = _blob_map()
+    for solver in ("lbfgs", "adam"):
+        settings = DiscriminatorParams(n_valid=1000, hidden_sizes=(8,), max_iter=200, solver=solver)
+        network, scores = train_discriminator(occupancy, settings, np.random.default_rng(3))
+        # The stored network takes raw radians: the input standardisation is folded into it.
+        fresh, labels = synthetic_labels(occupancy, 1000, np.random.default_rng(4))
+        assert np.mean(network_valid(network, fresh) == labels) > 0.85
+        assert np.array_equal(labels, is_valid(occupancy, fresh))
+        assert 0.85 < scores.accuracy <= 1.0

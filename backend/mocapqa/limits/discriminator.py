@@ -10,8 +10,15 @@ the interval), which has the distribution of rejection sampling from the cube wi
 on sparse maps. Several networks (hidden sizes 4–32, a few seeds) are trained with scikit-learn;
 the one with the best validation accuracy is kept and scored once on the test set.
 
+Training inputs are standardised: centred on the mean of the valid training samples and divided
+by twice their standard deviation, so the valid region spans about ``[−1, 1]`` on each axis
+whatever its size. The default solver is full-batch L-BFGS, which on these small sets reaches a
+tighter boundary than Adam in fewer passes; BLAS runs on one thread while training (several
+threads only contend on matrices this small).
+
 A trained network is stored as plain arrays (:class:`Network`) and evaluated with numpy, so a
-model file never holds pickled objects. Inputs are the parameters divided by π.
+model file never holds pickled objects. Stored inputs are the parameters divided by π: the
+standardisation is folded into the hidden layer's weights and biases.
 """
 
 from __future__ import annotations
@@ -35,6 +42,7 @@ __all__ = [
 ]
 
 _ACTIVATIONS = ("relu", "tanh")
+_SOLVERS = ("lbfgs", "adam")
 
 
 @dataclass(frozen=True, slots=True)
@@ -50,15 +58,17 @@ class DiscriminatorParams:
     seeds_per_size : int
         Networks trained per hidden size; ensemble size = sizes × seeds (paper: 20 in all).
     max_iter : int
-        Training epochs per network (Adam).
+        Iterations per network: L-BFGS iterations, or Adam epochs (learning rate 0.01).
     activation : {"relu", "tanh"}
+    solver : {"lbfgs", "adam"}
     """
 
     n_valid: int = 5000
     hidden_sizes: tuple[int, ...] = (16, 32)
     seeds_per_size: int = 1
-    max_iter: int = 400
+    max_iter: int = 1500
     activation: str = "tanh"
+    solver: str = "lbfgs"
 
     def __post_init__(self) -> None:
         if self.n_valid < 20 or self.seeds_per_size < 1 or self.max_iter < 1:
@@ -70,6 +80,8 @@ class DiscriminatorParams:
             raise InputError(f"Expected hidden sizes in 1..256, got {self.hidden_sizes}")
         if self.activation not in _ACTIVATIONS:
             raise InputError(f"Expected `activation` in {_ACTIVATIONS}, got {self.activation!r}")
+        if self.solver not in _SOLVERS:
+            raise InputError(f"Expected `solver` in {_SOLVERS}, got {self.solver!r}")
 
 
 @dataclass(frozen=True, slots=True)
@@ -203,28 +215,45 @@ def train_discriminator(
     """
     from sklearn.exceptions import ConvergenceWarning
     from sklearn.neural_network import MLPClassifier
+    from threadpoolctl import threadpool_limits  # type: ignore[import-untyped]
 
     params, labels = synthetic_labels(occupancy, settings.n_valid, rng)
     n = params.shape[0]
     n_train, n_val = int(0.70 * n), int(0.15 * n)
-    x = params / np.pi
     train, val, test = slice(0, n_train), slice(n_train, n_train + n_val), slice(n_train + n_val, n)
+    inside = params[train][labels[train]]
+    centre = inside.mean(axis=0)
+    spread = np.maximum(2.0 * inside.std(axis=0), 1e-3)
+    x = (params - centre) / spread
     best: tuple[float, Network, int] | None = None
     for size in settings.hidden_sizes:
         for _ in range(settings.seeds_per_size):
-            classifier = MLPClassifier(
-                hidden_layer_sizes=(size,),
-                activation=settings.activation,
-                max_iter=settings.max_iter,
-                learning_rate_init=0.01,
-                random_state=int(rng.integers(2**31 - 1)),
-            )
-            with warnings.catch_warnings():
+            seed = int(rng.integers(2**31 - 1))
+            if settings.solver == "lbfgs":
+                classifier = MLPClassifier(
+                    hidden_layer_sizes=(size,),
+                    activation=settings.activation,
+                    solver="lbfgs",
+                    max_iter=settings.max_iter,
+                    max_fun=10 * settings.max_iter,
+                    tol=0.0,
+                    random_state=seed,
+                )
+            else:
+                classifier = MLPClassifier(
+                    hidden_layer_sizes=(size,),
+                    activation=settings.activation,
+                    max_iter=settings.max_iter,
+                    learning_rate_init=0.01,
+                    random_state=seed,
+                )
+            with warnings.catch_warnings(), threadpool_limits(limits=1, user_api="blas"):
                 warnings.simplefilter("ignore", ConvergenceWarning)
                 classifier.fit(x[train], labels[train])
+            weights = classifier.coefs_[0]
             network = Network(
-                hidden_weights=classifier.coefs_[0],
-                hidden_biases=classifier.intercepts_[0],
+                hidden_weights=weights * (np.pi / spread)[:, None],
+                hidden_biases=classifier.intercepts_[0] - (centre / spread) @ weights,
                 output_weights=classifier.coefs_[1][:, 0],
                 output_bias=float(classifier.intercepts_[1][0]),
                 activation=settings.activation,
