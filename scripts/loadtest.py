@@ -8,6 +8,8 @@ and the error count; exits non-zero on any error. Every loop is bounded in count
 
 ``--big`` also times one 10,000-frame, 31-joint take (the CMU walk tiled) and the bytes a take
 view transfers on first load (page, scripts, Plotly, result and the first frame window, gzip).
+``--paint`` then opens that take view in Debian's headless Chromium and prints the browser's
+own first-contentful-paint time and the time until both 3D views hold data.
 
     .venv/bin/python scripts/loadtest.py --clients 20 --big
 """
@@ -103,7 +105,7 @@ def one_client(base: str, path: Path, stats: dict[str, list[float]], errors: lis
             errors.append(f"{type(e).__name__}: {e}")
 
 
-def big_take(base: str, corpus: Path, folder: Path) -> None:
+def big_take(base: str, corpus: Path, folder: Path, paint: bool = False) -> None:
     walk = read_bvh(corpus / "bvh/cmu/cmu_12_01_walk.bvh")
     reps = int(np.ceil(10_000 / (walk.n_frames - 1)))
     quats = np.concatenate([walk.quats[1:]] * reps)[:10_000]
@@ -156,6 +158,48 @@ def big_take(base: str, corpus: Path, folder: Path) -> None:
         print(
             f"take view first load transfers {sent / 1e6:.2f} MB over {len(urls)} requests (gzip)"
         )
+        if paint:
+            first_paint(base + "/" + f"#/take/{created['id']}?run={created['run_id']}")
+
+
+CHROMIUM_ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-dev-shm-usage",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
+]
+
+
+def first_paint(url: str) -> None:
+    """Open ``url`` in a fresh headless Chromium; print paint and 3D-ready times (cold cache)."""
+    from playwright.sync_api import sync_playwright
+
+    script = """() => new Promise((resolve) => {
+      const ready = () => ['view-raw', 'view-corrected'].every((id) => {
+        const d = document.getElementById(id); return d && d.data && d.data.length > 0; });
+      const tick = () => ready() ? resolve(performance.now()) : setTimeout(tick, 20);
+      tick(); })"""
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(
+            executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS
+        )
+        for attempt in ("cold", "warm"):
+            page = browser.new_page(viewport={"width": 1400, "height": 1000})
+            page.goto(url, wait_until="commit")
+            views_ms = page.evaluate(script)
+            fcp_ms = page.evaluate(
+                "() => (performance.getEntriesByName('first-contentful-paint')[0] || {}).startTime"
+            )
+            print(
+                f"take view ({attempt} page): first contentful paint {fcp_ms / 1000:.2f} s, "
+                f"both 3D views drawn {views_ms / 1000:.2f} s"
+            )
+            page.close()
+        browser.close()
 
 
 def main() -> int:
@@ -163,6 +207,9 @@ def main() -> int:
     parser.add_argument("--clients", type=int, default=20)
     parser.add_argument("--url", default=None, help="a loopback server (default: start one)")
     parser.add_argument("--big", action="store_true", help="also time a 10,000-frame take")
+    parser.add_argument(
+        "--paint", action="store_true", help="with --big: time the take view in headless Chromium"
+    )
     args = parser.parse_args()
     corpus = find_corpus()
     if corpus is None:
@@ -206,7 +253,7 @@ def main() -> int:
         for error in errors[:10]:
             print("error:", error)
         if args.big:
-            big_take(base, corpus, folder)
+            big_take(base, corpus, folder, paint=args.paint)
         if server is not None:
             server.should_exit = True  # type: ignore[attr-defined]
             thread.join(timeout=10)
