@@ -35,6 +35,7 @@ sys.path.insert(0, str(ROOT / "backend"))
 sys.path.insert(0, str(ROOT / "tests"))
 
 from conftest import find_corpus  # noqa: E402
+from headless_chromium import CHROMIUM_ARGS, CHROMIUM_PATH  # noqa: E402
 from mocapqa.io.bvh import format_bvh, read_bvh  # noqa: E402
 
 DEADLINE_S = 300.0
@@ -162,18 +163,6 @@ def big_take(base: str, corpus: Path, folder: Path, paint: bool = False) -> None
             first_paint(base + "/" + f"#/take/{created['id']}?run={created['run_id']}")
 
 
-CHROMIUM_ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-dev-shm-usage",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
-
-
 def first_paint(url: str) -> None:
     """Open ``url`` in a fresh headless Chromium; print paint and 3D-ready times (cold cache)."""
     from playwright.sync_api import sync_playwright
@@ -184,9 +173,7 @@ def first_paint(url: str) -> None:
       const tick = () => ready() ? resolve(performance.now()) : setTimeout(tick, 20);
       tick(); })"""
     with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(
-            executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS
-        )
+        browser = playwright.chromium.launch(executable_path=CHROMIUM_PATH, args=CHROMIUM_ARGS)
         for attempt in ("cold", "warm"):
             page = browser.new_page(viewport={"width": 1400, "height": 1000})
             page.goto(url, wait_until="commit")

@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 import uvicorn
 
+from headless_chromium import CHROMIUM_ARGS, CHROMIUM_PATH
 from mocapqa.api.app import create_app
 from mocapqa.config import Settings
 from mocapqa.io.bvh import parse_bvh, read_bvh
@@ -22,17 +23,6 @@ from mocapqa.jobs.demo import demo_paths
 pytestmark = pytest.mark.browser
 
 ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts"
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-dev-shm-usage",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
 
 
 @pytest.fixture(scope="module")
@@ -62,7 +52,7 @@ def browser() -> Iterator[object]:
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as playwright:
-        chromium = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        chromium = playwright.chromium.launch(executable_path=CHROMIUM_PATH, args=CHROMIUM_ARGS)
         yield chromium
         chromium.close()
 

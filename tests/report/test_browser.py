@@ -6,20 +6,10 @@ from pathlib import Path
 
 import pytest
 
+from headless_chromium import CHROMIUM_ARGS, CHROMIUM_PATH
 from mocapqa.cli.main import main
 
 KICK = "bvh/bandai/dataset-1_kick_normal_001.bvh"
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-dev-shm-usage",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +28,7 @@ def test_report_opens_offline_with_plots_and_contact_sheet(report_file: Path) ->
     console_errors: list[str] = []
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(
-            executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS
+            executable_path=CHROMIUM_PATH, headless=True, args=CHROMIUM_ARGS
         )
         try:
             context = browser.new_context(offline=True, viewport={"width": 1200, "height": 900})
