@@ -252,15 +252,17 @@ class AdaptiveFilter:
             if conf.shape != (k,):
                 check_shape(conf, "confidence", (k,))
         z = frame.reshape(-1)
-        c = np.repeat(conf, 3)
         if self.innovation:
             # The batch loop over one frame: the same compiled code as adaptive_filter.
             out = np.empty((1, 3 * k))
             weights = np.empty((1, k, 3))
-            flags = np.empty((1, 3 * k))
-            adaptive_batch(z[None], c[None], self.settings, *self.kernel_state, out, weights, flags)
-            self.bridged = flags.reshape(k, 3).max(axis=1) > 0.5
+            flags = np.empty((1, k), dtype=bool)
+            adaptive_batch(
+                z[None], conf[None], self.settings, *self.kernel_state, out, weights, flags
+            )
+            self.bridged = flags[0]
             return out.reshape(k, 3), weights[0]
+        c = np.repeat(conf, 3)
         p = self.params
         xk = self.kalman.update(z, c)
         bridged = self.kalman.bridged
@@ -311,12 +313,12 @@ def adaptive_filter(
     if f.innovation:
         conf = np.ones((n, k)) if confidence is None else np.asarray(confidence, np.float64)
         flat = np.ascontiguousarray(positions.reshape(n, 3 * k))
-        c3 = np.ascontiguousarray(np.repeat(conf, 3, axis=1))
         out_flat = np.empty((n, 3 * k))
         w = np.empty((n, k, 3))
-        flags = np.empty((n, 3 * k))
-        adaptive_batch(flat, c3, f.settings, *f.kernel_state, out_flat, w, flags)
-        bridged = flags.reshape(n, k, 3).max(axis=2) > 0.5
+        bridged = np.empty((n, k), dtype=bool)
+        adaptive_batch(
+            flat, np.ascontiguousarray(conf), f.settings, *f.kernel_state, out_flat, w, bridged
+        )
         return AdaptiveResult(out_flat.reshape(n, k, 3), w, bridged)
     out = np.empty_like(positions)
     weights = np.empty((n, k, 3))

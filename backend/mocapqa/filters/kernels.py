@@ -19,17 +19,18 @@ import math
 import numpy as np
 from numba import njit
 
-from mocapqa.core.arrays import FloatArray
+from mocapqa.core.arrays import BoolArray, FloatArray
 
 __all__ = [
     "adaptive_batch",
+    "adaptive_frame",
     "adaptive_step",
     "quat_pd_batch",
     "quat_pd_step",
 ]
 
 
-def _adaptive_step(
+def _adaptive_frame(
     z: FloatArray,
     c: FloatArray,
     settings: FloatArray,
@@ -39,14 +40,18 @@ def _adaptive_step(
     mse: FloatArray,
     out: FloatArray,
     weights: FloatArray,
-    bridged: FloatArray,
+    bridged: BoolArray,
+    scratch: FloatArray,
+    drift: FloatArray,
 ) -> None:
     """One frame of the innovation-weighted blend over ``N = 3K`` channels, in place.
 
     Parameters
     ----------
-    z, c : ndarray, shape (N,)
-        Measurements (NaN where missing) and confidences.
+    z : ndarray, shape (N,)
+        Measurements, NaN where missing.
+    c : ndarray, shape (K,)
+        Confidence per keypoint (shared by its three channels).
     settings : ndarray, shape (23,)
         Packed parameters, see :func:`mocapqa.filters.adaptive.pack_settings`.
     kstate : ndarray, shape (6, N)
@@ -61,8 +66,12 @@ def _adaptive_step(
         Blended output (written).
     weights : ndarray, shape (K, 3)
         Weights (written).
-    bridged : ndarray, shape (N,)
-        1.0 where the Kalman filter bridged the sample (written).
+    bridged : ndarray of bool, shape (K,)
+        True where the Kalman filter bridged any of the keypoint's channels (written).
+    scratch : ndarray, shape (6, N)
+        Work space: squared innovations and filter outputs (overwritten).
+    drift : ndarray, shape (2, 3)
+        Work space: body velocity sums and counts per axis (overwritten).
     """
     dt, fps = settings[0], settings[1]
     q00, q01, q11 = settings[2], settings[3], settings[4]
@@ -74,92 +83,98 @@ def _adaptive_step(
     body_prior = settings[22]
     n = z.shape[0]
     k = n // 3
-    sq = np.empty((3, n))
-    xs = np.empty((3, n))
+    sq = scratch[0:3]
+    xs = scratch[3:6]
+    body = drift[0]
+    count = drift[1]
     # Mean velocity per axis of the started channels: the whole body's drift, toward which a
     # bridged channel's velocity relaxes (a walking person's hidden wrist keeps walking).
-    body = np.zeros(3)
-    count = np.zeros(3)
+    for d in range(3):
+        body[d] = 0.0
+        count[d] = 0.0
+    for kp in range(k):
+        bridged[kp] = False
     for i in range(n):
         if kstate[5, i] > 0.5:
             body[i % 3] += kstate[1, i]
             count[i % 3] += 1.0
     for d in range(3):
         body[d] = body[d] / count[d] if count[d] > 0 else 0.0
-    for i in range(n):
-        x0, x1 = kstate[0, i], kstate[1, i]
-        started = kstate[5, i] > 0.5
-        pred_k = x0 + dt * x1 if started else np.nan
-        pos = x0 + dt * x1
-        vel = x1
-        p00 = kstate[2, i] + 2.0 * dt * kstate[3, i] + dt * dt * kstate[4, i] + q00
-        p01 = kstate[3, i] + dt * kstate[4, i] + q01
-        p11 = kstate[4, i] + q11
-        zi, ci = z[i], c[i]
-        valid = (not math.isnan(zi)) and ci > kminc
+    for kp in range(k):
+        # Confidence, and so the measurement noise, is shared by a keypoint's channels.
+        ci = c[kp]
         r = mr / max(ci * ci, 1e-6) if cw > 0.5 else mr
-        if valid and not started:
-            pos, vel, p00, p01, p11 = zi, 0.0, r, 0.0, 100.0 * q11
-            started = True
-        y = zi - pos if valid else 0.0
-        s = p00 + r
-        if gate2 > 0.0:
-            inside = y * y <= gate2 * s
-            reacquire = valid and (not inside) and krun[i] >= reacq_n
-            if reacquire:
-                p00 += y * y
-                p11 += y * y * (0.5 / dt) ** 2
-                s = p00 + r
-            gated = valid and (not inside) and (not reacquire)
-            krun[i] = krun[i] + 1.0 if gated else 0.0
-            if gated:
-                valid = False
-                y = 0.0
-        g0 = p00 / s if valid else 0.0
-        g1 = p01 / s if valid else 0.0
-        pos += g0 * y
-        vel += g1 * y
-        if (not valid) and decay_v < 1.0:
-            target = body[i % 3] if body_prior > 0.5 else 0.0
-            vel = target + decay_v * (vel - target)
-        p11 -= g1 * p01
-        p01 *= 1.0 - g0
-        p00 *= 1.0 - g0
-        kstate[0, i], kstate[1, i] = pos, vel
-        kstate[2, i], kstate[3, i], kstate[4, i] = p00, p01, p11
-        kstate[5, i] = 1.0 if started else 0.0
-        xk = pos if started else np.nan
-        bridged[i] = 0.0 if valid else 1.0
-        zo, co = zi, ci
-        if share > 0.5 and not valid:
-            zo, co = xk, 1.0
-        # One Euro.
-        prev = other[0, i]
-        pred_e = prev
-        ok = (not math.isnan(zo)) and co > ominc
-        if ok:
-            if math.isnan(prev):
-                prev = zo
-            dxh = other[1, i] + alpha_d * ((zo - prev) * fps - other[1, i])
-            cutoff = minw + betaw * abs(dxh)
-            other[0, i] = prev + cutoff / (cutoff + fps) * (zo - prev)
-            other[1, i] = dxh
-        # EMA.
-        prev = other[2, i]
-        pred_a = prev
-        if (not math.isnan(zo)) and co > aminc:
-            if math.isnan(prev):
-                prev = zo
-            other[2, i] = prev + ema_alpha * (zo - prev)
-        xs[0, i], xs[1, i], xs[2, i] = xk, other[0, i], other[2, i]
-        usable = valid
-        for f, pred in enumerate((pred_k, pred_e, pred_a)):
-            e = zi - pred
-            sq[f, i] = e * e
-            if math.isnan(e):
-                usable = False
-        if not usable:
-            sq[0, i] = np.nan
+        for d in range(3):
+            i = 3 * kp + d
+            x0, x1 = kstate[0, i], kstate[1, i]
+            started = kstate[5, i] > 0.5
+            pred_k = x0 + dt * x1 if started else np.nan
+            pos = x0 + dt * x1
+            vel = x1
+            p00 = kstate[2, i] + 2.0 * dt * kstate[3, i] + dt * dt * kstate[4, i] + q00
+            p01 = kstate[3, i] + dt * kstate[4, i] + q01
+            p11 = kstate[4, i] + q11
+            zi = z[i]
+            valid = (not math.isnan(zi)) and ci > kminc
+            if valid and not started:
+                pos, vel, p00, p01, p11 = zi, 0.0, r, 0.0, 100.0 * q11
+                started = True
+            y = zi - pos if valid else 0.0
+            s = p00 + r
+            if gate2 > 0.0:
+                inside = y * y <= gate2 * s
+                reacquire = valid and (not inside) and krun[i] >= reacq_n
+                if reacquire:
+                    p00 += y * y
+                    p11 += y * y * (0.5 / dt) ** 2
+                    s = p00 + r
+                gated = valid and (not inside) and (not reacquire)
+                krun[i] = krun[i] + 1.0 if gated else 0.0
+                if gated:
+                    valid = False
+                    y = 0.0
+            g0 = p00 / s if valid else 0.0
+            g1 = p01 / s if valid else 0.0
+            pos += g0 * y
+            vel += g1 * y
+            if (not valid) and decay_v < 1.0:
+                target = body[i % 3] if body_prior > 0.5 else 0.0
+                vel = target + decay_v * (vel - target)
+            p11 -= g1 * p01
+            p01 *= 1.0 - g0
+            p00 *= 1.0 - g0
+            kstate[0, i], kstate[1, i] = pos, vel
+            kstate[2, i], kstate[3, i], kstate[4, i] = p00, p01, p11
+            kstate[5, i] = 1.0 if started else 0.0
+            xk = pos if started else np.nan
+            if not valid:
+                bridged[kp] = True
+            zo, co = zi, ci
+            if share > 0.5 and not valid:
+                zo, co = xk, 1.0
+            # One Euro.
+            prev = other[0, i]
+            pred_e = prev
+            ok = (not math.isnan(zo)) and co > ominc
+            if ok:
+                if math.isnan(prev):
+                    prev = zo
+                dxh = other[1, i] + alpha_d * ((zo - prev) * fps - other[1, i])
+                cutoff = minw + betaw * abs(dxh)
+                other[0, i] = prev + cutoff / (cutoff + fps) * (zo - prev)
+                other[1, i] = dxh
+            # EMA.
+            prev = other[2, i]
+            pred_a = prev
+            if (not math.isnan(zo)) and co > aminc:
+                if math.isnan(prev):
+                    prev = zo
+                other[2, i] = prev + ema_alpha * (zo - prev)
+            xs[0, i], xs[1, i], xs[2, i] = xk, other[0, i], other[2, i]
+            ek, ee, ea = zi - pred_k, zi - pred_e, zi - pred_a
+            sq[0, i], sq[1, i], sq[2, i] = ek * ek, ee * ee, ea * ea
+            if not (valid and not (math.isnan(ek) or math.isnan(ee) or math.isnan(ea))):
+                sq[0, i] = np.nan
     for kp in range(k):
         good = True
         for d in range(3):
@@ -190,6 +205,40 @@ def _adaptive_step(
             out[i] = blend + weights[kp, 2] * xs[2, i] + lead * kstate[1, i]
 
 
+# Compiled kernel: one frame of the blend with caller-owned work space (see _adaptive_frame).
+adaptive_frame = njit(cache=True)(_adaptive_frame)
+
+
+def _adaptive_step(
+    z: FloatArray,
+    c: FloatArray,
+    settings: FloatArray,
+    kstate: FloatArray,
+    krun: FloatArray,
+    other: FloatArray,
+    mse: FloatArray,
+    out: FloatArray,
+    weights: FloatArray,
+    bridged: BoolArray,
+) -> None:
+    """:func:`adaptive_frame` with its own work space (arguments as there)."""
+    n = z.shape[0]
+    adaptive_frame(
+        z,
+        c,
+        settings,
+        kstate,
+        krun,
+        other,
+        mse,
+        out,
+        weights,
+        bridged,
+        np.empty((6, n)),
+        np.empty((2, 3)),
+    )
+
+
 # Compiled kernel: one frame of the innovation-weighted blend (see _adaptive_step).
 adaptive_step = njit(cache=True)(_adaptive_step)
 
@@ -204,16 +253,32 @@ def _adaptive_batch(
     mse: FloatArray,
     out: FloatArray,
     weights: FloatArray,
-    bridged: FloatArray,
+    bridged: BoolArray,
 ) -> None:
-    """:func:`adaptive_step` over frames (``z, c, out, bridged`` are ``(F, N)``)."""
+    """:func:`adaptive_frame` over frames: ``z, out`` are ``(F, N)``, ``c, bridged`` ``(F, K)``.
+
+    The work space is allocated once for all frames.
+    """
+    scratch = np.empty((6, z.shape[1]))
+    drift = np.empty((2, 3))
     for t in range(z.shape[0]):
-        adaptive_step(
-            z[t], c[t], settings, kstate, krun, other, mse, out[t], weights[t], bridged[t]
+        adaptive_frame(
+            z[t],
+            c[t],
+            settings,
+            kstate,
+            krun,
+            other,
+            mse,
+            out[t],
+            weights[t],
+            bridged[t],
+            scratch,
+            drift,
         )
 
 
-# Compiled kernel: frames of the blend, each by adaptive_step (see _adaptive_batch).
+# Compiled kernel: frames of the blend, each by adaptive_frame (see _adaptive_batch).
 adaptive_batch = njit(cache=True)(_adaptive_batch)
 
 
