@@ -17,6 +17,7 @@ import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.errors import InputError
+from mocapqa.filters.streaming import channel_count, run_streaming
 
 __all__ = ["EmaFilter", "EmaParams", "ema_filter", "time_constant_from_alpha"]
 
@@ -105,14 +106,4 @@ def ema_filter(
     filtered : ndarray, shape (F, ...)
     bridged : ndarray of bool, shape (F, ...)
     """
-    values = np.asarray(values, dtype=np.float64)
-    n = values.shape[0]
-    flat = values.reshape(n, -1)
-    conf = None if confidence is None else np.asarray(confidence, np.float64).reshape(n, -1)
-    f = EmaFilter(params, flat.shape[1], fps)
-    out = np.empty_like(flat)
-    bridged = np.empty(flat.shape, dtype=bool)
-    for t in range(n):
-        out[t] = f.update(flat[t], None if conf is None else conf[t])
-        bridged[t] = f.bridged
-    return out.reshape(values.shape), bridged.reshape(values.shape)
+    return run_streaming(EmaFilter(params, channel_count(values), fps), values, confidence)
