@@ -36,7 +36,8 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 from conftest import find_corpus  # noqa: E402
 from headless_chromium import CHROMIUM_ARGS, CHROMIUM_PATH  # noqa: E402
-from mocapqa.io.bvh import format_bvh, read_bvh  # noqa: E402
+from mocapqa.io.bvh import read_bvh  # noqa: E402
+from mocapqa.io.bvh_write import format_bvh  # noqa: E402
 
 DEADLINE_S = 300.0
 

@@ -11,7 +11,8 @@ import pytest
 
 from mocapqa.cli.main import main
 from mocapqa.core.keypoints import KeypointSequence
-from mocapqa.io.bvh import channel_values, read_bvh
+from mocapqa.io.bvh import read_bvh
+from mocapqa.io.bvh_write import channel_values
 from mocapqa.io.formats import read_take
 
 OPENPOSE = "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose/cam01_json"

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from mocapqa.core.motion import Motion
-from mocapqa.io.bvh import channel_values, format_bvh, parse_bvh, read_bvh
+from mocapqa.io.bvh import parse_bvh, read_bvh
+from mocapqa.io.bvh_write import channel_values, format_bvh
 
 PRECISION = 6
 

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from mocapqa.errors import InputError, ParseError
-from mocapqa.io.bvh import MAX_JOINTS, channel_values, parse_bvh, read_bvh
+from mocapqa.io.bvh import MAX_JOINTS, parse_bvh, read_bvh
+from mocapqa.io.bvh_write import channel_values
 
 # Line numbers are 1-based; the comments give them.
 GOOD_LINES = [

@@ -15,7 +15,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from mocapqa.core.motion import POSITION_CHANNELS, Motion
-from mocapqa.io.bvh import channel_values, read_bvh
+from mocapqa.io.bvh import read_bvh
+from mocapqa.io.bvh_write import channel_values
 from mocapqa.kinematics.forward import end_site_positions, forward_kinematics, world_from_local
 
 

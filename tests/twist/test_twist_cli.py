@@ -11,7 +11,8 @@ import pytest
 
 from mocapqa.cli.main import main
 from mocapqa.core.motion import Motion
-from mocapqa.io.bvh import read_bvh, write_bvh
+from mocapqa.io.bvh import read_bvh
+from mocapqa.io.bvh_write import write_bvh
 from mocapqa.twist.inject import inject_twist_errors
 
 

@@ -24,7 +24,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mocapqa.errors import InputError
-from mocapqa.io.bvh import format_bvh, read_bvh, write_bvh
+from mocapqa.io.bvh import read_bvh
+from mocapqa.io.bvh_write import format_bvh, write_bvh
 from mocapqa.kinematics.forward import end_site_positions, forward_kinematics
 
 __all__ = [

@@ -46,7 +46,7 @@ def filter_command(
     from mocapqa.core.motion import Motion
     from mocapqa.filters.apply import filter_keypoints, filter_motion
     from mocapqa.filters.registry import FILTERS
-    from mocapqa.io.bvh import write_bvh
+    from mocapqa.io.bvh_write import write_bvh
     from mocapqa.io.formats import read_take, write_keypoints
     from mocapqa.metrics.smoothness import lag_frames, mean_abs_jerk
 

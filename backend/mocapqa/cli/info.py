@@ -196,7 +196,7 @@ def convert_command(
 ) -> None:
     """Convert a take: BVH to BVH, keypoints between TRC, CSV, NPY, NPZ and JSON."""
     from mocapqa.core.motion import Motion
-    from mocapqa.io.bvh import write_bvh
+    from mocapqa.io.bvh_write import write_bvh
     from mocapqa.io.formats import KEYPOINT_WRITE_FORMATS, read_take, write_keypoints
 
     if fps is not None and not fps > 0:

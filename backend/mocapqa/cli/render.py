@@ -137,7 +137,8 @@ def render(
 
 def _long_take(source: Path, n_frames: int, folder: Path) -> Path:
     """A BVH of ``n_frames`` frames made by repeating a real take end to end."""
-    from mocapqa.io.bvh import read_bvh, write_bvh
+    from mocapqa.io.bvh import read_bvh
+    from mocapqa.io.bvh_write import write_bvh
 
     motion = read_bvh(source)
     index = np.arange(n_frames) % motion.n_frames

@@ -52,7 +52,8 @@ def refine(
     ] = None,
 ) -> None:
     """Remove axial twist errors; writes the take with the input's layout and frame time."""
-    from mocapqa.io.bvh import read_bvh, write_bvh
+    from mocapqa.io.bvh import read_bvh
+    from mocapqa.io.bvh_write import write_bvh
     from mocapqa.twist.analysis import analyze_twist
 
     _check_method(method)

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from mocapqa.errors import MocapQAError
-from mocapqa.io.bvh import format_bvh
+from mocapqa.io.bvh_write import format_bvh
 from mocapqa.jobs.rendered import render_thumbnail
 from mocapqa.pipeline.analyze import AnalysisResult, analyze
 from mocapqa.pipeline.loading import Take, read_take_file, write_keypoints_file
