@@ -75,23 +75,83 @@ def test_the_uncorrupted_take_reads(small_take: bytes) -> None:
     assert motion.n_frames == 4
 
 
+def outcome(data: bytes, name: str, reader: NumberReader) -> Motion | str:
+    """The parsed take, or the InputError's message; anything else fails the test."""
+    try:
+        return parse_bvh(data, name, number_reader=reader)
+    except InputError as e:
+        return str(e)
+    except Exception as e:  # the test's point: report what escaped, and on what
+        pytest.fail(f"{name}: {type(e).__name__}: {e}\n{data[:3000]!r}")
+
+
 def test_corrupted_takes_raise_only_input_errors(small_take: bytes) -> None:
+    """Both number readers give the same take or the same error on every corruption."""
     rng = np.random.default_rng(20240611)
-    readers: tuple[NumberReader, ...] = ("python", "arrow")
     outcomes = {"read": 0, "refused": 0}
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         for case in range(N_CASES):
             data = corrupt(small_take, rng)
-            try:
-                result = parse_bvh(data, f"case{case}.bvh", number_reader=readers[case % 2])
-            except InputError:
+            result = outcome(data, f"case{case}.bvh", "arrow")
+            careful = outcome(data, f"case{case}.bvh", "python")
+            if isinstance(result, str):
+                assert result == careful, f"case {case}"
                 outcomes["refused"] += 1
                 continue
-            except Exception as e:  # the test's point: report what escaped, and on what
-                pytest.fail(f"case {case}: {type(e).__name__}: {e}\n{data[:3000]!r}")
-            assert isinstance(result, Motion)
+            assert isinstance(careful, Motion), f"case {case}: {careful}"
+            np.testing.assert_array_equal(result.quats, careful.quats)
+            np.testing.assert_array_equal(result.translations, careful.translations)
             outcomes["read"] += 1
     # The corruptions must exercise both outcomes in earnest.
     assert outcomes["refused"] > N_CASES // 4
     assert outcomes["read"] > N_CASES // 50
+
+
+def frame_layouts(take: bytes) -> dict[str, bytes]:
+    """The take with its frame lines laid out in the ways exporters and editors write them."""
+    head, rest = take.split(b"Frame Time:", 1)
+    time_line, block = rest.split(b"\n", 1)
+    rows = [line.split() for line in block.splitlines() if line.strip()]
+
+    def joined(sep: bytes, end: bytes, lead: bytes = b"") -> bytes:
+        return b"".join(lead + sep.join(row) + end for row in rows)
+
+    layouts = {
+        "single spaces": joined(b" ", b"\n"),
+        "trailing space": joined(b" ", b" \n"),
+        "CRLF": joined(b" ", b"\r\n"),
+        "trailing space CRLF": joined(b" ", b" \r\n"),
+        "double spaces": joined(b"  ", b"\n"),
+        "leading space": joined(b" ", b"\n", b" "),
+        "tabs": joined(b"\t", b"\n"),
+        "blank lines": joined(b" ", b"\n\n"),
+        "whitespace-only lines": joined(b" ", b"\n \n"),
+        "no final newline": joined(b" ", b"\n")[:-1],
+        # Wrong: a lone CR is whitespace, so two frames share one line.
+        "lone CR": joined(b" ", b"\r"),
+        # Wrong: one value too many where the trailing space would be.
+        "extra value": joined(b" ", b" \n").replace(b" \n", b" 1\n", 1),
+        "extra value, last line": joined(b" ", b" \n")[:-2] + b" 1\n",
+        "mixed trailing spaces": joined(b" ", b" \n").replace(b" \n", b"\n", 1),
+        # Wrong: the first frame is one value short.
+        "missing value": joined(b" ", b" \n").replace(b" " + rows[0][-1] + b" \n", b" \n", 1),
+    }
+    return {
+        name: head + b"Frame Time:" + time_line + b"\n" + block for name, block in layouts.items()
+    }
+
+
+@pytest.mark.parametrize("layout", sorted(frame_layouts(b"Frame Time: 1\n1\n")))
+def test_number_readers_agree_on_frame_layouts(small_take: bytes, layout: str) -> None:
+    data = frame_layouts(small_take)[layout]
+    result = outcome(data, f"{layout}.bvh", "arrow")
+    careful = outcome(data, f"{layout}.bvh", "python")
+    if isinstance(careful, str):
+        assert result == careful
+        assert layout in {"lone CR", "extra value", "extra value, last line", "missing value"}
+    else:
+        assert isinstance(result, Motion), result
+        np.testing.assert_array_equal(result.quats, careful.quats)
+        np.testing.assert_array_equal(result.translations, careful.translations)
+        assert result.n_frames == 4

@@ -56,6 +56,12 @@ def frames_by_arrow(block: str, n_frames: int, n_channels: int) -> FloatArray | 
         raw = block.encode("ascii")
     except UnicodeEncodeError:
         return None
+    arrow, arrow_csv = _arrow()
+    if arrow is None:
+        return None
+    columns = _frames_by_columns(arrow, arrow_csv, raw, n_frames, n_channels)
+    if columns is not None:
+        return columns
     # Every non-blank line must hold exactly n_channels values: count token starts per line
     # on a copy where whitespace is " " and anything else "x".
     # A value starts at each " x" and at an "x" opening a line.
@@ -67,11 +73,6 @@ def frames_by_arrow(block: str, n_frames: int, n_channels: int) -> FloatArray | 
         return None
     n_tokens = sum(counts)
     if n_tokens != n_frames * n_channels:
-        return None
-    try:
-        arrow: Any = importlib.import_module("pyarrow")
-        arrow_csv: Any = importlib.import_module("pyarrow.csv")
-    except ImportError:
         return None
     try:
         table = arrow_csv.read_csv(
@@ -87,19 +88,101 @@ def frames_by_arrow(block: str, n_frames: int, n_channels: int) -> FloatArray | 
                 quoted_strings_can_be_null=False,
             ),
         )
-        # Straight from the buffers: Arrow's to_numpy() imports pandas (~0.3 s).
-        parts = []
-        for chunk in table.column(0).chunks:
-            if chunk.null_count:
-                return None
-            data = chunk.buffers()[1]
-            parts.append(np.frombuffer(data, np.float64, count=len(chunk), offset=8 * chunk.offset))
+        column = _float_column(table.column(0))
     except (arrow.ArrowException, ValueError):
         return None
-    column: FloatArray = np.concatenate(parts) if parts else np.zeros(0)
-    if column.shape != (n_tokens,) or not np.all(np.isfinite(column)):
+    if column is None or column.shape != (n_tokens,) or not np.all(np.isfinite(column)):
         return None
     return column.reshape(n_frames, n_channels)
+
+
+def _arrow() -> tuple[Any, Any]:
+    """pyarrow and pyarrow.csv, or (None, None) when pyarrow is not installed."""
+    try:
+        return importlib.import_module("pyarrow"), importlib.import_module("pyarrow.csv")
+    except ImportError:
+        return None, None
+
+
+def _frames_by_columns(
+    arrow: Any, arrow_csv: Any, raw: bytes, n_frames: int, n_channels: int
+) -> FloatArray | None:
+    """The common layout, one frame per line and one space between values, read as a table.
+
+    Arrow checks the layout itself: a line with another value count, a doubled or leading
+    space (an empty field) or a non-number fails the read, and the caller falls back. One
+    trailing space per line is allowed and must leave the extra column empty on every line.
+    About 3× faster than one value per row, as the per-row cost is paid once per frame.
+    """
+    end = raw.find(b"\n")
+    first = raw[: end if end >= 0 else len(raw)].rstrip(b"\r")
+    if b"\t" in raw[:4096] or _has_lone_cr(raw):
+        return None  # tabs; Arrow would end a line at a lone CR, BVH lines end only at LF
+    n_columns = n_channels + 1 if first.endswith(b" ") else n_channels
+    names = [str(i) for i in range(n_columns)]
+    types = dict.fromkeys(names[:n_channels], arrow.float64())
+    if n_columns > n_channels:
+        types[names[-1]] = arrow.string()
+    try:
+        table = arrow_csv.read_csv(
+            arrow.BufferReader(raw),
+            # Threads convert columns in parallel (~1.6× on two cores).
+            read_options=arrow_csv.ReadOptions(column_names=names, use_threads=True),
+            parse_options=arrow_csv.ParseOptions(
+                delimiter=" ", quote_char=False, escape_char=False, ignore_empty_lines=True
+            ),
+            convert_options=arrow_csv.ConvertOptions(
+                column_types=types,
+                null_values=[],
+                strings_can_be_null=False,
+                quoted_strings_can_be_null=False,
+            ),
+        )
+        if table.num_rows != n_frames:
+            return None
+        if n_columns > n_channels and any(map(_has_text, table.column(n_channels).chunks)):
+            return None
+        # One C++ call per batch (a loop over columns costs ~5 µs each); nulls raise.
+        batches = table.select(names[:n_channels]).to_batches()
+        values: FloatArray = np.concatenate(
+            [np.asarray(batch.to_tensor(null_to_nan=False, row_major=True)) for batch in batches]
+        )
+    except (arrow.ArrowException, ValueError):
+        return None
+    if values.shape != (n_frames, n_channels) or not np.all(np.isfinite(values)):
+        return None
+    return values
+
+
+def _has_lone_cr(raw: bytes) -> bool:
+    """Whether a CR stands anywhere but right before an LF (~0.1 ms for 0.5 MB)."""
+    if b"\r" not in raw:
+        return False
+    data = np.frombuffer(raw, np.uint8)
+    after = np.flatnonzero(data == 13) + 1
+    return bool(after[-1] == data.size or np.any(data[after] != 10))
+
+
+def _has_text(chunk: Any) -> bool:
+    """Whether a chunk of an Arrow string column holds any non-empty string."""
+    offsets = np.frombuffer(
+        chunk.buffers()[1], np.int32, count=len(chunk) + 1, offset=4 * chunk.offset
+    )
+    return bool(offsets[-1] != offsets[0])
+
+
+def _float_column(column: Any) -> FloatArray | None:
+    """A float64 Arrow column as numpy, or None if it holds nulls.
+
+    Straight from the buffers: Arrow's ``to_numpy()`` imports pandas (~0.3 s).
+    """
+    parts = []
+    for chunk in column.chunks:
+        if chunk.null_count:
+            return None
+        data = chunk.buffers()[1]
+        parts.append(np.frombuffer(data, np.float64, count=len(chunk), offset=8 * chunk.offset))
+    return np.concatenate(parts) if parts else np.zeros(0)
 
 
 def frames_by_line(
