@@ -27,6 +27,30 @@ def test_quats_from_euler_matches_scipy(order: str, angles: np.ndarray) -> None:
     assert rotation_gap(quats_from_euler(angles, order), expected) < 1e-12
 
 
+@pytest.mark.parametrize("order", EULER_ORDERS)
+def test_quats_from_euler_far_outside_one_turn(order: str) -> None:
+    """Unwrapped exports write angles of many turns; half-angle tangents pass every pole."""
+    rng = np.random.default_rng(7)
+    angles = np.concatenate(
+        (
+            rng.uniform(-1e4, 1e4, size=(500, 3)),
+            # Exact multiples of a half and a whole turn, where tan(angle / 4) peaks.
+            np.pi * rng.integers(-8, 9, size=(500, 3)),
+        )
+    )
+    expected = Rotation.from_euler(order, angles).as_quat()
+    assert rotation_gap(quats_from_euler(angles, order), expected) < 1e-12
+
+
+@pytest.mark.parametrize("order", EULER_ORDERS)
+def test_degrees_give_the_same_quaternions_as_converting_first(order: str) -> None:
+    angles_deg = np.random.default_rng(3).uniform(-720.0, 720.0, size=(2000, 3))
+    np.testing.assert_array_equal(
+        quats_from_euler(angles_deg, order, degrees=True),
+        quats_from_euler(np.deg2rad(angles_deg), order),
+    )
+
+
 @pytest.mark.filterwarnings("ignore:Gimbal lock detected:UserWarning")
 @pytest.mark.parametrize("order", EULER_ORDERS)
 @settings(deadline=None, max_examples=60)

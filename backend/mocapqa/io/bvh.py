@@ -365,7 +365,7 @@ def _motion_from_channels(
         # One rotation order on every joint (the usual case): no identity fill, no scatter.
         ((order, entries),) = by_order.items()
         euler_deg = np.take(values, np.array([c for _, c in entries]), axis=1)  # (F, J, 3)
-        quats = quats_from_euler(np.deg2rad(euler_deg), order)
+        quats = quats_from_euler(euler_deg, order, degrees=True)
     else:
         quats = np.zeros((n_frames, n_joints, 4))
         quats[..., 3] = 1.0
@@ -374,7 +374,7 @@ def _motion_from_channels(
             joints = [j for j, _ in entries]
             angles_deg = values[:, np.array([c for _, c in entries])]  # (F, n, 3)
             euler_deg[:, joints] = angles_deg
-            quats[:, joints] = quats_from_euler(np.deg2rad(angles_deg), order)
+            quats[:, joints] = quats_from_euler(angles_deg, order, degrees=True)
     offsets = np.array(parser.offsets, dtype=np.float64).reshape(n_joints, 3)
     mode = root_translation
     if mode == "auto":

@@ -109,7 +109,7 @@ def channel_values(motion: Motion) -> FloatArray:
         # Where the hint still describes the rotation, write it verbatim: near gimbal lock the
         # quaternion → Euler step loses digits that the file had. Compared by components, not
         # by angle: arccos near 1 turns a 1e-16 difference in the dot product into 1e-8 rad.
-        from_hint = quats_from_euler(np.deg2rad(hint_deg), order)
+        from_hint = quats_from_euler(hint_deg, order, degrees=True)
         gap = np.minimum(
             np.max(np.abs(from_hint - quats), axis=-1), np.max(np.abs(from_hint + quats), axis=-1)
         )

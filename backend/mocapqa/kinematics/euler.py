@@ -37,15 +37,18 @@ def _check_order(order: str) -> None:
         raise ShapeError(f"Expected a rotation order in {EULER_ORDERS}, got {order!r}")
 
 
-def quats_from_euler(angles_rad: FloatArray, order: str) -> FloatArray:
+def quats_from_euler(angles_rad: FloatArray, order: str, degrees: bool = False) -> FloatArray:
     """Unit quaternions from intrinsic Euler angles.
 
     Parameters
     ----------
     angles_rad : ndarray, shape (..., 3)
-        Angles in radians, in the order of ``order``.
+        Angles in radians, in the order of ``order`` (degrees when ``degrees``).
     order : str
         Intrinsic axis sequence such as ``"ZYX"``.
+    degrees : bool
+        Whether the angles are in degrees (as in scipy's ``Rotation.from_euler``). The result
+        equals that of ``np.deg2rad`` first, bit for bit, without the extra pass.
 
     Returns
     -------
@@ -56,8 +59,23 @@ def quats_from_euler(angles_rad: FloatArray, order: str) -> FloatArray:
     angles = np.asarray(angles_rad, dtype=np.float64)
     # Angle axis first and contiguous, so sin/cos run once over one block and every
     # component below is a contiguous (...) array.
-    half = np.multiply(0.5, np.moveaxis(angles, -1, 0), order="C")
-    cos, sin = np.cos(half), np.sin(half)
+    # sin and cos of the half angles from one tangent, t = tan(angle / 4):
+    # sin = 2t / (1 + t²), cos = (1 − t²) / (1 + t²). One transcendental call instead of two
+    # halves the cost (numpy's float64 sin and cos are scalar libm calls without AVX-512), and
+    # the error stays within a few ulp. It holds for every finite angle: tan never reaches
+    # infinity in floating point (π/2 is not representable) and t² cannot overflow.
+    # Computed in place: three buffers instead of nine, each a fresh page-faulted block.
+    # π/720 is π/180 divided by 4 exactly, so degrees give deg2rad's result times 0.25.
+    factor = 0.25 * (np.pi / 180.0) if degrees else 0.25
+    quarter_tan = np.multiply(factor, np.moveaxis(angles, -1, 0), order="C")
+    np.tan(quarter_tan, out=quarter_tan)
+    squared = np.square(quarter_tan)
+    scale = np.add(squared, 1.0)
+    np.reciprocal(scale, out=scale)
+    sin = np.multiply(quarter_tan, 2.0, out=quarter_tan)
+    sin *= scale
+    cos = np.subtract(1.0, squared, out=squared)
+    cos *= scale
     # Intrinsic sequence: q = q_a(a0) ⊗ q_b(a1) ⊗ q_c(a2) with q_axis(t) = cos(t/2) +
     # sin(t/2)·e_axis. With e_a·e_b = s·e_c (s the order's parity), e_b·e_c = s·e_a and
     # e_a·e_c = -s·e_b, the product is, in closed form (first the two left factors):
