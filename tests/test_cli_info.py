@@ -190,3 +190,25 @@ def test_bench_io_prints_its_tables(
     out = capsys.readouterr().out
     for label in ("read + FK", "write", "largest Bandai", "pybvh 0.9", "mocapqa info"):
         assert label in out
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["info", "--bogus", "x.bvh"], "No such option: --bogus"),
+        (["info"], "Missing argument"),
+        (["no-such-command"], "No such command"),
+    ],
+)
+def test_usage_errors_exit_2_without_a_traceback(
+    args: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert message in err
+    assert "Traceback" not in err
+
+
+def test_help_exits_0(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["--help"]) == 0
+    assert "info" in capsys.readouterr().out

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import sys
 
-import click
 from rich.markup import escape
 
 from mocapqa.cli import (
@@ -24,22 +23,22 @@ __all__ = ["main"]
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the CLI; user errors print one line and exit non-zero, without a traceback."""
+    """Run the CLI; user errors print one line and exit non-zero, without a traceback.
+
+    Typer runs in its standalone mode: it prints usage errors itself and ends every run with
+    ``SystemExit``, whose code is returned here, so no exception class of its bundled Click
+    is needed.
+    """
     try:
-        result = app(args=argv, standalone_mode=False)
-    except click.exceptions.Exit as e:
-        return int(e.exit_code)
-    except click.exceptions.Abort:
-        err_console.print("aborted")
-        return 130
-    except click.ClickException as e:
-        e.show()
-        return int(e.exit_code)
+        app(args=argv, prog_name="mocapqa")
+    except SystemExit as e:
+        code = e.code
+        return code if isinstance(code, int) else (0 if code is None else 1)
     except MocapQAError as e:
         # One line, never wrapped, and the message is not read as Rich markup.
         err_console.print(f"[bold red]error:[/] {escape(str(e))}", soft_wrap=True)
         return exit_code_for(e)
-    return int(result) if isinstance(result, int) else 0
+    return 0
 
 
 if __name__ == "__main__":
