@@ -22,7 +22,11 @@ def bench_io(
     files: Annotated[
         int | None, typer.Option(help="Only the first N BVH files (sorted by path).")
     ] = None,
-    info_runs: Annotated[int, typer.Option(help="Runs of the `mocapqa info` process.")] = 3,
+    info_runs: Annotated[int, typer.Option(help="Runs of the `mocapqa info` process.")] = 5,
+    headline_repeats: Annotated[
+        int,
+        typer.Option(help="Timed runs of the largest Bandai read and of the pybvh comparison."),
+    ] = 30,
 ) -> None:
     """Read, read + FK and write throughput (frames/s, MB/s); pybvh on the CMU walk."""
     from rich.console import Console
@@ -33,6 +37,7 @@ def bench_io(
     from mocapqa.bench.io import (
         IoBenchParams,
         Throughput,
+        best_time_s,
         info_process_time_s,
         pybvh_comparison,
         scratch_folder,
@@ -41,8 +46,11 @@ def bench_io(
         warm_up,
     )
     from mocapqa.errors import NotFoundError
+    from mocapqa.io.bvh import read_bvh
 
-    params = IoBenchParams(repeats=repeats, max_files=files, info_runs=info_runs)
+    params = IoBenchParams(
+        repeats=repeats, max_files=files, info_runs=info_runs, headline_repeats=headline_repeats
+    )
     root = require_corpus(data)
     paths = corpus_bvh_files(root)
     if not paths:
@@ -77,7 +85,8 @@ def bench_io(
     bandai = [t for t in timings if "bandai" in t.path.parts]
     if bandai:
         big = max(bandai, key=lambda t: t.n_bytes)
-        add(Throughput("read, largest Bandai", big.n_bytes, big.n_frames, big.read_s), 1)
+        big_read_s = best_time_s(lambda: read_bvh(big.path), params.headline_repeats)
+        add(Throughput("read, largest Bandai", big.n_bytes, big.n_frames, big_read_s), 1)
         table.caption = f"largest Bandai file: {big.path.name}"
     console.print(table)
 
@@ -89,7 +98,7 @@ def bench_io(
     for column in ("reader", "seconds", "frames/s", "MB/s"):
         compare.add_column(column, justify="left" if column == "reader" else "right")
     walk_timing = next(t for t in timings if t.path == walk)
-    pair = pybvh_comparison(walk, params.repeats)
+    pair = pybvh_comparison(walk, params.headline_repeats)
     if pair is None:
         console.print("pybvh is not installed (pip install '.[bench]'): no comparison")
     else:
