@@ -57,15 +57,15 @@ def quats_from_euler(angles_rad: FloatArray, order: str, degrees: bool = False) 
     """
     _check_order(order)
     angles = np.asarray(angles_rad, dtype=np.float64)
-    # Angle axis first and contiguous, so sin/cos run once over one block and every
-    # component below is a contiguous (...) array.
-    # sin and cos of the half angles from one tangent, t = tan(angle / 4):
-    # sin = 2t / (1 + t²), cos = (1 − t²) / (1 + t²). One transcendental call instead of two
-    # halves the cost (numpy's float64 sin and cos are scalar libm calls without AVX-512), and
-    # the error stays within a few ulp. It holds for every finite angle: tan never reaches
-    # infinity in floating point (π/2 is not representable) and t² cannot overflow.
-    # Computed in place: three buffers instead of nine, each a fresh page-faulted block.
-    # π/720 is π/180 divided by 4 exactly, so degrees give deg2rad's result times 0.25.
+    # Angle axis first and contiguous, so the sines and cosines below are computed over one
+    # block and every component is a contiguous (...) array. Both come from one tangent of
+    # the quarter angle, t = tan(angle / 4): sin = 2t / (1 + t²), cos = (1 − t²) / (1 + t²)
+    # for the half angle. One transcendental call instead of two halves the cost (numpy's
+    # float64 sin and cos are scalar libm calls without AVX-512) and the error stays within a
+    # few ulp. It holds for every finite angle: tan never reaches infinity in floating point
+    # (π/2 is not representable) and t² cannot overflow. Computed in place: three buffers
+    # instead of nine, each a fresh block to fault in. π/720 is π/180 divided by 4 exactly,
+    # so degrees give deg2rad's result times 0.25, bit for bit.
     factor = 0.25 * (np.pi / 180.0) if degrees else 0.25
     quarter_tan = np.multiply(factor, np.moveaxis(angles, -1, 0), order="C")
     np.tan(quarter_tan, out=quarter_tan)

@@ -63,8 +63,8 @@ class DiscriminatorParams:
     solver : {"lbfgs", "adam"}
     """
 
-    n_valid: int = 5000
-    hidden_sizes: tuple[int, ...] = (16, 32)
+    n_valid: int = 20000
+    hidden_sizes: tuple[int, ...] = (32,)
     seeds_per_size: int = 1
     max_iter: int = 1500
     activation: str = "tanh"
