@@ -228,20 +228,34 @@ class Motion:
         """Duration in seconds (frames × frame time)."""
         return self.n_frames / self.fps
 
+    def translation_channels(self) -> list[tuple[int, int, bool]]:
+        """Where the position channels go in the local translations.
+
+        Returns
+        -------
+        list of (joint, axis, add)
+            One entry per position channel: the joint, the axis (0, 1, 2 for X, Y, Z) and
+            whether the value adds to the OFFSET (a root with ``root_translation == "add"``)
+            rather than replacing it.
+        """
+        sk = self.skeleton
+        return [
+            (j, axis, bool(sk.parents[j] < 0 and sk.root_translation == "add"))
+            for j in range(sk.n_joints)
+            for axis, name in enumerate("XYZ")
+            if f"{name}position" in sk.channels[j]
+        ]
+
     def local_translations(self) -> FloatArray:
         """Translation of each joint from its parent, per frame, shape (F, J, 3), file units.
 
         The OFFSET, replaced by the position channels where a joint has them (or, for a root
         with ``root_translation == "add"``, the OFFSET plus the channels).
         """
-        sk = self.skeleton
-        out = np.broadcast_to(sk.offsets, self.translations.shape).copy()
-        for j in range(sk.n_joints):
-            if not sk.has_position_channels(j):
-                continue
-            present = [i for i, axis in enumerate("XYZ") if f"{axis}position" in sk.channels[j]]
-            if sk.parents[j] < 0 and sk.root_translation == "add":
-                out[:, j, present] += self.translations[:, j, present]
+        out = np.broadcast_to(self.skeleton.offsets, self.translations.shape).copy()
+        for j, axis, add in self.translation_channels():
+            if add:
+                out[:, j, axis] += self.translations[:, j, axis]
             else:
-                out[:, j, present] = self.translations[:, j, present]
+                out[:, j, axis] = self.translations[:, j, axis]
         return out

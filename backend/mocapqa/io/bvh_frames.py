@@ -144,9 +144,10 @@ def _frames_by_columns(
             return None
         # One C++ call per batch (a loop over columns costs ~5 µs each); nulls raise.
         batches = table.select(names[:n_channels]).to_batches()
-        values: FloatArray = np.concatenate(
-            [np.asarray(batch.to_tensor(null_to_nan=False, row_major=True)) for batch in batches]
-        )
+        blocks = [
+            np.asarray(batch.to_tensor(null_to_nan=False, row_major=True)) for batch in batches
+        ]
+        values: FloatArray = blocks[0] if len(blocks) == 1 else np.concatenate(blocks)
     except (arrow.ArrowException, ValueError):
         return None
     if values.shape != (n_frames, n_channels) or not np.all(np.isfinite(values)):

@@ -39,6 +39,15 @@ def world_from_local(
     world_quats : ndarray, shape (F, J, 4)
     world_positions : ndarray, shape (F, J, 3)
     """
+    lq = np.ascontiguousarray(np.transpose(local_quats, (2, 1, 0)))
+    lt = np.ascontiguousarray(np.transpose(local_translations, (2, 1, 0)))
+    return _frame_major(*_world_joint_major(parents, lq, lt))
+
+
+def _world_joint_major(
+    parents: IntArray, lq: FloatArray, lt: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """World rotations (4, J, F) and positions (3, J, F) from joint-major local ones."""
     n_joints = len(parents)
     depth = np.zeros(n_joints, dtype=np.intp)
     for j, p in enumerate(parents):
@@ -48,8 +57,6 @@ def world_from_local(
     # then copies contiguous rows, and the products below (the formulas of `multiply` and
     # `rotate`, term for term, so results are identical) run on contiguous (n, F) blocks
     # instead of stacking (F, n, 4) arrays at every level.
-    lq = np.ascontiguousarray(np.transpose(local_quats, (2, 1, 0)))
-    lt = np.ascontiguousarray(np.transpose(local_translations, (2, 1, 0)))
     wq = np.empty_like(lq)
     wt = np.empty_like(lt)
     roots = depth == 0
@@ -71,6 +78,10 @@ def world_from_local(
         wt[0, joints] = wt[0, par] + (vx + pw * tx + (py * tz - pz * ty))
         wt[1, joints] = wt[1, par] + (vy + pw * ty + (pz * tx - px * tz))
         wt[2, joints] = wt[2, par] + (vz + pw * tz + (px * ty - py * tx))
+    return wq, wt
+
+
+def _frame_major(wq: FloatArray, wt: FloatArray) -> tuple[FloatArray, FloatArray]:
     world_quats: FloatArray = np.ascontiguousarray(np.transpose(wq, (2, 1, 0)))
     world_positions: FloatArray = np.ascontiguousarray(np.transpose(wt, (2, 1, 0)))
     return world_quats, world_positions
@@ -78,7 +89,18 @@ def world_from_local(
 
 def forward_kinematics(motion: Motion) -> tuple[FloatArray, FloatArray]:
     """World rotations ``(F, J, 4)`` and positions ``(F, J, 3)`` of a motion, file units."""
-    return world_from_local(motion.skeleton.parents, motion.quats, motion.local_translations())
+    # Local translations are built joint-major directly: the OFFSETs, then the position
+    # channels (one fresh array instead of a frame-major one and its transposed copy).
+    skeleton = motion.skeleton
+    lt = np.empty((3, skeleton.n_joints, motion.n_frames))
+    lt[...] = skeleton.offsets.T[:, :, None]
+    for joint, axis, add in motion.translation_channels():
+        if add:
+            lt[axis, joint] += motion.translations[:, joint, axis]
+        else:
+            lt[axis, joint] = motion.translations[:, joint, axis]
+    lq = np.ascontiguousarray(np.transpose(motion.quats, (2, 1, 0)))
+    return _frame_major(*_world_joint_major(skeleton.parents, lq, lt))
 
 
 def end_site_positions(
