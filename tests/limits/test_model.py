@@ -142,3 +142,16 @@ def test_shipped_models_are_small() -> None:
     paths = list(default_model_paths())
     assert len(paths) == 3
     assert sum(p.stat().st_size for p in paths) <= 5 * 1024 * 1024
+
+
+def test_every_shipped_network_meets_the_accuracy_target() -> None:
+    # Issue target: >= 97 % held-out synthetic test accuracy on every joint of every rig, with
+    # the test split of the default synthetic set (15 % of 2 x n_valid samples).
+    default = DiscriminatorParams()
+    n_test = 2 * default.n_valid - int(0.70 * 2 * default.n_valid) - int(0.15 * 2 * default.n_valid)
+    for path in default_model_paths():
+        model = load_model(path)
+        for joint in model.joints:
+            assert joint.scores is not None, f"{path.name}: {joint.name} has no network"
+            assert joint.scores.n_test == n_test, f"{path.name}: {joint.name}"
+            assert joint.scores.accuracy >= 0.97, f"{path.name}: {joint.name}"

@@ -7,8 +7,11 @@ sample with the lookup map's ``isValid``, keep a balanced 50/50 set and split it
 training, validation and test sets. Valid samples are drawn uniformly over the valid region
 directly (a bin chosen in proportion to its twist interval, then a uniform point in the bin and
 the interval), which has the distribution of rejection sampling from the cube without its cost
-on sparse maps. Several networks (hidden sizes 4–32, a few seeds) are trained with scikit-learn;
-the one with the best validation accuracy is kept and scored once on the test set.
+on sparse maps. A small ensemble, one network per hidden size (4–32 units; default 32 and 16)
+and seed, is trained with scikit-learn; the one with the best validation accuracy is kept and
+scored once on the test set. The first network's seed is drawn from the build's random stream
+and the other members' from a child stream, so the ensemble's size does not change the synthetic
+sets of the joints that follow.
 
 Training inputs are standardised: centred on the mean of the valid training samples and divided
 by twice their standard deviation, so the valid region spans about ``[−1, 1]`` on each axis
@@ -52,9 +55,12 @@ class DiscriminatorParams:
     Parameters
     ----------
     n_valid : int
-        Valid samples in the balanced synthetic set (as many invalid ones are drawn).
+        Valid samples in the balanced synthetic set (as many invalid ones are drawn). The
+        paper fixes no count; 20,000 (6,000 test samples) lets a 32-unit network reach 97 %
+        on the large Character Creator maps, where 5,000 left a 1–1.5 % train–test gap.
     hidden_sizes : tuple of int
-        Hidden-layer sizes tried (paper: 4, 8, 16, 32).
+        Hidden-layer sizes tried (paper: 4, 8, 16, 32); the best by validation is kept. The
+        first size's first network takes the build stream's seed (see the module notes).
     seeds_per_size : int
         Networks trained per hidden size; ensemble size = sizes × seeds (paper: 20 in all).
     max_iter : int
@@ -64,7 +70,7 @@ class DiscriminatorParams:
     """
 
     n_valid: int = 20000
-    hidden_sizes: tuple[int, ...] = (32,)
+    hidden_sizes: tuple[int, ...] = (32, 16)
     seeds_per_size: int = 1
     max_iter: int = 1500
     activation: str = "tanh"
@@ -226,41 +232,45 @@ def train_discriminator(
     spread = np.maximum(2.0 * inside.std(axis=0), 1e-3)
     x = (params - centre) / spread
     best: tuple[float, Network, int] | None = None
-    for size in settings.hidden_sizes:
-        for _ in range(settings.seeds_per_size):
-            seed = int(rng.integers(2**31 - 1))
-            if settings.solver == "lbfgs":
-                classifier = MLPClassifier(
-                    hidden_layer_sizes=(size,),
-                    activation=settings.activation,
-                    solver="lbfgs",
-                    max_iter=settings.max_iter,
-                    max_fun=10 * settings.max_iter,
-                    tol=0.0,
-                    random_state=seed,
-                )
-            else:
-                classifier = MLPClassifier(
-                    hidden_layer_sizes=(size,),
-                    activation=settings.activation,
-                    max_iter=settings.max_iter,
-                    learning_rate_init=0.01,
-                    random_state=seed,
-                )
-            with warnings.catch_warnings(), threadpool_limits(limits=1, user_api="blas"):
-                warnings.simplefilter("ignore", ConvergenceWarning)
-                classifier.fit(x[train], labels[train])
-            weights = classifier.coefs_[0]
-            network = Network(
-                hidden_weights=weights * (np.pi / spread)[:, None],
-                hidden_biases=classifier.intercepts_[0] - (centre / spread) @ weights,
-                output_weights=classifier.coefs_[1][:, 0],
-                output_bias=float(classifier.intercepts_[1][0]),
+    # The first network's seed comes from the build's stream; the other members' seeds from
+    # a child stream, which draws nothing from it, so the ensemble's size never changes the
+    # synthetic sets of the joints built after this one.
+    members = rng.spawn(1)[0]
+    sizes = [size for size in settings.hidden_sizes for _ in range(settings.seeds_per_size)]
+    for index, size in enumerate(sizes):
+        seed = int((rng if index == 0 else members).integers(2**31 - 1))
+        if settings.solver == "lbfgs":
+            classifier = MLPClassifier(
+                hidden_layer_sizes=(size,),
                 activation=settings.activation,
+                solver="lbfgs",
+                max_iter=settings.max_iter,
+                max_fun=10 * settings.max_iter,
+                tol=0.0,
+                random_state=seed,
             )
-            accuracy = float(np.mean(network_valid(network, params[val]) == labels[val]))
-            if best is None or accuracy > best[0]:
-                best = (accuracy, network, size)
+        else:
+            classifier = MLPClassifier(
+                hidden_layer_sizes=(size,),
+                activation=settings.activation,
+                max_iter=settings.max_iter,
+                learning_rate_init=0.01,
+                random_state=seed,
+            )
+        with warnings.catch_warnings(), threadpool_limits(limits=1, user_api="blas"):
+            warnings.simplefilter("ignore", ConvergenceWarning)
+            classifier.fit(x[train], labels[train])
+        weights = classifier.coefs_[0]
+        network = Network(
+            hidden_weights=weights * (np.pi / spread)[:, None],
+            hidden_biases=classifier.intercepts_[0] - (centre / spread) @ weights,
+            output_weights=classifier.coefs_[1][:, 0],
+            output_bias=float(classifier.intercepts_[1][0]),
+            activation=settings.activation,
+        )
+        accuracy = float(np.mean(network_valid(network, params[val]) == labels[val]))
+        if best is None or accuracy > best[0]:
+            best = (accuracy, network, size)
     if best is None:  # unreachable: hidden_sizes is non-empty
         raise InputError("Expected at least one hidden size, got none")
     _, network, size = best
