@@ -98,3 +98,26 @@ def test_world_from_local_composes_a_two_joint_chain() -> None:
     # The child sits one unit along the parent's rotated x axis, i.e. along +y.
     np.testing.assert_allclose(world_positions[0, 1], [1.0, 3.0, 3.0], atol=1e-15)
     np.testing.assert_allclose(world_quats[0, 1], quarter_turn_z, atol=1e-15)
+
+
+def test_world_from_local_leaves_its_inputs_alone() -> None:
+    # One frame, where a transposed array can be a view of the caller's.
+    parents = np.array([-1, 0, 1])
+    rng = np.random.default_rng(0)
+    quats = Rotation.random(3, random_state=1).as_quat()[None]
+    translations = rng.normal(size=(1, 3, 3))
+    before = quats.copy(), translations.copy()
+    world_from_local(parents, quats, translations)
+    np.testing.assert_array_equal(quats, before[0])
+    np.testing.assert_array_equal(translations, before[1])
+
+
+@pytest.mark.parametrize("relative", ["cmu/iclone/002_10.bvh", "misc/bvh_test3.bvh"])
+def test_forward_kinematics_equals_world_from_local(corpus_dir: Path, relative: str) -> None:
+    # Character Creator roots add their channels to the OFFSET; bvh_test3 has position
+    # channels on non-root joints. forward_kinematics builds the local translations itself.
+    motion = read_bvh(corpus_dir / "bvh" / relative)
+    ours = forward_kinematics(motion)
+    reference = world_from_local(motion.skeleton.parents, motion.quats, motion.local_translations())
+    np.testing.assert_array_equal(ours[0], reference[0])
+    np.testing.assert_array_equal(ours[1], reference[1])

@@ -39,15 +39,21 @@ def world_from_local(
     world_quats : ndarray, shape (F, J, 4)
     world_positions : ndarray, shape (F, J, 3)
     """
-    lq = np.ascontiguousarray(np.transpose(local_quats, (2, 1, 0)))
-    lt = np.ascontiguousarray(np.transpose(local_translations, (2, 1, 0)))
+    # Copies (never views of the caller's arrays): the world values overwrite them.
+    lq = np.transpose(local_quats, (2, 1, 0)).copy()
+    lt = np.transpose(local_translations, (2, 1, 0)).copy()
     return _frame_major(*_world_joint_major(parents, lq, lt))
 
 
 def _world_joint_major(
     parents: IntArray, lq: FloatArray, lt: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
-    """World rotations (4, J, F) and positions (3, J, F) from joint-major local ones."""
+    """World rotations (4, J, F) and positions (3, J, F) from joint-major local ones.
+
+    Works in place: ``lq`` and ``lt`` are overwritten with the world values and returned.
+    Parents come before children, so each level reads its parents' world values and its own
+    local ones (gathered as copies before its rows are written).
+    """
     n_joints = len(parents)
     depth = np.zeros(n_joints, dtype=np.intp)
     for j, p in enumerate(parents):
@@ -57,11 +63,7 @@ def _world_joint_major(
     # then copies contiguous rows, and the products below (the formulas of `multiply` and
     # `rotate`, term for term, so results are identical) run on contiguous (n, F) blocks
     # instead of stacking (F, n, 4) arrays at every level.
-    wq = np.empty_like(lq)
-    wt = np.empty_like(lt)
-    roots = depth == 0
-    wq[:, roots] = lq[:, roots]
-    wt[:, roots] = lt[:, roots]
+    wq, wt = lq, lt  # roots: world = local
     for level in range(1, int(depth.max(initial=0)) + 1):
         joints = np.flatnonzero(depth == level)
         par = parents[joints]
