@@ -46,9 +46,12 @@ def frames_by_arrow(block: str, n_frames: int, n_channels: int) -> FloatArray | 
         None when pyarrow is missing or anything is off (then :func:`frames_by_line`
         reports the problem with its line).
 
-    Every whitespace becomes a line break, so Arrow reads one float column (its parser is
-    correctly rounded, like ``float``); the line structure is checked separately. Arrow's
-    CSV module imports in ~0.04 s, unlike pandas (~0.3 s), so even one small file gains.
+    The usual layout (single spaces, one frame per line) is read as a table of one column
+    per channel (:func:`_frames_by_columns`). Otherwise every whitespace becomes a line
+    break, so Arrow reads one float column, and the line structure is checked separately.
+    Arrow's parser is correctly rounded, like ``float``, and its CSV module imports in
+    ~0.04 s, unlike pandas (~0.3 s), so even one small file gains. The returned array may be
+    read-only (a view of Arrow's memory).
     """
     if n_frames == 0 or n_channels == 0:
         return None
