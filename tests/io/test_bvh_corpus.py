@@ -6,6 +6,7 @@ hierarchy walk over whitespace tokens and ``float`` on every frame value.
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -127,6 +128,16 @@ def test_number_readers_agree_exactly(corpus_dir: Path, relative: str) -> None:
     by_python = parse_bvh(data, relative, number_reader="python")
     np.testing.assert_array_equal(channel_values(by_arrow), channel_values(by_python))
     np.testing.assert_array_equal(by_arrow.quats, by_python.quats)
+
+
+def test_reads_in_many_threads_at_once_agree(cmu_walk: Path) -> None:
+    # A server reads takes concurrently: nothing in the reader may be shared between reads.
+    alone = read_bvh(cmu_walk)
+    with ThreadPoolExecutor(max_workers=6) as pool:
+        motions = list(pool.map(read_bvh, [cmu_walk] * 18))
+    for motion in motions:
+        np.testing.assert_array_equal(motion.quats, alone.quats)
+        np.testing.assert_array_equal(motion.translations, alone.translations)
 
 
 def test_cmu_walk_matches_its_readme(cmu_walk: Path) -> None:
