@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+import importlib
 import json
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from mocapqa.cli.main import main
+from mocapqa.cli.app import app
+from mocapqa.cli.main import COMMAND_MODULES, main, modules_for
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.io.bvh import read_bvh
 from mocapqa.io.bvh_write import channel_values
@@ -213,3 +217,46 @@ def test_usage_errors_exit_2_without_a_traceback(
 def test_help_exits_0(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["--help"]) == 0
     assert "info" in capsys.readouterr().out
+
+
+def test_the_command_table_names_every_command_s_module() -> None:
+    for module in {m for modules in COMMAND_MODULES.values() for m in modules}:
+        importlib.import_module(f"mocapqa.cli.{module}")
+    commands = {}
+    groups = [("", app), *((f"{g.name} ", g.typer_instance) for g in app.registered_groups)]
+    for prefix, group in groups:
+        assert group is not None
+        for command in group.registered_commands:
+            assert command.callback is not None
+            name = command.name or command.callback.__name__.replace("_", "-")
+            commands[prefix + name] = command.callback.__module__.rsplit(".", 1)[-1]
+    for path, module in commands.items():
+        assert module in modules_for(path.split()), path
+    # Groups load their module for their own help; every other key is a command.
+    assert set(COMMAND_MODULES) - set(commands) == {"limits"}
+    assert all(path.startswith("limits ") for path in set(commands) - set(COMMAND_MODULES))
+
+
+def test_info_in_a_fresh_process_loads_only_what_it_needs(cmu_walk: Path, corpus_dir: Path) -> None:
+    # `mocapqa info` must start fast: only its own command module, and no pyarrow for a
+    # small take (the line-by-line reader is quicker than importing it); a large take
+    # (3.5 MB) is worth the import.
+    large = corpus_dir / "bvh" / "cmu" / "iclone" / "001_14.bvh"
+    script = (
+        "import sys, json\n"
+        "from mocapqa.cli.main import main\n"
+        "codes = [main(['info', sys.argv[1], '--json'])]\n"
+        "arrow_after_small = 'pyarrow' in sys.modules\n"
+        "codes.append(main(['info', sys.argv[2], '--json']))\n"
+        "cli = sorted(m for m in sys.modules if m.startswith('mocapqa.cli.'))\n"
+        "print(json.dumps([codes, arrow_after_small, 'pyarrow.csv' in sys.modules, cli]))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script, str(cmu_walk), str(large)],
+        capture_output=True, text=True, check=True, timeout=120,
+    )  # fmt: skip
+    codes, arrow_after_small, arrow_after_large, cli = json.loads(done.stdout.splitlines()[-1])
+    assert codes == [0, 0]
+    assert not arrow_after_small
+    assert arrow_after_large
+    assert cli == ["mocapqa.cli.app", "mocapqa.cli.info", "mocapqa.cli.main"]

@@ -172,7 +172,7 @@ def info_command(
         raise InputError(f"Expected --fps > 0, got {fps}")
     roles = read_mapping(mapping) if mapping is not None else None
     format_name = detect_format(file)
-    take = read_take(file, fps=fps)
+    take = read_take(file, fps=fps, number_reader="auto")
     if isinstance(take, Motion):
         summary = motion_summary(take, roles)
     else:
@@ -204,7 +204,7 @@ def convert_command(
     if not 0 <= precision <= 15:
         raise InputError(f"Expected --precision between 0 and 15, got {precision}")
     suffix = output.suffix.lower().lstrip(".")
-    take = read_take(source, fps=fps)
+    take = read_take(source, fps=fps, number_reader="auto")
     if isinstance(take, Motion):
         if suffix != "bvh":
             raise UnsupportedFormatError(

@@ -1,25 +1,48 @@
-"""Entry point of the ``mocapqa`` command: registers every command module and maps errors."""
+"""Entry point of the ``mocapqa`` command: registers the command modules and maps errors."""
 
 from __future__ import annotations
 
+import importlib
 import sys
+from collections.abc import Sequence
 
 from rich.markup import escape
 
-from mocapqa.cli import (
-    bench_io,  # noqa: F401  (registers commands)
-    info,  # noqa: F401  (registers commands)
-    limits,  # noqa: F401  (registers commands)
-    render,  # noqa: F401  (registers commands)
-    report,  # noqa: F401  (registers commands)
-    serve,  # noqa: F401  (registers commands)
-)
-from mocapqa.cli import filters as filter_commands  # noqa: F401  (registers commands)
-from mocapqa.cli import twist as twist_commands  # noqa: F401  (registers commands)
 from mocapqa.cli.app import app, err_console, exit_code_for
 from mocapqa.errors import MocapQAError
 
-__all__ = ["main"]
+__all__ = ["COMMAND_MODULES", "main", "modules_for"]
+
+COMMAND_MODULES: dict[str, tuple[str, ...]] = {
+    "info": ("info",),
+    "convert": ("info",),
+    "detect": ("twist",),
+    "refine": ("twist",),
+    "filter": ("filters",),
+    "render": ("render",),
+    "report": ("report",),
+    "serve": ("serve",),
+    "limits": ("limits",),
+    "bench io": ("bench_io",),
+    "bench filters": ("filters",),
+    "bench limits": ("limits",),
+    "bench render": ("render",),
+    "bench twist": ("twist",),
+}
+"""The modules of :mod:`mocapqa.cli` that register each command (a test checks the table)."""
+_ALL_MODULES = tuple(sorted({m for modules in COMMAND_MODULES.values() for m in modules}))
+
+
+def modules_for(argv: Sequence[str]) -> tuple[str, ...]:
+    """The command modules to import for a command line: those of its command, or all.
+
+    Only the invoked command's module is imported (each costs a few ms to register, and
+    ``mocapqa info`` should start fast); help, no command, or an unknown one load them all, so
+    that Typer lists every command or suggests the nearest.
+    """
+    words = [arg for arg in argv if not arg.startswith("-")]
+    key = " ".join(words[:2] if words[:1] == ["bench"] else words[:1])
+    return COMMAND_MODULES.get(key, _ALL_MODULES)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -29,8 +52,11 @@ def main(argv: list[str] | None = None) -> int:
     ``SystemExit``, whose code is returned here, so no exception class of its bundled Click
     is needed.
     """
+    args = sys.argv[1:] if argv is None else argv
+    for module in modules_for(args):
+        importlib.import_module(f"mocapqa.cli.{module}")
     try:
-        app(args=argv, prog_name="mocapqa")
+        app(args=args, prog_name="mocapqa")
     except SystemExit as e:
         code = e.code
         return code if isinstance(code, int) else (0 if code is None else 1)

@@ -22,7 +22,7 @@ from typing import Any
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import ParseError, UnsupportedFormatError
-from mocapqa.io.bvh import read_bvh
+from mocapqa.io.bvh import NumberReader, read_bvh
 from mocapqa.io.keypoint_arrays import (
     read_keypoint_npy,
     read_keypoint_npz,
@@ -177,6 +177,7 @@ def read_take(
     fps: float | None = None,
     person_index: int = 0,
     length_unit: str | None = None,
+    number_reader: NumberReader = "arrow",
 ) -> Motion | KeypointSequence:
     """Read a take of any supported format.
 
@@ -191,6 +192,9 @@ def read_take(
         Person to read from OpenPose output.
     length_unit : str, optional
         Unit for formats that do not store one.
+    number_reader : {"arrow", "python", "auto"}
+        How BVH frame values are read (see :func:`mocapqa.io.bvh.parse_bvh`); "auto" suits
+        a one-off read in a fresh process.
 
     Returns
     -------
@@ -206,7 +210,7 @@ def read_take(
     """
     kind = detect_format(path)
     if kind == "bvh":
-        return read_bvh(path, length_unit=length_unit or "unknown")
+        return read_bvh(path, length_unit=length_unit or "unknown", number_reader=number_reader)
     if kind == "trc":
         return read_trc(path)
     if kind == "openpose":
