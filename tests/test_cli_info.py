@@ -190,10 +190,11 @@ def test_bench_io_prints_its_tables(
     small = corpus_dir / "bvh" / "bandai" / "dataset-1_bow_sad_001.bvh"
     shutil.copy(small, data / "bvh" / "bandai" / small.name)
     argv = ["bench", "io", "--data", str(data), "--repeats", "1", "--info-runs", "1",
-            "--headline-repeats", "2"]  # fmt: skip
+            "--headline-repeats", "3", "--block-runs", "2"]  # fmt: skip
     assert main(argv) == 0
     out = capsys.readouterr().out
-    for label in ("read + FK", "write", "largest Bandai", "pybvh 0.9", "mocapqa info"):
+    for label in ("read + FK", "write", "largest Bandai", "pybvh 0.9", "mocapqa info",
+                  "right after pybvh", "time ratio"):  # fmt: skip
         assert label in out
 
 
