@@ -15,9 +15,11 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from mocapqa.core.motion import POSITION_CHANNELS, Motion
+from mocapqa.errors import ShapeError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.io.bvh_write import channel_values
 from mocapqa.kinematics.forward import end_site_positions, forward_kinematics, world_from_local
+from mocapqa.kinematics.quaternion import multiply, rotate
 
 
 def skeleton_size(positions: np.ndarray) -> float:
@@ -121,3 +123,76 @@ def test_forward_kinematics_equals_world_from_local(corpus_dir: Path, relative: 
     reference = world_from_local(motion.skeleton.parents, motion.quats, motion.local_translations())
     np.testing.assert_array_equal(ours[0], reference[0])
     np.testing.assert_array_equal(ours[1], reference[1])
+
+
+def joint_by_joint(motion: Motion) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """World rotations, positions and End Site positions with the NumPy quaternion helpers."""
+    sk = motion.skeleton
+    local = motion.local_translations()
+    quats = np.empty_like(motion.quats)
+    positions = np.empty_like(local)
+    for j, parent in enumerate(sk.parents):
+        if parent < 0:
+            quats[:, j], positions[:, j] = motion.quats[:, j], local[:, j]
+        else:
+            quats[:, j] = multiply(quats[:, parent], motion.quats[:, j])
+            positions[:, j] = positions[:, parent] + rotate(quats[:, parent], local[:, j])
+    sites = np.stack(
+        [positions[:, e.parent] + rotate(quats[:, e.parent], np.array(e.offset))
+         for e in sk.end_sites],
+        axis=1,
+    )  # fmt: skip
+    return quats, positions, sites
+
+
+@pytest.mark.parametrize(
+    "relative", ["cmu/cmu_12_01_walk.bvh", "cmu/iclone/002_10.bvh", "misc/bvh_test3.bvh"]
+)
+def test_the_compiled_loops_give_the_quaternion_helpers_results_bit_for_bit(
+    corpus_dir: Path, relative: str
+) -> None:
+    motion = read_bvh(corpus_dir / "bvh" / relative)
+    world_quats, positions = forward_kinematics(motion)
+    sites = end_site_positions(motion, world_quats, positions)
+    expected = joint_by_joint(motion)
+    np.testing.assert_array_equal(world_quats, expected[0])
+    np.testing.assert_array_equal(positions, expected[1])
+    np.testing.assert_array_equal(sites, expected[2])
+
+
+@pytest.mark.parametrize(
+    ("parents", "quats_shape", "translations_shape", "message"),
+    [
+        ([-1, 2, 0], (2, 3, 4), (2, 3, 3), "precede its child"),
+        ([-1, 0, 3], (2, 3, 4), (2, 3, 3), "precede its child"),
+        ([-2, 0, 1], (2, 3, 4), (2, 3, 3), "precede its child"),
+        ([[-1, 0, 1]], (2, 3, 4), (2, 3, 3), "parents of shape"),
+        ([-1, 0], (2, 3, 4), (2, 3, 3), "local_quats of shape"),
+        ([-1, 0, 1], (2, 3, 3), (2, 3, 3), "local_quats of shape"),
+        ([-1, 0, 1], (2, 3, 4), (3, 3, 3), "local_translations of shape"),
+    ],
+)
+def test_world_from_local_refuses_what_the_compiled_loop_cannot_take(
+    parents: list[int], quats_shape: tuple[int, ...], translations_shape: tuple[int, ...],
+    message: str,
+) -> None:  # fmt: skip
+    quats = np.zeros(quats_shape)
+    quats[..., -1] = 1.0
+    with pytest.raises(ShapeError, match=message):
+        world_from_local(np.array(parents), quats, np.zeros(translations_shape))
+
+
+def test_end_site_positions_refuses_world_arrays_of_another_take(cmu_walk: Path) -> None:
+    motion = read_bvh(cmu_walk)
+    world_quats, positions = forward_kinematics(motion)
+    with pytest.raises(ShapeError, match="Expected world rotations and positions"):
+        end_site_positions(motion, world_quats[:-1], positions[:-1])
+
+
+def test_a_take_without_frames_has_empty_world_arrays(cmu_walk: Path) -> None:
+    motion = read_bvh(cmu_walk)
+    empty = Motion(motion.skeleton, motion.quats[:0], motion.translations[:0], motion.fps)
+    world_quats, positions = forward_kinematics(empty)
+    assert world_quats.shape == (0, 31, 4)
+    assert positions.shape == (0, 31, 3)
+    assert end_site_positions(empty, world_quats, positions).shape == (0, 7, 3)

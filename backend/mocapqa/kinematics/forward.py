@@ -5,8 +5,9 @@ Conventions
 ``world_rot[j] = world_rot[parent] ⊗ local[j]`` and
 ``world_pos[j] = world_pos[parent] + world_rot[parent] · translation[j]``, where the
 translation is the joint's OFFSET (or its position channels, see
-:meth:`mocapqa.core.motion.Motion.local_translations`). The loop runs over tree depth (≤ ~20
-levels) and is vectorised over frames and over every joint at one depth.
+:meth:`mocapqa.core.motion.Motion.local_translations`). The walk down the tree runs in compiled
+loops (:mod:`mocapqa.kinematics.kernels`, imported on first use: numba takes ~0.6 s to load);
+the functions here check what the loops rely on.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray, IntArray
 from mocapqa.core.motion import Motion
-from mocapqa.kinematics.quaternion import rotate
+from mocapqa.errors import ShapeError
 
 __all__ = ["end_site_positions", "forward_kinematics", "world_from_local"]
 
@@ -38,80 +39,77 @@ def world_from_local(
     -------
     world_quats : ndarray, shape (F, J, 4)
     world_positions : ndarray, shape (F, J, 3)
+
+    Raises
+    ------
+    ShapeError
+        When the shapes disagree or a parent does not come before its child.
     """
-    # Copies (never views of the caller's arrays): the world values overwrite them.
-    lq = np.transpose(local_quats, (2, 1, 0)).copy()
-    lt = np.transpose(local_translations, (2, 1, 0)).copy()
-    return _frame_major(*_world_joint_major(parents, lq, lt))
+    from mocapqa.kinematics.kernels import CHANNEL, world_kernel
 
-
-def _world_joint_major(
-    parents: IntArray, lq: FloatArray, lt: FloatArray
-) -> tuple[FloatArray, FloatArray]:
-    """World rotations (4, J, F) and positions (3, J, F) from joint-major local ones.
-
-    Works in place: ``lq`` and ``lt`` are overwritten with the world values and returned.
-    Parents come before children, so each level reads its parents' world values and its own
-    local ones (gathered as copies before its rows are written).
-    """
+    parents = _checked_parents(parents)
+    quats = np.ascontiguousarray(local_quats, dtype=np.float64)
+    translations = np.ascontiguousarray(local_translations, dtype=np.float64)
     n_joints = len(parents)
-    depth = np.zeros(n_joints, dtype=np.intp)
-    for j, p in enumerate(parents):
-        if p >= 0:
-            depth[j] = depth[p] + 1
-    # Work joint-major per component, (4, J, F) and (3, J, F): gathering a level's parents
-    # then copies contiguous rows, and the products below (the formulas of `multiply` and
-    # `rotate`, term for term, so results are identical) run on contiguous (n, F) blocks
-    # instead of stacking (F, n, 4) arrays at every level.
-    wq, wt = lq, lt  # roots: world = local
-    for level in range(1, int(depth.max(initial=0)) + 1):
-        joints = np.flatnonzero(depth == level)
-        par = parents[joints]
-        px, py, pz, pw = wq[0, par], wq[1, par], wq[2, par], wq[3, par]
-        qx, qy, qz, qw = lq[0, joints], lq[1, joints], lq[2, joints], lq[3, joints]
-        wq[0, joints] = pw * qx + px * qw + py * qz - pz * qy
-        wq[1, joints] = pw * qy - px * qz + py * qw + pz * qx
-        wq[2, joints] = pw * qz + px * qy - py * qx + pz * qw
-        wq[3, joints] = pw * qw - px * qx - py * qy - pz * qz
-        vx, vy, vz = lt[0, joints], lt[1, joints], lt[2, joints]
-        tx = 2.0 * (py * vz - pz * vy)
-        ty = 2.0 * (pz * vx - px * vz)
-        tz = 2.0 * (px * vy - py * vx)
-        wt[0, joints] = wt[0, par] + (vx + pw * tx + (py * tz - pz * ty))
-        wt[1, joints] = wt[1, par] + (vy + pw * ty + (pz * tx - px * tz))
-        wt[2, joints] = wt[2, par] + (vz + pw * tz + (px * ty - py * tx))
-    return wq, wt
+    if quats.ndim != 3 or quats.shape[1:] != (n_joints, 4):
+        raise ShapeError(f"Expected local_quats of shape (F, {n_joints}, 4), got {quats.shape}")
+    if translations.shape != (*quats.shape[:2], 3):
+        raise ShapeError(
+            f"Expected local_translations of shape {(*quats.shape[:2], 3)}, "
+            f"got {translations.shape}"
+        )
+    modes = np.full((n_joints, 3), CHANNEL, dtype=np.int8)
+    world: tuple[FloatArray, FloatArray] = world_kernel(
+        parents, np.zeros((n_joints, 3)), modes, translations, quats
+    )
+    return world
 
 
-def _frame_major(wq: FloatArray, wt: FloatArray) -> tuple[FloatArray, FloatArray]:
-    world_quats: FloatArray = np.ascontiguousarray(np.transpose(wq, (2, 1, 0)))
-    world_positions: FloatArray = np.ascontiguousarray(np.transpose(wt, (2, 1, 0)))
-    return world_quats, world_positions
+def _checked_parents(parents: IntArray) -> IntArray:
+    """Parents as intp, each -1 or an earlier joint (the compiled loops rely on it)."""
+    checked = np.ascontiguousarray(parents, dtype=np.intp)
+    if checked.ndim != 1:
+        raise ShapeError(f"Expected parents of shape (J,), got {checked.shape}")
+    if np.any(checked < -1) or np.any(checked >= np.arange(len(checked))):
+        raise ShapeError("Expected every parent to be -1 or to precede its child")
+    return checked
 
 
 def forward_kinematics(motion: Motion) -> tuple[FloatArray, FloatArray]:
     """World rotations ``(F, J, 4)`` and positions ``(F, J, 3)`` of a motion, file units."""
-    # Local translations are built joint-major directly: the OFFSETs, then the position
-    # channels (one fresh array instead of a frame-major one and its transposed copy).
+    from mocapqa.kinematics.kernels import CHANNEL, OFFSET, OFFSET_AND_CHANNEL, world_kernel
+
+    # A Motion's arrays are validated, C-contiguous float64 of the skeleton's shapes.
     skeleton = motion.skeleton
-    lt = np.empty((3, skeleton.n_joints, motion.n_frames))
-    lt[...] = skeleton.offsets.T[:, :, None]
+    modes = np.full((skeleton.n_joints, 3), OFFSET, dtype=np.int8)
     for joint, axis, add in motion.translation_channels():
-        if add:
-            lt[axis, joint] += motion.translations[:, joint, axis]
-        else:
-            lt[axis, joint] = motion.translations[:, joint, axis]
-    lq = np.ascontiguousarray(np.transpose(motion.quats, (2, 1, 0)))
-    return _frame_major(*_world_joint_major(skeleton.parents, lq, lt))
+        modes[joint, axis] = OFFSET_AND_CHANNEL if add else CHANNEL
+    world: tuple[FloatArray, FloatArray] = world_kernel(
+        _checked_parents(skeleton.parents),
+        np.ascontiguousarray(skeleton.offsets, dtype=np.float64),
+        modes,
+        np.ascontiguousarray(motion.translations, dtype=np.float64),
+        np.ascontiguousarray(motion.quats, dtype=np.float64),
+    )
+    return world
 
 
 def end_site_positions(
     motion: Motion, world_quats: FloatArray, world_positions: FloatArray
 ) -> FloatArray:
     """World positions of the End Sites, shape (F, E, 3), in ``skeleton.end_sites`` order."""
+    from mocapqa.kinematics.kernels import end_sites_kernel
+
     sites = motion.skeleton.end_sites
-    if not sites:
-        return np.zeros((motion.n_frames, 0, 3))
-    par = np.array([e.parent for e in sites], dtype=np.intp)
-    offs = np.array([e.offset for e in sites], dtype=np.float64)
-    return world_positions[:, par] + rotate(world_quats[:, par], offs)
+    quats = np.ascontiguousarray(world_quats, dtype=np.float64)
+    positions = np.ascontiguousarray(world_positions, dtype=np.float64)
+    n_frames, n_joints = motion.n_frames, motion.skeleton.n_joints
+    if quats.shape != (n_frames, n_joints, 4) or positions.shape != (n_frames, n_joints, 3):
+        raise ShapeError(
+            f"Expected world rotations and positions of shapes {(n_frames, n_joints, 4)} and "
+            f"{(n_frames, n_joints, 3)}, got {quats.shape} and {positions.shape}"
+        )
+    parents = np.array([e.parent for e in sites], dtype=np.intp)
+    offsets = np.array([e.offset for e in sites], dtype=np.float64).reshape(-1, 3)
+    out: FloatArray = end_sites_kernel(parents, offsets, quats, positions)
+    return out
