@@ -360,19 +360,24 @@ def _motion_from_channels(
     n_joints = len(parser.names)
     translations = np.zeros((n_frames, n_joints, 3))
     by_order: dict[str, list[tuple[int, list[int]]]] = {}
+    # Position channels: (column, joint, axis), copied in one gather and one scatter.
+    position_columns: list[tuple[int, int, int]] = []
     column = 0
     for j, chans in enumerate(parser.channels):
         rot_cols: list[int] = []
         order = ""
         for k, channel in enumerate(chans):
             if channel in POSITION_CHANNELS:
-                translations[:, j, "XYZ".index(channel[0])] = values[:, column + k]
+                position_columns.append((column + k, j, "XYZ".index(channel[0])))
             else:
                 rot_cols.append(column + k)
                 order += channel[0]
         if order:
             by_order.setdefault(order, []).append((j, rot_cols))
         column += len(chans)
+    if position_columns:
+        where = np.array(position_columns, dtype=np.intp).T
+        translations[:, where[1], where[2]] = values[:, where[0]]
     all_rotating = sum(len(entries) for entries in by_order.values()) == n_joints
     if len(by_order) == 1 and all_rotating:
         # One rotation order on every joint (the usual case): no identity fill, no scatter.
