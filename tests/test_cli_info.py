@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from mocapqa.bench.io import timed_in_turns
 from mocapqa.cli.app import app
 from mocapqa.cli.main import COMMAND_MODULES, main, modules_for
 from mocapqa.core.keypoints import KeypointSequence
@@ -261,3 +262,13 @@ def test_info_in_a_fresh_process_loads_only_what_it_needs(cmu_walk: Path, corpus
     assert not arrow_after_small
     assert arrow_after_large
     assert cli == ["mocapqa.cli.app", "mocapqa.cli.info", "mocapqa.cli.main"]
+
+
+def test_timed_works_take_turns_of_consecutive_runs() -> None:
+    calls: list[str] = []
+    works = {name: (lambda name=name: calls.append(name)) for name in ("a", "b")}
+    times = timed_in_turns(works, repeats=5, block_runs=2)
+    # One untimed run each, then three turns of two runs (5 rounded up to whole turns).
+    assert calls == ["a", "b"] + (["a"] * 2 + ["b"] * 2) * 3
+    assert [len(turn) for turn in times["a"]] == [2, 2, 2]
+    assert all(seconds >= 0.0 for turn in times["b"] for seconds in turn)

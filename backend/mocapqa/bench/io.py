@@ -9,11 +9,11 @@ Conventions
   ``mocapqa info`` process.
 * The pybvh comparison times ``pybvh.read_bvh_file`` + ``node_positions()`` (joints and End
   Sites) against :func:`~mocapqa.io.bvh.read_bvh` + forward kinematics + End Site positions.
-  The readers take turns in blocks of consecutive runs, so that a busy spell on the machine
-  falls on both alike while each is timed in its steady state, as in a loop over files. The
-  first run of each block, right after the other reader, pays for caches and predictors the
-  other reader left cold (~1.5 ms here, a fifth of ours and a twentieth of pybvh's); its best
-  is reported beside the headline.
+  The readers, and the largest Bandai read, take turns of consecutive runs
+  (:func:`timed_in_turns`), so that a slow spell on the machine falls on all alike while each
+  is timed in its steady state, as in a loop over files. The first run of each turn, right
+  after the other reader, pays for caches and predictors the other reader left cold (~1 ms
+  here, a sixth of ours and a twentieth of pybvh's); its best is reported beside the headline.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -35,14 +35,17 @@ from mocapqa.kinematics.forward import end_site_positions, forward_kinematics
 
 __all__ = [
     "FileTiming",
+    "HeadlineTimes",
     "IoBenchParams",
     "ReaderComparison",
     "Throughput",
     "best_time_s",
+    "headline_times",
     "info_process_time_s",
-    "pybvh_comparison",
+    "pybvh_work",
     "scratch_folder",
     "time_file",
+    "timed_in_turns",
     "total_throughput",
     "warm_up",
 ]
@@ -64,8 +67,7 @@ class IoBenchParams:
         Timed runs of the figures with targets (the largest Bandai read, and each reader of
         the pybvh comparison); the best of each is kept.
     block_runs : int
-        Consecutive runs of one reader before the other takes its turn, in the pybvh
-        comparison.
+        Consecutive runs of one of those works before the next takes its turn.
     """
 
     repeats: int = 3
@@ -212,7 +214,7 @@ class ReaderComparison:
     ours_s, theirs_s : float
         Best over every run: each reader in its steady state.
     ours_first_s, theirs_first_s : float
-        Best over the first run of each block, right after the other reader ran.
+        Best over the first run of each turn, right after the other reader ran.
     """
 
     ours_s: float
@@ -231,47 +233,96 @@ class ReaderComparison:
         return self.theirs_first_s / self.ours_first_s
 
 
-def pybvh_comparison(path: Path, repeats: int, block_runs: int) -> ReaderComparison | None:
-    """Time read + positions of joints and End Sites, ours against pybvh's, in turns.
+@dataclass(frozen=True, slots=True)
+class HeadlineTimes:
+    """The figures with targets: the pybvh comparison and the largest Bandai read.
 
     Parameters
     ----------
-    path : Path
-        The BVH file.
-    repeats : int
-        Timed runs of each reader (rounded up to whole blocks).
-    block_runs : int
-        Consecutive runs of one reader per turn.
-
-    Returns
-    -------
-    ReaderComparison or None
-        None when pybvh (the ``bench`` extra) is not installed.
+    comparison : ReaderComparison or None
+        None without the CMU walk or without pybvh.
+    bandai_read_s : float or None
+        Best seconds to read the largest Bandai file; None without one.
     """
+
+    comparison: ReaderComparison | None
+    bandai_read_s: float | None
+
+
+def pybvh_work(path: Path) -> Callable[[], object] | None:
+    """pybvh's read + positions of joints and End Sites of ``path``; None without pybvh."""
     try:
         pybvh = importlib.import_module("pybvh")
     except ImportError:
         return None
+    return lambda: pybvh.read_bvh_file(str(path)).node_positions()
 
-    def theirs() -> None:
-        pybvh.read_bvh_file(str(path)).node_positions()
 
-    def ours() -> None:
-        _read_fk(path)
+def timed_in_turns(
+    works: Mapping[str, Callable[[], object]], repeats: int, block_runs: int
+) -> dict[str, list[list[float]]]:
+    """Seconds of every run of each work, the works taking turns of ``block_runs`` runs.
 
-    ours()
-    theirs()  # so that our first block, too, starts right after pybvh
-    ours_runs: list[list[float]] = []
-    theirs_runs: list[list[float]] = []
+    The machine's speed changes in spells of a second or so (a fixed workload here takes
+    3.1 ms in some and 4.6 ms in others), so runs of one work in a row could all fall in a slow
+    spell; in turns, the runs of every work spread over the whole measurement.
+
+    Parameters
+    ----------
+    works : mapping of str to callable
+        The works, in turn order; each runs once first, untimed.
+    repeats : int
+        Timed runs of each work (rounded up to whole turns).
+    block_runs : int
+        Consecutive runs per turn.
+
+    Returns
+    -------
+    dict of str to list of list of float
+        Per work, the seconds of each run, turn by turn.
+    """
+    for work in works.values():
+        work()
+    times: dict[str, list[list[float]]] = {name: [] for name in works}
     for _ in range(-(-repeats // block_runs)):
-        ours_runs.append([best_time_s(ours, 1) for _ in range(block_runs)])
-        theirs_runs.append([best_time_s(theirs, 1) for _ in range(block_runs)])
-    return ReaderComparison(
-        ours_s=min(map(min, ours_runs)),
-        theirs_s=min(map(min, theirs_runs)),
-        ours_first_s=min(block[0] for block in ours_runs),
-        theirs_first_s=min(block[0] for block in theirs_runs),
-    )
+        for name, work in works.items():
+            times[name].append([best_time_s(work, 1) for _ in range(block_runs)])
+    return times
+
+
+def headline_times(
+    walk: Path | None, bandai: Path | None, repeats: int, block_runs: int
+) -> HeadlineTimes:
+    """Time the figures with targets, in turns (see :func:`timed_in_turns`).
+
+    Parameters
+    ----------
+    walk : Path or None
+        The CMU walk, for read + FK against pybvh.
+    bandai : Path or None
+        The largest Bandai file, for the read throughput.
+    repeats, block_runs : int
+        Timed runs of each work, and runs per turn.
+    """
+    works: dict[str, Callable[[], object]] = {}
+    if bandai is not None:
+        works["bandai"] = lambda: read_bvh(bandai)
+    theirs = pybvh_work(walk) if walk is not None else None
+    if walk is not None and theirs is not None:
+        # This order puts each reader's turn right after the other's.
+        works["pybvh"] = theirs
+        works["ours"] = lambda: _read_fk(walk)
+    times = timed_in_turns(works, repeats, block_runs)
+    comparison = None
+    if "ours" in times:
+        comparison = ReaderComparison(
+            ours_s=min(map(min, times["ours"])),
+            theirs_s=min(map(min, times["pybvh"])),
+            ours_first_s=min(turn[0] for turn in times["ours"]),
+            theirs_first_s=min(turn[0] for turn in times["pybvh"]),
+        )
+    bandai_s = min(map(min, times["bandai"])) if "bandai" in times else None
+    return HeadlineTimes(comparison, bandai_s)
 
 
 def info_process_time_s(path: Path, runs: int) -> float:

@@ -30,7 +30,7 @@ def bench_io(
         ),
     ] = 100,
     block_runs: Annotated[
-        int, typer.Option(help="Consecutive runs of one reader per turn, in the pybvh comparison.")
+        int, typer.Option(help="Consecutive runs per turn of the figures with targets.")
     ] = 10,
 ) -> None:
     """Read, read + FK and write throughput (frames/s, MB/s); pybvh on the CMU walk."""
@@ -42,16 +42,14 @@ def bench_io(
     from mocapqa.bench.io import (
         IoBenchParams,
         Throughput,
-        best_time_s,
+        headline_times,
         info_process_time_s,
-        pybvh_comparison,
         scratch_folder,
         time_file,
         total_throughput,
         warm_up,
     )
     from mocapqa.errors import NotFoundError
-    from mocapqa.io.bvh import read_bvh
 
     params = IoBenchParams(
         repeats=repeats,
@@ -92,22 +90,27 @@ def bench_io(
     for row in total_throughput(timings):
         add(row, len(timings))
     bandai = [t for t in timings if "bandai" in t.path.parts]
-    if bandai:
-        big = max(bandai, key=lambda t: t.n_bytes)
-        big_read_s = best_time_s(lambda: read_bvh(big.path), params.headline_repeats)
-        add(Throughput("read, largest Bandai", big.n_bytes, big.n_frames, big_read_s), 1)
+    big = max(bandai, key=lambda t: t.n_bytes) if bandai else None
+    walk_timing = next((t for t in timings if t.path.name == "cmu_12_01_walk.bvh"), None)
+    walk = walk_timing.path if walk_timing is not None else None
+    with console.status("timing the figures with targets, in turns"):
+        headline = headline_times(
+            walk, big.path if big else None, params.headline_repeats, params.block_runs
+        )
+    if big is not None and headline.bandai_read_s is not None:
+        add(
+            Throughput("read, largest Bandai", big.n_bytes, big.n_frames, headline.bandai_read_s), 1
+        )
         table.caption = f"largest Bandai file: {big.path.name}"
     console.print(table)
 
-    walk = next((p for p in paths if p.name == "cmu_12_01_walk.bvh"), None)
-    if walk is None:
+    if walk is None or walk_timing is None:
         console.print("CMU walk (cmu_12_01_walk.bvh) not among the files: no pybvh comparison")
         return
     compare = Table(title=f"Read + joint and End Site positions, {walk.name}", title_justify="left")
     for column in ("reader", "seconds", "frames/s", "MB/s"):
         compare.add_column(column, justify="left" if column == "reader" else "right")
-    walk_timing = next(t for t in timings if t.path == walk)
-    pair = pybvh_comparison(walk, params.headline_repeats, params.block_runs)
+    pair = headline.comparison
     if pair is None:
         console.print("pybvh is not installed (pip install '.[bench]'): no comparison")
     else:
