@@ -22,7 +22,14 @@ from numba import njit
 
 from mocapqa.core.arrays import FloatArray, IntArray
 
-__all__ = ["CHANNEL", "OFFSET", "OFFSET_AND_CHANNEL", "end_sites_kernel", "world_kernel"]
+__all__ = [
+    "CHANNEL",
+    "OFFSET",
+    "OFFSET_AND_CHANNEL",
+    "end_sites_kernel",
+    "place_kernel",
+    "world_kernel",
+]
 
 OFFSET = 0
 """Local translation mode of one axis of a joint: its OFFSET."""
@@ -30,6 +37,36 @@ CHANNEL = 1
 """Local translation mode: the position channel's value (BVH's rule)."""
 OFFSET_AND_CHANNEL = 2
 """Local translation mode: the OFFSET plus the channel (a root stored as a delta)."""
+
+
+def _place(
+    world_quats: FloatArray,
+    world_positions: FloatArray,
+    f: int,
+    p: int,
+    vx: float,
+    vy: float,
+    vz: float,
+    out: FloatArray,
+    i: int,
+) -> None:
+    """``out[f, i] = world_positions[f, p] + world_quats[f, p] · v``: a point placed by joint p.
+
+    The terms of :func:`mocapqa.kinematics.quaternion.rotate` in its order:
+    v + w·t + u × t with t = 2 u × v.
+    """
+    px, py, pz = world_quats[f, p, 0], world_quats[f, p, 1], world_quats[f, p, 2]
+    pw = world_quats[f, p, 3]
+    tx = 2.0 * (py * vz - pz * vy)
+    ty = 2.0 * (pz * vx - px * vz)
+    tz = 2.0 * (px * vy - py * vx)
+    out[f, i, 0] = world_positions[f, p, 0] + (vx + pw * tx + (py * tz - pz * ty))
+    out[f, i, 1] = world_positions[f, p, 1] + (vy + pw * ty + (pz * tx - px * tz))
+    out[f, i, 2] = world_positions[f, p, 2] + (vz + pw * tz + (px * ty - py * tx))
+
+
+# Compiled kernel: one joint or End Site placed by its parent (called by the two below).
+place_kernel = njit(cache=True)(_place)
 
 
 def _world(
@@ -92,18 +129,7 @@ def _world(
             world_quats[f, j, 1] = pw * qy - px * qz + py * qw + pz * qx
             world_quats[f, j, 2] = pw * qz + px * qy - py * qx + pz * qw
             world_quats[f, j, 3] = pw * qw - px * qx - py * qy - pz * qz
-            tx = 2.0 * (py * vz - pz * vy)
-            ty = 2.0 * (pz * vx - px * vz)
-            tz = 2.0 * (px * vy - py * vx)
-            world_positions[f, j, 0] = world_positions[f, p, 0] + (
-                vx + pw * tx + (py * tz - pz * ty)
-            )
-            world_positions[f, j, 1] = world_positions[f, p, 1] + (
-                vy + pw * ty + (pz * tx - px * tz)
-            )
-            world_positions[f, j, 2] = world_positions[f, p, 2] + (
-                vz + pw * tz + (px * ty - py * tx)
-            )
+            place_kernel(world_quats, world_positions, f, p, vx, vy, vz, world_positions, j)
     return world_quats, world_positions
 
 
@@ -135,16 +161,8 @@ def _end_sites(
     out = np.empty((world_quats.shape[0], parents.shape[0], 3))
     for f in range(out.shape[0]):
         for e in range(out.shape[1]):
-            p = parents[e]
-            px, py, pz = world_quats[f, p, 0], world_quats[f, p, 1], world_quats[f, p, 2]
-            pw = world_quats[f, p, 3]
             vx, vy, vz = offsets[e, 0], offsets[e, 1], offsets[e, 2]
-            tx = 2.0 * (py * vz - pz * vy)
-            ty = 2.0 * (pz * vx - px * vz)
-            tz = 2.0 * (px * vy - py * vx)
-            out[f, e, 0] = world_positions[f, p, 0] + (vx + pw * tx + (py * tz - pz * ty))
-            out[f, e, 1] = world_positions[f, p, 1] + (vy + pw * ty + (pz * tx - px * tz))
-            out[f, e, 2] = world_positions[f, p, 2] + (vz + pw * tz + (px * ty - py * tx))
+            place_kernel(world_quats, world_positions, f, parents[e], vx, vy, vz, out, e)
     return out
 
 
