@@ -177,7 +177,7 @@ def test_a_mapping_overrides_the_guess() -> None:
 @pytest.mark.parametrize(
     ("mapping", "pattern"),
     [
-        ({"upperarm_l": "left_elbow"}, r"Expected a role in .*got 'left_elbow'"),
+        ({"upperarm_l": "left_elbow"}, r"Expected a role in .*got 'upperarm_l': 'left_elbow'"),
         ({"no_such_joint": "left_hand"}, r"Expected a joint of this skeleton, got 'no_such_joint'"),
     ],
 )

@@ -1,31 +1,44 @@
 """Rig roles: which joint is the left upper arm, the right lower leg, and so on.
 
-Names are matched after normalising common rig conventions: CMU/cgspeed and Mixamo
-(``LeftArm``, ``mixamorig:LeftForeArm``), Character Creator (``CC_Base_L_Upperarm``), Bandai
-(``UpperArm_L``), Unreal (``upperarm_l``) and BVH classics (``RightCollar``, ``RightShoulder``,
-``RightElbow``). Helper bones (twist, share, roll, fingers, ``_End`` joints) never take a role,
-so the limb chains skip them. Where a rig has both a collar/clavicle and a "shoulder", the
-shoulder is the upper arm; otherwise "shoulder" is the clavicle (CMU, Bandai, Mixamo). An
-explicit mapping (JSON ``{"joint name": "left_upper_arm", ...}``) overrides the guesses.
+Roles are found from joint names *and* the skeleton's structure. The names of
+:mod:`mocapqa.core.rig_names` give each joint a side and a limb token (CMU/cgspeed, HumanIK/Maya,
+Mixamo with any ``mixamorigN:`` prefix, Perception Neuron, Rokoko, Xsens MVN, 3ds Max Biped,
+MakeHuman classic and default, Biovision, Unity/Unreal humanoid, SMPL, Character Creator,
+Bandai). Tokens that mean different joints in different conventions (``shoulder``, ``leg``,
+``foot``) are then resolved along each limb chain: the named joints of one side's arm (or leg)
+are ordered from the body outwards, and the levels (clavicle, upper arm, forearm, hand) are
+assigned so that they increase along the chain, fill as many roles as possible without holes,
+prefer unambiguous names, and keep consecutive roles close in the tree. So ``LeftShoulder`` is
+the clavicle above ``LeftArm`` (CMU) and the upper arm below ``LeftCollar`` and above
+``LeftElbow`` (Xsens). Helper bones (twist, share, roll, fingers, ``_End``, MakeHuman's ``__``
+bones) never take a role.
+
+An explicit mapping overrides the guesses, role key → joint name
+(``{"left_upper_arm": "LeftShoulder", ...}``); the older orientation, joint name → role key, is
+accepted too (see :func:`normalise_mapping`).
 """
 
 from __future__ import annotations
 
-import re
+import functools
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Literal
 
 from mocapqa.core.motion import Skeleton
+from mocapqa.core.rig_names import ARM_TOKENS, LEG_TOKENS, is_helper, split_side, token_of
 from mocapqa.errors import InputError
 
 __all__ = [
     "ROLES",
+    "ROLE_KEYS",
     "SEGMENTS",
     "SIDES",
     "Chain",
     "RigMap",
     "find_roles",
     "limb_chains",
+    "normalise_mapping",
     "role_key",
     "split_side",
 ]
@@ -37,64 +50,19 @@ ROLES = ("clavicle", "upper_arm", "forearm", "hand", "upper_leg", "lower_leg", "
 """Limb roles, arm then leg, proximal to distal."""
 # The limb segments whose twist the twist detector checks (parent role of a chain).
 SEGMENTS = ("clavicle", "upper_arm", "forearm", "upper_leg", "lower_leg")
-
-_NAMES: dict[str, str] = {
-    "clavicle": "clavicle", "collar": "clavicle", "shoulder": "clavicle",
-    "arm": "upper_arm", "upperarm": "upper_arm", "uparm": "upper_arm", "humerus": "upper_arm",
-    "forearm": "forearm", "lowerarm": "forearm", "elbow": "forearm", "radius": "forearm",
-    "hand": "hand", "wrist": "hand",
-    "upleg": "upper_leg", "upperleg": "upper_leg", "thigh": "upper_leg", "hip": "upper_leg",
-    "femur": "upper_leg",
-    "leg": "lower_leg", "lowerleg": "lower_leg", "calf": "lower_leg", "knee": "lower_leg",
-    "shin": "lower_leg", "tibia": "lower_leg",
-    "foot": "foot", "ankle": "foot",
-    "toe": "toe", "toes": "toe", "toebase": "toe", "ball": "toe", "forefoot": "toe",
-}  # fmt: skip
-_HELPER = re.compile(r"twist|share|roll|index|thumb|finger|middle|ring|pinky|nub|_end$|end$|dummy")
-_PREFIX = re.compile(r"^(.*:)|^(cc_base_|joint_|bip01_|def-|mixamorig)", re.IGNORECASE)
-
-
-def split_side(name: str) -> tuple[Side | None, str]:
-    """Split a joint name into its side and the normalised rest.
-
-    Examples
-    --------
-    >>> split_side("mixamorig:LeftForeArm")
-    ('left', 'forearm')
-    >>> split_side("UpperArm_L")
-    ('left', 'upperarm')
-    >>> split_side("CC_Base_R_Calf")
-    ('right', 'calf')
-    """
-    raw = _PREFIX.sub("", name.split(":")[-1])
-    raw = _PREFIX.sub("", raw)
-    low = raw.lower()
-    side: Side | None = None
-    rest = low
-    patterns: list[tuple[str, int, int]] = [
-        (r"^(left|right)[_.\s-]?(.+)$", 1, 2),
-        (r"^(l|r)[_.\s-](.+)$", 1, 2),
-        (r"^(.+?)[_.\s-](l|r|left|right)$", 2, 1),
-        (r"^(.+?)(left|right)$", 2, 1),
-    ]
-    for pattern, side_group, rest_group in patterns:
-        match = re.match(pattern, low)
-        if match:
-            side = "left" if match.group(side_group).startswith("l") else "right"
-            rest = match.group(rest_group)
-            break
-    else:
-        # CMU style "LHipJoint", "RThumb": one capital L/R before another capital.
-        match = re.match(r"^([LR])([A-Z].*)$", raw)
-        if match:
-            side = "left" if match.group(1) == "L" else "right"
-            rest = match.group(2).lower()
-    return side, re.sub(r"[_.\s-]", "", rest)
+_LIMBS: tuple[tuple[tuple[str, ...], dict[str, tuple[int, ...]]], ...] = (
+    (ROLES[:4], ARM_TOKENS),
+    (ROLES[4:], LEG_TOKENS),
+)
 
 
 def role_key(side: Side, role: str) -> str:
     """The key of a role in mappings, e.g. ``"left_upper_arm"``."""
     return f"{side}_{role}"
+
+
+ROLE_KEYS: tuple[str, ...] = tuple(role_key(s, r) for s in SIDES for r in ROLES)
+"""Every role key, left side first, in :data:`ROLES` order."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -148,14 +116,111 @@ def _is_descendant(skeleton: Skeleton, joint: int, ancestor: int) -> bool:
     return False
 
 
-def find_roles(skeleton: Skeleton, mapping: dict[str, str] | None = None) -> RigMap:
+Score = tuple[int, int, int, int]
+"""(roles filled, −holes between them, unambiguous names, −tree distance between roles)."""
+
+
+def _assign(
+    levels: tuple[tuple[int, ...], ...], depths: tuple[int, ...]
+) -> tuple[Score, tuple[int, ...]]:
+    """Best strictly increasing level per chain entry (−1: no role), by :data:`Score`."""
+
+    @functools.lru_cache(maxsize=None)
+    def best(i: int, last: int, prev: int) -> tuple[Score, tuple[int, ...]]:
+        if i == len(levels):
+            return (0, 0, 0, 0), ()
+        score, rest = best(i + 1, last, prev)
+        choice: tuple[Score, tuple[int, ...]] = (score, (-1, *rest))
+        for level in levels[i]:
+            if level <= last:
+                continue
+            sub, tail = best(i + 1, level, i)
+            holes = level - last - 1 if last >= 0 else 0
+            span = depths[i] - depths[prev] if prev >= 0 else 0
+            gain = (1, -holes, 1 if len(levels[i]) == 1 else 0, -span)
+            total: Score = (
+                sub[0] + gain[0],
+                sub[1] + gain[1],
+                sub[2] + gain[2],
+                sub[3] + gain[3],
+            )
+            if total > choice[0]:
+                choice = (total, (level, *tail))
+        return choice
+
+    return best(0, -1, -1)
+
+
+def _limb_roles(
+    skeleton: Skeleton, candidates: list[tuple[int, str]], tokens: dict[str, tuple[int, ...]]
+) -> dict[int, int]:
+    """Level → joint for one side's limb, from its named joints ``(joint, token)``."""
+    depths = skeleton.depths
+    best_score: Score | None = None
+    best_roles: dict[int, int] = {}
+    for end, _ in candidates:
+        chain = sorted(
+            ((j, t) for j, t in candidates if j == end or _is_descendant(skeleton, end, j)),
+            key=lambda item: int(depths[item[0]]),
+        )
+        # Consecutive joints with one token (upperarm01, upperarm02) are one segment: the first.
+        merged: list[tuple[int, str]] = []
+        for joint, token in chain:
+            if not merged or merged[-1][1] != token:
+                merged.append((joint, token))
+        score, levels = _assign(
+            tuple(tokens[t] for _, t in merged), tuple(int(depths[j]) for j, _ in merged)
+        )
+        if best_score is None or score > best_score:
+            best_score = score
+            best_roles = {lv: merged[k][0] for k, lv in enumerate(levels) if lv >= 0}
+    return best_roles
+
+
+def normalise_mapping(mapping: Mapping[str, str]) -> dict[str, str]:
+    """A mapping as role key → joint name.
+
+    Parameters
+    ----------
+    mapping : mapping of str to str
+        Either role key → joint name (``{"left_upper_arm": "LeftShoulder"}``) or, as older
+        mapping files have it, joint name → role key (``{"LeftShoulder": "left_upper_arm"}``).
+
+    Raises
+    ------
+    InputError
+        If neither all keys nor all values are role keys, or a value is not a string.
+    """
+    if not all(isinstance(k, str) and isinstance(v, str) for k, v in mapping.items()):
+        raise InputError("Expected a mapping of role keys to joint names (strings)")
+    valid = set(ROLE_KEYS)
+    if all(k in valid for k in mapping):
+        return dict(mapping)
+    if all(v in valid for v in mapping.values()):
+        inverted: dict[str, str] = {}
+        for joint, key in mapping.items():
+            if key in inverted:
+                raise InputError(f"Expected one joint per role, got two for {key!r}")
+            inverted[key] = joint
+        return inverted
+    key, joint = next(
+        ((k, v) for k, v in mapping.items() if k not in valid and v not in valid),
+        next((k, v) for k, v in mapping.items() if k not in valid),
+    )
+    raise InputError(
+        f"Expected a role in {sorted(valid)} as every key (or every value), got {key!r}: {joint!r}"
+    )
+
+
+def find_roles(skeleton: Skeleton, mapping: Mapping[str, str] | None = None) -> RigMap:
     """Map joints to limb roles.
 
     Parameters
     ----------
     skeleton : Skeleton
-    mapping : dict, optional
-        Joint name → role key (``"left_upper_arm"``) overriding the automatic guesses.
+    mapping : mapping, optional
+        Role key → joint name (or joint name → role key, see :func:`normalise_mapping`)
+        overriding the automatic guesses.
 
     Returns
     -------
@@ -166,37 +231,28 @@ def find_roles(skeleton: Skeleton, mapping: dict[str, str] | None = None) -> Rig
     InputError
         If ``mapping`` names a joint or a role that does not exist.
     """
-    depths = skeleton.depths
-    candidates: dict[str, list[int]] = {}
-    has_collar: dict[str, bool] = {"left": False, "right": False}
-    parsed: list[tuple[Side | None, str]] = [split_side(n) for n in skeleton.names]
-    for side, rest in parsed:
-        if side and rest in ("collar", "clavicle"):
-            has_collar[side] = True
-    for j, (side, rest) in enumerate(parsed):
-        if side is None or _HELPER.search(rest) or _HELPER.search(skeleton.names[j].lower()):
-            continue
-        role = _NAMES.get(rest)
-        if role is None:
-            continue
-        if rest == "shoulder" and has_collar[side]:
-            role = "upper_arm"
-        candidates.setdefault(role_key(side, role), []).append(j)
-    roles = {key: min(js, key=lambda j: depths[j]) for key, js in candidates.items()}
+    parsed = [split_side(n) for n in skeleton.names]
+    roles: dict[str, int] = {}
+    for side in SIDES:
+        for limb_roles, tokens in _LIMBS:
+            candidates = [
+                (j, token_of(rest))
+                for j, (s, rest) in enumerate(parsed)
+                if s == side and token_of(rest) in tokens and not is_helper(skeleton.names[j])
+            ]
+            for level, joint in _limb_roles(skeleton, candidates, tokens).items():
+                roles[role_key(side, limb_roles[level])] = joint
     if mapping:
-        valid = {role_key(s, r) for s in SIDES for r in ROLES}
-        for joint_name, key in mapping.items():
-            if key not in valid:
-                raise InputError(f"Expected a role in {sorted(valid)}, got {key!r}")
+        for key, joint_name in normalise_mapping(mapping).items():
             try:
                 roles[key] = skeleton.index(joint_name)
             except KeyError:
                 raise InputError(f"Expected a joint of this skeleton, got {joint_name!r}") from None
     # Keep only roles whose limb order holds (each a descendant of the previous one).
     for side in SIDES:
-        for limb in (ROLES[:4], ROLES[4:]):
+        for limb_roles, _ in _LIMBS:
             previous: int | None = None
-            for role in limb:
+            for role in limb_roles:
                 key = role_key(side, role)
                 if key not in roles:
                     continue
@@ -204,7 +260,7 @@ def find_roles(skeleton: Skeleton, mapping: dict[str, str] | None = None) -> Rig
                     del roles[key]
                     continue
                 previous = roles[key]
-    unmapped = tuple(role_key(s, r) for s in SIDES for r in ROLES if role_key(s, r) not in roles)
+    unmapped = tuple(key for key in ROLE_KEYS if key not in roles)
     return RigMap(roles=roles, unmapped=unmapped)
 
 
