@@ -240,7 +240,8 @@ def test_the_command_table_names_every_command_s_module() -> None:
 
 
 def test_info_in_a_fresh_process_loads_only_what_it_needs(cmu_walk: Path, corpus_dir: Path) -> None:
-    # `mocapqa info` must start fast: only its own command module, and no pyarrow for a
+    # `mocapqa info` must start fast: only its own command module (and the small shared
+    # --mapping option of every BVH command), and no pyarrow for a
     # small take (the line-by-line reader is quicker than importing it); a large take
     # (3.5 MB) is worth the import.
     large = corpus_dir / "bvh" / "cmu" / "iclone" / "001_14.bvh"
@@ -261,7 +262,7 @@ def test_info_in_a_fresh_process_loads_only_what_it_needs(cmu_walk: Path, corpus
     assert codes == [0, 0]
     assert not arrow_after_small
     assert arrow_after_large
-    assert cli == ["mocapqa.cli.app", "mocapqa.cli.info", "mocapqa.cli.main"]
+    assert cli == ["mocapqa.cli.app", "mocapqa.cli.info", "mocapqa.cli.main", "mocapqa.cli.roles"]
 
 
 def test_timed_works_take_turns_of_consecutive_runs() -> None:

@@ -5,7 +5,10 @@ from __future__ import annotations
 from datetime import datetime
 from typing import Any, Literal
 
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, Field, field_validator
+
+from mocapqa.errors import InputError
+from mocapqa.pipeline.options import check_mapping
 
 __all__ = [
     "AnalysisOptionsIn",
@@ -43,6 +46,19 @@ class AnalysisOptionsIn(BaseModel):
     filter_preset: str | None = None
     filter_params: dict[str, float | int | bool | str] = Field(default_factory=dict)
     max_points: int = Field(2000, ge=10, le=100_000)
+    mapping: dict[str, str] = Field(
+        default_factory=dict,
+        description='Rig roles by hand, role key → joint name ({"left_upper_arm": "LeftArm"}); '
+        "roles not named are found from the joint names and the skeleton's structure.",
+    )
+
+    @field_validator("mapping")
+    @classmethod
+    def _roles_are_known(cls, value: dict[str, str]) -> dict[str, str]:
+        try:
+            return check_mapping(value)
+        except InputError as e:
+            raise ValueError(str(e)) from e
 
 
 class RunOut(BaseModel):

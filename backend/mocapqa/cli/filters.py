@@ -12,6 +12,7 @@ from rich.console import Console
 from rich.table import Table
 
 from mocapqa.cli.app import app, bench_app
+from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
 from mocapqa.errors import InputError
 
 __all__ = ["bench_filters", "filter_command", "parse_overrides"]
@@ -41,6 +42,7 @@ def filter_command(
     ] = None,
     report: Annotated[Path | None, typer.Option(help="Write a JSON report here.")] = None,
     fps: Annotated[float | None, typer.Option(help="Frame rate for formats without one.")] = None,
+    mapping: MappingOption = None,
 ) -> None:
     """Filter a keypoint file or the rotations of a BVH take."""
     from mocapqa.core.motion import Motion
@@ -51,9 +53,13 @@ def filter_command(
     from mocapqa.metrics.smoothness import lag_frames, mean_abs_jerk
 
     overrides = parse_overrides(param or [])
+    roles = load_mapping(mapping)
     take = read_take(input_path, fps=fps)
     summary: dict[str, Any]
+    if roles is not None and not isinstance(take, Motion):
+        raise InputError("Expected --mapping only for BVH input, got a keypoint take")
     if isinstance(take, Motion):
+        missing_roles(take.skeleton, roles)
         method = method or "quat-pd"
         if preset != "default":
             raise InputError(f"Expected preset 'default' for rotation filters, got {preset!r}")

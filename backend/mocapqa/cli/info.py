@@ -15,40 +15,14 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from mocapqa.cli.app import app
-from mocapqa.errors import InputError, ParseError, UnsupportedFormatError
+from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
+from mocapqa.errors import InputError, UnsupportedFormatError
 
 if TYPE_CHECKING:
     from mocapqa.core.keypoints import KeypointSequence
     from mocapqa.core.motion import Motion
 
-__all__ = ["convert_command", "info_command", "keypoints_summary", "motion_summary", "read_mapping"]
-
-
-def read_mapping(path: Path) -> dict[str, str]:
-    """Read a rig mapping file: JSON ``{"joint name": "left_upper_arm", ...}``.
-
-    Raises
-    ------
-    ParseError
-        If the file cannot be read or is not a JSON object of strings.
-    """
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as e:
-        raise ParseError(f"Expected a readable UTF-8 mapping file, got {e}", path) from e
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise ParseError(f"Expected JSON, got {e.msg}", path, e.lineno) from e
-    if not isinstance(data, dict) or not all(
-        isinstance(k, str) and isinstance(v, str) for k, v in data.items()
-    ):
-        raise ParseError(
-            'Expected a JSON object {"joint name": "left_upper_arm", ...}, '
-            f"got {type(data).__name__}",
-            path,
-        )
-    return data
+__all__ = ["convert_command", "info_command", "keypoints_summary", "motion_summary"]
 
 
 def motion_summary(motion: Motion, mapping: dict[str, str] | None = None) -> dict[str, Any]:
@@ -59,7 +33,7 @@ def motion_summary(motion: Motion, mapping: dict[str, str] | None = None) -> dic
     motion : Motion
         The take.
     mapping : dict, optional
-        Joint name → role key, overriding the automatic role guesses.
+        Role key → joint name, overriding the roles found from names and structure.
 
     Returns
     -------
@@ -159,10 +133,7 @@ def info_command(
     fps: Annotated[
         float | None, typer.Option(help="Frames per second, for formats that do not store it.")
     ] = None,
-    mapping: Annotated[
-        Path | None,
-        typer.Option(help='Rig roles as JSON {"joint": "left_upper_arm"} (BVH only).'),
-    ] = None,
+    mapping: MappingOption = None,
 ) -> None:
     """Show what a take holds: frames, rate, joints or keypoints, units, rig roles."""
     from mocapqa.core.motion import Motion
@@ -170,11 +141,12 @@ def info_command(
 
     if fps is not None and not fps > 0:
         raise InputError(f"Expected --fps > 0, got {fps}")
-    roles = read_mapping(mapping) if mapping is not None else None
+    roles = load_mapping(mapping)
     format_name = detect_format(file)
     take = read_take(file, fps=fps, number_reader="auto")
     if isinstance(take, Motion):
         summary = motion_summary(take, roles)
+        missing_roles(take.skeleton, roles)
     else:
         if roles is not None:
             raise InputError(f"Expected --mapping only for BVH input, got a {format_name} file")
@@ -193,6 +165,7 @@ def convert_command(
         float | None, typer.Option(help="Frames per second, for inputs that do not store it.")
     ] = None,
     precision: Annotated[int, typer.Option(help="Decimal places of BVH channel values.")] = 6,
+    mapping: MappingOption = None,
 ) -> None:
     """Convert a take: BVH to BVH, keypoints between TRC, CSV, NPY, NPZ and JSON."""
     from mocapqa.core.motion import Motion
@@ -204,14 +177,18 @@ def convert_command(
     if not 0 <= precision <= 15:
         raise InputError(f"Expected --precision between 0 and 15, got {precision}")
     suffix = output.suffix.lower().lstrip(".")
+    roles = load_mapping(mapping)
     take = read_take(source, fps=fps, number_reader="auto")
     if isinstance(take, Motion):
+        missing_roles(take.skeleton, roles)
         if suffix != "bvh":
             raise UnsupportedFormatError(
                 f"Expected a .bvh output for a BVH input, got {output.name!r}"
             )
         writer: Callable[[], None] = lambda: write_bvh(output, take, precision=precision)  # noqa: E731
     else:
+        if roles is not None:
+            raise InputError("Expected --mapping only for BVH input, got a keypoint take")
         if suffix not in KEYPOINT_WRITE_FORMATS:
             raise UnsupportedFormatError(
                 f"Expected a keypoint output among {', '.join(KEYPOINT_WRITE_FORMATS)}, "

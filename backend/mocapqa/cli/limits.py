@@ -12,6 +12,7 @@ from rich.console import Console
 from rich.table import Table
 
 from mocapqa.cli.app import bench_app, limits_app
+from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
 from mocapqa.errors import InputError
 
 if TYPE_CHECKING:
@@ -104,18 +105,26 @@ def limits_check(
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     network: Annotated[bool, typer.Option(help="Let the discriminator decide.")] = False,
+    mapping: MappingOption = None,
 ) -> None:
-    """Check a take against joint limits: share of frames outside and the worst frames."""
+    """Check a take against joint limits: share of frames outside and the worst frames.
+
+    A limits model applies to the rig it was built on (matched by joint names and bone axes);
+    ``--mapping`` names roles the names do not give, and the roles still missing are listed.
+    """
     from mocapqa.io.bvh import read_bvh
     from mocapqa.limits.analysis import check_limits
     from mocapqa.limits.model import load_model
 
+    roles = load_mapping(mapping)
     motion = read_bvh(path)
+    missing = missing_roles(motion.skeleton, roles)
     model = load_model(model_path) if model_path is not None else None
     report = check_limits(motion, model, method="network" if network else "map")
     data = report.to_json(max_points=0)
     for joint in data["joints"]:
         del joint["frames"]
+    data["missing_roles"] = missing
     if as_json:
         print(json.dumps(data, indent=2))
         return

@@ -17,6 +17,7 @@ from rich.table import Table
 
 from mocapqa.cli.app import app, bench_app
 from mocapqa.cli.report import TakeRun, analyze_take, build_take_report, sheet_tiles
+from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles, warn_missing
 from mocapqa.errors import InputError, NotFoundError
 
 __all__ = ["bench_render", "flagged_at", "parse_interval", "raw_run", "render"]
@@ -37,15 +38,23 @@ def parse_interval(text: str) -> tuple[str, int, int]:
     return joint, start, end
 
 
-def raw_run(path: Path) -> TakeRun:
+def raw_run(path: Path, mapping: dict[str, str] | None = None) -> TakeRun:
     """A take read without analysis: corrected is the raw take, no findings."""
     from mocapqa.core.motion import Motion
     from mocapqa.io.formats import read_take
     from mocapqa.render.scene import track_from_keypoints, track_from_motion
 
     take = read_take(path)
-    track = track_from_motion(take) if isinstance(take, Motion) else track_from_keypoints(take)
-    return TakeRun({"findings": [], "summary": {"fps": track.fps}}, track, track)
+    summary: dict[str, object] = {"fps": 0.0}
+    if isinstance(take, Motion):
+        track = track_from_motion(take)
+        summary["missing_roles"] = missing_roles(take.skeleton, mapping, warn=False)
+    else:
+        if mapping:
+            raise InputError("Expected --mapping only for BVH input, got a keypoint take")
+        track = track_from_keypoints(take)
+    summary["fps"] = track.fps
+    return TakeRun({"findings": [], "summary": summary}, track, track)
 
 
 def flagged_at(run: TakeRun, frame: int) -> np.ndarray:
@@ -80,6 +89,7 @@ def render(
     ] = None,
     width: Annotated[int, typer.Option(help="Width of one view, px.")] = 640,
     height: Annotated[int, typer.Option(help="Height of one view, px.")] = 480,
+    mapping: MappingOption = None,
 ) -> None:
     """Render a still (--frame), a clip (--interval) or a contact sheet (--contact-sheet)."""
     from mocapqa.render.service import RenderService
@@ -98,7 +108,12 @@ def render(
         def step(percent: int, text: str) -> None:
             bar.update(task, completed=percent, description=text)
 
-        run = analyze_take(input_path, None, step) if analyze else raw_run(input_path)
+        roles = load_mapping(mapping)
+        if analyze:
+            run = analyze_take(input_path, {"mapping": roles} if roles else None, step)
+        else:
+            run = raw_run(input_path, roles)
+        warn_missing(run.analysis.get("summary", {}).get("missing_roles") or [])
         if up_axis is not None:
             run = TakeRun(
                 run.analysis,

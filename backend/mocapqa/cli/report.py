@@ -24,6 +24,7 @@ from rich.console import Console
 from rich.progress import Progress
 
 from mocapqa.cli.app import app
+from mocapqa.cli.roles import MappingOption, load_mapping, warn_missing
 from mocapqa.errors import InputError, MocapQAError, NotFoundError
 
 if TYPE_CHECKING:
@@ -153,6 +154,7 @@ def build_take_report(
 
     step = progress or (lambda percent, text: None)
     run = load_run(run_folder) if run_folder is not None else analyze_take(path, options, progress)
+    warn_missing(run.analysis.get("summary", {}).get("missing_roles") or [])
     tiles = sheet_tiles(run)
     sheet: bytes | None = None
     unavailable: dict[str, str] = {}
@@ -228,6 +230,7 @@ def report(
     pdf: Annotated[
         Path | None, typer.Option(help="Also print the report to this PDF (needs Chromium).")
     ] = None,
+    mapping: MappingOption = None,
 ) -> None:
     """Write a self-contained HTML QA report: summary, findings, timelines, contact sheet."""
     from mocapqa.render.service import RenderService
@@ -240,6 +243,11 @@ def report(
             option_values = json.loads(options.read_text(encoding="utf-8"))
         except (OSError, ValueError) as e:
             raise InputError(f"{options}: Expected a JSON object of options, got {e}") from e
+    roles = load_mapping(mapping)
+    if roles is not None:
+        if run is not None:
+            raise InputError("Expected --mapping only when analysing, got --run too")
+        option_values = {**(option_values or {}), "mapping": roles}
     with Progress(console=console, transient=True) as bar, RenderService() as service:
         task = bar.add_task("analysing", total=100)
 

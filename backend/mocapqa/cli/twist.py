@@ -14,6 +14,7 @@ from rich.progress import Progress
 from rich.table import Table
 
 from mocapqa.cli.app import app, bench_app
+from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
 
 if TYPE_CHECKING:
     from mocapqa.twist.analysis import TwistAnalysis
@@ -23,10 +24,11 @@ __all__ = ["bench_twist", "detect", "refine"]
 _METHOD_HELP = "Detector: robust (default) or paper (the published rule as written)."
 
 
-def _report(analysis: TwistAnalysis, path: Path) -> dict[str, Any]:
+def _report(analysis: TwistAnalysis, path: Path, missing: list[str]) -> dict[str, Any]:
     return {
         "input": str(path),
         "method": analysis.method,
+        "missing_roles": missing,
         "n_frames": analysis.refined.n_frames,
         "fps": analysis.fps,
         "intervals": [i.to_json() for i in analysis.intervals],
@@ -50,6 +52,7 @@ def refine(
     report: Annotated[
         Path | None, typer.Option(help="Write the intervals and per-joint summaries as JSON.")
     ] = None,
+    mapping: MappingOption = None,
 ) -> None:
     """Remove axial twist errors; writes the take with the input's layout and frame time."""
     from mocapqa.io.bvh import read_bvh
@@ -57,11 +60,14 @@ def refine(
     from mocapqa.twist.analysis import analyze_twist
 
     _check_method(method)
+    roles = load_mapping(mapping)
     motion = read_bvh(input_path)
-    analysis = analyze_twist(motion, method)
+    missing = missing_roles(motion.skeleton, roles)
+    analysis = analyze_twist(motion, method, roles)
     write_bvh(output, analysis.refined)
     if report is not None:
-        report.write_text(json.dumps(_report(analysis, input_path), indent=2), encoding="utf-8")
+        text = json.dumps(_report(analysis, input_path, missing), indent=2)
+        report.write_text(text, encoding="utf-8")
     console = Console(highlight=False)
     frames = sum(i.end_frame - i.start_frame + 1 for i in analysis.intervals)
     console.print(
@@ -74,15 +80,19 @@ def detect(
     input_path: Annotated[Path, typer.Argument(metavar="IN.bvh", help="Take to check.")],
     method: Annotated[str, typer.Option(help=_METHOD_HELP)] = "robust",
     as_json: Annotated[bool, typer.Option("--json", help="Print the report as JSON.")] = False,
+    mapping: MappingOption = None,
 ) -> None:
     """Report axial twist error intervals without writing anything."""
     from mocapqa.io.bvh import read_bvh
     from mocapqa.twist.analysis import analyze_twist
 
     _check_method(method)
-    analysis = analyze_twist(read_bvh(input_path), method)
+    roles = load_mapping(mapping)
+    motion = read_bvh(input_path)
+    missing = missing_roles(motion.skeleton, roles)
+    analysis = analyze_twist(motion, method, roles)
     if as_json:
-        typer.echo(json.dumps(_report(analysis, input_path), indent=2))
+        typer.echo(json.dumps(_report(analysis, input_path, missing), indent=2))
         return
     table = Table(title=f"Twist intervals ({method}) in {input_path.name}")
     for column in ("joint", "start", "end", "offset °", "confidence"):

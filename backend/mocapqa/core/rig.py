@@ -125,7 +125,7 @@ def _assign(
 ) -> tuple[Score, tuple[int, ...]]:
     """Best strictly increasing level per chain entry (−1: no role), by :data:`Score`."""
 
-    @functools.lru_cache(maxsize=None)
+    @functools.cache
     def best(i: int, last: int, prev: int) -> tuple[Score, tuple[int, ...]]:
         if i == len(levels):
             return (0, 0, 0, 0), ()

@@ -26,6 +26,7 @@ from typing import Literal
 __all__ = ["ARM_TOKENS", "LEG_TOKENS", "Side", "is_helper", "split_side", "token_of"]
 
 Side = Literal["left", "right"]
+"""A body side."""
 
 ARM_TOKENS: dict[str, tuple[int, ...]] = {
     "clavicle": (0,), "collar": (0,),
@@ -115,5 +116,5 @@ def is_helper(name: str) -> bool:
 
 
 def token_of(rest: str) -> str:
-    """The limb token of a normalised name: trailing digits dropped (``upperarm01`` → ``upperarm``)."""
+    """The limb token of a normalised name, without trailing digits (``upperarm01``: upperarm)."""
     return rest.rstrip("0123456789")

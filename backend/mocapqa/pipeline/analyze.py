@@ -23,6 +23,8 @@ from mocapqa import __version__
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
+from mocapqa.core.rig import find_roles
+from mocapqa.errors import InputError
 from mocapqa.pipeline.frames import motion_points, sample_frames
 from mocapqa.pipeline.loading import Take
 from mocapqa.pipeline.options import AnalysisOptions
@@ -82,6 +84,7 @@ def _analyze_motion(
     timings: dict[str, float] = {}
     frames = sample_frames(motion.n_frames, options.max_points)
 
+    rig = find_roles(motion.skeleton, options.mapping)  # a bad mapping fails the run here
     progress(10, "forward kinematics (raw)")
     clock = time.perf_counter()
     names, parents, raw_points = motion_points(motion)
@@ -91,7 +94,7 @@ def _analyze_motion(
     if "twist" in options.checks:
         progress(25, "twist analysis")
         clock = time.perf_counter()
-        outcome = run_twist(motion, options.twist_method, frames)
+        outcome = run_twist(motion, options.twist_method, frames, options.mapping)
         timings["twist_s"] = time.perf_counter() - clock
         outcomes["twist"] = outcome
         if outcome.motion is not None:
@@ -137,6 +140,9 @@ def _analyze_motion(
             "duration_s": motion.n_frames / motion.fps,
             "n_joints": skeleton.n_joints,
             "length_unit": skeleton.length_unit,
+            "root_translation": skeleton.root_translation,
+            "roles": {key: skeleton.names[j] for key, j in sorted(rig.roles.items())},
+            "missing_roles": list(rig.unmapped),
             "n_findings": len(findings),
             "findings_by_kind": _count_by_kind(findings),
         },
@@ -153,6 +159,8 @@ def _analyze_motion(
 def _analyze_keypoints(
     sequence: KeypointSequence, options: AnalysisOptions, progress: ProgressCallback
 ) -> AnalysisResult:
+    if options.mapping:
+        raise InputError("Expected the mapping option only for BVH takes, got a keypoint take")
     outcomes: dict[str, StepOutcome] = {
         "twist": StepOutcome("skipped", "keypoint takes have no joint rotations"),
         "limits": StepOutcome("skipped", "keypoint takes have no joint rotations"),

@@ -10,11 +10,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from mocapqa.core.rig import normalise_mapping
 from mocapqa.errors import InputError
 from mocapqa.filters.registry import FILTERS
 from mocapqa.twist.analysis import METHODS
 
-__all__ = ["CHECKS", "TWIST_METHODS", "AnalysisOptions", "ParamValue"]
+__all__ = ["CHECKS", "TWIST_METHODS", "AnalysisOptions", "ParamValue", "check_mapping"]
 
 ParamValue = float | int | bool | str
 """Value of one filter parameter override."""
@@ -44,6 +45,11 @@ class AnalysisOptions:
         Parameter overrides for the filter by dotted name, in the registry's units.
     max_points : int
         Largest number of time samples per plotted series (the result is decimated to it).
+    mapping : dict of str to str
+        Rig roles named by hand, role key → joint name (``{"left_upper_arm": "LeftShoulder"}``),
+        overriding the roles found from names and structure (:func:`mocapqa.core.rig.find_roles`).
+        Checked here for its role keys; its joint names are checked against the take when the
+        run reads it.
     """
 
     checks: tuple[str, ...] = CHECKS
@@ -52,6 +58,7 @@ class AnalysisOptions:
     filter_preset: str | None = None
     filter_params: dict[str, ParamValue] = field(default_factory=dict)
     max_points: int = 2000
+    mapping: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         unknown = [c for c in self.checks if c not in CHECKS]
@@ -68,6 +75,7 @@ class AnalysisOptions:
         if not 10 <= self.max_points <= 100_000:
             raise InputError(f"Expected max_points in [10, 100000], got {self.max_points}")
         object.__setattr__(self, "checks", tuple(self.checks))
+        object.__setattr__(self, "mapping", check_mapping(self.mapping))
 
     def to_json(self) -> dict[str, Any]:
         """The options as a JSON-ready dict."""
@@ -78,6 +86,7 @@ class AnalysisOptions:
             "filter_preset": self.filter_preset,
             "filter_params": dict(self.filter_params),
             "max_points": self.max_points,
+            "mapping": dict(self.mapping),
         }
 
     @classmethod
@@ -92,7 +101,7 @@ class AnalysisOptions:
         if not data:
             return cls()
         known = {"checks", "twist_method", "filter_method", "filter_preset", "filter_params"}
-        known |= {"max_points"}
+        known |= {"max_points", "mapping"}
         extra = sorted(set(data) - known)
         if extra:
             raise InputError(f"Expected option fields among {sorted(known)}, got {extra}")
@@ -118,4 +127,20 @@ class AnalysisOptions:
             filter_preset=data.get("filter_preset"),
             filter_params={str(k): v for k, v in params.items()},
             max_points=max_points,
+            mapping=data.get("mapping") or {},
         )
+
+
+def check_mapping(mapping: object) -> dict[str, str]:
+    """The ``mapping`` option as role key → joint name, or an InputError naming the field.
+
+    The one check of the option, used by :class:`AnalysisOptions` and the API's request model.
+    """
+    if not isinstance(mapping, dict):
+        raise InputError(f"Expected mapping to be an object of role → joint name, got {mapping!r}")
+    if any(not isinstance(v, str) or not v for v in mapping.values()):
+        raise InputError("Expected mapping to name a joint (a non-empty string) for each role")
+    try:
+        return normalise_mapping(mapping)
+    except InputError as e:
+        raise InputError(f"mapping: {e}") from e

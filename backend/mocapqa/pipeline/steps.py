@@ -23,6 +23,7 @@ import numpy as np
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion, Skeleton
+from mocapqa.core.rig import find_roles
 from mocapqa.errors import LimitsFileError
 from mocapqa.filters.apply import filter_keypoints, filter_motion
 from mocapqa.limits.analysis import check_limits
@@ -68,9 +69,16 @@ class StepOutcome:
     keypoints: KeypointSequence | None = None
 
 
-def run_twist(motion: Motion, method: str, frames: IntArray) -> StepOutcome:
-    """Detect and remove twist offsets (θP level shifts) on every limb chain."""
-    analysis = analyze_twist(motion, method=method)
+def run_twist(
+    motion: Motion, method: str, frames: IntArray, mapping: dict[str, str] | None = None
+) -> StepOutcome:
+    """Detect and remove twist offsets (θP level shifts) on every limb chain.
+
+    ``mapping`` (role key → joint name) overrides the roles found on the rig; the message names
+    the roles that were not found, whose chains are not checked.
+    """
+    analysis = analyze_twist(motion, method=method, mapping=mapping)
+    missing = find_roles(motion.skeleton, mapping).unmapped
     findings = [
         {
             "kind": "twist",
@@ -84,9 +92,10 @@ def run_twist(motion: Motion, method: str, frames: IntArray) -> StepOutcome:
         for interval in analysis.intervals
     ]
     series = analysis.to_json(max_points=int(frames.size))
+    unchecked = f"; roles not found, not checked: {', '.join(missing)}" if missing else ""
     return StepOutcome(
         "done",
-        f"{len(findings)} twist interval(s) on {len(analysis.chains)} chain(s)",
+        f"{len(findings)} twist interval(s) on {len(analysis.chains)} chain(s){unchecked}",
         findings,
         series,
         analysis.refined,

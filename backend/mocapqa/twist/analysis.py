@@ -318,7 +318,7 @@ def analyze_twist(
     method : {"robust", "paper"}
         The robust detector (default) or the paper's rule as written.
     mapping : dict, optional
-        Joint name → role key overrides (see :func:`mocapqa.core.rig.find_roles`).
+        Role key → joint name overrides (see :func:`mocapqa.core.rig.find_roles`).
     params : RobustParams or PaperParams, optional
         Detector parameters; the method's defaults when omitted.
 

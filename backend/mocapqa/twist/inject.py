@@ -137,7 +137,7 @@ def inject_twist_errors(
     min_offset_deg, max_offset_deg : float
         Range of the offset magnitude, degrees; the sign is random.
     mapping : dict, optional
-        Joint name → role key overrides for :func:`mocapqa.core.rig.find_roles`.
+        Role key → joint name overrides for :func:`mocapqa.core.rig.find_roles`.
 
     Returns
     -------

@@ -1,0 +1,139 @@
+"""``--mapping FILE`` on every command that reads a BVH, and the warning naming missing roles."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from mocapqa.cli.main import main
+from mocapqa.errors import InputError
+from mocapqa.io.bvh import read_bvh
+from mocapqa.io.bvh_write import write_bvh
+from mocapqa.io.mapping import read_mapping
+from mocapqa.pipeline.options import AnalysisOptions
+
+# The CMU walk with its toes and forearms renamed to words no convention uses.
+RENAMED = {
+    "LeftToeBase": "LeftDigits", "RightToeBase": "RightDigits",
+    "LeftForeArm": "LeftLimbB", "RightForeArm": "RightLimbB",
+}  # fmt: skip
+MISSING = ["left_forearm", "left_toe", "right_forearm", "right_toe"]
+MAPPING_TOML = (
+    'left_toe = "LeftDigits"\nright_toe = "RightDigits"\n'
+    'left_forearm = "LeftLimbB"\nright_forearm = "RightLimbB"\n'
+)
+
+
+@pytest.fixture
+def odd_walk(cmu_walk: Path, tmp_path: Path) -> Path:
+    motion = read_bvh(cmu_walk)
+    names = tuple(RENAMED.get(n, n) for n in motion.skeleton.names)
+    renamed = replace(motion, skeleton=replace(motion.skeleton, names=names))
+    path = tmp_path / "odd_walk.bvh"
+    write_bvh(path, renamed)
+    return path
+
+
+@pytest.fixture
+def mapping_file(tmp_path: Path) -> Path:
+    path = tmp_path / "rig.toml"
+    path.write_text(MAPPING_TOML, encoding="utf-8")
+    return path
+
+
+def commands(take: Path, out: Path) -> list[list[str]]:
+    return [
+        ["info", str(take)],
+        ["convert", str(take), "-o", str(out / "copy.bvh")],
+        ["filter", str(take), "-o", str(out / "filtered.bvh")],
+        ["detect", str(take)],
+        ["refine", str(take), "-o", str(out / "refined.bvh")],
+        ["limits", "check", str(take)],
+    ]
+
+
+def test_every_bvh_command_names_the_missing_roles(
+    odd_walk: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    for args in commands(odd_walk, tmp_path):
+        code = main(args)
+        err = capsys.readouterr().err
+        assert "rig roles not found: " + ", ".join(MISSING) in " ".join(err.split()), args
+        assert code in (0, 6), args  # limits check: no shipped model for a renamed rig
+
+
+def test_every_bvh_command_takes_a_mapping(
+    odd_walk: Path, mapping_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    for args in commands(odd_walk, tmp_path):
+        code = main([*args, "--mapping", str(mapping_file)])
+        err = capsys.readouterr().err
+        assert "rig roles not found" not in err, args
+        assert code in (0, 6), args
+
+
+def test_the_mapping_reaches_the_twist_check(
+    odd_walk: Path, mapping_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["detect", str(odd_walk), "--json"]) == 0
+    without = json.loads(capsys.readouterr().out)
+    assert without["missing_roles"] == MISSING
+    assert main(["detect", str(odd_walk), "--json", "--mapping", str(mapping_file)]) == 0
+    with_mapping = json.loads(capsys.readouterr().out)
+    assert with_mapping["missing_roles"] == []
+    # Without forearms no arm chain is checked, without toes no foot chain: only the thighs.
+    assert [j["segment"] for j in without["joints"]] == ["upper_leg", "upper_leg"]
+    assert len(with_mapping["joints"]) == 10
+
+
+def test_a_mapping_naming_an_unknown_joint_exits_3(
+    odd_walk: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"left_toe": "NoSuchJoint"}', encoding="utf-8")
+    assert main(["detect", str(odd_walk), "--mapping", str(bad)]) == 3
+    assert "Expected a joint of this skeleton, got 'NoSuchJoint'" in capsys.readouterr().err
+
+
+def test_mapping_files_in_json_and_toml_either_way_round(tmp_path: Path) -> None:
+    as_json = tmp_path / "rig.json"
+    as_json.write_text('{"LeftDigits": "left_toe"}', encoding="utf-8")
+    as_toml = tmp_path / "rig.toml"
+    as_toml.write_text('left_toe = "LeftDigits"\n', encoding="utf-8")
+    assert read_mapping(as_json) == read_mapping(as_toml) == {"left_toe": "LeftDigits"}
+
+
+def test_run_options_carry_the_mapping() -> None:
+    options = AnalysisOptions.from_json({"mapping": {"left_toe": "LeftDigits"}})
+    assert options.mapping == {"left_toe": "LeftDigits"}
+    assert AnalysisOptions.from_json(options.to_json()) == options
+    with pytest.raises(InputError, match="mapping: Expected a role in"):
+        AnalysisOptions.from_json({"mapping": {"left_toes": "LeftDigits"}})
+    with pytest.raises(InputError, match="Expected mapping to be an object"):
+        AnalysisOptions.from_json({"mapping": ["left_toe"]})
+
+
+def test_a_run_reports_its_roles_and_uses_the_mapping(odd_walk: Path) -> None:
+    from mocapqa.pipeline.analyze import analyze
+
+    motion = read_bvh(odd_walk)
+    plain = analyze(motion, AnalysisOptions(checks=("twist",), max_points=100)).report
+    assert plain["summary"]["missing_roles"] == MISSING
+    assert "roles not found, not checked: left_forearm" in plain["steps"]["twist"]["message"]
+    mapped = analyze(
+        motion,
+        AnalysisOptions(checks=("twist",), max_points=100, mapping=read_mapping_text()),
+    ).report
+    assert mapped["summary"]["missing_roles"] == []
+    assert mapped["summary"]["roles"]["left_toe"] == "LeftDigits"
+    assert mapped["options"]["mapping"]["right_forearm"] == "RightLimbB"
+    assert "10 chain(s)" in mapped["steps"]["twist"]["message"]
+
+
+def read_mapping_text() -> dict[str, str]:
+    import tomllib
+
+    return dict(tomllib.loads(MAPPING_TOML))
