@@ -10,6 +10,9 @@ Conventions
 * ``confidence`` is ``(F, K)`` in [0, 1]; formats without one get 1.0 where a value exists.
 * ``length_unit`` is recorded from the file ("m", "mm", "cm", "px", "normalized") or "unknown";
   nothing is rescaled silently.
+* ``frame_numbers`` and ``times`` keep the source's own frame numbers and time column when it
+  has them (a TRC's ``Frame#``/``Time``, an OpenPose folder's file numbers), so a writer can
+  write them back; None means frames ``0..F-1`` at ``frame / fps`` seconds.
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mocapqa.core.arrays import FloatArray, as_float_array
+from mocapqa.core.arrays import FloatArray, IntArray, as_float_array
 from mocapqa.errors import ShapeError
 
 __all__ = ["LENGTH_UNITS", "KeypointSequence"]
@@ -50,6 +53,12 @@ class KeypointSequence:
     assumptions : tuple of str
         What a reader had to assume because the file did not say (for example
         ``"fps 30 assumed: OpenPose JSON stores no frame rate"``); empty when nothing was assumed.
+    frame_numbers : ndarray of int, shape (F,), optional
+        The source's frame numbers (increasing), when it has them.
+    times : ndarray, shape (F,), optional
+        The source's time column, seconds, when it has one.
+    start_frame : int, optional
+        The source's own first-frame field, when it has one (a TRC's ``OrigDataStartFrame``).
     """
 
     names: tuple[str, ...]
@@ -60,6 +69,9 @@ class KeypointSequence:
     n_dims: int = 3
     source_format: str = "unknown"
     assumptions: tuple[str, ...] = ()
+    frame_numbers: IntArray | None = None
+    times: FloatArray | None = None
+    start_frame: int | None = None
 
     def __post_init__(self) -> None:
         k = len(self.names)
@@ -83,6 +95,14 @@ class KeypointSequence:
         object.__setattr__(self, "positions", positions)
         object.__setattr__(self, "confidence", confidence)
         object.__setattr__(self, "fps", float(self.fps))
+        if self.frame_numbers is not None:
+            numbers = np.asarray(self.frame_numbers, dtype=np.intp)
+            if numbers.shape != (n,) or np.any(np.diff(numbers) <= 0):
+                raise ShapeError(f"Expected {n} increasing frame numbers, got {numbers.shape}")
+            object.__setattr__(self, "frame_numbers", numbers)
+        if self.times is not None:
+            times = as_float_array(self.times, "times", (n,), finite=False)
+            object.__setattr__(self, "times", times)
 
     @property
     def n_frames(self) -> int:

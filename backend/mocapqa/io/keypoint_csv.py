@@ -5,24 +5,31 @@ Conventions
 * Header ``frame,time,keypoint,x,y,z,confidence``; ``frame``, ``keypoint``, ``x`` and ``y`` are
   required, ``time``, ``z`` and ``confidence`` optional, extra columns ignored. Without ``z`` the
   data are 2D (``n_dims=2``, Z = 0).
-* Optional leading comment lines ``# fps: 30`` and ``# unit: m`` carry the frame rate and the
-  length unit (the writer emits them so that a written file reads back exactly); other ``#``
-  lines are ignored.
-* The frame rate is the caller's ``fps``, else the ``# fps`` line, else derived from ``time``
-  (median seconds per frame-number step); without any of these the reader raises an error that
-  asks for ``fps``.
+* The file is plain CSV: the header is the first line, so ``pandas.read_csv`` and
+  ``csv.DictReader`` read it with no options. The frame rate and the length unit travel in a
+  sidecar JSON beside it, ``<file>.meta.json`` (``{"fps": 30.0, "length_unit": "m", ...}``),
+  which the writer writes and the reader reads when it is there.
+* Files written by earlier versions, with leading comment lines ``# fps: 30`` and
+  ``# unit: m``, are still read; other leading ``#`` lines are ignored.
+* The frame rate is the caller's ``fps``, else the sidecar's, else the ``# fps`` line, else
+  derived from ``time`` (median seconds per frame-number step) and snapped to a standard rate
+  within 0.02 % (:func:`~mocapqa.io.keypoint_input.snap_fps`, recorded in ``assumptions``);
+  without any of these the reader raises an error that asks for ``fps``.
 * Keypoints keep the order of their first appearance. Frame numbers may start anywhere; a frame
   missing from the file is missing in the sequence. An empty cell or ``nan`` is missing;
   an empty ``confidence`` is 1.0 where the position exists.
-* The unit is the caller's ``length_unit``, else the ``# unit`` line, else "unknown".
+* The unit is the caller's ``length_unit``, else the sidecar's, else the ``# unit`` line, else
+  "unknown".
 """
 
 from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -35,10 +42,13 @@ from mocapqa.io.keypoint_input import (
     read_file_bytes,
     resolve_fps,
     resolve_length_unit,
+    snap_fps,
 )
 
 __all__ = [
     "KEYPOINT_CSV_COLUMNS",
+    "csv_sidecar",
+    "csv_sidecar_path",
     "format_keypoint_csv",
     "parse_keypoint_csv",
     "read_keypoint_csv",
@@ -69,6 +79,31 @@ def _frame_number(text: str, path: str, line: int) -> int:
     return int(value)
 
 
+def csv_sidecar_path(path: str | Path) -> Path:
+    """The metadata sidecar of a long keypoint CSV: ``walk.csv`` → ``walk.csv.meta.json``."""
+    path = Path(path)
+    return path.with_name(path.name + ".meta.json")
+
+
+def _read_sidecar(path: str | Path) -> dict[str, Any] | None:
+    sidecar = csv_sidecar_path(path)
+    if not sidecar.is_file():
+        return None
+    try:
+        data = json.loads(sidecar.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        raise ParseError(f"Expected a JSON metadata sidecar, got {e}", sidecar) from e
+    if not isinstance(data, dict):
+        raise ParseError(f"Expected a JSON object, got {type(data).__name__}", sidecar)
+    fps = data.get("fps")
+    if fps is not None and (isinstance(fps, bool) or not isinstance(fps, int | float)):
+        raise ParseError(f"Expected a number, got {fps!r}", sidecar, field="fps")
+    unit = data.get("length_unit")
+    if unit is not None and not isinstance(unit, str):
+        raise ParseError(f"Expected a unit name, got {unit!r}", sidecar, field="length_unit")
+    return data
+
+
 def _fps_from_times(frames: dict[int, float], path: str) -> float | None:
     known = sorted((f, t) for f, t in frames.items() if not math.isnan(t))
     if len(known) < 2:
@@ -80,11 +115,17 @@ def _fps_from_times(frames: dict[int, float], path: str) -> float | None:
     return 1.0 / seconds_per_frame
 
 
+def _fps_from_time_column(times: dict[int, float], path: str, notes: list[str]) -> float | None:
+    estimate = _fps_from_times(times, path)
+    return None if estimate is None else snap_fps(estimate, "the time column", notes)
+
+
 def parse_keypoint_csv(
     data: bytes | str,
     path: str | Path = "<keypoints.csv>",
     fps: float | None = None,
     length_unit: str | None = None,
+    sidecar: dict[str, Any] | None = None,
 ) -> KeypointSequence:
     """Parse the long keypoint CSV into a :class:`~mocapqa.core.keypoints.KeypointSequence`.
 
@@ -98,6 +139,9 @@ def parse_keypoint_csv(
         Frames per second; required when the file has neither ``time`` nor ``# fps``.
     length_unit : str, optional
         Unit of x, y, z when the file has no ``# unit`` line.
+    sidecar : dict, optional
+        The file's metadata sidecar (``fps``, ``length_unit``), read by
+        :func:`read_keypoint_csv`.
 
     Returns
     -------
@@ -172,27 +216,29 @@ def parse_keypoint_csv(
         positions[frame - first, index] = xyz
         confidence[frame - first, index] = conf
     notes: list[str] = []
+    side = sidecar or {}
     file_fps = float_from_text(meta["fps"], path, None, "fps") if "fps" in meta else None
-    rate = resolve_fps(
-        fps,
-        file_fps if file_fps is not None else _fps_from_times(times, path),
-        None,
-        path,
-        "CSV",
-        notes,
-    )
-    unit = resolve_length_unit(length_unit or meta.get("unit"), "unknown", path, notes)
+    if side.get("fps") is not None:
+        file_fps = float(side["fps"])
+    if fps is None and file_fps is None:
+        file_fps = _fps_from_time_column(times, path, notes)
+    rate = resolve_fps(fps, file_fps, None, path, "CSV", notes)
+    file_unit = side.get("length_unit") or meta.get("unit")
+    unit = resolve_length_unit(length_unit or file_unit, "unknown", path, notes)
+    numbers = first + np.arange(n_frames)
+    column = np.array([times.get(int(f), math.nan) for f in numbers]) if times else None
     return build_keypoint_sequence(
         path, tuple(names), positions, confidence, rate,
         length_unit=unit, n_dims=len(axes), source_format="csv", assumptions=notes,
+        frame_numbers=numbers, times=column,
     )  # fmt: skip
 
 
 def read_keypoint_csv(
     path: str | Path, fps: float | None = None, length_unit: str | None = None
 ) -> KeypointSequence:
-    """Read a long keypoint CSV file. See :func:`parse_keypoint_csv`."""
-    return parse_keypoint_csv(read_file_bytes(path), path, fps, length_unit)
+    """Read a long keypoint CSV file and its sidecar, if any. See :func:`parse_keypoint_csv`."""
+    return parse_keypoint_csv(read_file_bytes(path), path, fps, length_unit, _read_sidecar(path))
 
 
 def _cell(value: float) -> str:
@@ -200,7 +246,7 @@ def _cell(value: float) -> str:
 
 
 def format_keypoint_csv(seq: KeypointSequence) -> str:
-    """Format a sequence as the long keypoint CSV, with ``# fps`` and ``# unit`` lines.
+    """Format a sequence as the long keypoint CSV: the header, then one row per frame × keypoint.
 
     Parameters
     ----------
@@ -210,17 +256,19 @@ def format_keypoint_csv(seq: KeypointSequence) -> str:
     Returns
     -------
     str
-        The file content (LF line endings); missing values are empty cells.
+        The file content (LF line endings); missing values are empty cells. Frame numbers and
+        times are the source's when it had them, else ``0..F-1`` and ``frame / fps``.
     """
     axes = 2 if seq.n_dims == 2 else 3
     columns = [c for c in KEYPOINT_CSV_COLUMNS if c != "z" or axes == 3]
-    out = [f"# fps: {seq.fps!r}", f"# unit: {seq.length_unit}", ",".join(columns)]
-    for frame in range(seq.n_frames):
-        time = repr(frame / seq.fps)
+    out = [",".join(columns)]
+    numbers = range(seq.n_frames) if seq.frame_numbers is None else seq.frame_numbers.tolist()
+    for frame, number in enumerate(numbers):
+        time = _cell(float(seq.times[frame])) if seq.times is not None else repr(frame / seq.fps)
         for k, name in enumerate(seq.names):
             coords = ",".join(_cell(v) for v in seq.positions[frame, k, :axes])
             conf = repr(float(seq.confidence[frame, k]))
-            out.append(f"{frame},{time},{_quoted(name)},{coords},{conf}")
+            out.append(f"{number},{time},{_quoted(name)},{coords},{conf}")
     return "\n".join(out) + "\n"
 
 
@@ -230,8 +278,23 @@ def _quoted(name: str) -> str:
     return buffer.getvalue()
 
 
+def csv_sidecar(seq: KeypointSequence) -> dict[str, Any]:
+    """The metadata written beside a long keypoint CSV (see :func:`csv_sidecar_path`)."""
+    return {
+        "format": "mocapqa long keypoint CSV",
+        "columns": [c for c in KEYPOINT_CSV_COLUMNS if c != "z" or seq.n_dims != 2],
+        "fps": seq.fps,
+        "length_unit": seq.length_unit,
+        "n_frames": seq.n_frames,
+        "keypoints": list(seq.names),
+        "assumptions": list(seq.assumptions),
+    }
+
+
 def write_keypoint_csv(path: str | Path, seq: KeypointSequence) -> None:
-    """Write a sequence as a long keypoint CSV file (temporary name, then renamed into place).
+    """Write a sequence as a long keypoint CSV file and its ``.meta.json`` sidecar.
+
+    Each is written under a temporary name, then renamed into place.
 
     Parameters
     ----------
@@ -244,3 +307,7 @@ def write_keypoint_csv(path: str | Path, seq: KeypointSequence) -> None:
     tmp = path.with_name(path.name + ".tmp")
     tmp.write_text(format_keypoint_csv(seq), encoding="utf-8", newline="\n")
     tmp.replace(path)
+    sidecar = csv_sidecar_path(path)
+    tmp = sidecar.with_name(sidecar.name + ".tmp")
+    tmp.write_text(json.dumps(csv_sidecar(seq), indent=1), encoding="utf-8")
+    tmp.replace(sidecar)

@@ -18,18 +18,21 @@ from pathlib import Path
 
 import numpy as np
 
-from mocapqa.core.arrays import FloatArray
+from mocapqa.core.arrays import FloatArray, IntArray
 from mocapqa.core.keypoints import LENGTH_UNITS, KeypointSequence
 from mocapqa.errors import ParseError, ShapeError
 
 __all__ = [
+    "FPS_SNAP_TOLERANCE",
     "MAX_FILE_BYTES",
+    "STANDARD_FPS",
     "build_keypoint_sequence",
     "decode_text",
     "float_from_text",
     "read_file_bytes",
     "resolve_fps",
     "resolve_length_unit",
+    "snap_fps",
 ]
 
 # Largest keypoint file read into memory, bytes.
@@ -183,6 +186,56 @@ def resolve_fps(
     return float(fps)
 
 
+STANDARD_FPS: tuple[float, ...] = (
+    24000 / 1001, 24.0, 25.0, 30000 / 1001, 30.0, 48.0, 50.0, 60000 / 1001, 60.0, 72.0, 90.0,
+    96.0, 100.0, 120000 / 1001, 120.0, 144.0, 150.0, 180.0, 200.0, 240.0, 250.0, 300.0, 360.0,
+    400.0, 480.0, 500.0, 960.0, 1000.0,
+)  # fmt: skip
+"""Camera and mocap frame rates an estimate is snapped to (NTSC rates as 24000/1001 etc.)."""
+FPS_SNAP_TOLERANCE = 2e-4
+"""Largest relative distance (0.02 %) from a standard rate that is snapped to it; 29.97 and 30
+differ by 0.1 %, so they stay apart."""
+
+
+def snap_fps(estimate: float, source: str, assumptions: list[str]) -> float:
+    """Snap a frame rate estimated from times to the nearest standard rate, and say so.
+
+    Parameters
+    ----------
+    estimate : float
+        Frames per second estimated from a time column (> 0).
+    source : str
+        What it was estimated from, for the note (``"the time column"``).
+    assumptions : list of str
+        Appended to with what was done.
+
+    Returns
+    -------
+    float
+        The standard rate within :data:`FPS_SNAP_TOLERANCE`, else ``estimate``.
+
+    Examples
+    --------
+    >>> notes = []
+    >>> snap_fps(30.0003, "the time column", notes)
+    30.0
+    >>> notes[0]
+    'fps 30.0003 estimated from the time column, snapped to the standard 30 (within 0.02 %)'
+    """
+    nearest = min(STANDARD_FPS, key=lambda rate: abs(estimate / rate - 1.0))
+    if abs(estimate / nearest - 1.0) <= FPS_SNAP_TOLERANCE:
+        assumptions.append(
+            f"fps {estimate:.6g} estimated from {source}, snapped to the standard "
+            f"{nearest:.6g} (within {100 * FPS_SNAP_TOLERANCE:g} %)"
+        )
+        return nearest
+    assumptions.append(
+        f"fps {estimate:.6g} estimated from {source} (no standard rate within "
+        f"{100 * FPS_SNAP_TOLERANCE:g} %)"
+    )
+    return estimate
+
+
 def resolve_length_unit(
     caller_unit: str | None, default_unit: str, path: str | Path, assumptions: list[str]
 ) -> str:
@@ -231,6 +284,9 @@ def build_keypoint_sequence(
     n_dims: int,
     source_format: str,
     assumptions: list[str] | tuple[str, ...] = (),
+    frame_numbers: IntArray | None = None,
+    times: FloatArray | None = None,
+    start_frame: int | None = None,
 ) -> KeypointSequence:
     """Build a KeypointSequence, turning its validation errors into ParseError for ``path``.
 
@@ -252,6 +308,9 @@ def build_keypoint_sequence(
         2 or 3.
     assumptions : sequence of str
         Recorded assumptions.
+    frame_numbers, times, start_frame : optional
+        The source's frame numbers, time column and first-frame field (see
+        :class:`~mocapqa.core.keypoints.KeypointSequence`).
 
     Returns
     -------
@@ -273,6 +332,9 @@ def build_keypoint_sequence(
             n_dims=n_dims,
             source_format=source_format,
             assumptions=tuple(assumptions),
+            frame_numbers=frame_numbers,
+            times=times,
+            start_frame=start_frame,
         )
     except ShapeError as e:
         raise ParseError(str(e), path) from e

@@ -5,7 +5,10 @@ Conventions
 * Each file is ``{"people": [{"pose_keypoints_2d": [x0, y0, c0, x1, ...]}, ...]}``; pixels,
   so ``length_unit="px"`` and ``n_dims=2`` (Z is 0).
 * A folder's files are ordered by the last run of digits in their names (``cam01.0012.json``
-  → 12, ``video_000000000012_keypoints.json`` → 12), then by name.
+  → 12, ``video_000000000012_keypoints.json`` → 12), then by name. Those numbers are the frame
+  numbers: where they skip (``…000``–``…003``, ``…009``), the frames in between are missing
+  (all NaN), recorded in ``assumptions``. Without a number in every name, with a number
+  repeated, or with gaps spanning more than 4× the files, the files are consecutive frames.
 * ``person_index`` picks one entry of ``people`` (default 0). A frame where that person is
   absent is all missing.
 * A keypoint with confidence 0 (OpenPose writes ``0,0,0`` for undetected points) is missing:
@@ -62,6 +65,34 @@ _MIDPOINT_TOLERANCE = 0.15
 def _frame_key(path: Path) -> tuple[int, str]:
     runs = _DIGITS.findall(path.stem)
     return (int(runs[-1]) if runs else -1, path.name)
+
+
+_MAX_GAP_FACTOR = 4
+
+
+def _frame_slots(files: list[Path], notes: list[str]) -> tuple[list[int], int | None]:
+    """Frame index of each file (in order) and the first frame number, if the names give them.
+
+    The index is the file's frame number less the first one, or its position in the folder.
+    """
+    numbers = [_frame_key(f)[0] for f in files]
+    consecutive = list(range(len(files)))
+    if min(numbers) < 0 or len(set(numbers)) != len(numbers):
+        return consecutive, None
+    slots = [n - numbers[0] for n in numbers]
+    span = slots[-1] + 1
+    if span == len(files):
+        return slots, numbers[0]
+    if span > _MAX_GAP_FACTOR * len(files):
+        notes.append(
+            f"frame numbers span {span} frames for {len(files)} files: read as consecutive frames"
+        )
+        return consecutive, None
+    notes.append(
+        f"frame numbers {numbers[0]}–{numbers[-1]} skip {span - len(files)} frame(s): "
+        "those frames are missing"
+    )
+    return slots, numbers[0]
 
 
 def openpose_frame_files(folder: str | Path) -> list[Path]:
@@ -204,6 +235,8 @@ def read_openpose(
     if person_index < 0:
         raise ParseError(f"Expected person_index >= 0, got {person_index}", path)
     files = openpose_frame_files(path) if Path(path).is_dir() else [Path(path)]
+    notes: list[str] = []
+    slots, first_number = _frame_slots(files, notes)
     frames: list[FloatArray | None] = []
     n_keypoints: int | None = None
     for file in files:
@@ -219,16 +252,16 @@ def read_openpose(
         frames.append(triples)
     if n_keypoints is None:
         raise ParseError(f"Expected person {person_index} in at least one frame, got none", path)
-    positions = np.full((len(frames), n_keypoints, 3), np.nan)
-    confidence = np.zeros((len(frames), n_keypoints))
-    for i, triples in enumerate(frames):
+    n_frames = int(slots[-1]) + 1
+    positions = np.full((n_frames, n_keypoints, 3), np.nan)
+    confidence = np.zeros((n_frames, n_keypoints))
+    for i, triples in zip(slots, frames, strict=True):
         if triples is None:
             continue
         found = triples[:, 2] > 0
         positions[i, found, :2] = triples[found, :2]
         positions[i, found, 2] = 0.0
         confidence[i, found] = triples[found, 2]
-    notes: list[str] = []
     names = _names(positions[..., :2], layout, path, notes)
     rate = resolve_fps(fps, None, OPENPOSE_DEFAULT_FPS, path, "OpenPose JSON", notes)
     return build_keypoint_sequence(
@@ -241,4 +274,5 @@ def read_openpose(
         n_dims=2,
         source_format="openpose",
         assumptions=notes,
+        frame_numbers=None if first_number is None else first_number + np.arange(n_frames),
     )

@@ -13,8 +13,13 @@ Conventions
   cells; extra empty cells at the end of a row are ignored.
 * The frame rate is ``DataRate``; the unit is ``Units`` (``m``, ``mm``, ``cm``, ``in``, also
   spelled out), recorded as is and never rescaled. Confidence is 1.0 where a value exists.
+* The reader keeps the ``Frame#`` and ``Time`` columns (when frame numbers are whole and
+  increasing) and ``OrigDataStartFrame``, and the writer writes them back; a sequence without
+  them is written with frames from 1 at ``index / DataRate`` seconds.
 * The writer prints every number with Python's shortest round-trip repr, so a written file
-  reads back exactly; missing values are written as empty cells. Confidence is not stored.
+  reads back exactly, and writes every cell of every row: a missing value is ``NaN`` (an
+  empty trailing cell makes OpenSim refuse the file for a short row). Confidence is not
+  stored.
 """
 
 from __future__ import annotations
@@ -146,6 +151,8 @@ def parse_trc(data: bytes | str, path: str | Path = "<trc>") -> KeypointSequence
         start = 5
     width = 2 + 3 * len(names)
     rows: list[list[float]] = []
+    frame_cells: list[float] = []
+    time_cells: list[float] = []
     for number, line in enumerate(lines[start:], start=start + 1):
         if not line.strip():
             continue
@@ -158,8 +165,8 @@ def parse_trc(data: bytes | str, path: str | Path = "<trc>") -> KeypointSequence
                 path,
                 number,
             )
-        float_from_text(cells[0], path, number, "Frame#")
-        float_from_text(cells[1], path, number, "Time")
+        frame_cells.append(float_from_text(cells[0], path, number, "Frame#"))
+        time_cells.append(float_from_text(cells[1], path, number, "Time"))
         rows.append([float_from_text(c, path, number) for c in cells[2:]])
     n_frames = _count(header, "NumFrames", path)
     if n_frames is not None and n_frames != len(rows):
@@ -168,9 +175,14 @@ def parse_trc(data: bytes | str, path: str | Path = "<trc>") -> KeypointSequence
         )
     positions = np.array(rows, dtype=np.float64).reshape(len(rows), len(names), 3)
     confidence = np.ones(positions.shape[:2])
+    frames = np.array(frame_cells)
+    whole = bool(np.all(np.isfinite(frames)) and np.all(frames == np.round(frames)))
+    increasing = whole and bool(np.all(np.diff(frames) > 0))
     return build_keypoint_sequence(
-        path, names, positions, confidence, fps, length_unit=unit, n_dims=3, source_format="trc"
-    )
+        path, names, positions, confidence, fps, length_unit=unit, n_dims=3, source_format="trc",
+        frame_numbers=frames.astype(np.intp) if increasing else None,
+        times=np.array(time_cells), start_frame=_count(header, "OrigDataStartFrame", path),
+    )  # fmt: skip
 
 
 def read_trc(path: str | Path) -> KeypointSequence:
@@ -179,7 +191,7 @@ def read_trc(path: str | Path) -> KeypointSequence:
 
 
 def _number(value: float) -> str:
-    return "" if math.isnan(value) else repr(float(value))
+    return "NaN" if math.isnan(value) else repr(float(value))
 
 
 def format_trc(seq: KeypointSequence, file_name: str = "keypoints.trc") -> str:
@@ -199,19 +211,24 @@ def format_trc(seq: KeypointSequence, file_name: str = "keypoints.trc") -> str:
     """
     n_frames, n_markers = seq.n_frames, seq.n_keypoints
     fps = repr(seq.fps)
+    numbers = (
+        seq.frame_numbers.tolist() if seq.frame_numbers is not None else range(1, n_frames + 1)
+    )
+    times = seq.times if seq.times is not None else np.arange(n_frames) / seq.fps
+    first = seq.start_frame if seq.start_frame is not None else (numbers[0] if n_frames else 1)
     out = [
         f"PathFileType\t4\t(X/Y/Z)\t{file_name}",
         "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\t"
         "OrigDataStartFrame\tOrigNumFrames",
-        f"{fps}\t{fps}\t{n_frames}\t{n_markers}\t{seq.length_unit}\t{fps}\t1\t{n_frames}",
+        f"{fps}\t{fps}\t{n_frames}\t{n_markers}\t{seq.length_unit}\t{fps}\t{first}\t{n_frames}",
         "Frame#\tTime\t" + "\t".join(f"{name}\t\t" for name in seq.names),
         "\t\t" + "\t".join(f"X{i}\tY{i}\tZ{i}" for i in range(1, n_markers + 1)),
         "",
     ]
     flat = seq.positions.reshape(n_frames, 3 * n_markers)
-    for frame in range(n_frames):
+    for frame, number in enumerate(numbers):
         values = "\t".join(_number(v) for v in flat[frame])
-        out.append(f"{frame + 1}\t{frame / seq.fps!r}\t{values}")
+        out.append(f"{number}\t{_number(float(times[frame]))}\t{values}")
     return "\n".join(out) + "\n"
 
 

@@ -20,6 +20,7 @@ import numpy as np
 
 from mocapqa.errors import MocapQAError
 from mocapqa.io.bvh_write import format_bvh
+from mocapqa.io.keypoint_csv import csv_sidecar_path
 from mocapqa.jobs.rendered import render_thumbnail
 from mocapqa.pipeline.analyze import AnalysisResult, analyze
 from mocapqa.pipeline.loading import Take, read_take_file, write_keypoints_file
@@ -60,6 +61,9 @@ def write_outputs(files: FileStore, run_id: str, result: AnalysisResult) -> list
                 temporary = folder / f".filtered.{run_id}.{suffix}"
                 write_keypoints_file(temporary, result.filtered_keypoints)
                 temporary.replace(target)
+                sidecar = csv_sidecar_path(temporary)  # the CSV's fps and unit
+                if sidecar.is_file():
+                    sidecar.replace(csv_sidecar_path(target))
                 kinds.append(suffix)
             except MocapQAError as e:
                 log.info("no %s output for run %s: %s", suffix, run_id, e)

@@ -8,10 +8,15 @@ difference between second differences (unit/frame², QuaMo's "Accel"); lag is th
 frames (sub-frame by a parabola through the peak), that maximises the cross-correlation of
 the first differences of the two signals summed over channels; positive means the second
 signal trails the first. Differences are used instead of raw positions so that slow drifts do
-not dominate the correlation (the note correlates raw positions).
+not dominate the correlation (the note correlates raw positions). A mean over no finite sample
+(a take of a few frames, a keypoint never seen) is NaN, without numpy's "Mean of empty slice"
+warning.
 """
 
 from __future__ import annotations
+
+import warnings
+from typing import Any
 
 import numpy as np
 
@@ -27,17 +32,24 @@ __all__ = [
 ]
 
 
+def _nanmean(values: Any, axis: int | None = None) -> Any:
+    """``np.nanmean``, NaN where a slice has no finite sample, without the warning."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmean(values, axis=axis)
+
+
 def rmse(estimate: FloatArray, truth: FloatArray, mask: FloatArray | None = None) -> float:
     """Root mean squared Euclidean error of ``(F, K, D)`` points, where ``mask`` (F, K) is set."""
     sq = np.sum((np.asarray(estimate) - np.asarray(truth)) ** 2, axis=-1)
     if mask is not None:
         sq = sq[np.asarray(mask, dtype=bool)]
-    return float(np.sqrt(np.nanmean(sq))) if sq.size else float("nan")
+    return float(np.sqrt(_nanmean(sq))) if sq.size else float("nan")
 
 
 def mean_distance(estimate: FloatArray, truth: FloatArray) -> float:
     """Mean Euclidean distance of ``(F, K, D)`` points (MPJPE when ``K`` are joints)."""
-    return float(np.nanmean(np.linalg.norm(np.asarray(estimate) - np.asarray(truth), axis=-1)))
+    return float(_nanmean(np.linalg.norm(np.asarray(estimate) - np.asarray(truth), axis=-1)))
 
 
 def mean_abs_jerk(values: FloatArray, fps: float) -> float:
@@ -45,19 +57,19 @@ def mean_abs_jerk(values: FloatArray, fps: float) -> float:
     values = np.asarray(values, dtype=np.float64)
     if values.shape[0] < 4:
         return float("nan")
-    return float(np.nanmean(np.abs(np.diff(values, n=3, axis=0)))) * fps**3
+    return float(_nanmean(np.abs(np.diff(values, n=3, axis=0)))) * fps**3
 
 
 def acceleration_error(estimate: FloatArray, truth: FloatArray) -> float:
     """Mean ``|Δ²estimate − Δ²truth|`` (Euclidean over the last axis), unit/frame²."""
     d = np.diff(np.asarray(estimate), n=2, axis=0) - np.diff(np.asarray(truth), n=2, axis=0)
-    return float(np.nanmean(np.linalg.norm(d, axis=-1)))
+    return float(_nanmean(np.linalg.norm(d, axis=-1)))
 
 
 def jitter_score(values: FloatArray) -> float:
     """Share of direction reversals ``sign(Δx_{t+1}) ≠ sign(Δx_t)`` over all channels, [0, 1]."""
     d = np.diff(np.asarray(values, dtype=np.float64), axis=0)
-    return float(np.nanmean(d[1:] * d[:-1] < 0)) if d.shape[0] > 1 else 0.0
+    return float(_nanmean(d[1:] * d[:-1] < 0)) if d.shape[0] > 1 else 0.0
 
 
 def lag_frames(reference: FloatArray, signal: FloatArray, max_lag: int = 10) -> float:
@@ -78,8 +90,8 @@ def lag_frames(reference: FloatArray, signal: FloatArray, max_lag: int = 10) -> 
     a = np.diff(np.asarray(reference, dtype=np.float64), axis=0)
     b = np.diff(np.asarray(signal, dtype=np.float64), axis=0)
     n = a.shape[0]
-    a = np.nan_to_num(a.reshape(n, -1) - np.nanmean(a.reshape(n, -1), axis=0))
-    b = np.nan_to_num(b.reshape(n, -1) - np.nanmean(b.reshape(n, -1), axis=0))
+    a = np.nan_to_num(a.reshape(n, -1) - _nanmean(a.reshape(n, -1), axis=0))
+    b = np.nan_to_num(b.reshape(n, -1) - _nanmean(b.reshape(n, -1), axis=0))
     max_lag = max(1, min(max_lag, (n - 1) // 3))
     lags = np.arange(-max_lag, max_lag + 1)
     # One fixed window of the reference for every shift, so a pure delay gives a curve
