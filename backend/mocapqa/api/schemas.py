@@ -103,6 +103,9 @@ class TakeCreatedOut(TakeOut):
     """The answer to an upload: the take and the run that started."""
 
     run_id: str
+    reading: dict[str, Any] | None = Field(
+        None, description="How the take was read: chosen options, what was assumed and why."
+    )
 
 
 class TakeDetailOut(TakeOut):
@@ -110,6 +113,12 @@ class TakeDetailOut(TakeOut):
 
     runs: list[RunOut]
     reviews: list[ReviewOut]
+    reading: dict[str, Any] | None = Field(
+        None,
+        description="How the take was read: the options chosen at upload (fps, length_unit, "
+        "root_translation), the frame rate and unit used, what the reader assumed "
+        "(keypoints) and the root position reading with its reason (BVH).",
+    )
 
 
 class TakePageOut(BaseModel):

@@ -10,12 +10,17 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import typer
 
 from mocapqa.cli.app import app
-from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
+from mocapqa.cli.roles import (
+    MappingOption,
+    RootTranslationOption,
+    load_mapping,
+    missing_roles,
+)
 from mocapqa.errors import InputError, UnsupportedFormatError
 
 if TYPE_CHECKING:
@@ -25,7 +30,11 @@ if TYPE_CHECKING:
 __all__ = ["convert_command", "info_command", "keypoints_summary", "motion_summary"]
 
 
-def motion_summary(motion: Motion, mapping: dict[str, str] | None = None) -> dict[str, Any]:
+def motion_summary(
+    motion: Motion,
+    mapping: dict[str, str] | None = None,
+    root_translation: Literal["auto", "add", "replace"] = "auto",
+) -> dict[str, Any]:
     """What a BVH take holds, as a JSON-ready dict.
 
     Parameters
@@ -34,15 +43,18 @@ def motion_summary(motion: Motion, mapping: dict[str, str] | None = None) -> dic
         The take.
     mapping : dict, optional
         Role key → joint name, overriding the roles found from names and structure.
+    root_translation : {"auto", "add", "replace"}
+        What the reader was asked for, to explain the root reading.
 
     Returns
     -------
     dict
         Frames, fps, duration (s), joints, length unit, rotation orders (order → joint
-        count), root translation mode, roles found (role key → joint name), roles not
+        count), root translation mode and why, roles found (role key → joint name), roles not
         mapped, and limb chains (``"left upper_arm: A > B > C"``).
     """
     from mocapqa.core.rig import find_roles, limb_chains
+    from mocapqa.io.bvh_root import explain_root_translation
 
     sk = motion.skeleton
     rig = find_roles(sk, mapping)
@@ -68,6 +80,7 @@ def motion_summary(motion: Motion, mapping: dict[str, str] | None = None) -> dic
         "length_unit": sk.length_unit,
         "rotation_orders": orders,
         "root_translation": sk.root_translation,
+        "root_translation_reason": explain_root_translation(motion, root_translation),
         "roles": {key: sk.names[j] for key, j in sorted(rig.roles.items())},
         "unmapped_roles": list(rig.unmapped),
         "limb_chains": chains,
@@ -82,7 +95,8 @@ def keypoints_summary(seq: KeypointSequence, format_name: str) -> dict[str, Any]
     -------
     dict
         Format, frames, fps, duration (s), keypoints, dimensions, length unit, the share
-        of missing frame × keypoint values (0–1) and the keypoint names.
+        of missing frame × keypoint values (0–1), what the reader assumed (frame rate, unit,
+        frame numbers) and the keypoint names.
     """
     return {
         "format": format_name,
@@ -93,6 +107,7 @@ def keypoints_summary(seq: KeypointSequence, format_name: str) -> dict[str, Any]
         "dimensions": seq.n_dims,
         "length_unit": seq.length_unit,
         "missing_fraction": seq.missing_fraction,
+        "assumptions": list(seq.assumptions),
         "keypoint_names": list(seq.names),
     }
 
@@ -120,6 +135,8 @@ def _print_table(path: Path, summary: dict[str, Any]) -> None:
             text = f"[yellow]{', '.join(value)}[/]" if value else "none (all roles mapped)"
         elif key == "limb_chains":
             text = "\n".join(value) or "none"
+        elif key == "assumptions":
+            text = "\n".join(f"[yellow]{v}[/]" for v in value) or "none (all stored in the file)"
         else:
             text = str(value)
         table.add_row(key.replace("_", " "), text)
@@ -134,6 +151,7 @@ def info_command(
         float | None, typer.Option(help="Frames per second, for formats that do not store it.")
     ] = None,
     mapping: MappingOption = None,
+    root_translation: RootTranslationOption = "auto",
 ) -> None:
     """Show what a take holds: frames, rate, joints or keypoints, units, rig roles."""
     from mocapqa.core.motion import Motion
@@ -143,9 +161,9 @@ def info_command(
         raise InputError(f"Expected --fps > 0, got {fps}")
     roles = load_mapping(mapping)
     format_name = detect_format(file)
-    take = read_take(file, fps=fps, number_reader="auto")
+    take = read_take(file, fps=fps, number_reader="auto", root_translation=root_translation)
     if isinstance(take, Motion):
-        summary = motion_summary(take, roles)
+        summary = motion_summary(take, roles, root_translation)
         missing_roles(take.skeleton, roles)
     else:
         if roles is not None:

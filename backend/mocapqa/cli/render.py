@@ -7,7 +7,7 @@ import time
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import numpy as np
 import typer
@@ -17,7 +17,13 @@ from rich.table import Table
 
 from mocapqa.cli.app import app, bench_app
 from mocapqa.cli.report import TakeRun, analyze_take, build_take_report, sheet_tiles
-from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles, warn_missing
+from mocapqa.cli.roles import (
+    MappingOption,
+    RootTranslationOption,
+    load_mapping,
+    missing_roles,
+    warn_missing,
+)
 from mocapqa.errors import InputError, NotFoundError
 
 __all__ = ["bench_render", "flagged_at", "parse_interval", "raw_run", "render"]
@@ -38,13 +44,17 @@ def parse_interval(text: str) -> tuple[str, int, int]:
     return joint, start, end
 
 
-def raw_run(path: Path, mapping: dict[str, str] | None = None) -> TakeRun:
+def raw_run(
+    path: Path,
+    mapping: dict[str, str] | None = None,
+    root_translation: Literal["auto", "add", "replace"] = "auto",
+) -> TakeRun:
     """A take read without analysis: corrected is the raw take, no findings."""
     from mocapqa.core.motion import Motion
     from mocapqa.io.formats import read_take
     from mocapqa.render.scene import track_from_keypoints, track_from_motion
 
-    take = read_take(path)
+    take = read_take(path, root_translation=root_translation)
     summary: dict[str, object] = {"fps": 0.0}
     if isinstance(take, Motion):
         track = track_from_motion(take)
@@ -90,6 +100,7 @@ def render(
     width: Annotated[int, typer.Option(help="Width of one view, px.")] = 640,
     height: Annotated[int, typer.Option(help="Height of one view, px.")] = 480,
     mapping: MappingOption = None,
+    root_translation: RootTranslationOption = "auto",
 ) -> None:
     """Render a still (--frame), a clip (--interval) or a contact sheet (--contact-sheet)."""
     from mocapqa.render.service import RenderService
@@ -110,9 +121,10 @@ def render(
 
         roles = load_mapping(mapping)
         if analyze:
-            run = analyze_take(input_path, {"mapping": roles} if roles else None, step)
+            chosen_options = {"mapping": roles} if roles else None
+            run = analyze_take(input_path, chosen_options, step, root_translation)
         else:
-            run = raw_run(input_path, roles)
+            run = raw_run(input_path, roles, root_translation)
         warn_missing(run.analysis.get("summary", {}).get("missing_roles") or [])
         if up_axis is not None:
             run = TakeRun(

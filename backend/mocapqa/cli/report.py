@@ -16,7 +16,7 @@ import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import numpy as np
 import typer
@@ -24,7 +24,12 @@ from rich.console import Console
 from rich.progress import Progress
 
 from mocapqa.cli.app import app
-from mocapqa.cli.roles import MappingOption, load_mapping, warn_missing
+from mocapqa.cli.roles import (
+    MappingOption,
+    RootTranslationOption,
+    load_mapping,
+    warn_missing,
+)
 from mocapqa.errors import InputError, MocapQAError, NotFoundError
 
 if TYPE_CHECKING:
@@ -82,16 +87,26 @@ def analyze_take(
     path: Path,
     options: dict[str, Any] | None = None,
     progress: Callable[[int, str], None] | None = None,
+    root_translation: Literal["auto", "add", "replace"] = "auto",
 ) -> TakeRun:
-    """Read and analyse a take with the pipeline's defaults (or ``options``)."""
+    """Read and analyse a take with the pipeline's defaults (or ``options``).
+
+    ``root_translation`` says how a BVH root's position is read (see
+    :mod:`mocapqa.io.bvh_root`); the report's summary says which reading was used and why.
+    """
     from mocapqa.core.keypoints import KeypointSequence
+    from mocapqa.core.motion import Motion
+    from mocapqa.io.bvh_root import explain_root_translation
     from mocapqa.io.formats import read_take
     from mocapqa.pipeline.analyze import analyze
     from mocapqa.pipeline.options import AnalysisOptions
     from mocapqa.render.scene import track_from_points
 
-    take = read_take(path)
+    take = read_take(path, root_translation=root_translation)
     result = analyze(take, AnalysisOptions.from_json(options), progress)
+    if isinstance(take, Motion):
+        reason = explain_root_translation(take, root_translation)
+        result.report["summary"]["root_translation_reason"] = reason
     points = result.report["points"]
     fps = float(result.report["summary"]["fps"])
     raw_positions = result.raw_points
@@ -148,12 +163,16 @@ def build_take_report(
     run_folder: Path | None = None,
     options: dict[str, Any] | None = None,
     progress: Callable[[int, str], None] | None = None,
+    root_translation: Literal["auto", "add", "replace"] = "auto",
 ) -> str:
     """Analyse (or load) a take, render its contact sheet and return the report's HTML."""
     from mocapqa.report.html import report_from_analysis
 
     step = progress or (lambda percent, text: None)
-    run = load_run(run_folder) if run_folder is not None else analyze_take(path, options, progress)
+    if run_folder is not None:
+        run = load_run(run_folder)
+    else:
+        run = analyze_take(path, options, progress, root_translation)
     warn_missing(run.analysis.get("summary", {}).get("missing_roles") or [])
     tiles = sheet_tiles(run)
     sheet: bytes | None = None
@@ -231,6 +250,7 @@ def report(
         Path | None, typer.Option(help="Also print the report to this PDF (needs Chromium).")
     ] = None,
     mapping: MappingOption = None,
+    root_translation: RootTranslationOption = "auto",
 ) -> None:
     """Write a self-contained HTML QA report: summary, findings, timelines, contact sheet."""
     from mocapqa.render.service import RenderService
@@ -254,7 +274,9 @@ def report(
         def progress(percent: int, text: str) -> None:
             bar.update(task, completed=percent, description=text)
 
-        html = build_take_report(input_path, service, run, option_values, progress)
+        html = build_take_report(
+            input_path, service, run, option_values, progress, root_translation
+        )
     output.write_text(html, encoding="utf-8")
     console.print(f"report → {output} ({len(html) / 1e6:.1f} MB)")
     if pdf is not None:

@@ -1,4 +1,5 @@
-"""The ``--mapping FILE`` option shared by every command that reads a BVH, and its warning.
+"""Options shared by the commands that read a BVH: ``--mapping FILE`` (with its warning about
+roles not found) and ``--root-translation``.
 
 Every such command takes ``--mapping`` (a JSON or TOML file of role → joint name, see
 :mod:`mocapqa.io.mapping`) and, for a BVH take, prints one warning line on stderr naming the
@@ -9,7 +10,7 @@ does so silently.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import typer
 
@@ -18,7 +19,13 @@ from mocapqa.cli.app import err_console
 if TYPE_CHECKING:
     from mocapqa.core.motion import Skeleton
 
-__all__ = ["MappingOption", "load_mapping", "missing_roles", "warn_missing"]
+__all__ = [
+    "MappingOption",
+    "RootTranslationOption",
+    "load_mapping",
+    "missing_roles",
+    "warn_missing",
+]
 
 MappingOption = Annotated[
     Path | None,
@@ -28,6 +35,16 @@ MappingOption = Annotated[
     ),
 ]
 """The ``--mapping FILE`` option."""
+
+RootTranslationOption = Annotated[
+    Literal["auto", "add", "replace"],
+    typer.Option(
+        "--root-translation",
+        help="BVH root position: add the channels to the root OFFSET, replace it (the BVH "
+        "convention, as Blender reads it), or auto-detect (default).",
+    ),
+]
+"""The ``--root-translation auto|add|replace`` option of the commands that place joints."""
 
 
 def load_mapping(path: Path | None) -> dict[str, str] | None:

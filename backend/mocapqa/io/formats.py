@@ -17,7 +17,7 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
@@ -178,6 +178,7 @@ def read_take(
     person_index: int = 0,
     length_unit: str | None = None,
     number_reader: NumberReader = "arrow",
+    root_translation: Literal["auto", "add", "replace"] = "auto",
 ) -> Motion | KeypointSequence:
     """Read a take of any supported format.
 
@@ -195,6 +196,9 @@ def read_take(
     number_reader : {"arrow", "python", "auto"}
         How BVH frame values are read (see :func:`mocapqa.io.bvh.parse_bvh`); "auto" suits
         a one-off read in a fresh process.
+    root_translation : {"auto", "add", "replace"}
+        How a BVH root's position channels combine with its OFFSET (see
+        :mod:`mocapqa.io.bvh_root`); ignored by keypoint formats.
 
     Returns
     -------
@@ -210,7 +214,12 @@ def read_take(
     """
     kind = detect_format(path)
     if kind == "bvh":
-        return read_bvh(path, length_unit=length_unit or "unknown", number_reader=number_reader)
+        return read_bvh(
+            path,
+            root_translation=root_translation,
+            length_unit=length_unit or "unknown",
+            number_reader=number_reader,
+        )
     if kind == "trc":
         return read_trc(path)
     if kind == "openpose":

@@ -6,22 +6,39 @@ Nothing is stored when any step fails: the partial file is removed and no row is
 from __future__ import annotations
 
 import hashlib
+import json
 import re
 from pathlib import Path
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError, MocapQAError, ParseError, TooLargeError
 from mocapqa.jobs.runner import JobRunner
-from mocapqa.pipeline.loading import detect_take_format, read_take_file
+from mocapqa.pipeline.loading import (
+    READING_FILE,
+    ReadOptions,
+    detect_take_format,
+    read_take_file,
+    reading_facts,
+)
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository, new_id
 
-__all__ = ["CHUNK_BYTES", "ingest_take", "safe_file_name"]
+__all__ = ["CHUNK_BYTES", "ingest_take", "reading_of", "safe_file_name"]
 
 CHUNK_BYTES = 1 << 20
 """Bytes read from an upload at a time while streaming it to disk."""
+
+
+def reading_of(files: FileStore, take_id: str) -> dict[str, Any] | None:
+    """How a take was read (:func:`~mocapqa.pipeline.loading.reading_facts`), if recorded."""
+    path = files.take_dir(take_id) / READING_FILE
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
 
 
 def safe_file_name(name: str) -> str:
@@ -39,6 +56,7 @@ def ingest_take(
     runner: JobRunner,
     max_bytes: int,
     options: AnalysisOptions | None = None,
+    read: ReadOptions | None = None,
 ) -> tuple[str, str]:
     """Store an uploaded take and queue its analysis.
 
@@ -52,6 +70,9 @@ def ingest_take(
         Largest accepted size, bytes.
     options : AnalysisOptions, optional
         Options of the first run (defaults when None).
+    read : ReadOptions, optional
+        How to read what the file leaves open (frame rate, unit, BVH root position); kept
+        with the take, with what the reader used or assumed, for every later run.
 
     Returns
     -------
@@ -79,7 +100,7 @@ def ingest_take(
             raise InputError(f"Expected a non-empty file, got 0 bytes ({name!r})")
         format_name = detect_take_format(incoming)
         try:
-            take = read_take_file(incoming, format_name, file_name)
+            take = read_take_file(incoming, format_name, file_name, read)
         except MocapQAError:
             raise
         except (ValueError, LookupError, TypeError, OverflowError, EOFError, OSError) as e:
@@ -95,6 +116,8 @@ def ingest_take(
             kind, n_points, fps = "keypoints", take.n_keypoints, take.fps
         take_id = new_id()
         files.adopt(incoming, take_id, file_name)
+        facts = reading_facts(take, read or ReadOptions())
+        files.write_bytes(files.take_dir(take_id) / READING_FILE, json.dumps(facts).encode())
         try:
             _, run_id = repository.add_take(
                 {

@@ -14,16 +14,23 @@ import logging
 import threading
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from mocapqa.errors import MocapQAError
+from mocapqa.errors import InputError, MocapQAError
 from mocapqa.io.bvh_write import format_bvh
 from mocapqa.io.keypoint_csv import csv_sidecar_path
 from mocapqa.jobs.rendered import render_thumbnail
 from mocapqa.pipeline.analyze import AnalysisResult, analyze
-from mocapqa.pipeline.loading import Take, read_take_file, write_keypoints_file
+from mocapqa.pipeline.loading import (
+    READING_FILE,
+    ReadOptions,
+    Take,
+    read_take_file,
+    write_keypoints_file,
+)
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
@@ -70,6 +77,15 @@ def write_outputs(files: FileStore, run_id: str, result: AnalysisResult) -> list
     report = {**result.report, "downloads": kinds}
     files.write_bytes(folder / "report.json", json.dumps(report, allow_nan=False).encode())
     return kinds
+
+
+def _reading(folder: Path) -> ReadOptions:
+    """The read options chosen at upload (recorded beside the take), else the defaults."""
+    try:
+        data = json.loads((folder / READING_FILE).read_text(encoding="utf-8"))
+        return ReadOptions.from_json(data.get("read_options"))
+    except (OSError, ValueError, AttributeError, InputError):
+        return ReadOptions()
 
 
 class JobRunner:
@@ -144,8 +160,9 @@ class JobRunner:
             options = AnalysisOptions.from_json(run["options"])
             with self._lock:
                 preloaded = self._preloaded.pop(run_id, None)
+            reading = _reading(path.parent)
             motion_or_keypoints = preloaded or read_take_file(
-                path, str(take["format"]), str(take["name"])
+                path, str(take["format"]), str(take["name"]), reading
             )
             last = [0.0]
 

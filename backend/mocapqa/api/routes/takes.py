@@ -2,17 +2,18 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Literal
 
-from fastapi import APIRouter, File, Query, Request, Response, UploadFile
+from fastapi import APIRouter, File, Form, Query, Request, Response, UploadFile
 
 from mocapqa.api.deps import ServicesDep, TakeDep
 from mocapqa.api.schemas import TakeCreatedOut, TakeDetailOut, TakeOut, TakePageOut
 from mocapqa.api.views import review_out, run_out, take_fields
 from mocapqa.errors import TooLargeError
-from mocapqa.jobs.intake import ingest_take
+from mocapqa.jobs.intake import ingest_take, reading_of
 from mocapqa.jobs.rendered import THUMBNAIL_PNG
 from mocapqa.jobs.thumbnails import thumbnail_svg
+from mocapqa.pipeline.loading import ReadOptions
 
 __all__ = ["router"]
 
@@ -22,9 +23,31 @@ router = APIRouter(prefix="/takes", tags=["takes"])
 
 @router.post("", status_code=201)
 def upload_take(
-    request: Request, services: ServicesDep, file: Annotated[UploadFile, File()]
+    request: Request,
+    services: ServicesDep,
+    file: Annotated[UploadFile, File()],
+    fps: Annotated[
+        float | None,
+        Form(gt=0, le=100_000, description="Frame rate, for formats that do not store one."),
+    ] = None,
+    length_unit: Annotated[
+        str | None,
+        Form(
+            description="Unit of keypoint coordinates (m, cm, mm, in, px, normalized), for "
+            "formats that do not store one."
+        ),
+    ] = None,
+    root_translation: Annotated[
+        Literal["auto", "add", "replace"],
+        Form(description="BVH root position: detect, add to the root OFFSET, or replace it."),
+    ] = "auto",
 ) -> TakeCreatedOut:
-    """Upload a take (multipart field ``file``); its analysis starts with default options."""
+    """Upload a take (multipart field ``file``); its analysis starts with default options.
+
+    Optional form fields say how to read what the file leaves open: ``fps`` and
+    ``length_unit`` (OpenPose, MediaPipe, NPY, CSV without times) and ``root_translation``
+    (BVH). The take's ``reading`` says what was used and assumed.
+    """
     max_bytes = int(services.settings.max_upload_mb * 1_000_000)
     length = request.headers.get("content-length")
     if length and length.isdigit() and int(length) > max_bytes + 64_000:
@@ -36,9 +59,11 @@ def upload_take(
         services.files,
         services.runner,
         max_bytes,
+        read=ReadOptions(fps, length_unit, root_translation),
     )
     row = services.repository.get_take(take_id)
-    return TakeCreatedOut(**take_fields(row), run_id=run_id)
+    reading = reading_of(services.files, take_id)
+    return TakeCreatedOut(**take_fields(row), run_id=run_id, reading=reading)
 
 
 @router.get("")
@@ -63,6 +88,7 @@ def get_take(take: TakeDep, services: ServicesDep) -> TakeDetailOut:
         **take_fields(take),
         runs=[run_out(r) for r in services.repository.list_runs(take_id)],
         reviews=[review_out(r) for r in services.repository.list_reviews(take_id)],
+        reading=reading_of(services.files, take_id),
     )
 
 
