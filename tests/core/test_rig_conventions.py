@@ -105,6 +105,14 @@ CONVENTIONS: dict[str, Convention] = {
                "upper_leg": ["upperleg02.{S}"], "lower_leg": ["lowerleg02.{S}"]},
         leaves={"hand": ["metacarpal1.{S}"]},
     ),
+    # MakeHuman's MakeWalk "Default" target rig: a deltoid helper between shoulder and arm.
+    "makehuman_makewalk": Convention(
+        ("L", "R"),
+        dict(zip(ARM + LEG, ["shoulder.{S}", "upper_arm.{S}", "forearm.{S}", "hand.{S}",
+                             "thigh.{S}", "shin.{S}", "foot.{S}", "toe.{S}"], strict=True)),
+        spine={"Hips": "hips", "LowerBack": "spine", "Spine": "spine-1", "Spine1": "chest"},
+        above={"upper_arm": ["deltoid.{S}"]},
+    ),
     "biovision": Convention(
         ("Left", "Right"),
         dict(zip(ARM + LEG[:3], ["{S}Collar", "{S}UpArm", "{S}LowArm", "{S}Hand", "{S}UpLeg",
