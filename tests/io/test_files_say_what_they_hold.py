@@ -128,7 +128,7 @@ def test_filter_on_a_five_frame_take_prints_no_numpy_warning(
 ) -> None:
     for take in five_frame_takes(corpus_dir, tmp_path):
         suffix = ".bvh" if take.suffix == ".bvh" else ".csv"
-        for method in ([] if suffix == ".bvh" else ["adaptive", "one-euro", "kalman", "ema"]):
+        for method in [] if suffix == ".bvh" else ["adaptive", "one-euro", "kalman", "ema"]:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
                 out = tmp_path / f"out_{take.stem}_{method}{suffix}"
@@ -177,3 +177,14 @@ def test_every_trc_the_project_writes_loads_in_opensim(corpus_dir: Path, tmp_pat
     source = (corpus_dir / TRC).read_text(encoding="utf-8").splitlines()
     written = outputs["pose2sim"][1].read_text(encoding="utf-8").splitlines()
     assert [r.split("\t")[:2] for r in written[6:]] == [r.split("\t")[:2] for r in source[5:]]
+
+
+def test_a_copy_with_other_frames_drops_the_source_numbering(corpus_dir: Path) -> None:
+    trc = read_trc(corpus_dir / TRC)
+    assert trc.frame_numbers is not None and trc.frame_numbers[0] == 1
+    assert trc.times is not None and trc.times[0] == pytest.approx(1 / 60)
+    assert trc.start_frame == 0
+    same = replace(trc, positions=trc.positions + 1.0)
+    assert same.frame_numbers is not None and same.times is not None
+    cut = replace(trc, positions=trc.positions[:5], confidence=trc.confidence[:5])
+    assert cut.frame_numbers is None and cut.times is None

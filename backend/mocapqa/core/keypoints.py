@@ -12,7 +12,8 @@ Conventions
   nothing is rescaled silently.
 * ``frame_numbers`` and ``times`` keep the source's own frame numbers and time column when it
   has them (a TRC's ``Frame#``/``Time``, an OpenPose folder's file numbers), so a writer can
-  write them back; None means frames ``0..F-1`` at ``frame / fps`` seconds.
+  write them back; None means frames ``0..F-1`` at ``frame / fps`` seconds. A copy whose frame
+  count differs (frames sliced off) drops them.
 """
 
 from __future__ import annotations
@@ -95,14 +96,16 @@ class KeypointSequence:
         object.__setattr__(self, "positions", positions)
         object.__setattr__(self, "confidence", confidence)
         object.__setattr__(self, "fps", float(self.fps))
+        # A copy with other frames (``dataclasses.replace(seq, positions=seq.positions[:40])``)
+        # no longer matches the source's numbering: the numbering is dropped, not kept wrong.
         if self.frame_numbers is not None:
             numbers = np.asarray(self.frame_numbers, dtype=np.intp)
-            if numbers.shape != (n,) or np.any(np.diff(numbers) <= 0):
-                raise ShapeError(f"Expected {n} increasing frame numbers, got {numbers.shape}")
-            object.__setattr__(self, "frame_numbers", numbers)
+            if numbers.shape == (n,) and np.any(np.diff(numbers) <= 0):
+                raise ShapeError("Expected increasing frame numbers, got a decrease or repeat")
+            object.__setattr__(self, "frame_numbers", numbers if numbers.shape == (n,) else None)
         if self.times is not None:
-            times = as_float_array(self.times, "times", (n,), finite=False)
-            object.__setattr__(self, "times", times)
+            times = np.asarray(self.times, dtype=np.float64)
+            object.__setattr__(self, "times", times if times.shape == (n,) else None)
 
     @property
     def n_frames(self) -> int:
