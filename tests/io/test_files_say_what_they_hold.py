@@ -47,7 +47,8 @@ def test_the_filtered_csv_reads_with_pandas_and_dictreader(
     with out.open(newline="", encoding="utf-8") as handle:
         rows = list(csv.DictReader(handle))
     assert len(rows) == len(frame) == 100 * 25
-    assert rows[0]["keypoint"] == "Nose" and rows[0]["frame"] == "0"
+    assert rows[0]["keypoint"] == "Nose"
+    assert rows[0]["frame"] == "0"
     assert frame["time"].iloc[-1] == pytest.approx(99 / 30)
     sidecar = csv_sidecar_path(out)
     assert sidecar.name == "filtered.csv.meta.json"
@@ -58,7 +59,8 @@ def test_the_filtered_csv_reads_with_pandas_and_dictreader(
     sidecar.unlink()
     alone = read_take(out)
     assert isinstance(alone, KeypointSequence)
-    assert alone.fps == 30.0 and alone.length_unit == "unknown"
+    assert alone.fps == 30.0
+    assert alone.length_unit == "unknown"
 
 
 def test_csv_with_the_older_comment_lines_still_reads() -> None:
@@ -92,7 +94,8 @@ def test_openpose_frame_numbers_keep_their_gaps(corpus_dir: Path, tmp_path: Path
     seq = read_openpose(tmp_path)
     full = read_openpose(corpus_dir / OPENPOSE)
     assert seq.n_frames == 10
-    assert seq.frame_numbers is not None and seq.frame_numbers.tolist() == list(range(10))
+    assert seq.frame_numbers is not None
+    assert seq.frame_numbers.tolist() == list(range(10))
     assert np.all(np.isnan(seq.positions[4:9]))
     np.testing.assert_array_equal(seq.positions[[0, 1, 2, 3, 9]], full.positions[[0, 1, 2, 3, 9]])
     assert any("skip 5 frame(s)" in a for a in seq.assumptions)
@@ -164,16 +167,20 @@ def test_every_trc_the_project_writes_loads_in_opensim(corpus_dir: Path, tmp_pat
         for line in out.read_text(encoding="utf-8").splitlines()[6:]:
             cells = line.split("\t")
             width = width or len(cells)
-            assert len(cells) == width and all(c.strip() for c in cells), line[:80]
+            assert len(cells) == width, line[:80]
+            assert all(c.strip() for c in cells), line[:80]
     n_rows, n_markers, times, meta = opensim_rows(outputs["openpose"][1])
     assert (n_rows, n_markers) == (100, 25)
-    assert meta["Units"] == "px" and meta["OrigDataStartFrame"] == "0"
+    assert meta["Units"] == "px"
+    assert meta["OrigDataStartFrame"] == "0"
     # The Pose2Sim TRC keeps its frame numbers (from 1), times (from 1/60 s) and start frame.
     for name in ("pose2sim", "filtered"):
         n_rows, n_markers, times, meta = opensim_rows(outputs[name][1])
         assert (n_rows, n_markers) == (100, 21)
-        assert times[0] == pytest.approx(1 / 60) and times[-1] == pytest.approx(100 / 60)
-        assert meta["OrigDataStartFrame"] == "0" and meta["DataRate"] == "60.0"
+        assert times[0] == pytest.approx(1 / 60)
+        assert times[-1] == pytest.approx(100 / 60)
+        assert meta["OrigDataStartFrame"] == "0"
+        assert meta["DataRate"] == "60.0"
     source = (corpus_dir / TRC).read_text(encoding="utf-8").splitlines()
     written = outputs["pose2sim"][1].read_text(encoding="utf-8").splitlines()
     assert [r.split("\t")[:2] for r in written[6:]] == [r.split("\t")[:2] for r in source[5:]]
@@ -181,10 +188,14 @@ def test_every_trc_the_project_writes_loads_in_opensim(corpus_dir: Path, tmp_pat
 
 def test_a_copy_with_other_frames_drops_the_source_numbering(corpus_dir: Path) -> None:
     trc = read_trc(corpus_dir / TRC)
-    assert trc.frame_numbers is not None and trc.frame_numbers[0] == 1
-    assert trc.times is not None and trc.times[0] == pytest.approx(1 / 60)
+    assert trc.frame_numbers is not None
+    assert trc.frame_numbers[0] == 1
+    assert trc.times is not None
+    assert trc.times[0] == pytest.approx(1 / 60)
     assert trc.start_frame == 0
     same = replace(trc, positions=trc.positions + 1.0)
-    assert same.frame_numbers is not None and same.times is not None
+    assert same.frame_numbers is not None
+    assert same.times is not None
     cut = replace(trc, positions=trc.positions[:5], confidence=trc.confidence[:5])
-    assert cut.frame_numbers is None and cut.times is None
+    assert cut.frame_numbers is None
+    assert cut.times is None
