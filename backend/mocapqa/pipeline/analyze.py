@@ -199,6 +199,7 @@ def _analyze_keypoints(
             "n_keypoints": sequence.n_keypoints,
             "length_unit": sequence.length_unit,
             "missing_fraction": sequence.missing_fraction,
+            "assumptions": list(sequence.assumptions),
             "n_findings": len(findings),
             "findings_by_kind": _count_by_kind(findings),
         },
