@@ -120,13 +120,21 @@ Score = tuple[int, int, int, int]
 """(roles filled, −holes between them, unambiguous names, −tree distance between roles)."""
 
 
+@functools.lru_cache(maxsize=256)
 def _assign(
     levels: tuple[tuple[int, ...], ...], depths: tuple[int, ...]
 ) -> tuple[Score, tuple[int, ...]]:
-    """Best strictly increasing level per chain entry (−1: no role), by :data:`Score`."""
+    """Best strictly increasing level per chain entry (−1: no role), by :data:`Score`.
 
-    @functools.cache
+    A small dynamic programme over (entry, last level used, last entry given a level); chains
+    hold a handful of named joints, and the same chain shapes recur, hence the cache.
+    """
+    memo: dict[tuple[int, int, int], tuple[Score, tuple[int, ...]]] = {}
+
     def best(i: int, last: int, prev: int) -> tuple[Score, tuple[int, ...]]:
+        key = (i, last, prev)
+        if key in memo:
+            return memo[key]
         if i == len(levels):
             return (0, 0, 0, 0), ()
         score, rest = best(i + 1, last, prev)
@@ -137,15 +145,15 @@ def _assign(
             sub, tail = best(i + 1, level, i)
             holes = level - last - 1 if last >= 0 else 0
             span = depths[i] - depths[prev] if prev >= 0 else 0
-            gain = (1, -holes, 1 if len(levels[i]) == 1 else 0, -span)
             total: Score = (
-                sub[0] + gain[0],
-                sub[1] + gain[1],
-                sub[2] + gain[2],
-                sub[3] + gain[3],
+                sub[0] + 1,
+                sub[1] - holes,
+                sub[2] + (1 if len(levels[i]) == 1 else 0),
+                sub[3] - span,
             )
             if total > choice[0]:
                 choice = (total, (level, *tail))
+        memo[key] = choice
         return choice
 
     return best(0, -1, -1)
@@ -158,7 +166,11 @@ def _limb_roles(
     depths = skeleton.depths
     best_score: Score | None = None
     best_roles: dict[int, int] = {}
-    for end, _ in candidates:
+    joints = [j for j, _ in candidates]
+    # Only the outermost named joints end a chain worth scoring: a chain ending higher up is
+    # a part of one of theirs.
+    ends = [e for e in joints if not any(_is_descendant(skeleton, j, e) for j in joints)]
+    for end in ends:
         chain = sorted(
             ((j, t) for j, t in candidates if j == end or _is_descendant(skeleton, end, j)),
             key=lambda item: int(depths[item[0]]),

@@ -20,6 +20,7 @@ Trailing digits are dropped (MakeHuman's ``upperarm01``/``upperarm02``, Biped's 
 
 from __future__ import annotations
 
+import functools
 import re
 from typing import Literal
 
@@ -70,6 +71,7 @@ def _strip(name: str) -> str:
     return raw
 
 
+@functools.lru_cache(maxsize=4096)
 def split_side(name: str) -> tuple[Side | None, str]:
     """Split a joint name into its side and the normalised rest.
 
@@ -103,6 +105,7 @@ def split_side(name: str) -> tuple[Side | None, str]:
     return side, re.sub(r"[_.\s-]", "", rest)
 
 
+@functools.lru_cache(maxsize=4096)
 def is_helper(name: str) -> bool:
     """Whether a joint is a helper bone that never takes a role.
 
