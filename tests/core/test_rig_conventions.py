@@ -150,6 +150,14 @@ CONVENTIONS: dict[str, Convention] = {
         leaves={"upper_arm": ["upperarm_twist_01_{S}"], "lower_leg": ["calf_twist_01_{S}"],
                 "hand": ["index_01_{S}"]},
     ),
+    # VRM humanoid (J_Bip_ prefix, side letter after it).
+    "vrm": Convention(
+        ("L", "R"),
+        dict(zip(ARM + LEG, ["J_Bip_{S}_Shoulder", "J_Bip_{S}_UpperArm", "J_Bip_{S}_LowerArm",
+                             "J_Bip_{S}_Hand", "J_Bip_{S}_UpperLeg", "J_Bip_{S}_LowerLeg",
+                             "J_Bip_{S}_Foot", "J_Bip_{S}_ToeBase"], strict=True)),
+        spine={"Hips": "J_Bip_C_Hips", "Spine": "J_Bip_C_Spine", "Head": "J_Bip_C_Head"},
+    ),
     # SMPL: the wrist is the hand joint (left_hand is the end below it), the ankle the foot
     # (left_foot is the toe joint below it).
     "smpl": Convention(

@@ -14,7 +14,8 @@ conventions and are resolved by the skeleton's structure in :func:`mocapqa.core.
   is the toe.
 
 Names are matched case-insensitively, after removing namespace (``anything:``) and rig prefixes
-(``CC_Base_``, ``Bip01``/``Bip001``, ``mixamorig``/``mixamorigN``, ``Character1_``, ``DEF-``).
+(``CC_Base_``, ``Bip01``/``Bip001``, ``mixamorig``/``mixamorigN``, ``Character1_``, ``DEF-``,
+VRM's ``J_Bip_``).
 Trailing digits are dropped (MakeHuman's ``upperarm01``/``upperarm02``, Biped's ``Toe0``).
 """
 
@@ -54,7 +55,7 @@ _HELPER = re.compile(
     r"twist|share|roll|index|thumb|finger|middle|ring|pinky|nub|_end$|end$|dummy|tip$|helper"
 )
 _PREFIX = re.compile(
-    r"^(cc_base_|joint_|bip0*1[ _]|def-|mixamorig\d*[:_]?|character\d*_)", re.IGNORECASE
+    r"^(cc_base_|joint_|bip0*1[ _]|def-|mixamorig\d*[:_]?|character\d*_|j_bip_)", re.IGNORECASE
 )
 _SIDE_PATTERNS: tuple[tuple[str, int, int], ...] = (
     (r"^(left|right)[_.\s-]?(.+)$", 1, 2),
