@@ -72,7 +72,6 @@ def _strip(name: str) -> str:
     return raw
 
 
-@functools.lru_cache(maxsize=4096)
 def split_side(name: str) -> tuple[Side | None, str]:
     """Split a joint name into its side and the normalised rest.
 
@@ -87,6 +86,11 @@ def split_side(name: str) -> tuple[Side | None, str]:
     >>> split_side("Bip01 L UpperArm")
     ('left', 'upperarm')
     """
+    return _split_side(name)
+
+
+@functools.lru_cache(maxsize=4096)
+def _split_side(name: str) -> tuple[Side | None, str]:
     raw = _strip(name)
     low = raw.lower()
     side: Side | None = None
@@ -106,13 +110,17 @@ def split_side(name: str) -> tuple[Side | None, str]:
     return side, re.sub(r"[_.\s-]", "", rest)
 
 
-@functools.lru_cache(maxsize=4096)
 def is_helper(name: str) -> bool:
     """Whether a joint is a helper bone that never takes a role.
 
     Twist, roll and share bones, fingers, ``_End``/``Nub``/``Tip`` joints, and MakeHuman's
     ``__`` bones (``__UpArm_L``) are helpers.
     """
+    return _is_helper(name)
+
+
+@functools.lru_cache(maxsize=4096)
+def _is_helper(name: str) -> bool:
     if _strip(name).startswith("__"):
         return True
     _, rest = split_side(name)
