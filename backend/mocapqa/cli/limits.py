@@ -109,8 +109,9 @@ def limits_check(
 ) -> None:
     """Check a take against joint limits: share of frames outside and the worst frames.
 
-    A limits model applies to the rig it was built on (matched by joint names and bone axes);
-    ``--mapping`` names roles the names do not give, and the roles still missing are listed.
+    A limits model applies to the rig it was built on, matched by joint names and bone axes, so
+    ``--mapping`` does not change the check itself; it changes which roles are reported missing
+    (the warning line and ``missing_roles`` in the JSON).
     """
     from mocapqa.io.bvh import read_bvh
     from mocapqa.limits.analysis import check_limits
