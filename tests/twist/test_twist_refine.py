@@ -73,7 +73,7 @@ def test_refine_touches_only_corrected_pairs_and_keeps_child_orientation(
         j
         for c, g in enumerate(analysis.chains)
         if np.any(analysis.offsets_rad[:, c] != 0.0)
-        for j in (g.chain.parent, g.chain.child)
+        for j in (g.chain.parent, g.chain.child, *g.children)
     }
     outside = [j for j in range(motion.skeleton.n_joints) if j not in corrected]
     assert np.array_equal(analysis.refined.quats[:, outside], corrupted.quats[:, outside])
@@ -149,21 +149,25 @@ def test_helper_joints_between_parent_and_child_are_composed_and_kept(
     offsets = np.zeros((motion.n_frames, 1))
     offsets[200:212, 0] = -np.deg2rad(60.0)
     corrupted_quats = refine_quats(motion.quats, [geometry], offsets)
-    assert np.array_equal(
-        corrupted_quats[:, skeleton.index("LeftArm")], motion.quats[:, skeleton.index("LeftArm")]
-    )
+    # The helper between parent and child is counter-rotated; the child's local rotation is
+    # kept, and every joint below the parent keeps its world orientation.
+    child = skeleton.index("LeftForeArm")
+    helper = skeleton.index("LeftArm")
+    assert np.array_equal(corrupted_quats[:, child], motion.quats[:, child])
     world_before, _ = forward_kinematics(motion)
     corrupted = Motion(skeleton, corrupted_quats, motion.translations, motion.fps)
     world_after, _ = forward_kinematics(corrupted)
-    child = skeleton.index("LeftForeArm")
-    a, b = world_before[:, child], world_after[:, child]
+    below = [
+        j for j in range(skeleton.n_joints) if j > helper and j != skeleton.index("LeftShoulder")
+    ]
+    a, b = world_before[:, below], world_after[:, below]
     assert np.max(np.minimum(np.abs(a - b).max(-1), np.abs(a + b).max(-1))) < 1e-9
     analysis = analyze_twist(corrupted, mapping=mapping)
     found = [i for i in analysis.intervals if i.joint == "LeftShoulder"]
     assert [(i.start_frame, i.end_frame) for i in found] == [(200, 211)]
     assert found[0].offset_deg == pytest.approx(60.0, abs=1.0)
-    restored = analysis.refined.quats[:, [skeleton.index("LeftShoulder"), child]]
-    expected = motion.quats[:, [skeleton.index("LeftShoulder"), child]]
+    restored = analysis.refined.quats[:, [skeleton.index("LeftShoulder"), helper]]
+    expected = motion.quats[:, [skeleton.index("LeftShoulder"), helper]]
     assert (
         np.max(np.minimum(np.abs(restored - expected).max(-1), np.abs(restored + expected).max(-1)))
         < 0.02

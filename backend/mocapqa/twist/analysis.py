@@ -29,6 +29,7 @@ from mocapqa.twist.angles import (
     parent_twist_angles,
     wrap_angle,
 )
+from mocapqa.twist.confidence import APPLY_THRESHOLD
 from mocapqa.twist.detect import (
     Detection,
     PaperParams,
@@ -38,10 +39,47 @@ from mocapqa.twist.detect import (
 )
 from mocapqa.twist.refine import refine_quats
 
-__all__ = ["METHODS", "TwistAnalysis", "TwistInterval", "analyze_twist", "detect_chains"]
+__all__ = [
+    "APPLY_CHOICES",
+    "METHODS",
+    "TwistAnalysis",
+    "TwistInterval",
+    "analyze_twist",
+    "detect_chains",
+    "parse_apply",
+]
 
 # Detection methods: the robust default and the paper as written.
 METHODS = ("robust", "paper")
+APPLY_CHOICES = ("confident", "all", "none")
+"""Which intervals a refinement applies, besides an explicit list of interval ids:
+``confident`` (calibrated probability ≥ :data:`mocapqa.twist.confidence.APPLY_THRESHOLD`, the
+default), ``all`` or ``none``."""
+
+
+def parse_apply(value: str | frozenset[int]) -> str | frozenset[int]:
+    """One of :data:`APPLY_CHOICES`, or the set of interval ids in ``"3,7"``.
+
+    Raises
+    ------
+    InputError
+        For anything else.
+    """
+    if isinstance(value, frozenset):
+        return value
+    text = str(value).strip()
+    if text in APPLY_CHOICES:
+        return text
+    try:
+        ids = frozenset(int(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        ids = frozenset({-1})
+    if not ids or min(ids) < 0:
+        raise InputError(
+            f"Expected apply to be one of {list(APPLY_CHOICES)} or interval ids like '0,3', "
+            f"got {value!r}"
+        )
+    return ids
 
 
 @dataclass(frozen=True, slots=True)
@@ -61,7 +99,14 @@ class TwistInterval:
     offset_deg : float
         Mean twist offset over the interval, degrees (−180, 180].
     confidence : float
-        Score in [0, 1].
+        Calibrated probability that applying the interval is right, [0, 1].
+    id : int
+        Position in the take's interval list (chain, then frame order), for ``apply``.
+    applied : bool
+        Whether the refinement removed it.
+    levels : tuple of (int, int, float)
+        ``(start_frame, end_frame, offset_deg)`` of each stretch of constant offset: the
+        refined take is the raw one with exactly these removed, so they also undo it.
     """
 
     joint: str
@@ -71,10 +116,14 @@ class TwistInterval:
     end_frame: int
     offset_deg: float
     confidence: float
+    id: int = 0
+    applied: bool = True
+    levels: tuple[tuple[int, int, float], ...] = ()
 
     def to_json(self) -> dict[str, Any]:
         """The interval as a JSON-ready dict."""
         return {
+            "id": self.id,
             "joint": self.joint,
             "side": self.side,
             "segment": self.segment,
@@ -82,6 +131,8 @@ class TwistInterval:
             "end_frame": self.end_frame,
             "offset_deg": round(self.offset_deg, 4),
             "confidence": round(self.confidence, 4),
+            "applied": self.applied,
+            "levels": [[a, b, round(v, 6)] for a, b, v in self.levels],
         }
 
 
@@ -106,7 +157,11 @@ class TwistAnalysis:
     parent_twist_rad : ndarray, shape (F, C)
         θP per chain (swing–twist angle of the parent about the axis), radians.
     offsets_rad : ndarray, shape (F, C)
-        Offset removed per chain and frame, radians.
+        Offset removed per chain and frame, radians (the applied intervals only).
+    detected_offsets_rad : ndarray, shape (F, C)
+        Offset of every interval found, applied or not, radians.
+    apply : str
+        The apply choice: one of :data:`APPLY_CHOICES` or ``"ids"``.
     """
 
     method: str
@@ -117,6 +172,8 @@ class TwistAnalysis:
     fps: float
     parent_twist_rad: FloatArray
     offsets_rad: FloatArray
+    detected_offsets_rad: FloatArray
+    apply: str = "confident"
 
     def summaries(self) -> list[dict[str, Any]]:
         """Per chain: joint, side, segment, interval count, flagged frames, largest offset."""
@@ -132,6 +189,7 @@ class TwistAnalysis:
                     "side": geometry.chain.side,
                     "segment": geometry.chain.segment,
                     "n_intervals": len(mine),
+                    "n_applied": sum(i.applied for i in mine),
                     "n_frames_flagged": int(sum(i.end_frame - i.start_frame + 1 for i in mine)),
                     "max_abs_offset_deg": round(float(offsets_deg.max(initial=0.0)), 4),
                 }
@@ -193,6 +251,7 @@ class TwistAnalysis:
             )
         return {
             "method": self.method,
+            "apply": self.apply,
             "fps": self.fps,
             "n_frames": n_frames,
             "frame_step": step,
@@ -308,8 +367,9 @@ def analyze_twist(
     method: str = "robust",
     mapping: dict[str, str] | None = None,
     params: RobustParams | PaperParams | None = None,
+    apply: str | frozenset[int] = "confident",
 ) -> TwistAnalysis:
-    """Detect and remove axial twist errors in a take.
+    """Detect axial twist errors in a take and remove those chosen by ``apply``.
 
     Parameters
     ----------
@@ -321,23 +381,69 @@ def analyze_twist(
         Role key → joint name overrides (see :func:`mocapqa.core.rig.find_roles`).
     params : RobustParams or PaperParams, optional
         Detector parameters; the method's defaults when omitted.
+    apply : str or frozenset of int
+        ``"confident"`` (default: intervals whose calibrated probability is at least
+        :data:`mocapqa.twist.confidence.APPLY_THRESHOLD`), ``"all"``, ``"none"``, or interval
+        ids (a set, or text such as ``"0,3"``). The paper's method has no calibrated
+        confidence: ``"confident"`` applies all its intervals.
 
     Returns
     -------
     TwistAnalysis
+        Every interval found, each marked applied or not.
 
     Raises
     ------
     InputError
-        For an unknown method, wrong parameters or a bad mapping.
+        For an unknown method or apply choice, wrong parameters, a bad mapping or an interval
+        id the take does not have.
     """
+    choice = parse_apply(apply)
     skeleton = motion.skeleton
     geometries = tuple(
         chain_geometry(skeleton, c) for c in limb_chains(find_roles(skeleton, mapping))
     )
     detection = detect_chains(motion.quats, geometries, motion.fps, method, params)
     n_frames = motion.n_frames
-    offsets = detection.offsets.reshape(n_frames, len(geometries))
+    detected = detection.offsets.reshape(n_frames, len(geometries))
+    found = sorted(detection.intervals, key=lambda i: (i.chain, i.start_frame))
+    if isinstance(choice, frozenset) and choice and max(choice) >= len(found):
+        raise InputError(f"Expected interval ids below {len(found)} in apply, got {sorted(choice)}")
+    offsets = np.zeros_like(detected)
+    intervals = []
+    for k, i in enumerate(found):
+        if isinstance(choice, frozenset):
+            applied = k in choice
+        elif choice == "confident" and method == "robust":
+            applied = i.confidence >= APPLY_THRESHOLD
+        else:
+            applied = choice != "none"
+        rows = slice(i.start_frame, i.end_frame + 1)
+        if applied:
+            offsets[rows, i.chain] = detected[rows, i.chain]
+        values = detected[rows, i.chain]
+        cuts = np.flatnonzero(np.diff(values) != 0.0) + 1
+        levels = tuple(
+            (i.start_frame + int(part[0]), i.start_frame + int(part[-1]),
+             float(np.rad2deg(values[part[0]])))
+            for part in np.split(np.arange(len(values)), cuts)
+            if values[part[0]] != 0.0
+        )  # fmt: skip
+        geometry = geometries[i.chain]
+        intervals.append(
+            TwistInterval(
+                joint=skeleton.names[geometry.chain.parent],
+                side=geometry.chain.side,
+                segment=geometry.chain.segment,
+                start_frame=i.start_frame,
+                end_frame=i.end_frame,
+                offset_deg=float(np.rad2deg(i.offset_rad)),
+                confidence=float(i.confidence),
+                id=k,
+                applied=applied,
+                levels=levels,
+            )
+        )
     refined_quats = refine_quats(motion.quats, geometries, offsets)
     changed = np.any(refined_quats != motion.quats, axis=-1)
     if changed.any():
@@ -348,18 +454,6 @@ def analyze_twist(
         )
     else:
         refined = motion
-    intervals = tuple(
-        TwistInterval(
-            joint=skeleton.names[geometries[i.chain].chain.parent],
-            side=geometries[i.chain].chain.side,
-            segment=geometries[i.chain].chain.segment,
-            start_frame=i.start_frame,
-            end_frame=i.end_frame,
-            offset_deg=float(np.rad2deg(i.offset_rad)),
-            confidence=float(i.confidence),
-        )
-        for i in sorted(detection.intervals, key=lambda i: (i.chain, i.start_frame))
-    )
     if geometries:
         axes = np.stack([g.axis for g in geometries])
         theta = parent_twist_angles(motion.quats[:, [g.chain.parent for g in geometries]], axes)
@@ -368,10 +462,12 @@ def analyze_twist(
     return TwistAnalysis(
         method=method,
         refined=refined,
-        intervals=intervals,
+        intervals=tuple(intervals),
         chains=geometries,
         joint_names=skeleton.names,
         fps=motion.fps,
         parent_twist_rad=theta,
         offsets_rad=offsets,
+        detected_offsets_rad=detected,
+        apply="ids" if isinstance(choice, frozenset) else choice,
     )

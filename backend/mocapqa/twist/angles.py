@@ -61,12 +61,16 @@ class ChainGeometry:
     grandchild_vector : ndarray, shape (3,)
         Unit child → grandchild direction ``b_GC`` in the child's frame (the child's local +Z
         when there is no grandchild, as in the paper).
+    children : tuple of int
+        Every direct child of the parent (the role child's path and helper bones such as
+        twist and share bones); the refinement counter-rotates all of them.
     """
 
     chain: Chain
     intermediates: tuple[int, ...]
     axis: FloatArray
     grandchild_vector: FloatArray
+    children: tuple[int, ...] = ()
 
 
 def wrap_angle(angles_rad: FloatArray) -> FloatArray:
@@ -120,7 +124,8 @@ def chain_geometry(skeleton: Skeleton, chain: Chain) -> ChainGeometry:
         g_length = float(np.linalg.norm(g_offset))
         if g_length > _EPS:
             grand = g_offset / g_length
-    return ChainGeometry(chain, between, offset / length, grand)
+    children = tuple(int(j) for j in np.flatnonzero(skeleton.parents == chain.parent))
+    return ChainGeometry(chain, between, offset / length, grand, children)
 
 
 def child_relative_quats(quats: FloatArray, geometry: ChainGeometry) -> FloatArray:

@@ -27,6 +27,8 @@ from scipy.ndimage import median_filter
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
 from mocapqa.errors import InputError
 from mocapqa.twist.angles import wrap_angle
+from mocapqa.twist.confidence import default_calibration
+from mocapqa.twist.intervals import IntervalEstimate, chain_intervals
 
 __all__ = [
     "DetectedInterval",
@@ -73,15 +75,22 @@ class RobustParams:
     noise_factor : float
         The threshold is ``max(min_threshold_deg, noise_factor × σ)`` with σ the chain's robust
         (MAD) scale of increment residuals; 0 disables the noise scaling.
-    neighbour_frames : int
-        Frames on each side whose median increment is the natural velocity.
+    neighbour_s : float
+        Time on each side whose median increment is the natural velocity, seconds (at least
+        2 frames).
     consistency : float
         Counter-rotation check: ``|wrap(rP + rC)| ≤ consistency × min(|rP|, |rC|)``.
     closure_fraction : float
-        An onset is released when the accumulated level is within
-        ``max(threshold, closure_fraction × largest jump)`` of zero.
+        Jumps cancel when their net is within ``max(threshold, closure_fraction × largest)``.
     max_interval_s : float
-        Longest interval searched for a release, seconds.
+        Longest level shift searched for a release, seconds.
+    burst_gap_s : float
+        Events closer than this form one burst, seconds.
+    agreement : float
+        The level from accumulated jumps is used where it is within
+        ``max(2 threshold, agreement × |level|)`` of the level measured from outside.
+    min_fps : float
+        Below this frame rate nothing is reported (a flip and a fast roll look alike).
     parent_source : {"increment", "swing_twist"}
         Parent twist from the body-frame increment or from swing–twist angle differences.
     child_source : {"increment", "azimuth", "auto"}
@@ -100,10 +109,13 @@ class RobustParams:
 
     min_threshold_deg: float = 2.0
     noise_factor: float = 8.0
-    neighbour_frames: int = 3
+    neighbour_s: float = 0.025
     consistency: float = 0.5
     closure_fraction: float = 0.2
     max_interval_s: float = 2.0
+    burst_gap_s: float = 0.1
+    agreement: float = 0.25
+    min_fps: float = 10.0
     parent_source: str = "increment"
     child_source: str = "increment"
     min_conditioning: float = 0.4
@@ -120,11 +132,20 @@ class RobustParams:
             raise InputError(
                 f"Expected child_source 'increment', 'azimuth' or 'auto', got {self.child_source!r}"
             )
-        if self.neighbour_frames < 1 or self.max_interval_s <= 0 or self.passes < 1:
+        if self.neighbour_s <= 0 or self.max_interval_s <= 0 or self.passes < 1:
             raise InputError(
-                "Expected neighbour_frames ≥ 1, max_interval_s > 0 and passes ≥ 1, got "
-                f"{self.neighbour_frames}, {self.max_interval_s}, {self.passes}"
+                "Expected neighbour_s > 0, max_interval_s > 0 and passes ≥ 1, got "
+                f"{self.neighbour_s}, {self.max_interval_s}, {self.passes}"
             )
+        if self.burst_gap_s <= 0 or self.agreement < 0 or self.min_fps < 0:
+            raise InputError(
+                "Expected burst_gap_s > 0, agreement ≥ 0 and min_fps ≥ 0, got "
+                f"{self.burst_gap_s}, {self.agreement}, {self.min_fps}"
+            )
+
+    def neighbour_frames(self, fps: float) -> int:
+        """Frames on each side for the natural velocity at ``fps`` (at least 2)."""
+        return max(2, round(self.neighbour_s * fps))
 
 
 @dataclass(frozen=True, slots=True)
@@ -140,7 +161,10 @@ class DetectedInterval:
     offset_rad : float
         Circular mean of the offset over the interval, radians (−π, π].
     confidence : float
-        Score in [0, 1].
+        Calibrated probability that applying the interval is right, [0, 1].
+    features : tuple of float
+        The confidence features (:data:`mocapqa.twist.intervals.FEATURES`; empty for the
+        paper's method).
     """
 
     chain: int
@@ -148,6 +172,7 @@ class DetectedInterval:
     end_frame: int
     offset_rad: float
     confidence: float
+    features: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -249,50 +274,22 @@ def _neighbour_median(
     return result
 
 
-def _pair_events(
-    frames: IntArray,
-    jumps: FloatArray,
-    strengths: FloatArray,
-    threshold: float,
-    params: RobustParams,
-    max_frames: int,
-    n_frames: int,
-) -> tuple[FloatArray, list[tuple[int, int, float]]]:
-    """Offsets of one chain from its events; also (start, end, confidence) per interval.
+def _clean_median(
+    increments: FloatArray, outliers: BoolArray, half: int, rows: IntArray, fallback: FloatArray
+) -> FloatArray:
+    """Median of the non-outlier increments within ``half`` frames of each of ``rows``.
 
-    Events are matched like brackets: each new event closes the most recent open events whose
-    jumps it cancels (modulo 2π), the shortest closure first. Open events older than
-    ``max_frames`` are dropped, and so are events never closed.
+    Returns shape (R, C); ``fallback`` where every neighbour is an outlier.
     """
-    offsets = np.zeros(n_frames)
-    found: list[tuple[int, int, float]] = []
-    stack: list[int] = []
-    for k in range(len(frames)):
-        stack = [i for i in stack if frames[k] - frames[i] <= max_frames]
-        level = float(jumps[k])
-        largest = abs(level)
-        closed = -1
-        for p in range(len(stack) - 1, -1, -1):
-            level = float(wrap_angle(np.array(level + jumps[stack[p]])))
-            largest = max(largest, abs(float(jumps[stack[p]])))
-            if abs(level) <= max(threshold, params.closure_fraction * largest):
-                closed = p
-                break
-        if closed < 0:
-            stack.append(k)
-            continue
-        members = [*stack[closed:], k]
-        stack = stack[:closed]
-        # Levels between events; the closure residual is spread evenly over the steps.
-        steps = jumps[members] - level / len(members)
-        levels = wrap_angle(np.cumsum(steps)[:-1])
-        for m, value in enumerate(levels):
-            offsets[frames[members[m]] : frames[members[m + 1]]] += value
-        tolerance = max(threshold, params.closure_fraction * largest)
-        closure = max(0.0, 1.0 - abs(level) / tolerance)
-        strength = float(np.min(strengths[members]))
-        found.append((int(frames[members[0]]), int(frames[k]) - 1, closure * strength))
-    return wrap_angle(offsets), found
+    n_frames = increments.shape[0]
+    offsets = np.array([k for k in range(-half, half + 1) if k != 0])
+    index = np.clip(rows[:, None] + offsets[None, :], 0, n_frames - 1)
+    values = np.where(outliers[index], np.nan, increments[index])  # (R, 2 half, C)
+    empty = np.isnan(values).all(axis=1)
+    values[:, 0][empty] = 0.0
+    median = np.nanmedian(values, axis=1)
+    result: FloatArray = np.where(empty, fallback, median)
+    return result
 
 
 def detect_robust(
@@ -301,24 +298,26 @@ def detect_robust(
     fps: float,
     params: RobustParams,
 ) -> Detection:
-    """Level-shift events paired into intervals.
+    """Level-shift events grouped into intervals whose levels are measured from outside.
 
     Parameters
     ----------
     parent_increments, child_increments : ndarray, shape (F, C)
         ΔθP and ΔθC in radians.
     fps : float
-        Frame rate (sets the longest interval in frames).
+        Frame rate: every window and duration of ``params`` is in seconds.
     params : RobustParams
 
     Returns
     -------
     Detection
+        ``offsets`` holds every interval found; their ``confidence`` is the calibrated
+        probability of :func:`mocapqa.twist.confidence.default_calibration`.
     """
     dp, dc = parent_increments, child_increments
     n_frames, n_chains = dp.shape
-    half = params.neighbour_frames
-    if n_frames <= 2 * half + 1:
+    half = params.neighbour_frames(fps)
+    if n_frames <= 2 * half + 1 or fps < params.min_fps:
         zeros = np.zeros_like(dp)
         return Detection(dp, dc, zeros.astype(bool), zeros, ())
     floor = np.deg2rad(params.min_threshold_deg)
@@ -340,49 +339,57 @@ def detect_robust(
         # Natural velocities again, with the event frames replaced by the residual-free
         # estimate, so that clustered events do not bias each other's neighbours. Only rows
         # within reach of an event can change.
+        # Every large step counts as an outlier here (not only consistent events), so that
+        # the flips of a burst do not hide each other.
+        outliers = np.maximum(np.abs(rp), np.abs(rc)) > threshold
         near = np.flatnonzero(
-            np.convolve(events.any(axis=1), np.ones(2 * half + 1), mode="same") > 0
+            np.convolve(outliers.any(axis=1), np.ones(2 * half + 1), mode="same") > 0
         )
         natural_p = natural_p.copy()
         natural_c = natural_c.copy()
-        natural_p[near] = _neighbour_median(np.where(events, natural_p, dp), half, near)
-        natural_c[near] = _neighbour_median(np.where(events, natural_c, dc), half, near)
+        natural_p[near] = _clean_median(dp, outliers, 2 * half, near, natural_p[near])
+        natural_c[near] = _clean_median(dc, outliers, 2 * half, near, natural_c[near])
     # The jump is the circular mean of the parent's step and the child's counter-step.
     rows, cols = np.nonzero(events)
     jumps = np.zeros_like(dp)
     jumps[rows, cols] = np.angle(np.exp(1j * rp[rows, cols]) + np.exp(-1j * rc[rows, cols]))
-    strengths = np.zeros_like(dp)
-    small = smaller[rows, cols]
-    strengths[rows, cols] = (1.0 - np.exp(-(small / threshold[cols] - 1.0))) * (
-        1.0 - mismatch[rows, cols] / np.maximum(allowed[rows, cols], 1e-12)
+    ratio = np.zeros_like(dp)
+    ratio[rows, cols] = mismatch[rows, cols] / np.maximum(smaller[rows, cols], 1e-12)
+    # The chain's natural roll per frame: noise or typical velocity, whichever is larger.
+    roll_scale = np.maximum(
+        np.maximum(scale, np.median(np.abs(natural_p), axis=0)), np.deg2rad(0.01)
     )
     offsets = np.zeros_like(dp)
-    intervals: list[DetectedInterval] = []
-    max_frames = max(2, round(params.max_interval_s * fps))
+    found: list[tuple[int, IntervalEstimate]] = []
     for c in range(n_chains):
         frames = np.flatnonzero(events[:, c])
         if len(frames) == 0:
             continue
         if params.pair_events:
-            offsets[:, c], found = _pair_events(
-                frames,
-                jumps[frames, c],
-                np.clip(strengths[frames, c], 0.0, 1.0),
-                float(threshold[c]),
-                params,
-                max_frames,
-                n_frames,
-            )
+            offsets[:, c], estimates = chain_intervals(
+                frames, jumps[frames, c], ratio[frames, c], dp[:, c], natural_p[:, c],
+                float(threshold[c]), float(roll_scale[c]), fps, params.closure_fraction,
+                params.agreement, params.burst_gap_s, params.max_interval_s,
+            )  # fmt: skip
         else:
             steps = np.zeros(n_frames)
             steps[frames] = jumps[frames, c]
             offsets[:, c] = wrap_angle(np.cumsum(steps))
             offsets[np.abs(offsets[:, c]) < 1e-12, c] = 0.0
-            found = [
-                (s, e, float(np.clip(np.min(strengths[frames, c]), 0.0, 1.0)))
+            estimates = [
+                IntervalEstimate(s, e, _circular_mean(offsets[s : e + 1, c]), ())
                 for s, e in runs(offsets[:, c] != 0.0)
             ]
-        for start, end, confidence in found:
-            level = _circular_mean(offsets[start : end + 1, c])
-            intervals.append(DetectedInterval(c, start, end, level, confidence))
-    return Detection(dp, dc, events, offsets, tuple(intervals))
+        found += [(c, e) for e in estimates]
+    with_features = [(c, e) for c, e in found if e.features]
+    probabilities = iter(
+        default_calibration().probability(np.array([e.features for _, e in with_features]))
+        if with_features
+        else []
+    )
+    intervals = tuple(
+        DetectedInterval(c, e.start_frame, e.end_frame, e.offset_rad,
+                         float(next(probabilities)) if e.features else 0.5, e.features)
+        for c, e in found
+    )  # fmt: skip
+    return Detection(dp, dc, events, offsets, intervals)

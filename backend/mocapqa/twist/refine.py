@@ -2,11 +2,13 @@
 
 Conventions
 -----------
-For a chain with parent P, intermediate helpers ``M = m1 ⊗ … ⊗ mk`` (usually none) and child
-C, an offset ``o(t)`` about the axis ``a`` is removed as ``qP' = qP ⊗ R(a, −o)`` and
-``qC' = M⁻¹ ⊗ R(a, o) ⊗ M ⊗ qC``, so that ``qP' ⊗ M ⊗ qC' = qP ⊗ M ⊗ qC``: the child's global
-orientation and everything below it are unchanged. Only the parent and child rows of frames
-whose offset is non-zero are written; every other value is copied bit for bit.
+For a chain with parent P, an offset ``o(t)`` about the axis ``a`` is removed as
+``qP' = qP ⊗ R(a, −o)``, and *every* direct child X of P (the role child or the first helper on
+the way to it, twist bones, share bones) is counter-rotated, ``qX' = R(a, o) ⊗ qX``, so that
+``qP' ⊗ qX' = qP ⊗ qX``: the world orientation of every joint below P is unchanged. (A child
+whose offset is off the axis is carried round it, so its position can move; on the corpus rigs
+the children sit on the bone or at the joint.) Only the rows of frames whose offset is non-zero
+are written; every other value is copied bit for bit.
 """
 
 from __future__ import annotations
@@ -59,13 +61,10 @@ def refine_quats(
         if len(rows) == 0:
             continue
         geometry = geometries[c]
-        parent, child = geometry.chain.parent, geometry.chain.child
+        parent = geometry.chain.parent
         forward = quats_from_axis_angle(geometry.axis, offsets_rad[rows, c])  # R(a, o)
         out[rows, parent] = multiply(out[rows, parent], conjugate(forward))
-        if geometry.intermediates:
-            between = out[rows, geometry.intermediates[0]]
-            for j in geometry.intermediates[1:]:
-                between = multiply(between, out[rows, j])
-            forward = multiply(conjugate(between), multiply(forward, between))
-        out[rows, child] = multiply(forward, out[rows, child])
+        first = geometry.intermediates[0] if geometry.intermediates else geometry.chain.child
+        for j in {first, *geometry.children}:
+            out[rows, j] = multiply(forward, out[rows, j])
     return out

@@ -1,0 +1,157 @@
+"""Calibrated confidence of a twist interval: the probability that applying it is right.
+
+Conventions
+-----------
+The model is a logistic regression on the features of
+:data:`mocapqa.twist.intervals.FEATURES`, standardised with the means and scales stored beside
+the coefficients in ``data/twist/calibration.json``. That file is written by
+``mocapqa bench twist --fit-calibration`` from injected errors on the *fit* takes of the corpus
+only (never the held-out takes and never ``005_05``, the take with real errors). An interval is
+labelled right when applying it alone removes at least 80 % of the twist error on its frames
+and raises no frame's error by more than 1°.
+
+``APPLY_THRESHOLD`` is the probability from which ``apply="confident"`` applies an interval.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mocapqa.core.arrays import FloatArray
+from mocapqa.errors import InputError
+from mocapqa.twist.intervals import FEATURES
+
+__all__ = [
+    "APPLY_THRESHOLD",
+    "CALIBRATION_FILE",
+    "Calibration",
+    "default_calibration",
+    "fit_calibration",
+]
+
+APPLY_THRESHOLD = 0.5
+"""Smallest calibrated probability at which ``apply="confident"`` applies an interval."""
+CALIBRATION_FILE = "calibration.json"
+"""Name of the stored calibration in the package's ``data/twist`` folder."""
+
+
+@dataclass(frozen=True, slots=True)
+class Calibration:
+    """A logistic model on standardised interval features.
+
+    Parameters
+    ----------
+    features : tuple of str
+        Feature names, in :data:`mocapqa.twist.intervals.FEATURES` order.
+    mean, scale : ndarray, shape (K,)
+        Standardisation of each feature.
+    coef : ndarray, shape (K,)
+        Logistic coefficients.
+    intercept : float
+    fitted_on : str
+        What the model was fitted on (written to the docs and the bench).
+    """
+
+    features: tuple[str, ...]
+    mean: FloatArray
+    scale: FloatArray
+    coef: FloatArray
+    intercept: float
+    fitted_on: str
+
+    def probability(self, features: FloatArray) -> FloatArray:
+        """Probability that each interval is right, shape (N,) from features (N, K)."""
+        x = (np.asarray(features, dtype=np.float64) - self.mean) / self.scale
+        result: FloatArray = 1.0 / (1.0 + np.exp(-(x @ self.coef + self.intercept)))
+        return result
+
+    def to_json(self) -> dict[str, Any]:
+        """The model as a JSON-ready dict."""
+        return {
+            "features": list(self.features),
+            "mean": self.mean.tolist(),
+            "scale": self.scale.tolist(),
+            "coef": self.coef.tolist(),
+            "intercept": self.intercept,
+            "fitted_on": self.fitted_on,
+        }
+
+    @classmethod
+    def from_json(cls, data: dict[str, Any], source: str = "calibration") -> Calibration:
+        """The model from :meth:`to_json`'s dict.
+
+        Raises
+        ------
+        InputError
+            When the features differ from :data:`FEATURES` or a field is missing.
+        """
+        try:
+            names = tuple(str(n) for n in data["features"])
+            arrays = [np.asarray(data[k], dtype=np.float64) for k in ("mean", "scale", "coef")]
+            intercept = float(data["intercept"])
+            fitted_on = str(data.get("fitted_on", ""))
+        except (KeyError, TypeError, ValueError) as error:
+            raise InputError(f"Expected a twist calibration in {source}, got {error!r}") from error
+        if names != FEATURES or any(a.shape != (len(FEATURES),) for a in arrays):
+            raise InputError(
+                f"Expected calibration features {list(FEATURES)} in {source}, got {list(names)}"
+            )
+        return cls(names, arrays[0], arrays[1], arrays[2], intercept, fitted_on)
+
+
+@functools.lru_cache(maxsize=1)
+def default_calibration() -> Calibration:
+    """The shipped calibration (``mocapqa/data/twist/calibration.json``)."""
+    resource = resources.files("mocapqa") / "data" / "twist" / CALIBRATION_FILE
+    data = json.loads(resource.read_text(encoding="utf-8"))
+    return Calibration.from_json(data, str(resource))
+
+
+def fit_calibration(
+    features: FloatArray, labels: Sequence[bool], fitted_on: str, path: Path | None = None
+) -> Calibration:
+    """Fit the logistic model (scikit-learn, L2, C = 1) and optionally write it.
+
+    Parameters
+    ----------
+    features : ndarray, shape (N, K)
+    labels : sequence of bool, length N
+        Whether each interval was right.
+    fitted_on : str
+        Description of the data, stored with the model.
+    path : Path, optional
+        Where to write the JSON.
+
+    Returns
+    -------
+    Calibration
+
+    Raises
+    ------
+    InputError
+        With fewer than two classes among the labels.
+    """
+    from sklearn.linear_model import LogisticRegression
+
+    x = np.asarray(features, dtype=np.float64)
+    y = np.asarray(labels, dtype=bool)
+    if len(set(y.tolist())) < 2:
+        raise InputError("Expected right and wrong intervals to fit a calibration, got one class")
+    mean = x.mean(axis=0)
+    scale = np.where(x.std(axis=0) > 1e-9, x.std(axis=0), 1.0)
+    model = LogisticRegression(C=1.0, max_iter=1000).fit((x - mean) / scale, y)
+    calibration = Calibration(
+        FEATURES, mean, scale, model.coef_[0].copy(), float(model.intercept_[0]), fitted_on
+    )
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(calibration.to_json(), indent=2) + "\n", encoding="utf-8")
+    return calibration
