@@ -10,8 +10,15 @@ speed in frames per second (detection and refinement, parsing excluded).
 
 Takes are grouped by rig: ``cmu`` (the cgspeed conversion), ``iclone`` (Character Creator
 retargets) and ``bandai``. Within each rig, files at even positions of the sorted list form the
-*fit* set (the one the robust defaults were tuned on) and those at odd positions the *held-out*
-set; results are reported for both and overall.
+*fit* set (the one the robust defaults and the confidence calibration were chosen on) and those
+at odd positions the *held-out* set; results are reported for both and overall. The takes of
+:data:`REAL_ERROR_TAKES` carry real twist errors and are never injected into (they are
+evaluation data only, see :mod:`mocapqa.bench.natural`).
+
+Every interval a method reports, on injected and on clean takes, is recorded with its
+confidence features and whether it is *right*: applying it alone removes at least 80 % of the
+injected twist error on its frames and raises no frame's error by more than 1° (an interval on
+a clean take is never right). Those records feed the calibration fit and reliability table.
 """
 
 from __future__ import annotations
@@ -24,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.errors import InputError
@@ -35,15 +43,17 @@ from mocapqa.metrics.twist import (
     rotation_errors_deg,
     twist_accuracy,
 )
-from mocapqa.twist.analysis import analyze_twist, detect_chains
-from mocapqa.twist.angles import chain_geometry
+from mocapqa.twist.analysis import TwistAnalysis, analyze_twist, detect_chains
+from mocapqa.twist.angles import chain_geometry, wrap_angle
 from mocapqa.twist.detect import PaperParams, RobustParams
 from mocapqa.twist.inject import inject_twist_errors
 from mocapqa.twist.refine import refine_quats
 
 __all__ = [
+    "REAL_ERROR_TAKES",
     "RIGS",
     "BenchFile",
+    "IntervalRecord",
     "MethodResult",
     "TwistBenchResult",
     "find_bench_files",
@@ -54,6 +64,34 @@ __all__ = [
 
 # Rig families reported separately, by corpus folder.
 RIGS = ("cmu", "iclone", "bandai")
+REAL_ERROR_TAKES = ("005_05.bvh",)
+"""Corpus takes with real twist errors: never injected into, never used to choose anything."""
+
+
+@dataclass(frozen=True, slots=True)
+class IntervalRecord:
+    """One reported interval of the benchmark.
+
+    Parameters
+    ----------
+    rig : str
+    held_out : bool
+    take : str
+        File name.
+    features : tuple of float
+        Confidence features (:data:`mocapqa.twist.intervals.FEATURES`).
+    confidence : float
+        Calibrated probability given by the shipped calibration.
+    right : bool
+        Whether applying it alone is right (see the module notes).
+    """
+
+    rig: str
+    held_out: bool
+    take: str
+    features: tuple[float, ...]
+    confidence: float
+    right: bool
 
 
 @dataclass(frozen=True, slots=True)
@@ -86,6 +124,12 @@ class MethodResult:
         ``(rig, held_out)`` → list of :class:`CleanChange`.
     seconds, frames : dict
         ``rig`` → detection + refinement time (s) and frames processed on the clean takes.
+    per_take : dict
+        ``(rig, held_out, take)`` → [frames succeeded, error frames], for bootstrap intervals.
+    spill : dict
+        ``(rig, held_out)`` → largest change of a target joint on its non-injected frames, °.
+    records : list of IntervalRecord
+        Every interval reported on the injected and the clean takes.
     """
 
     before: dict[tuple[str, bool, str, str], list[np.ndarray]] = field(default_factory=dict)
@@ -93,6 +137,37 @@ class MethodResult:
     clean: dict[tuple[str, bool], list[CleanChange]] = field(default_factory=dict)
     seconds: dict[str, float] = field(default_factory=dict)
     frames: dict[str, int] = field(default_factory=dict)
+    per_take: dict[tuple[str, bool, str], list[int]] = field(default_factory=dict)
+    spill: dict[tuple[str, bool], float] = field(default_factory=dict)
+    records: list[IntervalRecord] = field(default_factory=list)
+
+    def bootstrap_fsr(
+        self,
+        rigs: Sequence[str] = RIGS,
+        held_out: bool | None = None,
+        samples: int = 1000,
+        seed: int = 0,
+    ) -> tuple[float, float]:
+        """95 % bootstrap interval of the FSR, resampling takes (not frames)."""
+        counts = np.array(
+            [v for (rig, hold, _), v in self.per_take.items()
+             if rig in rigs and (held_out is None or hold == held_out) and v[1] > 0]
+        )  # fmt: skip
+        if len(counts) == 0:
+            return 0.0, 1.0
+        rng = np.random.default_rng(seed)
+        picks = rng.integers(0, len(counts), size=(samples, len(counts)))
+        rates = counts[picks, 0].sum(axis=1) / counts[picks, 1].sum(axis=1)
+        low, high = np.quantile(rates, [0.025, 0.975])
+        return float(low), float(high)
+
+    def max_spill(self, rigs: Sequence[str] = RIGS, held_out: bool | None = None) -> float:
+        """Largest spill onto non-injected frames of the target joints, degrees."""
+        return max(
+            (v for (rig, hold), v in self.spill.items()
+             if rig in rigs and (held_out is None or hold == held_out)),
+            default=0.0,
+        )  # fmt: skip
 
     def accuracy(
         self,
@@ -189,7 +264,7 @@ def find_bench_files(data_dir: Path, files_per_rig: int | None = None) -> list[B
     by_rig: dict[str, list[Path]] = {r: [] for r in RIGS}
     for path in sorted(Path(data_dir).glob("**/*.bvh")):
         rig = rig_of(path)
-        if rig is not None:
+        if rig is not None and path.name not in REAL_ERROR_TAKES:
             by_rig[rig].append(path)
     out: list[BenchFile] = []
     for rig, paths in by_rig.items():
@@ -233,12 +308,42 @@ def speed_frames_per_s(
     return n / best_wall, n / max(best_cpu, 1e-9), n / best_full
 
 
+def _interval_records(
+    analysis: TwistAnalysis,
+    truth_offsets: FloatArray | None,
+    bench_file: BenchFile,
+) -> list[IntervalRecord]:
+    """Each interval of ``analysis`` labelled right or wrong against the injected offsets."""
+    out = []
+    for interval, found in zip(analysis.intervals, analysis.found, strict=True):
+        if not found.features:
+            continue
+        rows = slice(interval.start_frame, interval.end_frame + 1)
+        parent = analysis.chains[found.chain].chain.parent
+        applied = analysis.detected_offsets_rad[rows, found.chain]
+        injected = np.zeros_like(applied) if truth_offsets is None else truth_offsets[rows, parent]
+        before = np.abs(wrap_angle(injected))
+        after = np.abs(wrap_angle(injected - applied))
+        right = bool(
+            before.sum() > 0
+            and after.sum() <= 0.2 * before.sum()
+            and np.max(after - before) <= np.deg2rad(1.0)
+        )
+        out.append(
+            IntervalRecord(bench_file.rig, bench_file.held_out, bench_file.path.name,
+                           found.features, interval.confidence, right)
+        )  # fmt: skip
+    return out
+
+
 def run_twist_bench(
     files: Sequence[BenchFile],
     methods: dict[str, tuple[str, RobustParams | PaperParams | None]],
     seed: int = 0,
     repeats: int = 2,
     on_file: Callable[[BenchFile], None] | None = None,
+    apply: str = "confident",
+    kind: str = "level",
 ) -> TwistBenchResult:
     """Inject, refine and score every take with every method.
 
@@ -253,6 +358,10 @@ def run_twist_bench(
         Injections per take.
     on_file : callable, optional
         Called after each take (progress).
+    apply : str
+        Which intervals the refinement applies (see :func:`mocapqa.twist.analysis.analyze_twist`).
+    kind : {"level", "burst"}
+        The injected error shape (see :func:`mocapqa.twist.inject.inject_twist_errors`).
 
     Returns
     -------
@@ -267,34 +376,46 @@ def run_twist_bench(
         for repeat in range(repeats):
             rng = np.random.default_rng((seed, name_key, repeat))
             try:
-                injected.append(inject_twist_errors(motion, rng))
+                injected.append(inject_twist_errors(motion, rng, kind=kind))
             except InputError:
                 continue
         n_injections += len(injected)
         has_rotation = np.array([bool(motion.skeleton.rotation_order(j)) for j in
                                  range(motion.skeleton.n_joints)])  # fmt: skip
+        take_key = (bench_file.rig, bench_file.held_out, bench_file.path.name)
+        group = (bench_file.rig, bench_file.held_out)
         for label, (method, params) in methods.items():
             result = results[label]
+            counts = result.per_take.setdefault(take_key, [0, 0])
             for corrupted, truth in injected:
-                refined = analyze_twist(corrupted, method, params=params).refined
+                analysis = analyze_twist(corrupted, method, params=params, apply=apply)
+                refined = analysis.refined
+                result.records += _interval_records(analysis, truth.offsets_rad, bench_file)
                 for k, target in enumerate(truth.targets):
                     rows = truth.error_mask[:, target]
                     key = (bench_file.rig, bench_file.held_out, truth.sides[k], truth.segments[k])
                     clean_rows = truth.clean_quats[rows, target]
-                    result.before.setdefault(key, []).append(
-                        rotation_errors_deg(clean_rows, corrupted.quats[rows, target])
+                    before = rotation_errors_deg(clean_rows, corrupted.quats[rows, target])
+                    after = rotation_errors_deg(clean_rows, refined.quats[rows, target])
+                    result.before.setdefault(key, []).append(before)
+                    result.after.setdefault(key, []).append(after)
+                    counts[0] += int(np.sum(after <= 0.2 * before))
+                    counts[1] += len(before)
+                    spill = rotation_errors_deg(
+                        truth.clean_quats[~rows, target], refined.quats[~rows, target]
                     )
-                    result.after.setdefault(key, []).append(
-                        rotation_errors_deg(clean_rows, refined.quats[rows, target])
+                    result.spill[group] = max(
+                        result.spill.get(group, 0.0), float(spill.max(initial=0.0))
                     )
             start = time.perf_counter()
-            analysis = analyze_twist(motion, method, params=params)
+            analysis = analyze_twist(motion, method, params=params, apply=apply)
             elapsed = time.perf_counter() - start
+            result.records += _interval_records(analysis, None, bench_file)
             result.seconds[bench_file.rig] = result.seconds.get(bench_file.rig, 0.0) + elapsed
             result.frames[bench_file.rig] = result.frames.get(bench_file.rig, 0) + motion.n_frames
             mask = np.broadcast_to(has_rotation, motion.quats.shape[:2])
             change = clean_change(motion.quats, analysis.refined.quats, 1.0, mask)
-            result.clean.setdefault((bench_file.rig, bench_file.held_out), []).append(change)
+            result.clean.setdefault(group, []).append(change)
         if on_file is not None:
             on_file(bench_file)
     return TwistBenchResult(results, len(files), n_injections)

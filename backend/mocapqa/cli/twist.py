@@ -22,6 +22,10 @@ if TYPE_CHECKING:
 __all__ = ["bench_twist", "detect", "refine"]
 
 _METHOD_HELP = "Detector: robust (default) or paper (the published rule as written)."
+_APPLY_HELP = (
+    "Intervals to remove: confident (calibrated probability ≥ 0.5, the default), all, none, "
+    "or interval ids from the report such as 0,3."
+)
 
 
 def _report(analysis: TwistAnalysis, path: Path, missing: list[str]) -> dict[str, Any]:
@@ -29,6 +33,7 @@ def _report(analysis: TwistAnalysis, path: Path, missing: list[str]) -> dict[str
         "input": str(path),
         "method": analysis.method,
         "missing_roles": missing,
+        "apply": analysis.apply,
         "n_frames": analysis.refined.n_frames,
         "fps": analysis.fps,
         "intervals": [i.to_json() for i in analysis.intervals],
@@ -49,12 +54,17 @@ def refine(
     input_path: Annotated[Path, typer.Argument(metavar="IN.bvh", help="Take to refine.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Refined BVH to write.")],
     method: Annotated[str, typer.Option(help=_METHOD_HELP)] = "robust",
+    apply: Annotated[str, typer.Option(help=_APPLY_HELP)] = "confident",
     report: Annotated[
         Path | None, typer.Option(help="Write the intervals and per-joint summaries as JSON.")
     ] = None,
     mapping: MappingOption = None,
 ) -> None:
-    """Remove axial twist errors; writes the take with the input's layout and frame time."""
+    """Remove axial twist errors; writes the take with the input's layout and frame time.
+
+    Every interval found is listed in the report with its confidence and whether it was
+    applied; the written take is the input with exactly the applied intervals' levels removed.
+    """
     from mocapqa.io.bvh import read_bvh
     from mocapqa.io.bvh_write import write_bvh
     from mocapqa.twist.analysis import analyze_twist
@@ -63,15 +73,17 @@ def refine(
     roles = load_mapping(mapping)
     motion = read_bvh(input_path)
     missing = missing_roles(motion.skeleton, roles)
-    analysis = analyze_twist(motion, method, roles)
+    analysis = analyze_twist(motion, method, roles, apply=apply)
     write_bvh(output, analysis.refined)
     if report is not None:
         text = json.dumps(_report(analysis, input_path, missing), indent=2)
         report.write_text(text, encoding="utf-8")
     console = Console(highlight=False)
-    frames = sum(i.end_frame - i.start_frame + 1 for i in analysis.intervals)
+    applied = [i for i in analysis.intervals if i.applied]
+    frames = sum(i.end_frame - i.start_frame + 1 for i in applied)
     console.print(
-        f"{len(analysis.intervals)} intervals ({frames} joint frames) corrected → {output}"
+        f"{len(applied)} of {len(analysis.intervals)} intervals applied ({frames} joint frames) "
+        f"→ {output}"
     )
 
 
@@ -79,10 +91,11 @@ def refine(
 def detect(
     input_path: Annotated[Path, typer.Argument(metavar="IN.bvh", help="Take to check.")],
     method: Annotated[str, typer.Option(help=_METHOD_HELP)] = "robust",
+    apply: Annotated[str, typer.Option(help=_APPLY_HELP)] = "confident",
     as_json: Annotated[bool, typer.Option("--json", help="Print the report as JSON.")] = False,
     mapping: MappingOption = None,
 ) -> None:
-    """Report axial twist error intervals without writing anything."""
+    """Report axial twist error intervals (and which refine would apply) without writing."""
     from mocapqa.io.bvh import read_bvh
     from mocapqa.twist.analysis import analyze_twist
 
@@ -90,20 +103,22 @@ def detect(
     roles = load_mapping(mapping)
     motion = read_bvh(input_path)
     missing = missing_roles(motion.skeleton, roles)
-    analysis = analyze_twist(motion, method, roles)
+    analysis = analyze_twist(motion, method, roles, apply=apply)
     if as_json:
         typer.echo(json.dumps(_report(analysis, input_path, missing), indent=2))
         return
     table = Table(title=f"Twist intervals ({method}) in {input_path.name}")
-    for column in ("joint", "start", "end", "offset °", "confidence"):
+    for column in ("id", "joint", "start", "end", "offset °", "confidence", "applied"):
         table.add_column(column, justify="left" if column == "joint" else "right")
     for i in analysis.intervals:
         table.add_row(
+            str(i.id),
             i.joint,
             str(i.start_frame),
             str(i.end_frame),
             f"{i.offset_deg:.1f}",
             f"{i.confidence:.2f}",
+            "yes" if i.applied else "no",
         )
     Console(highlight=False).print(table)
 
@@ -207,6 +222,76 @@ def _ablation_table(methods: dict[str, Any]) -> Table:
     return table
 
 
+def _run(
+    bench_files: list[Any],
+    methods: dict[str, Any],
+    seed: int,
+    repeats: int,
+    console: Console,
+    apply: str = "confident",
+    kind: str = "level",
+) -> Any:
+    from mocapqa.bench.twist import run_twist_bench
+
+    with Progress(console=console, transient=True) as progress:
+        task = progress.add_task("twist bench", total=len(bench_files))
+        return run_twist_bench(
+            bench_files,
+            methods,
+            seed=seed,
+            repeats=repeats,
+            on_file=lambda f: progress.update(task, advance=1, description=f.path.name),
+            apply=apply,
+            kind=kind,
+        )  # fmt: skip
+
+
+def _real_takes(data_dir: Path) -> list[Path]:
+    return sorted(p for p in data_dir.rglob("*.bvh") if p.is_file())
+
+
+def _print_real(data_dir: Path, console: Console, methods_chosen: list[str]) -> None:
+    """Natural-error figures on the real-error takes and the default refinement of every take."""
+    from mocapqa.bench.calibration import real_interval_records, reliability
+    from mocapqa.bench.natural import clean_take_figure, natural_error_figures
+    from mocapqa.bench.twist import REAL_ERROR_TAKES
+    from mocapqa.cli.twist_tables import calibration_table, clean_takes_table, natural_table
+    from mocapqa.io.bvh import read_bvh
+    from mocapqa.twist.analysis import analyze_twist
+
+    takes = _real_takes(data_dir)
+    for path in (p for p in takes if p.name in REAL_ERROR_TAKES):
+        motion = read_bvh(path)
+        rows = [
+            (f"{m} (apply {a})", natural_error_figures(motion, analyze_twist(motion, m, apply=a)))
+            for m in methods_chosen
+            for a in (("confident", "all") if m == "robust" else ("all",))
+        ]
+        console.print(f"{path.parent.name}/{path.name}: {motion.n_frames} frames, {motion.fps} fps")
+        console.print(natural_table(rows))
+        if "robust" in methods_chosen:
+            records = real_interval_records(motion, path.name, "iclone")
+            console.print(
+                calibration_table(
+                    f"Calibration on the real intervals of {path.name} "
+                    f"({sum(r.right for r in records)} of {len(records)} right)",
+                    reliability([r.confidence for r in records], [r.right for r in records]),
+                )
+            )
+    rows_clean = []
+    for path in takes:
+        motion = read_bvh(path)
+        rows_clean.append((path, (motion, clean_take_figure(motion, analyze_twist(motion)))))
+    console.print(clean_takes_table(rows_clean))
+    clean_rows = [r for p, r in rows_clean if p.name not in REAL_ERROR_TAKES]
+    console.print(
+        f"takes without real errors: {len(clean_rows)}, with an interval applied by default: "
+        f"{sum(f.n_applied > 0 for _, f in clean_rows)}, intervals applied: "
+        f"{sum(f.n_applied for _, f in clean_rows)}, largest change "
+        f"{max((f.max_change_deg for _, f in clean_rows), default=0.0):.1f}°"
+    )
+
+
 @bench_app.command("twist")
 def bench_twist(
     data: Annotated[
@@ -221,11 +306,29 @@ def bench_twist(
     ablation: Annotated[
         bool, typer.Option(help="Also run the robust method with each idea switched off.")
     ] = False,
+    loro: Annotated[
+        bool, typer.Option(help="Also choose parameters on two rigs and report the third.")
+    ] = False,
+    real: Annotated[
+        bool, typer.Option(help="Real-error figures (005_05) and the default on every take.")
+    ] = True,
+    fit_calibration: Annotated[
+        Path | None,
+        typer.Option(help="Fit the confidence calibration on the fit takes, write it here, stop."),
+    ] = None,
 ) -> None:
-    """The paper's Tables 1 and 2, the clean-data figure and the speed, per rig and overall."""
+    """The paper's Tables 1 and 2 with bootstrap intervals, real-error, clean-take,
+    calibration and (optionally) leave-one-rig-out figures, and the speed."""
     import numpy as np
 
-    from mocapqa.bench.twist import find_bench_files, run_twist_bench, speed_frames_per_s
+    from mocapqa.bench.calibration import fit_on_fit_takes, reliability
+    from mocapqa.bench.twist import find_bench_files, speed_frames_per_s
+    from mocapqa.cli.twist_tables import (
+        calibration_table,
+        loro_table,
+        loro_variants,
+        rates_table,
+    )
     from mocapqa.io.bvh import read_bvh
 
     methods_chosen = method or ["robust", "paper"]
@@ -233,28 +336,62 @@ def bench_twist(
         _check_method(m)
     data_dir = data if data is not None else _default_corpus()
     bench_files = find_bench_files(data_dir, files)
+    console = Console(highlight=False, width=max(Console().width, 170))
+    if fit_calibration is not None:
+        fit_files = [f for f in bench_files if not f.held_out]
+        records = [
+            r
+            for kind in ("level", "burst")
+            for r in _run(fit_files, {"robust": ("robust", None)}, seed, repeats, console, "all",
+                          kind).methods["robust"].records
+        ]  # fmt: skip
+        calibration = fit_on_fit_takes(records, fit_calibration)
+        console.print(f"calibration written to {fit_calibration}: {calibration.fitted_on}")
+        probabilities = calibration.probability(np.array([r.features for r in records]))
+        bins = reliability(probabilities, [r.right for r in records])
+        console.print(calibration_table("Reliability on the fit takes (in-sample)", bins))
+        return
     methods: dict[str, tuple[str, Any]] = {m: (m, None) for m in methods_chosen}
     if ablation:
         methods.update(_ablations())
-    console = Console(highlight=False, width=max(Console().width, 170))
-    with Progress(console=console, transient=True) as progress:
-        task = progress.add_task("twist bench", total=len(bench_files))
-        result = run_twist_bench(
-            bench_files,
-            methods,
-            seed=seed,
-            repeats=repeats,
-            on_file=lambda f: progress.update(task, advance=1, description=f.path.name),
-        )
+    result = _run(bench_files, methods, seed, repeats, console)
     console.print(
-        f"{result.n_files} takes, {result.n_injections} injected takes per method, seed {seed}"
+        f"{result.n_files} takes, {result.n_injections} injected takes per method, seed {seed}; "
+        "the robust defaults and the calibration were chosen on the fit set only"
     )
     main_methods = {k: v for k, v in result.methods.items() if k in methods_chosen}
     console.print(_table1(main_methods))
+    console.print(rates_table(main_methods))
     for label, res in main_methods.items():
         console.print(_table2(label, res))
+    if "robust" in main_methods:
+        bursts = _run(bench_files, {"robust": ("robust", None)}, seed, repeats, console,
+                      kind="burst").methods  # fmt: skip
+        console.print("Bursts of alternating flips (injected, kind=burst):")
+        console.print(rates_table(bursts))
+        for title, records in (
+            ("level shifts", main_methods["robust"].records),
+            ("bursts", bursts["robust"].records),
+        ):
+            held = [r for r in records if r.held_out]
+            console.print(
+                calibration_table(
+                    f"Calibration on the held-out takes, {title} ({len(held)} intervals, "
+                    "injected and clean)",
+                    reliability([r.confidence for r in held], [r.right for r in held]),
+                )
+            )
     if ablation:
         console.print(_ablation_table(result.methods))
+    if loro:
+        grid = {
+            label: _run(bench_files, {label: ("robust", params)}, seed, repeats, console,
+                        "all").methods[label]
+            for label, params in loro_variants().items()
+        }  # fmt: skip
+        console.print(loro_table(grid))
+    if real:
+        _print_real(data_dir, console, methods_chosen)
     cmu = [f for f in bench_files if f.rig == "cmu"]
     if cmu:
         motion = read_bvh(cmu[0].path)

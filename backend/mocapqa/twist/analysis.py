@@ -31,6 +31,7 @@ from mocapqa.twist.angles import (
 )
 from mocapqa.twist.confidence import APPLY_THRESHOLD
 from mocapqa.twist.detect import (
+    DetectedInterval,
     Detection,
     PaperParams,
     RobustParams,
@@ -162,6 +163,8 @@ class TwistAnalysis:
         Offset of every interval found, applied or not, radians.
     apply : str
         The apply choice: one of :data:`APPLY_CHOICES` or ``"ids"``.
+    found : tuple of DetectedInterval
+        The detector's intervals (chain index, confidence features), in ``intervals`` order.
     """
 
     method: str
@@ -174,6 +177,7 @@ class TwistAnalysis:
     offsets_rad: FloatArray
     detected_offsets_rad: FloatArray
     apply: str = "confident"
+    found: tuple[DetectedInterval, ...] = ()
 
     def summaries(self) -> list[dict[str, Any]]:
         """Per chain: joint, side, segment, interval count, flagged frames, largest offset."""
@@ -470,4 +474,5 @@ def analyze_twist(
         offsets_rad=offsets,
         detected_offsets_rad=detected,
         apply="ids" if isinstance(choice, frozenset) else choice,
+        found=tuple(found),
     )

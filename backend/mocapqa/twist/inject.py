@@ -9,12 +9,20 @@ frames, separated by at least one clean frame and away from the first and last f
 interval has an onset and a release). The offset (uniform magnitude in
 ``[min_offset_deg, max_offset_deg]``, random sign) is added to the twist of the target's local
 rotation, ``qP' = qP ⊗ R(a, δ)`` (equal to ``swing ⊗ (twist ⊗ R(a, δ))``), and the child is
-compensated with ``qC' = M⁻¹ ⊗ R(a, −δ) ⊗ M ⊗ qC`` so its global orientation is unchanged.
+compensated (every direct child X of the target gets ``R(a, −δ) ⊗ qX``) so the world
+orientation of everything below it is unchanged.
+
+``kind="burst"`` injects the other real error shape instead (bursts of counter-rotated flips
+as described for the retargeted CMU knees): 1–4 *holds*, each held for 1 frame up to 0.05 s
+with its own offset of ±20–90° and alternating sign, then a tail of up to 0.1 s that decays
+linearly from 10–40 % of the last offset back to the natural level; the child counter-rotates
+by (1 + ε) δ with ε uniform in ±0.2 over the burst, since a real retarget rarely does it exactly.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from itertools import pairwise
 
 import numpy as np
 
@@ -22,6 +30,7 @@ from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.errors import InputError
+from mocapqa.kinematics.quaternion import multiply, quats_from_axis_angle
 from mocapqa.twist.angles import ChainGeometry, chain_geometry
 from mocapqa.twist.refine import refine_quats
 
@@ -109,6 +118,27 @@ def _place_intervals(
     return out
 
 
+def _burst_parts(
+    rng: np.random.Generator, start: int, end: int, hold: int, tail_max: int
+) -> list[tuple[int, int, float]]:
+    """Holds of alternating ±20–90° offsets, then a decaying tail, inside ``[start, end]``."""
+    tail = int(rng.integers(0, min(tail_max, end - start) + 1))
+    last = end - tail
+    cuts = np.cumsum(rng.integers(1, hold + 1, size=4))
+    edges = [start, *(start + int(x) for x in cuts if start + x <= last), last + 1]
+    parts: list[tuple[int, int, float]] = []
+    sign = float(rng.choice((-1.0, 1.0)))
+    for a, b in pairwise(edges):
+        if b > a:
+            sign = -sign
+            parts.append((a, b - 1, float(sign * rng.uniform(20.0, 90.0))))
+    if tail:
+        residue = parts[-1][2] * rng.uniform(0.1, 0.4)
+        for k, value in enumerate(np.linspace(residue, 0.0, tail + 2)[1:-1]):
+            parts.append((last + 1 + k, last + 1 + k, float(value)))
+    return parts
+
+
 def inject_twist_errors(
     motion: Motion,
     rng: np.random.Generator,
@@ -119,6 +149,7 @@ def inject_twist_errors(
     min_offset_deg: float = 5.0,
     max_offset_deg: float = 180.0,
     mapping: dict[str, str] | None = None,
+    kind: str = "level",
 ) -> tuple[Motion, InjectionTruth]:
     """Corrupt a take with level-shift twist errors.
 
@@ -138,6 +169,9 @@ def inject_twist_errors(
         Range of the offset magnitude, degrees; the sign is random.
     mapping : dict, optional
         Role key → joint name overrides for :func:`mocapqa.core.rig.find_roles`.
+    kind : {"level", "burst"}
+        The paper's level shifts, or bursts of alternating flips (see the module notes; then
+        the interval count is per burst and the offsets and lengths are the burst's own).
 
     Returns
     -------
@@ -150,6 +184,8 @@ def inject_twist_errors(
     InputError
         If the parameters are inconsistent or the rig has too few separate limbs.
     """
+    if kind not in ("level", "burst"):
+        raise InputError(f"Expected kind 'level' or 'burst', got {kind!r}")
     if not (0 < min_offset_deg <= max_offset_deg <= 180.0):
         raise InputError(
             "Expected 0 < min_offset_deg ≤ max_offset_deg ≤ 180, got "
@@ -175,27 +211,41 @@ def inject_twist_errors(
     error_mask = np.zeros((n_frames, n_joints), dtype=bool)
     offsets_rad = np.zeros((n_frames, n_joints))
     intervals: list[InjectedInterval] = []
+    mismatch = np.zeros((n_frames, len(geometries)))
     for c, geometry in enumerate(geometries):
         count = int(rng.integers(min_intervals, max_intervals + 1))
-        for start, end in _place_intervals(rng, n_frames, count, max_interval_frames):
-            magnitude = rng.uniform(min_offset_deg, max_offset_deg)
-            offset_deg = float(magnitude * rng.choice((-1.0, 1.0)))
-            chain_offsets[start : end + 1, c] = np.deg2rad(offset_deg)
-            parent = geometry.chain.parent
-            error_mask[start : end + 1, parent] = True
-            offsets_rad[start : end + 1, parent] = np.deg2rad(offset_deg)
-            intervals.append(
-                InjectedInterval(
-                    skeleton.names[parent],
-                    geometry.chain.side,
-                    geometry.chain.segment,
-                    start,
-                    end,
-                    offset_deg,
-                )
-            )
+        hold = max(1, round(0.05 * motion.fps))
+        tail_max = round(0.1 * motion.fps)
+        longest = max_interval_frames if kind == "level" else 4 * hold + tail_max
+        parent = geometry.chain.parent
+        for start, end in _place_intervals(rng, n_frames, count, longest):
+            parts = [(start, end, 0.0)]
+            if kind == "burst":
+                parts = _burst_parts(rng, start, end, hold, tail_max)
+                mismatch[start : end + 1, c] = rng.uniform(-0.2, 0.2)
+            for a, b, value in parts:
+                if kind == "level":
+                    magnitude = rng.uniform(min_offset_deg, max_offset_deg)
+                    value = float(magnitude * rng.choice((-1.0, 1.0)))
+                chain_offsets[a : b + 1, c] = np.deg2rad(value)
+                error_mask[a : b + 1, parent] = True
+                offsets_rad[a : b + 1, parent] = np.deg2rad(value)
+                intervals.append(
+                    InjectedInterval(skeleton.names[parent], geometry.chain.side,
+                                     geometry.chain.segment, a, b, value)
+                )  # fmt: skip
     # Injecting +δ is refining by −δ.
     corrupted_quats = refine_quats(motion.quats, geometries, -chain_offsets)
+    for c, geometry in enumerate(geometries):
+        # Bursts: the child counter-rotates by (1 + ε) δ, as a real retarget rarely does it
+        # exactly (its world orientation moves by ε δ).
+        rows = np.flatnonzero(mismatch[:, c] != 0.0)
+        if len(rows):
+            first = geometry.intermediates[0] if geometry.intermediates else geometry.chain.child
+            extra = quats_from_axis_angle(
+                geometry.axis, -mismatch[rows, c] * chain_offsets[rows, c]
+            )
+            corrupted_quats[rows, first] = multiply(extra, corrupted_quats[rows, first])
     truth = InjectionTruth(
         clean_quats=motion.quats.copy(),
         targets=tuple(g.chain.parent for g in geometries),

@@ -5,17 +5,19 @@ Conventions
 * An *event* is a frame where the parent's roll steps away from its natural velocity and the
   child counter-rotates by the same amount (found by :func:`mocapqa.twist.detect.detect_robust`).
   Its *jump* is the size of that step, radians.
-* Events closer than ``burst_gap_s`` form a *cluster* (a burst of flips, or one edge of a level
-  shift). A cluster whose jumps cancel (net within ``max(threshold, closure_fraction × largest
-  jump)``) is an interval by itself (single-frame flips, bursts that return to the natural
-  level). Other clusters are paired like brackets with a later cluster whose net jump cancels
-  theirs (within ``max(threshold / 2, closure_fraction × larger net)``), within
-  ``max_interval_s`` (a level shift held for a while). A
-  cluster of two or more events that finds no partner is still an interval (a burst whose ends
-  do not agree), with a lower confidence. A lone unpaired event is never an interval.
+* Events are matched like brackets: each event closes the most recent open events whose jumps
+  it cancels (net within ``max(threshold, closure_fraction × largest jump)``), within
+  ``max_interval_s``. This finds isolated level shifts (onset and release), single-frame flips
+  and bursts of flips that return to the natural level. Events left unmatched that lie within
+  ``burst_gap_s`` of each other still form an interval (a burst whose ends do not agree), with a
+  lower confidence. A lone unmatched event is never an interval. A dense burst (events within
+  ``burst_gap_s`` of each other) whose jumps cancel as a whole is one interval, whatever pairs
+  the bracket matching made inside it. Groups whose spans overlap are merged into one.
 * The *natural roll* through an interval is the cubic Hermite continuation of the integrated
-  roll between the frame before its first event and its last event (where the roll is back at
-  its natural level), with the natural velocities at both ends. Each stretch between two events
+  roll between two anchors, with the natural velocities there: the last frame before its first
+  event and the frame of its last event (where the roll is back at its natural level), moved
+  outwards past any other interval and any other event within ``burst_gap_s``, so that an
+  anchor never sits inside another error. Each stretch between two events
   gets one level: the circular mean of the raw roll minus that continuation. The level from
   accumulating jump sizes is used only where it agrees with the outside one (it is less noisy);
   a stretch whose roll sits on the natural continuation gets level 0 and is left bit-identical,
@@ -80,45 +82,59 @@ def _groups(
     burst_gap: int,
     max_frames: int,
 ) -> list[list[int]]:
-    """Event indices of each interval, sorted and frame-disjoint."""
-    cuts = np.flatnonzero(np.diff(frames) > burst_gap) + 1
-    clusters = [list(c) for c in np.split(np.arange(len(frames)), cuts)]
-    nets = [float(wrap_angle(np.array(np.sum(jumps[c])))) for c in clusters]
-    largest = [float(np.max(np.abs(jumps[c]))) for c in clusters]
+    """Event indices of each interval, sorted and frame-disjoint.
+
+    Events are matched like brackets: each new event closes the most recent open events whose
+    jumps it cancels (the shortest closure first); open events older than ``max_frames`` are
+    dropped. Once two events of one burst (events within ``burst_gap`` frames of each other)
+    are open together, they may only be closed from inside that burst, so a burst's last flip
+    is never paired with an unrelated event far away. Events left unmatched that lie within
+    ``burst_gap`` of each other form a burst. Groups whose spans overlap (a burst inside a held
+    level shift) are merged.
+    """
     groups: list[list[int]] = []
-    used = [False] * len(clusters)
+    paired = np.zeros(len(frames), dtype=bool)
+    cluster = np.concatenate(([0], np.cumsum(np.diff(frames) > burst_gap)))
+    bound = np.zeros(len(frames), dtype=bool)
     stack: list[int] = []
-    for k, members in enumerate(clusters):
-        if len(members) >= 2 and _closes(nets[k], largest[k], threshold, closure_fraction):
-            groups.append(members)
-            used[k] = True
-            continue
-        start = frames[members[0]]
-        stack = [p for p in stack if start - frames[clusters[p][-1]] <= max_frames]
-        # Clusters pair when their net jumps cancel, relative to the nets themselves (not to
-        # the largest flip inside a burst, which would let a small unrelated event close it).
-        level, big, closed = nets[k], abs(nets[k]), -1
+    for k in range(len(frames)):
+        stack = [i for i in stack if frames[k] - frames[i] <= max_frames]
+        level, largest, closed = float(jumps[k]), abs(float(jumps[k])), -1
         for p in range(len(stack) - 1, -1, -1):
-            level = float(wrap_angle(np.array(level + nets[stack[p]])))
-            big = max(big, abs(nets[stack[p]]))
-            if _closes(level, big, 0.5 * threshold, closure_fraction):
+            if bound[stack[p]] and cluster[stack[p]] != cluster[k]:
+                break
+            level = float(wrap_angle(np.array(level + jumps[stack[p]])))
+            largest = max(largest, abs(float(jumps[stack[p]])))
+            if _closes(level, largest, threshold, closure_fraction):
                 closed = p
                 break
         if closed < 0:
+            # Two open events of one burst: the burst's events may only close each other.
+            same = [i for i in stack if cluster[i] == cluster[k]]
+            if same:
+                bound[[*same, k]] = True
             stack.append(k)
             continue
-        joined = [i for p in stack[closed:] for i in clusters[p]] + members
-        for p in stack[closed:]:
-            used[p] = True
-        used[k] = True
+        members = [*stack[closed:], k]
+        paired[members] = True
         stack = stack[:closed]
-        groups.append(joined)
-    groups += [c for k, c in enumerate(clusters) if not used[k] and len(c) >= 2]
-    # Merge groups whose frame spans overlap (a burst inside a held level shift).
-    groups.sort(key=lambda g: frames[g[0]])
+        groups.append(members)
+    loose = np.flatnonzero(~paired)
+    if len(loose) >= 2:
+        cuts = np.flatnonzero(np.diff(frames[loose]) > burst_gap) + 1
+        groups += [list(b) for b in np.split(loose, cuts) if len(b) >= 2]
+    # A dense burst whose jumps cancel as a whole is one interval, whatever pairs the bracket
+    # matching made inside it (alternating flips of similar size pair up wrongly).
+    cuts = np.flatnonzero(np.diff(frames) > burst_gap) + 1
+    for burst in np.split(np.arange(len(frames)), cuts):
+        largest = float(np.max(np.abs(jumps[burst])))
+        net = float(wrap_angle(np.array(np.sum(jumps[burst]))))
+        if len(burst) >= 3 and _closes(net, largest, threshold, closure_fraction):
+            groups.append(list(burst))
+    groups.sort(key=lambda g: frames[min(g)])
     merged: list[list[int]] = []
     for group in groups:
-        if merged and frames[group[0]] < frames[merged[-1][-1]]:
+        if merged and frames[min(group)] < frames[max(merged[-1])]:
             merged[-1] = sorted(set(merged[-1]) | set(group))
         else:
             merged.append(sorted(group))
@@ -177,29 +193,44 @@ def chain_intervals(
     n_frames = len(increments)
     offsets = np.zeros(n_frames)
     found: list[IntervalEstimate] = []
+    # Frame 0 has no increment, so no event can sit there.
+    keep = frames >= 1
+    frames, jumps, mismatch = frames[keep], jumps[keep], mismatch[keep]
     if len(frames) < 2:
         return offsets, found
     burst_gap = max(1, round(burst_gap_s * fps))
     max_frames = max(2, round(max_interval_s * fps))
     roll = np.cumsum(increments)
-    for group in _groups(frames, jumps, threshold, closure_fraction, burst_gap, max_frames):
+    groups = _groups(frames, jumps, threshold, closure_fraction, burst_gap, max_frames)
+    spans = np.zeros(n_frames, dtype=bool)
+    for group in groups:
+        spans[frames[group[0]] : frames[group[-1]]] = True
+    for group in groups:
         events = frames[group]
         first, last = int(events[0]), int(events[-1])
-        before = first - 1
-        span = last - before
-        # The natural roll's travel from the anchor before to the last event, modulo 2π.
-        travel = float(np.sum(natural[first : last + 1]))
-        end_value = roll[before] + travel + wrap_angle(roll[last] - roll[before] - travel)
+        # Anchors where the roll is at its natural level: outside every interval and away
+        # from the events of others (a burst's own release is not a natural level).
+        forbidden = spans.copy()
+        for k in np.setdiff1d(np.arange(len(frames)), group):
+            forbidden[max(0, frames[k] - burst_gap) : frames[k] + burst_gap + 1] = True
+        left = np.flatnonzero(~forbidden[:first])
+        right = np.flatnonzero(~forbidden[last:])
+        before = int(left[-1]) if len(left) else first - 1
+        after = last + int(right[0]) if len(right) else last
+        span = after - before
+        # The natural roll's travel between the anchors, modulo 2π.
+        travel = float(np.sum(natural[before + 1 : after + 1]))
+        end_value = roll[before] + travel + wrap_angle(roll[after] - roll[before] - travel)
         u = np.arange(span + 1) / span
         h00, h10 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u
         h01, h11 = -2 * u**3 + 3 * u**2, u**3 - u**2
         continuation = (
             h00 * roll[before]
-            + h10 * span * natural[first]
+            + h10 * span * natural[before]
             + h01 * end_value
-            + h11 * span * natural[last]
+            + h11 * span * natural[after]
         )
-        deviation = wrap_angle(roll[before : last + 1] - continuation)
+        deviation = wrap_angle(roll[before : after + 1] - continuation)
         steps = jumps[group]
         net = float(wrap_angle(np.array(np.sum(steps))))
         accumulated = wrap_angle(np.cumsum(steps - net / len(steps)))[:-1]

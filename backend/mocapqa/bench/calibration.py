@@ -1,0 +1,114 @@
+"""The confidence calibration: its fit on the fit takes, its reliability and the real intervals.
+
+* :func:`fit_on_fit_takes` fits :class:`mocapqa.twist.confidence.Calibration` on the interval
+  records of the *fit* takes only (never held-out takes, never the real-error take).
+* :func:`reliability` bins calibrated probabilities and compares them with how often the
+  intervals were right.
+* :func:`real_interval_records` labels the intervals found on a take with real errors: right
+  when it holds at least one counter-rotated roll jump over 20° (onset or release), applying it
+  alone leaves none of those jumps over 20°, and it moves no frame farther than 0.25 s from
+  such a jump by more than 5°.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from mocapqa.bench.natural import natural_error_figures, natural_jumps
+from mocapqa.bench.twist import IntervalRecord
+from mocapqa.core.motion import Motion
+from mocapqa.errors import InputError
+from mocapqa.twist.analysis import analyze_twist, detect_chains
+from mocapqa.twist.confidence import Calibration, fit_calibration
+
+__all__ = ["ReliabilityBin", "fit_on_fit_takes", "real_interval_records", "reliability"]
+
+
+@dataclass(frozen=True, slots=True)
+class ReliabilityBin:
+    """Intervals whose probability falls in ``[low, high)``.
+
+    Parameters
+    ----------
+    low, high : float
+    count : int
+    mean_probability : float
+    right_share : float
+        Share of them that were right.
+    """
+
+    low: float
+    high: float
+    count: int
+    mean_probability: float
+    right_share: float
+
+
+def fit_on_fit_takes(records: Sequence[IntervalRecord], path: Path | None = None) -> Calibration:
+    """Fit the calibration on the records of fit (not held-out) takes.
+
+    Raises
+    ------
+    InputError
+        When the fit takes gave too few right or wrong intervals.
+    """
+    fit = [r for r in records if not r.held_out and r.features]
+    if not fit:
+        raise InputError("Expected intervals on the fit takes to fit a calibration, got none")
+    rigs = sorted({r.rig for r in fit})
+    takes = len({(r.rig, r.take) for r in fit})
+    description = (
+        f"{len(fit)} intervals ({sum(r.right for r in fit)} right) on {takes} fit takes "
+        f"({', '.join(rigs)}), injected with level shifts (the paper's protocol) and with "
+        "bursts of flips, and their clean versions"
+    )
+    return fit_calibration(
+        np.array([r.features for r in fit]), [r.right for r in fit], description, path
+    )
+
+
+def reliability(
+    probabilities: Sequence[float], right: Sequence[bool], edges: Sequence[float] | None = None
+) -> list[ReliabilityBin]:
+    """Bins of predicted probability with the observed share of right intervals."""
+    p = np.asarray(probabilities, dtype=np.float64)
+    y = np.asarray(right, dtype=bool)
+    cuts = np.asarray(edges if edges is not None else [0.0, 0.1, 0.3, 0.5, 0.7, 0.9, 1.0])
+    out = []
+    for k in range(len(cuts) - 1):
+        last = k == len(cuts) - 2
+        inside = (p >= cuts[k]) & ((p <= cuts[k + 1]) if last else (p < cuts[k + 1]))
+        count = int(inside.sum())
+        out.append(
+            ReliabilityBin(
+                float(cuts[k]),
+                float(cuts[k + 1]),
+                count,
+                float(p[inside].mean()) if count else float("nan"),
+                float(y[inside].mean()) if count else float("nan"),
+            )
+        )
+    return out
+
+
+def real_interval_records(motion: Motion, take: str, rig: str) -> list[IntervalRecord]:
+    """Every interval of the robust method on a take with real errors, labelled (see above)."""
+    analysis = analyze_twist(motion, "robust", apply="none")
+    jumps = natural_jumps(motion, analysis)
+    out = []
+    for interval, found in zip(analysis.intervals, analysis.found, strict=True):
+        inside = jumps[interval.start_frame : interval.end_frame + 2, found.chain]
+        alone = analyze_twist(motion, "robust", apply=frozenset({interval.id}))
+        figures = natural_error_figures(motion, alone)
+        after = detect_chains(alone.refined.quats, alone.chains, motion.fps, "robust")
+        steps = np.rad2deg(np.abs(after.parent_increments[:, found.chain]))
+        frames = np.arange(interval.start_frame, interval.end_frame + 2)
+        frames = frames[frames < motion.n_frames]
+        kept = jumps[frames, found.chain] & (steps[frames] >= 20.0)
+        right = bool(inside.any() and not kept.any() and figures.n_far_moved == 0)
+        out.append(IntervalRecord(rig, True, take, found.features, interval.confidence, right))
+    return out
