@@ -22,7 +22,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import median_filter
 
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
 from mocapqa.errors import InputError
@@ -76,8 +75,8 @@ class RobustParams:
         The threshold is ``max(min_threshold_deg, noise_factor × σ)`` with σ the chain's robust
         (MAD) scale of increment residuals; 0 disables the noise scaling.
     neighbour_s : float
-        Time on each side whose median increment is the natural velocity, seconds (at least
-        2 frames).
+        Time on each side over which the natural velocity is the median of 3 increments per
+        side, evenly spaced, seconds (the spacing is at least one frame).
     consistency : float
         Counter-rotation check: ``|wrap(rP + rC)| ≤ consistency × min(|rP|, |rC|)``.
     closure_fraction : float
@@ -87,8 +86,8 @@ class RobustParams:
     burst_gap_s : float
         Events closer than this form one burst, seconds.
     agreement : float
-        The level from accumulated jumps is used where it is within
-        ``max(2 threshold, agreement × |level|)`` of the level measured from outside.
+        A stretch whose level measured from outside is less than ``agreement`` times the level
+        accumulated from its jumps is left unchanged.
     min_fps : float
         Below this frame rate nothing is reported (a flip and a fast roll look alike).
     parent_source : {"increment", "swing_twist"}
@@ -109,12 +108,12 @@ class RobustParams:
 
     min_threshold_deg: float = 2.0
     noise_factor: float = 8.0
-    neighbour_s: float = 0.025
+    neighbour_s: float = 0.1
     consistency: float = 0.5
     closure_fraction: float = 0.2
     max_interval_s: float = 2.0
     burst_gap_s: float = 0.1
-    agreement: float = 0.25
+    agreement: float = 0.5
     min_fps: float = 10.0
     parent_source: str = "increment"
     child_source: str = "increment"
@@ -143,9 +142,9 @@ class RobustParams:
                 f"{self.burst_gap_s}, {self.agreement}, {self.min_fps}"
             )
 
-    def neighbour_frames(self, fps: float) -> int:
-        """Frames on each side for the natural velocity at ``fps`` (at least 2)."""
-        return max(2, round(self.neighbour_s * fps))
+    def neighbour_stride(self, fps: float) -> int:
+        """Frames between the 3 samples taken on each side at ``fps`` (``neighbour_s`` / 3)."""
+        return max(1, round(self.neighbour_s * fps / 3))
 
 
 @dataclass(frozen=True, slots=True)
@@ -249,46 +248,43 @@ _SORT6 = ((0, 5), (1, 3), (2, 4), (1, 2), (3, 4), (0, 3), (2, 5), (0, 1), (2, 3)
 
 
 def _neighbour_median(
-    increments: FloatArray, half: int, rows: IntArray | None = None
+    increments: FloatArray, stride: int, rows: IntArray | None = None
 ) -> FloatArray:
-    """Median of the ``half`` increments on each side of each frame (itself excluded).
+    """Median of 6 increments around each frame, 1–3 strides away on each side (itself excluded).
 
-    Edges are mirrored. For an even count the upper of the two middle values is taken. With
-    ``rows``, only those frames are computed (shape (R, C)).
+    Edges are mirrored. Of the two middle values the upper is taken. With ``rows``, only those
+    frames are computed (shape (R, C)).
     """
     n_frames = increments.shape[0]
-    padded = np.pad(increments, ((half, half), (0, 0)), mode="reflect")
-    shifts = [k for k in range(2 * half + 1) if k != half]
+    reach = 3 * stride
+    padded = np.pad(increments, ((reach, reach), (0, 0)), mode="reflect")
+    shifts = [reach + k * stride for k in (-3, -2, -1, 1, 2, 3)]
     if rows is not None:
-        return np.sort(padded[rows[:, None] + np.array(shifts)[None, :]], axis=1)[:, half]
-    if half == 3:
-        values = [np.ascontiguousarray(padded[k : k + n_frames]) for k in shifts]
-        for i, j in _SORT6:
-            low = np.minimum(values[i], values[j])
-            values[j] = np.maximum(values[i], values[j])
-            values[i] = low
-        return values[half]
-    footprint = np.ones((2 * half + 1, 1), dtype=bool)
-    footprint[half] = False
-    result: FloatArray = median_filter(increments, footprint=footprint, mode="mirror")
-    return result
+        return np.sort(padded[rows[:, None] + np.array(shifts)[None, :]], axis=1)[:, 3]
+    values = [np.ascontiguousarray(padded[k : k + n_frames]) for k in shifts]
+    for i, j in _SORT6:
+        low = np.minimum(values[i], values[j])
+        values[j] = np.maximum(values[i], values[j])
+        values[i] = low
+    return values[3]
 
 
 def _clean_median(
-    increments: FloatArray, outliers: BoolArray, half: int, rows: IntArray, fallback: FloatArray
+    increments: FloatArray, outliers: BoolArray, stride: int, rows: IntArray, fallback: FloatArray
 ) -> FloatArray:
-    """Median of the non-outlier increments within ``half`` frames of each of ``rows``.
+    """Median of the non-outlier increments among 6 per side, ``stride`` apart, of ``rows``.
 
-    Returns shape (R, C); ``fallback`` where every neighbour is an outlier.
+    Of the two middle values the upper is taken. Returns shape (R, C); ``fallback`` where every
+    neighbour is an outlier.
     """
     n_frames = increments.shape[0]
-    offsets = np.array([k for k in range(-half, half + 1) if k != 0])
+    offsets = stride * np.array([k for k in range(-6, 7) if k != 0])
     index = np.clip(rows[:, None] + offsets[None, :], 0, n_frames - 1)
-    values = np.where(outliers[index], np.nan, increments[index])  # (R, 2 half, C)
-    empty = np.isnan(values).all(axis=1)
-    values[:, 0][empty] = 0.0
-    median = np.nanmedian(values, axis=1)
-    result: FloatArray = np.where(empty, fallback, median)
+    values = np.where(outliers[index], np.inf, increments[index])  # (R, 2 half, C)
+    values.sort(axis=1)
+    count = np.sum(~outliers[index], axis=1)  # (R, C)
+    upper = np.take_along_axis(values, (count // 2)[:, None, :], axis=1)[:, 0]
+    result: FloatArray = np.where(count > 0, upper, fallback)
     return result
 
 
@@ -316,13 +312,14 @@ def detect_robust(
     """
     dp, dc = parent_increments, child_increments
     n_frames, n_chains = dp.shape
-    half = params.neighbour_frames(fps)
-    if n_frames <= 2 * half + 1 or fps < params.min_fps:
+    stride = params.neighbour_stride(fps)
+    reach = 3 * stride
+    if n_frames <= 2 * reach + 1 or fps < params.min_fps:
         zeros = np.zeros_like(dp)
         return Detection(dp, dc, zeros.astype(bool), zeros, ())
     floor = np.deg2rad(params.min_threshold_deg)
-    natural_p = _neighbour_median(dp, half)
-    natural_c = _neighbour_median(dc, half)
+    natural_p = _neighbour_median(dp, stride)
+    natural_c = _neighbour_median(dc, stride)
     for done in range(1, params.passes + 1):
         rp = wrap_angle(dp - natural_p)
         rc = wrap_angle(dc - natural_c)
@@ -343,12 +340,12 @@ def detect_robust(
         # the flips of a burst do not hide each other.
         outliers = np.maximum(np.abs(rp), np.abs(rc)) > threshold
         near = np.flatnonzero(
-            np.convolve(outliers.any(axis=1), np.ones(2 * half + 1), mode="same") > 0
+            np.convolve(outliers.any(axis=1), np.ones(2 * reach + 1), mode="same") > 0
         )
         natural_p = natural_p.copy()
         natural_c = natural_c.copy()
-        natural_p[near] = _clean_median(dp, outliers, 2 * half, near, natural_p[near])
-        natural_c[near] = _clean_median(dc, outliers, 2 * half, near, natural_c[near])
+        natural_p[near] = _clean_median(dp, outliers, stride, near, natural_p[near])
+        natural_c[near] = _clean_median(dc, outliers, stride, near, natural_c[near])
     # The jump is the circular mean of the parent's step and the child's counter-step.
     rows, cols = np.nonzero(events)
     jumps = np.zeros_like(dp)

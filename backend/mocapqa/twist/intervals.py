@@ -18,10 +18,12 @@ Conventions
   event and the frame of its last event (where the roll is back at its natural level), moved
   outwards past any other interval and any other event within ``burst_gap_s``, so that an
   anchor never sits inside another error. Each stretch between two events
-  gets one level: the circular mean of the raw roll minus that continuation. The level from
-  accumulating jump sizes is used only where it agrees with the outside one (it is less noisy);
-  a stretch whose roll sits on the natural continuation gets level 0 and is left bit-identical,
-  so a mismatched pair of events cannot shift clean frames.
+  gets one level measured from outside: the circular mean of the raw roll minus that
+  continuation. Where the interval's jumps cancel, the level accumulated from its jumps (less
+  noisy over long holds) is used instead, unless the outside level is less than ``agreement``
+  times it: a stretch whose roll sits near the natural continuation gets level 0 and is left
+  bit-identical, so a mismatched pair of events cannot shift clean frames. Where the jumps do
+  not cancel (a burst whose ends disagree), the outside level is used.
 """
 
 from __future__ import annotations
@@ -178,8 +180,8 @@ def chain_intervals(
     closure_fraction : float
         Jumps cancel when their net is within ``max(threshold, closure_fraction × largest)``.
     agreement : float
-        The accumulated level is used where it is within
-        ``max(2 threshold, agreement × |level|)`` of the outside level.
+        A stretch whose outside level is less than ``agreement`` times its accumulated level is
+        left at level 0.
     burst_gap_s, max_interval_s : float
         Largest gap inside a cluster and longest level shift, seconds.
 
@@ -202,21 +204,23 @@ def chain_intervals(
     max_frames = max(2, round(max_interval_s * fps))
     roll = np.cumsum(increments)
     groups = _groups(frames, jumps, threshold, closure_fraction, burst_gap, max_frames)
-    spans = np.zeros(n_frames, dtype=bool)
+    # Anchors must sit where the roll is at its natural level: outside every interval and
+    # away from events that belong to none.
+    forbidden = np.zeros(n_frames, dtype=bool)
     for group in groups:
-        spans[frames[group[0]] : frames[group[-1]]] = True
+        forbidden[frames[group[0]] : frames[group[-1]]] = True
+    grouped = np.zeros(len(frames), dtype=bool)
+    grouped[[k for g in groups for k in g]] = True
+    for f in frames[~grouped]:
+        forbidden[max(0, f - burst_gap) : f + burst_gap + 1] = True
     for group in groups:
         events = frames[group]
         first, last = int(events[0]), int(events[-1])
-        # Anchors where the roll is at its natural level: outside every interval and away
-        # from the events of others (a burst's own release is not a natural level).
-        forbidden = spans.copy()
-        for k in np.setdiff1d(np.arange(len(frames)), group):
-            forbidden[max(0, frames[k] - burst_gap) : frames[k] + burst_gap + 1] = True
-        left = np.flatnonzero(~forbidden[:first])
-        right = np.flatnonzero(~forbidden[last:])
-        before = int(left[-1]) if len(left) else first - 1
-        after = last + int(right[0]) if len(right) else last
+        before, after = first - 1, last
+        while before > 0 and forbidden[before]:
+            before -= 1
+        while after < n_frames - 1 and forbidden[after]:
+            after += 1
         span = after - before
         # The natural roll's travel between the anchors, modulo 2π.
         travel = float(np.sum(natural[before + 1 : after + 1]))
@@ -233,6 +237,7 @@ def chain_intervals(
         deviation = wrap_angle(roll[before : after + 1] - continuation)
         steps = jumps[group]
         net = float(wrap_angle(np.array(np.sum(steps))))
+        closed = _closes(net, float(np.max(np.abs(steps))), threshold, closure_fraction)
         accumulated = wrap_angle(np.cumsum(steps - net / len(steps)))[:-1]
         disagreement = 0.0
         for m in range(len(events) - 1):
@@ -241,7 +246,12 @@ def chain_intervals(
             jumped = float(accumulated[m])
             gap = abs(float(wrap_angle(np.array(outside - jumped))))
             disagreement = max(disagreement, gap / max(abs(jumped), threshold))
-            level = jumped if gap <= max(2 * threshold, agreement * abs(jumped)) else outside
+            if not closed:
+                level = outside
+            elif abs(outside) < agreement * abs(jumped):
+                level = 0.0
+            else:
+                level = jumped
             if abs(level) >= threshold:
                 offsets[lo:hi] = level
         applied = offsets[first:last]
