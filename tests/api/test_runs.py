@@ -194,3 +194,40 @@ def test_frontend_and_plotly_are_served(client: TestClient) -> None:
     for path in ("/static/js/app.js", "/static/js/api.js", "/static/js/charts.js"):
         assert client.get(path).status_code == 200
     assert client.get("/docs").status_code == 200
+
+
+def test_twist_apply_choice_decides_the_corrected_take(
+    client: TestClient, corpus_dir: Path, tmp_path: Path, upload: Uploader, wait_for_run: Waiter
+) -> None:
+    from mocapqa.io.bvh_write import write_bvh
+    from mocapqa.twist.inject import inject_twist_errors
+
+    motion = read_bvh(corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh")
+    corrupted, truth = inject_twist_errors(motion, np.random.default_rng(2))
+    path = tmp_path / "corrupted.bvh"
+    write_bvh(path, corrupted)
+    created = upload(client, path)
+    assert wait_for_run(client, created["run_id"])["status"] == "done"
+    results = {}
+    for apply in ("none", "all", "0"):
+        response = client.post(
+            f"/api/v1/takes/{created['id']}/runs", json={"checks": ["twist"], "twist_apply": apply}
+        )
+        assert response.status_code == 201, response.text
+        run = wait_for_run(client, response.json()["id"])
+        assert run["status"] == "done", run["error"]
+        assert run["options"]["twist_apply"] == apply
+        result = client.get(f"/api/v1/runs/{run['id']}/result").json()
+        twist = [f for f in result["findings"] if f["kind"] == "twist"]
+        assert len(twist) >= len({i.joint for i in truth.intervals})
+        assert [f["id"] for f in twist] == list(range(len(twist)))
+        results[apply] = (twist, client.get(f"/api/v1/runs/{run['id']}/download/bvh").content)
+    assert not any(f["applied"] for f in results["none"][0])
+    assert all(f["applied"] for f in results["all"][0])
+    assert [f["applied"] for f in results["0"][0]] == [True] + [False] * (len(twist) - 1)
+    assert len({results["none"][1], results["all"][1], results["0"][1]}) == 3
+    for bad in ("maybe", "-1", "0,x"):
+        response = client.post(
+            f"/api/v1/takes/{created['id']}/runs", json={"checks": ["twist"], "twist_apply": bad}
+        )
+        assert response.status_code == 422, bad

@@ -42,6 +42,11 @@ class AnalysisOptionsIn(BaseModel):
 
     checks: list[Literal["twist", "limits", "filter"]] = ["twist", "limits", "filter"]
     twist_method: Literal["robust", "paper"] = "robust"
+    twist_apply: str = Field(
+        "confident",
+        description="Twist intervals to remove: confident, all, none, or interval ids ('0,3'); "
+        "checked by the run options (pipeline/options.py)",
+    )
     filter_method: str | None = None
     filter_preset: str | None = None
     filter_params: dict[str, float | int | bool | str] = Field(default_factory=dict)

@@ -94,7 +94,9 @@ def _analyze_motion(
     if "twist" in options.checks:
         progress(25, "twist analysis")
         clock = time.perf_counter()
-        outcome = run_twist(motion, options.twist_method, frames, options.mapping)
+        outcome = run_twist(
+            motion, options.twist_method, frames, options.mapping, options.twist_apply
+        )
         timings["twist_s"] = time.perf_counter() - clock
         outcomes["twist"] = outcome
         if outcome.motion is not None:

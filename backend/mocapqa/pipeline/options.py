@@ -13,9 +13,16 @@ from typing import Any
 from mocapqa.core.rig import normalise_mapping
 from mocapqa.errors import InputError
 from mocapqa.filters.registry import FILTERS
-from mocapqa.twist.analysis import METHODS
+from mocapqa.twist.analysis import APPLY_CHOICES, METHODS, parse_apply
 
-__all__ = ["CHECKS", "TWIST_METHODS", "AnalysisOptions", "ParamValue", "check_mapping"]
+__all__ = [
+    "CHECKS",
+    "TWIST_APPLY_CHOICES",
+    "TWIST_METHODS",
+    "AnalysisOptions",
+    "ParamValue",
+    "check_mapping",
+]
 
 ParamValue = float | int | bool | str
 """Value of one filter parameter override."""
@@ -24,6 +31,8 @@ CHECKS = ("twist", "limits", "filter")
 """The checks a run can do."""
 TWIST_METHODS = METHODS
 """Twist detection methods (those of :mod:`mocapqa.twist.analysis`)."""
+TWIST_APPLY_CHOICES = APPLY_CHOICES
+"""Which twist intervals a run applies (besides a list of interval ids such as ``"0,3"``)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -36,6 +45,9 @@ class AnalysisOptions:
         Subset of :data:`CHECKS` to run.
     twist_method : str
         One of :data:`TWIST_METHODS`.
+    twist_apply : str
+        One of :data:`TWIST_APPLY_CHOICES` (default ``"confident"``), or comma-separated
+        interval ids of the take (``"0,3"``): which detected intervals the corrected take has.
     filter_method : str, optional
         A name from the filter registry; ``None`` means "adaptive" for keypoint takes and no
         filtering of the corrected BVH.
@@ -54,6 +66,7 @@ class AnalysisOptions:
 
     checks: tuple[str, ...] = CHECKS
     twist_method: str = "robust"
+    twist_apply: str = "confident"
     filter_method: str | None = None
     filter_preset: str | None = None
     filter_params: dict[str, ParamValue] = field(default_factory=dict)
@@ -68,6 +81,7 @@ class AnalysisOptions:
             raise InputError(
                 f"Expected twist_method in {list(TWIST_METHODS)}, got {self.twist_method!r}"
             )
+        parse_apply(self.twist_apply)
         if self.filter_method is not None and self.filter_method not in FILTERS:
             raise InputError(
                 f"Expected filter_method in {sorted(FILTERS)}, got {self.filter_method!r}"
@@ -82,6 +96,7 @@ class AnalysisOptions:
         return {
             "checks": list(self.checks),
             "twist_method": self.twist_method,
+            "twist_apply": self.twist_apply,
             "filter_method": self.filter_method,
             "filter_preset": self.filter_preset,
             "filter_params": dict(self.filter_params),
@@ -100,8 +115,8 @@ class AnalysisOptions:
         """
         if not data:
             return cls()
-        known = {"checks", "twist_method", "filter_method", "filter_preset", "filter_params"}
-        known |= {"max_points", "mapping"}
+        known = {"checks", "twist_method", "twist_apply", "filter_method", "filter_preset"}
+        known |= {"filter_params", "max_points", "mapping"}
         extra = sorted(set(data) - known)
         if extra:
             raise InputError(f"Expected option fields among {sorted(known)}, got {extra}")
@@ -116,13 +131,14 @@ class AnalysisOptions:
         max_points = data.get("max_points", 2000)
         if not isinstance(max_points, int) or isinstance(max_points, bool):
             raise InputError(f"Expected max_points to be an integer, got {max_points!r}")
-        for name in ("twist_method", "filter_method", "filter_preset"):
+        for name in ("twist_method", "twist_apply", "filter_method", "filter_preset"):
             value = data.get(name)
             if value is not None and not isinstance(value, str):
                 raise InputError(f"Expected {name} to be a string, got {value!r}")
         return cls(
             checks=tuple(checks),
             twist_method=data.get("twist_method") or "robust",
+            twist_apply=data.get("twist_apply") or "confident",
             filter_method=data.get("filter_method"),
             filter_preset=data.get("filter_preset"),
             filter_params={str(k): v for k, v in params.items()},

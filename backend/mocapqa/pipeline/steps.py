@@ -70,14 +70,20 @@ class StepOutcome:
 
 
 def run_twist(
-    motion: Motion, method: str, frames: IntArray, mapping: dict[str, str] | None = None
+    motion: Motion,
+    method: str,
+    frames: IntArray,
+    mapping: dict[str, str] | None = None,
+    apply: str = "confident",
 ) -> StepOutcome:
-    """Detect and remove twist offsets (θP level shifts) on every limb chain.
+    """Detect twist errors on every limb chain and remove those ``apply`` chooses.
 
     ``mapping`` (role key → joint name) overrides the roles found on the rig; the message names
-    the roles that were not found, whose chains are not checked.
+    the roles that were not found, whose chains are not checked. Every interval is a finding,
+    with its calibrated confidence, its id (for ``apply``) and whether the corrected take has it
+    removed.
     """
-    analysis = analyze_twist(motion, method=method, mapping=mapping)
+    analysis = analyze_twist(motion, method=method, mapping=mapping, apply=apply)
     missing = find_roles(motion.skeleton, mapping).unmapped
     findings = [
         {
@@ -88,6 +94,8 @@ def run_twist(
             "value": round(float(interval.offset_deg), 3),
             "unit": "deg",
             "confidence": round(float(interval.confidence), 3),
+            "id": interval.id,
+            "applied": interval.applied,
         }
         for interval in analysis.intervals
     ]
@@ -95,7 +103,8 @@ def run_twist(
     unchecked = f"; roles not found, not checked: {', '.join(missing)}" if missing else ""
     return StepOutcome(
         "done",
-        f"{len(findings)} twist interval(s) on {len(analysis.chains)} chain(s){unchecked}",
+        f"{len(findings)} twist interval(s) on {len(analysis.chains)} chain(s), "
+        f"{sum(i.applied for i in analysis.intervals)} applied ({analysis.apply}){unchecked}",
         findings,
         series,
         analysis.refined,
