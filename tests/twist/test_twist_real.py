@@ -15,7 +15,6 @@ from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
-from mocapqa.io.bvh_write import write_bvh
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.kinematics.resample import resample_motion
 from mocapqa.twist.analysis import analyze_twist
@@ -69,7 +68,8 @@ def test_real_errors_are_removed_and_far_frames_barely_move(real_take: Motion) -
 
 def test_apply_choices_and_levels_rebuild_the_refined_take(real_take: Motion) -> None:
     full = analyze_twist(real_take, apply="all")
-    assert full.intervals and all(i.applied for i in full.intervals)
+    assert full.intervals
+    assert all(i.applied for i in full.intervals)
     none = analyze_twist(real_take, apply="none")
     assert not any(i.applied for i in none.intervals)
     assert np.array_equal(none.refined.quats, real_take.quats)
@@ -105,7 +105,8 @@ def test_refine_cli_apply_option(real_take: Motion, corpus_dir: Path, tmp_path: 
                  "--report", str(report)]) == 0  # fmt: skip
     data = json.loads(report.read_text())
     assert data["apply"] == "none"
-    assert data["intervals"] and not any(i["applied"] for i in data["intervals"])
+    assert data["intervals"]
+    assert not any(i["applied"] for i in data["intervals"])
     assert {"id", "confidence", "applied", "levels"} <= set(data["intervals"][0])
     assert _same_rotation(read_bvh(out).quats, real_take.quats) < 1e-5
     assert main(["refine", str(source), "-o", str(out), "--apply", "sometimes"]) == 3
@@ -148,7 +149,7 @@ def _decisions(motion: Motion) -> tuple[list[bool], int, float]:
         used |= {i.id for i in hits}
     extra = sum(1 for i in analysis.intervals if i.applied and i.id not in used)
     left = 0.0
-    for c, g in enumerate(geometries):
+    for c in range(len(geometries)):
         rows = np.flatnonzero(offsets[:, c])
         if len(rows):
             remaining = np.abs(offsets[rows, c] - analysis.offsets_rad[rows, c])
@@ -162,7 +163,7 @@ def _decisions(motion: Motion) -> tuple[list[bool], int, float]:
         "bvh/cmu/cmu_12_01_walk.bvh",
         "bvh/cmu/iclone/002_09.bvh",
         "bvh/bandai/dataset-2_walk_normal_001.bvh",
-    ],  # fmt: skip
+    ],
 )
 def test_the_same_decisions_at_every_frame_rate(corpus_dir: Path, path: str) -> None:
     motion = read_bvh(corpus_dir / path)

@@ -10,8 +10,8 @@ speed in frames per second (detection and refinement, parsing excluded).
 
 Takes are grouped by rig: ``cmu`` (the cgspeed conversion), ``iclone`` (Character Creator
 retargets) and ``bandai``. Within each rig, files at even positions of the sorted list form the
-*fit* set (the one the robust defaults and the confidence calibration were chosen on) and those
-at odd positions the *held-out* set; results are reported for both and overall. The takes of
+*fit* set (the one the confidence calibration is fitted on) and those at odd positions the
+*held-out* set; results are reported for both and overall. The takes of
 :data:`REAL_ERROR_TAKES` carry real twist errors and are never injected into (they are
 evaluation data only, see :mod:`mocapqa.bench.natural`).
 

@@ -379,11 +379,12 @@ def detect_robust(
             ]
         found += [(c, e) for e in estimates]
     with_features = [(c, e) for c, e in found if e.features]
-    probabilities = iter(
-        default_calibration().probability(np.array([e.features for _, e in with_features]))
+    scores: list[float] = (
+        default_calibration().probability(np.array([e.features for _, e in with_features])).tolist()
         if with_features
         else []
     )
+    probabilities = iter(scores)
     intervals = tuple(
         DetectedInterval(c, e.start_frame, e.end_frame, e.offset_rad,
                          float(next(probabilities)) if e.features else 0.5, e.features)
