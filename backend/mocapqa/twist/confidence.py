@@ -15,7 +15,6 @@ and raises no frame's error by more than 1°.
 
 from __future__ import annotations
 
-import functools
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -107,12 +106,16 @@ class Calibration:
         return cls(names, arrays[0], arrays[1], arrays[2], intercept, fitted_on)
 
 
-@functools.lru_cache(maxsize=1)
+_LOADED: dict[str, Calibration] = {}
+
+
 def default_calibration() -> Calibration:
-    """The shipped calibration (``mocapqa/data/twist/calibration.json``)."""
-    resource = resources.files("mocapqa") / "data" / "twist" / CALIBRATION_FILE
-    data = json.loads(resource.read_text(encoding="utf-8"))
-    return Calibration.from_json(data, str(resource))
+    """The shipped calibration (``mocapqa/data/twist/calibration.json``), read once."""
+    if CALIBRATION_FILE not in _LOADED:
+        resource = resources.files("mocapqa") / "data" / "twist" / CALIBRATION_FILE
+        data = json.loads(resource.read_text(encoding="utf-8"))
+        _LOADED[CALIBRATION_FILE] = Calibration.from_json(data, str(resource))
+    return _LOADED[CALIBRATION_FILE]
 
 
 def fit_calibration(
