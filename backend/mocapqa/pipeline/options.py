@@ -13,7 +13,8 @@ from typing import Any
 from mocapqa.core.rig import normalise_mapping
 from mocapqa.errors import InputError
 from mocapqa.filters.registry import FILTERS
-from mocapqa.twist.analysis import APPLY_CHOICES, METHODS, parse_apply
+from mocapqa.twist.analysis import METHODS
+from mocapqa.twist.choice import APPLY_CHOICES, parse_apply
 
 __all__ = [
     "CHECKS",

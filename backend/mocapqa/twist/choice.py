@@ -1,0 +1,183 @@
+"""Which detected twist intervals a refinement applies, and their report entries.
+
+``apply`` is one of :data:`APPLY_CHOICES` or a set of interval ids. Ids number the intervals of
+a take in chain, then frame order. ``confident`` applies intervals whose calibrated probability
+is at least :data:`mocapqa.twist.confidence.APPLY_THRESHOLD` (methods without a calibrated
+confidence apply all). Each :class:`TwistInterval` lists its ``levels``: the stretches of
+constant offset, so the refined take is exactly the raw one with the applied levels removed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from mocapqa.core.arrays import FloatArray
+from mocapqa.errors import InputError
+from mocapqa.twist.angles import ChainGeometry
+from mocapqa.twist.confidence import APPLY_THRESHOLD
+from mocapqa.twist.detect import DetectedInterval
+
+__all__ = ["APPLY_CHOICES", "TwistInterval", "choose_intervals", "parse_apply"]
+
+APPLY_CHOICES = ("confident", "all", "none")
+"""Which intervals a refinement applies, besides an explicit list of interval ids:
+``confident`` (calibrated probability ≥ :data:`mocapqa.twist.confidence.APPLY_THRESHOLD`, the
+default), ``all`` or ``none``."""
+
+
+def parse_apply(value: str | frozenset[int]) -> str | frozenset[int]:
+    """One of :data:`APPLY_CHOICES`, or the set of interval ids in ``"3,7"``.
+
+    Raises
+    ------
+    InputError
+        For anything else.
+    """
+    if isinstance(value, frozenset):
+        return value
+    text = str(value).strip()
+    if text in APPLY_CHOICES:
+        return text
+    try:
+        ids = frozenset(int(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        ids = frozenset({-1})
+    if not ids or min(ids) < 0:
+        raise InputError(
+            f"Expected apply to be one of {list(APPLY_CHOICES)} or interval ids like '0,3', "
+            f"got {value!r}"
+        )
+    return ids
+
+
+@dataclass(frozen=True, slots=True)
+class TwistInterval:
+    """An error interval on one target (parent) joint.
+
+    Parameters
+    ----------
+    joint : str
+        Name of the parent joint whose twist is offset.
+    side : str
+        "left" or "right".
+    segment : str
+        Role of the joint ("clavicle", "upper_arm", "forearm", "upper_leg", "lower_leg").
+    start_frame, end_frame : int
+        First and last frame of the interval (inclusive, 0-based).
+    offset_deg : float
+        Mean twist offset over the interval, degrees (−180, 180].
+    confidence : float
+        Calibrated probability that applying the interval is right, [0, 1].
+    id : int
+        Position in the take's interval list (chain, then frame order), for ``apply``.
+    applied : bool
+        Whether the refinement removed it.
+    levels : tuple of (int, int, float)
+        ``(start_frame, end_frame, offset_deg)`` of each stretch of constant offset: the
+        refined take is the raw one with exactly these removed, so they also undo it.
+    """
+
+    joint: str
+    side: str
+    segment: str
+    start_frame: int
+    end_frame: int
+    offset_deg: float
+    confidence: float
+    id: int = 0
+    applied: bool = True
+    levels: tuple[tuple[int, int, float], ...] = ()
+
+    def to_json(self) -> dict[str, Any]:
+        """The interval as a JSON-ready dict."""
+        return {
+            "id": self.id,
+            "joint": self.joint,
+            "side": self.side,
+            "segment": self.segment,
+            "start_frame": self.start_frame,
+            "end_frame": self.end_frame,
+            "offset_deg": round(self.offset_deg, 4),
+            "confidence": round(self.confidence, 4),
+            "applied": self.applied,
+            "levels": [[a, b, round(v, 6)] for a, b, v in self.levels],
+        }
+
+
+def choose_intervals(
+    found: Sequence[DetectedInterval],
+    detected: FloatArray,
+    geometries: Sequence[ChainGeometry],
+    names: Sequence[str],
+    choice: str | frozenset[int],
+    calibrated: bool,
+) -> tuple[FloatArray, list[TwistInterval]]:
+    """The offsets to remove and the report entry of every interval.
+
+    Parameters
+    ----------
+    found : sequence of DetectedInterval
+        In chain, then frame order (their position is their id).
+    detected : ndarray, shape (F, C)
+        Offsets of every interval found, radians.
+    geometries : sequence of ChainGeometry, length C
+    names : sequence of str
+        Joint names.
+    choice : str or frozenset of int
+        From :func:`parse_apply`.
+    calibrated : bool
+        Whether the confidences are calibrated probabilities (else ``confident`` applies all).
+
+    Returns
+    -------
+    offsets : ndarray, shape (F, C)
+        The applied intervals' offsets, 0 elsewhere.
+    intervals : list of TwistInterval
+
+    Raises
+    ------
+    InputError
+        For an interval id the take does not have.
+    """
+    if isinstance(choice, frozenset) and choice and max(choice) >= len(found):
+        raise InputError(f"Expected interval ids below {len(found)} in apply, got {sorted(choice)}")
+    offsets = np.zeros_like(detected)
+    intervals = []
+    for k, i in enumerate(found):
+        if isinstance(choice, frozenset):
+            applied = k in choice
+        elif choice == "confident" and calibrated:
+            applied = i.confidence >= APPLY_THRESHOLD
+        else:
+            applied = choice != "none"
+        rows = slice(i.start_frame, i.end_frame + 1)
+        if applied:
+            offsets[rows, i.chain] = detected[rows, i.chain]
+        values = detected[rows, i.chain]
+        cuts = np.flatnonzero(np.diff(values) != 0.0) + 1
+        levels = tuple(
+            (i.start_frame + int(part[0]), i.start_frame + int(part[-1]),
+             float(np.rad2deg(values[part[0]])))
+            for part in np.split(np.arange(len(values)), cuts)
+            if values[part[0]] != 0.0
+        )  # fmt: skip
+        geometry = geometries[i.chain]
+        intervals.append(
+            TwistInterval(
+                joint=names[geometry.chain.parent],
+                side=geometry.chain.side,
+                segment=geometry.chain.segment,
+                start_frame=i.start_frame,
+                end_frame=i.end_frame,
+                offset_deg=float(np.rad2deg(i.offset_rad)),
+                confidence=float(i.confidence),
+                id=k,
+                applied=applied,
+                levels=levels,
+            )
+        )
+    return offsets, intervals
