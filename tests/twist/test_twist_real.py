@@ -210,3 +210,12 @@ def test_wilson_interval_matches_the_formula() -> None:
     assert low == pytest.approx(0.742, abs=1e-3)
     assert high == pytest.approx(0.990, abs=1e-3)
     assert wilson_interval(0, 0) == (0.0, 1.0)
+
+
+def test_the_real_error_take_is_never_injected_or_fitted_on(corpus_dir: Path) -> None:
+    from mocapqa.bench.twist import REAL_ERROR_TAKES, find_bench_files
+
+    files = find_bench_files(corpus_dir / "bvh")
+    assert "005_05.bvh" in REAL_ERROR_TAKES
+    assert files
+    assert not [f for f in files if f.path.name in REAL_ERROR_TAKES]
