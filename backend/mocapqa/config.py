@@ -11,9 +11,13 @@ tests and benchmarks read (``../shared/data``) is found by ``MOCAPQA_CORPUS_DIR`
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
+
+if TYPE_CHECKING:
+    from mocapqa.io.guards import ReadLimits
 
 __all__ = ["Settings", "get_settings"]
 
@@ -31,6 +35,40 @@ class Settings(BaseSettings):
         Largest accepted upload, MB.
     corpus_dir : Path, optional
         The real-data corpus (for ``bench`` and ``limits build`` defaults).
+    job_workers : int
+        Analysis worker threads.
+
+    The limits below are refused with their 4xx (413, 422 or 429) before their cost is paid;
+    ``docs/api.md`` lists them with the reasoning behind each default.
+
+    max_request_kb : float
+        Largest body of any request other than an upload (JSON), KB.
+    max_unpacked_mb : float
+        Largest total size of the arrays inside an uploaded ``.npz``/``.npy``, MB.
+    max_frame_points : int
+        Largest frames × points (joints or keypoints) of a take.
+    max_joints : int
+        Largest number of joints in a BVH hierarchy.
+    max_line_bytes : int
+        Longest line of a text take, bytes.
+    max_json_depth : int
+        Deepest nesting of a JSON take.
+    max_run_attempts : int
+        Starts of a run interrupted by a server stop before it is failed with the reason.
+    max_queued_runs_per_client : int
+        Runs one client (address) may have queued or running at once; more get 429.
+    uploads_per_minute_per_client : int
+        Uploads one client may start per minute; more get 429 with ``Retry-After``.
+    allowed_hosts : list of str
+        Accepted ``Host`` header names (``*`` accepts any); loopback names by default.
+    cors_origins : list of str
+        Origins allowed to call the API from another site (CORS); none by default.
+    stream_max_keypoints : int
+        Largest ``n_keypoints`` of a live-filter stream.
+    stream_max_frame_bytes : int
+        Largest WebSocket message of a live-filter stream, bytes.
+    stream_max_frames_per_s : float
+        Most frames per second a live-filter stream may send (averaged over a second).
     """
 
     model_config = SettingsConfigDict(env_prefix="MOCAPQA_", extra="ignore")
@@ -40,6 +78,35 @@ class Settings(BaseSettings):
     max_upload_mb: float = 200.0
     corpus_dir: Path | None = None
     job_workers: int = 2
+    max_request_kb: float = 1024.0
+    max_unpacked_mb: float = 200.0
+    max_frame_points: int = 5_000_000
+    max_joints: int = 500
+    max_line_bytes: int = 1_000_000
+    max_json_depth: int = 64
+    max_run_attempts: int = 2
+    max_queued_runs_per_client: int = 20
+    uploads_per_minute_per_client: int = 30
+    allowed_hosts: list[str] = Field(
+        default_factory=lambda: ["localhost", "127.0.0.1", "::1", "[::1]"]
+    )
+    cors_origins: list[str] = Field(default_factory=list)
+    stream_max_keypoints: int = 1000
+    stream_max_frame_bytes: int = 1_000_000
+    stream_max_frames_per_s: float = 240.0
+
+    @property
+    def read_limits(self) -> ReadLimits:
+        """The take readers' limits from these settings."""
+        from mocapqa.io.guards import ReadLimits  # numpy: imported only where takes are read
+
+        return ReadLimits(
+            max_unpacked_bytes=int(self.max_unpacked_mb * 1_000_000),
+            max_frame_points=self.max_frame_points,
+            max_joints=self.max_joints,
+            max_line_bytes=self.max_line_bytes,
+            max_json_depth=self.max_json_depth,
+        )
 
     @property
     def resolved_database_url(self) -> str:

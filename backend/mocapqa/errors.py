@@ -11,12 +11,15 @@ from pathlib import Path
 
 __all__ = [
     "ConflictError",
+    "ForbiddenError",
     "FormatError",
     "InputError",
     "LimitsFileError",
     "MocapQAError",
     "NotFoundError",
+    "OptionError",
     "ParseError",
+    "RateLimitError",
     "RenderUnavailableError",
     "ShapeError",
     "TooLargeError",
@@ -69,6 +72,23 @@ class ParseError(InputError):
         super().__init__(f"{prefix}: {message}" if prefix else message)
 
 
+class OptionError(InputError):
+    """A run option is invalid, or does not suit the take.
+
+    Parameters
+    ----------
+    field : str
+        The option's name (dotted for a filter parameter, e.g. ``filter_params.beta``).
+    message : str
+        What was expected and what was found.
+    """
+
+    def __init__(self, field: str, message: str) -> None:
+        self.field = field
+        self.message = message
+        super().__init__(f"{field}: {message}")
+
+
 class FormatError(InputError):
     """A file's format could not be recognised or is not supported for this operation."""
 
@@ -95,6 +115,26 @@ class NotFoundError(MocapQAError):
 
 class ConflictError(MocapQAError):
     """The request conflicts with the stored state (for example a run that is not finished)."""
+
+
+class ForbiddenError(MocapQAError):
+    """The request is not allowed from where it came (for example a cross-site upload)."""
+
+
+class RateLimitError(MocapQAError):
+    """A client asked for more than its share (queued runs, uploads per minute).
+
+    Parameters
+    ----------
+    message : str
+        What was exceeded.
+    retry_after_s : int
+        Seconds after which the request may succeed.
+    """
+
+    def __init__(self, message: str, retry_after_s: int) -> None:
+        self.retry_after_s = max(1, int(retry_after_s))
+        super().__init__(message)
 
 
 class RenderUnavailableError(MocapQAError):

@@ -28,6 +28,7 @@ def make_settings(kind: str, tmp_path: Path, **changes: Any) -> Settings:
         cleaner = Repository(url)
         metadata.drop_all(cleaner.engine)
         cleaner.close()
+    changes.setdefault("allowed_hosts", ["testserver", "localhost", "127.0.0.1"])
     return Settings(data_dir=tmp_path / "data", database_url=url, **changes)
 
 

@@ -11,7 +11,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from mocapqa.api.app import create_app
-from mocapqa.config import Settings
+from tests.api.conftest import make_settings
 from mocapqa.io.bvh import parse_bvh, read_bvh
 from mocapqa.io.formats import read_take
 from mocapqa.jobs.demo import demo_paths
@@ -141,7 +141,7 @@ def test_missing_file_field_is_422(client: TestClient) -> None:
 def test_too_large_upload_is_413_and_stores_nothing(
     tmp_path: Path, cmu_walk: Path, renderer: RenderService
 ) -> None:
-    settings = Settings(data_dir=tmp_path / "data", max_upload_mb=0.1)
+    settings = make_settings("sqlite", tmp_path, max_upload_mb=0.1)
     with TestClient(create_app(settings, renderer=renderer)) as client:
         with cmu_walk.open("rb") as handle:
             response = client.post("/api/v1/takes", files={"file": ("walk.bvh", handle)})

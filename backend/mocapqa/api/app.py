@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import gzip
 import logging
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Sequence
 from contextlib import asynccontextmanager
 from pathlib import Path
+from typing import Any
 
 import plotly
-from fastapi import FastAPI, Request, Response
+from fastapi import APIRouter, FastAPI, Request, Response
 from fastapi.middleware.gzip import GZipMiddleware
 from fastapi.responses import FileResponse, HTMLResponse, RedirectResponse
 from fastapi.staticfiles import StaticFiles
@@ -23,6 +24,7 @@ from fastapi.staticfiles import StaticFiles
 from mocapqa import __version__
 from mocapqa.api.deps import Services
 from mocapqa.api.errors import install_error_handlers
+from mocapqa.api.http_guards import install_http_guards
 from mocapqa.api.routes import filters, health, reviews, runs, stream, takes
 from mocapqa.config import Settings
 from mocapqa.jobs.demo import load_demo
@@ -35,6 +37,17 @@ __all__ = ["API_PREFIX", "create_app", "frontend_dir", "plotly_js_path"]
 
 API_PREFIX = "/api/v1"
 """Path prefix of every API route."""
+
+ROUTERS: tuple[tuple[APIRouter, Sequence[Any]], ...] = (
+    (health.router, ()),
+    (takes.router, ()),
+    (runs.router, ()),
+    (reviews.router, ()),
+    (filters.router, ()),
+    (stream.router, ()),
+)
+"""Every router with the dependencies that guard all its routes (``Depends(...)`` items):
+the one place where a router gets, for example, a sign-in requirement."""
 log = logging.getLogger(__name__)
 
 
@@ -73,11 +86,21 @@ def create_app(
     files = FileStore(settings.data_dir)
     owns_renderer = renderer is None
     render_service = RenderService() if renderer is None else renderer
-    runner = JobRunner(repository, files, settings.job_workers, render_service)
+    runner = JobRunner(
+        repository,
+        files,
+        settings.job_workers,
+        render_service,
+        max_attempts=settings.max_run_attempts,
+        read_limits=settings.read_limits,
+    )
     services = Services(settings, repository, files, runner, render_service)
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        swept = files.sweep_incoming()
+        if swept:
+            log.info("removed %d partial upload(s) left by a stopped server", swept)
         requeued = runner.start()
         if requeued:
             log.info("re-queued %d interrupted run(s)", len(requeued))
@@ -99,9 +122,10 @@ def create_app(
     )
     app.state.services = services
     app.add_middleware(GZipMiddleware, minimum_size=2048, compresslevel=5)
+    install_http_guards(app, settings, f"{API_PREFIX}/takes", runner.pending)
     install_error_handlers(app)
-    for module in (health, takes, runs, reviews, filters, stream):
-        app.include_router(module.router, prefix=API_PREFIX)
+    for router, dependencies in ROUTERS:
+        app.include_router(router, prefix=API_PREFIX, dependencies=list(dependencies))
 
     plotly_name = f"plotly-{plotly.__version__}.min.js"
 

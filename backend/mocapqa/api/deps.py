@@ -8,12 +8,22 @@ from typing import Annotated, Any
 from fastapi import Depends, Request
 
 from mocapqa.config import Settings
+from mocapqa.errors import RateLimitError
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
 
-__all__ = ["Services", "ServicesDep", "TakeDep", "get_services", "get_take"]
+__all__ = [
+    "ClientDep",
+    "Services",
+    "ServicesDep",
+    "TakeDep",
+    "get_client",
+    "get_services",
+    "get_take",
+    "require_run_slot",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -46,3 +56,28 @@ def get_take(take_id: str, services: ServicesDep) -> dict[str, Any]:
 
 TakeDep = Annotated[dict[str, Any], Depends(get_take)]
 """Route parameter type that receives the take row named by ``take_id`` (404 when missing)."""
+
+
+def get_client(request: Request) -> str:
+    """Who is asking, for quotas: the client's address (the user, once there are accounts)."""
+    return request.client.host if request.client else "unknown"
+
+
+ClientDep = Annotated[str, Depends(get_client)]
+"""Route parameter type that receives the client's key."""
+
+
+def require_run_slot(services: Services, client: str) -> None:
+    """Refuse (429) a new run from a client with ``max_queued_runs_per_client`` waiting.
+
+    Raises
+    ------
+    RateLimitError
+    """
+    limit = services.settings.max_queued_runs_per_client
+    if services.runner.pending(client) >= limit:
+        raise RateLimitError(
+            f"Expected at most {limit} queued runs per client (setting "
+            "max_queued_runs_per_client), got that many waiting",
+            retry_after_s=10,
+        )

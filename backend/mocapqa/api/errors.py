@@ -1,27 +1,45 @@
-"""The one table from :mod:`mocapqa.errors` classes to HTTP status codes, and its handler.
+"""The one table from :mod:`mocapqa.errors` classes to HTTP status codes, and its handlers.
 
-The body is ``{"detail": message, "error": class name}`` plus ``line``/``field`` for parse
-errors, so the UI can show the file's line.
+Every error answer has one shape, :class:`~mocapqa.api.schemas.ErrorOut`:
+``{"detail": message, "error": class name}`` plus ``line``/``field`` for parse errors (so the
+UI can show the file's line) and ``field``/``errors`` for request validation. FastAPI's own
+validation errors and HTTP exceptions (unknown route, 405, 413 of the body limit) are turned
+into the same shape. :func:`responses` gives a route's OpenAPI ``responses=`` from the same
+table, so the documented statuses are the ones the handlers answer.
 """
 
 from __future__ import annotations
 
-from fastapi import FastAPI, Request
-from fastapi.responses import JSONResponse
+from typing import Any
 
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse
+from starlette.exceptions import HTTPException
+
+from mocapqa.api.schemas import ErrorOut
 from mocapqa.errors import (
     ConflictError,
+    ForbiddenError,
     FormatError,
     InputError,
     LimitsFileError,
     MocapQAError,
     NotFoundError,
     ParseError,
+    RateLimitError,
     TooLargeError,
     UnsupportedFormatError,
 )
 
-__all__ = ["STATUS_CODES", "install_error_handlers", "status_for"]
+__all__ = [
+    "STATUS_CODES",
+    "STATUS_MEANING",
+    "error_body",
+    "install_error_handlers",
+    "responses",
+    "status_for",
+]
 
 # Most specific class first: the first match wins.
 STATUS_CODES: tuple[tuple[type[MocapQAError], int], ...] = (
@@ -33,8 +51,22 @@ STATUS_CODES: tuple[tuple[type[MocapQAError], int], ...] = (
     (InputError, 422),
     (NotFoundError, 404),
     (ConflictError, 409),
+    (ForbiddenError, 403),
+    (RateLimitError, 429),
     (MocapQAError, 400),
 )
+
+STATUS_MEANING: dict[int, str] = {
+    400: "Bad request (the Host header is not allowed, or another client error)",
+    403: "Refused: a state-changing request from another site",
+    404: "Not found: the take or run does not exist",
+    409: "Conflict: the run is not finished",
+    413: "Too large: the body or the take exceeds a limit (named in the detail)",
+    415: "Unsupported media: the file's format is not recognised",
+    422: "Invalid: a parameter, an option or the file's content (field or line named)",
+    429: "Too many requests from this client (see Retry-After)",
+}
+"""What each error status means, for the OpenAPI ``responses`` of every route."""
 
 
 def status_for(error: MocapQAError) -> int:
@@ -45,16 +77,63 @@ def status_for(error: MocapQAError) -> int:
     return 400
 
 
+def responses(*statuses: int) -> dict[int | str, dict[str, Any]]:
+    """The OpenAPI ``responses=`` of a route answering these error statuses (and 400/422,
+    which every route may answer: a refused Host header, a malformed parameter)."""
+    wanted = sorted({400, 422, *statuses})
+    return {s: {"model": ErrorOut, "description": STATUS_MEANING[s]} for s in wanted}
+
+
+def error_body(error: str, detail: str, **extra: Any) -> dict[str, Any]:
+    """An :class:`ErrorOut` body as a dict (for middleware answering before the routes)."""
+    return ErrorOut(error=error, detail=detail, **extra).model_dump(exclude_none=True)
+
+
 async def _handle(request: Request, error: Exception) -> JSONResponse:
     del request
     if not isinstance(error, MocapQAError):  # pragma: no cover - registered for MocapQAError
         raise error
-    body: dict[str, object] = {"detail": str(error), "error": type(error).__name__}
+    extra: dict[str, Any] = {}
     if isinstance(error, ParseError):
-        body.update(line=error.line, field=error.field, message=error.message)
-    return JSONResponse(body, status_code=status_for(error))
+        extra.update(line=error.line, field=error.field, message=error.message)
+    headers = None
+    if isinstance(error, RateLimitError):
+        headers = {"Retry-After": str(error.retry_after_s)}
+    body = error_body(type(error).__name__, str(error), **extra)
+    return JSONResponse(body, status_code=status_for(error), headers=headers)
+
+
+async def _handle_http(request: Request, error: Exception) -> JSONResponse:
+    del request
+    if not isinstance(error, HTTPException):  # pragma: no cover - registered for HTTPException
+        raise error
+    body = error_body("HTTPError", str(error.detail))
+    return JSONResponse(body, status_code=error.status_code, headers=error.headers)
+
+
+def _location(entry: dict[str, Any]) -> str:
+    return ".".join(str(part) for part in entry.get("loc", ()))
+
+
+async def _handle_validation(request: Request, error: Exception) -> JSONResponse:
+    del request
+    if not isinstance(error, RequestValidationError):  # pragma: no cover - registered for it
+        raise error
+    entries = [
+        {"field": _location(e), "message": str(e.get("msg", ""))} for e in error.errors()[:20]
+    ]
+    first = entries[0] if entries else {"field": "", "message": "invalid request"}
+    body = error_body(
+        "ValidationError",
+        f"{first['field']}: {first['message']}",
+        field=first["field"],
+        errors=entries,
+    )
+    return JSONResponse(body, status_code=422)
 
 
 def install_error_handlers(app: FastAPI) -> None:
-    """Register the handler for every :class:`MocapQAError`."""
+    """Register the handlers for :class:`MocapQAError`, HTTP exceptions and validation."""
     app.add_exception_handler(MocapQAError, _handle)
+    app.add_exception_handler(HTTPException, _handle_http)
+    app.add_exception_handler(RequestValidationError, _handle_validation)

@@ -12,11 +12,15 @@ from mocapqa.pipeline.options import check_mapping
 
 __all__ = [
     "AnalysisOptionsIn",
+    "ErrorOut",
+    "FieldError",
     "FilterInfo",
     "HealthOut",
     "ReviewIn",
     "ReviewOut",
+    "ReviewStatus",
     "RunOut",
+    "RunStatus",
     "TakeCreatedOut",
     "TakeDetailOut",
     "TakeOut",
@@ -25,6 +29,24 @@ __all__ = [
 
 RunStatus = Literal["queued", "running", "done", "failed"]
 ReviewStatus = Literal["unreviewed", "approved", "needs_fix", "rejected"]
+
+
+class FieldError(BaseModel):
+    """One invalid field of a request."""
+
+    field: str = Field(description="Where: e.g. query.offset or body.filter_params")
+    message: str
+
+
+class ErrorOut(BaseModel):
+    """Every error answer (4xx): what went wrong, and where when it is known."""
+
+    detail: str = Field(description="Expected X, got Y, and where")
+    error: str = Field(description="Error class, e.g. ParseError, TooLargeError")
+    field: str | None = Field(None, description="The field, column or option at fault")
+    line: int | None = Field(None, description="1-based line of the file at fault")
+    message: str | None = Field(None, description="The detail without the location")
+    errors: list[FieldError] | None = Field(None, description="Every invalid field (422)")
 
 
 class HealthOut(BaseModel):
@@ -49,7 +71,7 @@ class AnalysisOptionsIn(BaseModel):
     )
     filter_method: str | None = None
     filter_preset: str | None = None
-    filter_params: dict[str, float | int | bool | str] = Field(default_factory=dict)
+    filter_params: dict[str, float | int | bool | str] = Field(default_factory=dict, max_length=64)
     max_points: int = Field(2000, ge=10, le=100_000)
     mapping: dict[str, str] = Field(
         default_factory=dict,
@@ -80,6 +102,7 @@ class RunOut(BaseModel):
     error: str | None
     summary: dict[str, Any] | None
     server_time_s: float | None
+    attempts: int = Field(0, description="Times the run was started (a restart starts it again)")
     created_at: datetime
     started_at: datetime | None
     finished_at: datetime | None

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from mocapqa.api.schemas import ReviewOut, RunOut, TakeOut
+from mocapqa.core.text import display_name
 
 __all__ = ["review_out", "run_out", "take_fields"]
 
@@ -17,6 +18,7 @@ def take_fields(row: dict[str, Any]) -> dict[str, Any]:
     fields.setdefault("latest_run_id", None)
     fields.setdefault("status", None)
     fields["review_status"] = row.get("review_status") or "unreviewed"
+    fields["name"] = display_name(str(row.get("name") or "")) or str(row.get("file_name"))
     return fields
 
 
@@ -27,4 +29,4 @@ def run_out(row: dict[str, Any]) -> RunOut:
 
 def review_out(row: dict[str, Any]) -> ReviewOut:
     """A review row as :class:`ReviewOut`."""
-    return ReviewOut.model_validate(row)
+    return ReviewOut.model_validate({**row, "reviewer": display_name(str(row["reviewer"]))})

@@ -55,28 +55,39 @@ def format_bvh(motion: Motion, precision: int = 6) -> str:
     for j, p in enumerate(sk.parents):
         children.setdefault(int(p), []).append(j)
 
-    def emit(j: int, depth: int) -> None:
-        pad = "\t" * depth
-        keyword = "ROOT" if sk.parents[j] < 0 else "JOINT"
-        out.append(f"{pad}{keyword} {sk.names[j]}")
-        out.append(f"{pad}{{")
-        off = " ".join(_format_number(v) for v in sk.offsets[j])
-        out.append(f"{pad}\tOFFSET {off}")
-        if sk.channels[j]:
-            out.append(f"{pad}\tCHANNELS {len(sk.channels[j])} {' '.join(sk.channels[j])}")
-        for c in children.get(j, []):
-            emit(c, depth + 1)
-        for site in sk.end_sites:
-            if site.parent == j:
+    sites: dict[int, list[str]] = {}
+    for site in sk.end_sites:
+        sites.setdefault(int(site.parent), []).append(
+            " ".join(_format_number(v) for v in site.offset)
+        )
+    # Depth-first with an explicit stack (no recursion, so a chain of any length is written):
+    # an int opens a joint, a negative one -(j + 1) closes it after its children.
+    stack = [item for r in reversed(children.get(-1, [])) for item in (-(r + 1), r)]
+    depth = 0
+    while stack:
+        j = stack.pop()
+        if j >= 0:
+            pad = "\t" * depth
+            keyword = "ROOT" if sk.parents[j] < 0 else "JOINT"
+            out.append(f"{pad}{keyword} {sk.names[j]}")
+            out.append(f"{pad}{{")
+            off = " ".join(_format_number(v) for v in sk.offsets[j])
+            out.append(f"{pad}\tOFFSET {off}")
+            if sk.channels[j]:
+                out.append(f"{pad}\tCHANNELS {len(sk.channels[j])} {' '.join(sk.channels[j])}")
+            for c in reversed(children.get(j, [])):
+                stack.extend((-(c + 1), c))
+            depth += 1
+        else:
+            depth -= 1
+            pad = "\t" * depth
+            for site_off in sites.get(-j - 1, []):
                 out.append(f"{pad}\tEnd Site")
                 out.append(f"{pad}\t{{")
-                site_off = " ".join(_format_number(v) for v in site.offset)
                 out.append(f"{pad}\t\tOFFSET {site_off}")
                 out.append(f"{pad}\t}}")
-        out.append(f"{pad}}}")
+            out.append(f"{pad}}}")
 
-    for root in children.get(-1, []):
-        emit(root, 0)
     out.append("MOTION")
     out.append(f"Frames: {motion.n_frames}")
     out.append(f"Frame Time: {1.0 / motion.fps:.7g}")

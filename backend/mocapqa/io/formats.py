@@ -23,6 +23,7 @@ from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import ParseError, UnsupportedFormatError
 from mocapqa.io.bvh import NumberReader, read_bvh
+from mocapqa.io.guards import ReadLimits, check_take_input, check_take_size
 from mocapqa.io.keypoint_arrays import (
     read_keypoint_npy,
     read_keypoint_npz,
@@ -179,6 +180,7 @@ def read_take(
     length_unit: str | None = None,
     number_reader: NumberReader = "arrow",
     root_translation: Literal["auto", "add", "replace"] = "auto",
+    limits: ReadLimits | None = None,
 ) -> Motion | KeypointSequence:
     """Read a take of any supported format.
 
@@ -199,6 +201,9 @@ def read_take(
     root_translation : {"auto", "add", "replace"}
         How a BVH root's position channels combine with its OFFSET (see
         :mod:`mocapqa.io.bvh_root`); ignored by keypoint formats.
+    limits : ReadLimits, optional
+        Refuse takes beyond these limits, before reading where the bytes tell (see
+        :mod:`mocapqa.io.guards`); no limits when None (trusted local files).
 
     Returns
     -------
@@ -211,8 +216,33 @@ def read_take(
         On unreadable or malformed input.
     UnsupportedFormatError
         On an unknown format.
+    TooLargeError
+        When the take exceeds ``limits``.
     """
     kind = detect_format(path)
+    if limits is None:
+        return _read(path, kind, fps, person_index, length_unit, number_reader, root_translation)
+    check_take_input(path, kind, limits)
+    try:
+        take = _read(path, kind, fps, person_index, length_unit, number_reader, root_translation)
+    except RecursionError as e:  # a backstop: the depth check above refuses such files first
+        raise ParseError("Expected a shallower document, got one nested too deep", path) from e
+    if isinstance(take, Motion):
+        check_take_size(take.n_frames, take.skeleton.n_joints, Path(path).name, limits)
+    else:
+        check_take_size(take.n_frames, take.n_keypoints, Path(path).name, limits)
+    return take
+
+
+def _read(
+    path: str | Path,
+    kind: str,
+    fps: float | None,
+    person_index: int,
+    length_unit: str | None,
+    number_reader: NumberReader,
+    root_translation: Literal["auto", "add", "replace"],
+) -> Motion | KeypointSequence:
     if kind == "bvh":
         return read_bvh(
             path,

@@ -12,10 +12,12 @@ from pathlib import Path
 from typing import Any, BinaryIO
 
 from mocapqa.core.motion import Motion
+from mocapqa.core.text import display_name
 from mocapqa.errors import InputError, MocapQAError, ParseError, TooLargeError
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.pipeline.loading import (
     READING_FILE,
+    ReadLimits,
     ReadOptions,
     detect_take_format,
     read_take_file,
@@ -57,6 +59,8 @@ def ingest_take(
     max_bytes: int,
     options: AnalysisOptions | None = None,
     read: ReadOptions | None = None,
+    limits: ReadLimits | None = None,
+    client: str = "local",
 ) -> tuple[str, str]:
     """Store an uploaded take and queue its analysis.
 
@@ -73,6 +77,10 @@ def ingest_take(
     read : ReadOptions, optional
         How to read what the file leaves open (frame rate, unit, BVH root position); kept
         with the take, with what the reader used or assumed, for every later run.
+    limits : ReadLimits, optional
+        Take size limits, checked before parsing where the bytes tell (none when None).
+    client : str
+        Who uploads (for the runner's fair queue).
 
     Returns
     -------
@@ -100,10 +108,18 @@ def ingest_take(
             raise InputError(f"Expected a non-empty file, got 0 bytes ({name!r})")
         format_name = detect_take_format(incoming)
         try:
-            take = read_take_file(incoming, format_name, file_name, read)
+            take = read_take_file(incoming, format_name, file_name, read, limits)
         except MocapQAError:
             raise
-        except (ValueError, LookupError, TypeError, OverflowError, EOFError, OSError) as e:
+        except (
+            ValueError,
+            LookupError,
+            TypeError,
+            OverflowError,
+            EOFError,
+            OSError,
+            RecursionError,
+        ) as e:
             # A reader tripping over bytes it did not foresee is still the input's fault.
             raise ParseError(
                 f"Expected a readable {format_name} file, got {type(e).__name__}: {e}", file_name
@@ -122,7 +138,7 @@ def ingest_take(
             _, run_id = repository.add_take(
                 {
                     "id": take_id,
-                    "name": Path(name.replace("\\", "/")).name[:255] or file_name,
+                    "name": display_name(Path(name.replace("\\", "/")).name) or file_name,
                     "format": format_name,
                     "kind": kind,
                     "size_bytes": size,
@@ -139,5 +155,5 @@ def ingest_take(
             raise
     finally:
         incoming.unlink(missing_ok=True)
-    runner.submit(run_id, take)
+    runner.submit(run_id, take, client)
     return take_id, run_id

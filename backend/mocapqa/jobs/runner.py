@@ -2,7 +2,10 @@
 
 A run's outputs are written to its folder (each file atomically) *before* the run is marked
 done, so a run seen as done always has complete files; a server that stops mid-run leaves the
-run queued or running, and :meth:`JobRunner.start` re-queues it on the next start. numpy and the
+run queued or running, and :meth:`JobRunner.start` re-queues it on the next start (counting
+its attempts: a run that was started ``max_attempts`` times and never finished is failed with
+the reason instead, so a take that crashes the server cannot do so forever). Deleting a take
+cancels its runs (:meth:`JobRunner.cancel`) and removes their folders. numpy and the
 file I/O release the GIL for most of the work, so the event loop stays responsive.
 """
 
@@ -13,7 +16,7 @@ import json
 import logging
 import threading
 import time
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future
 from pathlib import Path
 from typing import Any
 
@@ -21,7 +24,9 @@ import numpy as np
 
 from mocapqa.errors import InputError, MocapQAError
 from mocapqa.io.bvh_write import format_bvh
+from mocapqa.io.guards import ReadLimits
 from mocapqa.io.keypoint_csv import csv_sidecar_path
+from mocapqa.jobs.fair_queue import FairQueue
 from mocapqa.jobs.rendered import render_thumbnail
 from mocapqa.pipeline.analyze import AnalysisResult, analyze
 from mocapqa.pipeline.loading import (
@@ -88,8 +93,12 @@ def _reading(folder: Path) -> ReadOptions:
         return ReadOptions()
 
 
+class _RunCancelledError(Exception):
+    """Raised inside a run whose take was deleted, at its next progress report."""
+
+
 class JobRunner:
-    """Runs analyses on worker threads.
+    """Runs analyses on worker threads, taking clients in turn (:class:`FairQueue`).
 
     Parameters
     ----------
@@ -102,6 +111,10 @@ class JobRunner:
     renderer : RenderService, optional
         The app's render thread; with it each run gets a rendered ``thumbnail.png`` after the
         analysis (skipped, with the SVG thumbnail as fallback, when rendering is unavailable).
+    max_attempts : int
+        Starts of a run interrupted by a server stop before :meth:`start` fails it.
+    read_limits : ReadLimits, optional
+        Limits for re-reading a stored take (the upload was checked against the same).
     """
 
     def __init__(
@@ -110,34 +123,64 @@ class JobRunner:
         files: FileStore,
         workers: int = 2,
         renderer: RenderService | None = None,
+        max_attempts: int = 2,
+        read_limits: ReadLimits | None = None,
     ) -> None:
         self.repository = repository
         self.files = files
         self.renderer = renderer
-        self._pool = ThreadPoolExecutor(max_workers=max(1, workers), thread_name_prefix="run")
+        self.max_attempts = max(1, max_attempts)
+        self.read_limits = read_limits
+        self._workers = max(1, workers)
+        self._threads: list[threading.Thread] = []
+        self._queue = FairQueue()
         self._futures: dict[str, Future[None]] = {}
+        self._clients: dict[str, str] = {}
+        self._cancelled: set[str] = set()
         self._preloaded: dict[str, Take] = {}
         self._lock = threading.Lock()
 
     def start(self) -> list[str]:
-        """Re-queue runs left by a stopped server and submit them; returns their ids."""
-        ids = self.repository.recover_interrupted()
+        """Start the workers; re-queue runs left by a stopped server (failing those already
+        started ``max_attempts`` times, with the reason); returns the re-queued ids."""
+        ids = self.repository.recover_interrupted(self.max_attempts)
         for run_id in ids:
-            self.submit(run_id)
+            self.submit(run_id, client="restart")
+        for number in range(self._workers):
+            thread = threading.Thread(target=self._work, name=f"run-{number}", daemon=True)
+            thread.start()
+            self._threads.append(thread)
         return ids
 
-    def submit(self, run_id: str, take: Take | None = None) -> None:
-        """Queue a run (already recorded as queued) for a worker.
+    def submit(self, run_id: str, take: Take | None = None, client: str = "local") -> None:
+        """Queue a run (already recorded as queued) for a worker, in ``client``'s line.
 
         ``take`` is the take as already read by the upload, which spares the worker a second
         parse of the same bytes.
         """
-        if take is not None:
-            with self._lock:
-                self._preloaded[run_id] = take
-        future = self._pool.submit(self._execute, run_id)
         with self._lock:
-            self._futures[run_id] = future
+            if take is not None:
+                self._preloaded[run_id] = take
+            self._futures[run_id] = Future()
+            self._clients[run_id] = client
+        self._queue.put(client, run_id)
+
+    def pending(self, client: str) -> int:
+        """Runs of ``client`` queued or running."""
+        with self._lock:
+            return sum(1 for c in self._clients.values() if c == client)
+
+    def cancel(self, run_ids: list[str]) -> None:
+        """Stop these runs (their take is being deleted): queued ones never start, running
+        ones stop at their next progress report; their output folders are removed."""
+        for run_id in run_ids:
+            if self._queue.remove(run_id):
+                self._settle(run_id)
+            else:
+                with self._lock:
+                    if run_id in self._clients:
+                        self._cancelled.add(run_id)
+            self.files.remove_run(run_id)
 
     def wait(self, run_id: str, timeout_s: float = 60.0) -> None:
         """Block until a submitted run has finished (for tests and the demo loader)."""
@@ -148,7 +191,28 @@ class JobRunner:
 
     def shutdown(self) -> None:
         """Stop taking runs; running ones finish, queued ones stay queued for the next start."""
-        self._pool.shutdown(wait=True, cancel_futures=True)
+        self._queue.close()
+        for thread in self._threads:
+            thread.join()
+
+    def _settle(self, run_id: str) -> None:
+        with self._lock:
+            future = self._futures.pop(run_id, None)
+            self._clients.pop(run_id, None)
+            self._preloaded.pop(run_id, None)
+            cancelled = run_id in self._cancelled
+            self._cancelled.discard(run_id)
+        if cancelled:
+            self.files.remove_run(run_id)
+        if future is not None:
+            future.set_result(None)
+
+    def _work(self) -> None:
+        while (run_id := self._queue.get()) is not None:
+            try:
+                self._execute(run_id)
+            finally:
+                self._settle(run_id)
 
     def _execute(self, run_id: str) -> None:
         started = time.perf_counter()
@@ -162,20 +226,24 @@ class JobRunner:
                 preloaded = self._preloaded.pop(run_id, None)
             reading = _reading(path.parent)
             motion_or_keypoints = preloaded or read_take_file(
-                path, str(take["format"]), str(take["name"]), reading
+                path, str(take["format"]), str(take["name"]), reading, self.read_limits
             )
             last = [0.0]
 
             def progress(percent: int, step: str) -> None:
+                with self._lock:
+                    if run_id in self._cancelled:
+                        raise _RunCancelledError(run_id)
                 now = time.perf_counter()
                 if now - last[0] > 0.2 or percent >= 95:
                     last[0] = now
                     self.repository.set_progress(run_id, percent, step)
 
             result = analyze(motion_or_keypoints, options, progress)
+            progress(96, "writing the outputs")
             write_outputs(self.files, run_id, result)
             if self.renderer is not None:
-                self.repository.set_progress(run_id, 97, "rendering the thumbnail")
+                progress(97, "rendering the thumbnail")
                 render_thumbnail(
                     self.files, run_id, result.report, result.raw_points, self.renderer
                 )
@@ -184,6 +252,8 @@ class JobRunner:
                 "steps": {k: v["state"] for k, v in result.report["steps"].items()},
             }
             self.repository.finish_run(run_id, summary, None, time.perf_counter() - started)
+        except _RunCancelledError:
+            log.info("run %s cancelled: its take was deleted", run_id)
         except MocapQAError as e:
             self._fail(run_id, str(e), started)
         except Exception as e:  # a bug must not leave the run "running" forever

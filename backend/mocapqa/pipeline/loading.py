@@ -19,12 +19,14 @@ from typing import Any, Literal
 
 from mocapqa.core.keypoints import LENGTH_UNITS, KeypointSequence
 from mocapqa.core.motion import Motion
-from mocapqa.errors import InputError, ParseError
+from mocapqa.errors import InputError, ParseError, TooLargeError
 from mocapqa.io.bvh_root import ROOT_TRANSLATIONS, explain_root_translation
 from mocapqa.io.formats import detect_format, read_take, write_keypoints
+from mocapqa.io.guards import ReadLimits
 
 __all__ = [
     "READING_FILE",
+    "ReadLimits",
     "ReadOptions",
     "Take",
     "detect_take_format",
@@ -128,6 +130,7 @@ def read_take_file(
     format_name: str,
     display_name: str | None = None,
     read: ReadOptions | None = None,
+    limits: ReadLimits | None = None,
 ) -> Take:
     """Read a take whose format is known.
 
@@ -141,6 +144,8 @@ def read_take_file(
         Name used in error messages instead of the storage path.
     read : ReadOptions, optional
         How to read what the file leaves open (defaults when None).
+    limits : ReadLimits, optional
+        Size limits checked before and after the read (the server passes its settings').
 
     Raises
     ------
@@ -155,9 +160,13 @@ def read_take_file(
             fps=read.fps,
             length_unit=read.length_unit,
             root_translation=read.root_translation,
+            limits=limits,
         )
     except ParseError as e:
         raise ParseError(e.message, display_name or path, e.line, e.field) from e
+    except TooLargeError as e:
+        message = str(e).replace(path.name, display_name or path.name, 1)
+        raise TooLargeError(message) from e
 
 
 def write_keypoints_file(path: Path, sequence: KeypointSequence) -> None:

@@ -7,12 +7,15 @@ round-trips. Angles are degrees only at this edge (names end in ``_deg``).
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
 from mocapqa.core.rig import normalise_mapping
-from mocapqa.errors import InputError
-from mocapqa.filters.registry import FILTERS
+from mocapqa.errors import InputError, OptionError
+from mocapqa.filters.apply import apply_overrides
+from mocapqa.filters.registry import FILTERS, DataScale
 from mocapqa.twist.analysis import METHODS
 from mocapqa.twist.choice import APPLY_CHOICES, parse_apply
 
@@ -34,6 +37,17 @@ TWIST_METHODS = METHODS
 """Twist detection methods (those of :mod:`mocapqa.twist.analysis`)."""
 TWIST_APPLY_CHOICES = APPLY_CHOICES
 """Which twist intervals a run applies (besides a list of interval ids such as ``"0,3"``)."""
+
+
+def _same_kind(value: Any, current: Any) -> bool:
+    """Whether an override ``value`` can stand in for a parameter's ``current`` value."""
+    if isinstance(value, str):
+        return not dataclasses.is_dataclass(current)  # converted (and checked) by the filter
+    if isinstance(current, bool) or isinstance(value, bool):
+        return isinstance(current, bool) and isinstance(value, bool)
+    if isinstance(current, int | float) and isinstance(value, int | float):
+        return math.isfinite(value) and (isinstance(current, float) or isinstance(value, int))
+    return False
 
 
 @dataclass(frozen=True, slots=True)
@@ -77,20 +91,82 @@ class AnalysisOptions:
     def __post_init__(self) -> None:
         unknown = [c for c in self.checks if c not in CHECKS]
         if unknown:
-            raise InputError(f"Expected checks among {list(CHECKS)}, got {unknown}")
+            raise OptionError("checks", f"Expected names among {list(CHECKS)}, got {unknown}")
         if self.twist_method not in TWIST_METHODS:
-            raise InputError(
-                f"Expected twist_method in {list(TWIST_METHODS)}, got {self.twist_method!r}"
+            raise OptionError(
+                "twist_method",
+                f"Expected one of {list(TWIST_METHODS)}, got {self.twist_method!r}",
             )
-        parse_apply(self.twist_apply)
+        try:
+            parse_apply(self.twist_apply)
+        except InputError as e:
+            raise OptionError("twist_apply", str(e)) from e
         if self.filter_method is not None and self.filter_method not in FILTERS:
-            raise InputError(
-                f"Expected filter_method in {sorted(FILTERS)}, got {self.filter_method!r}"
+            raise OptionError(
+                "filter_method",
+                f"Expected one of {sorted(FILTERS)}, got {self.filter_method!r}",
             )
         if not 10 <= self.max_points <= 100_000:
-            raise InputError(f"Expected max_points in [10, 100000], got {self.max_points}")
+            raise OptionError("max_points", f"Expected 10 to 100000, got {self.max_points}")
         object.__setattr__(self, "checks", tuple(self.checks))
         object.__setattr__(self, "mapping", check_mapping(self.mapping))
+        self._check_filter(self.filter_method or "adaptive")
+
+    def _check_filter(self, method: str) -> None:
+        entry = FILTERS[method]
+        if self.filter_preset is not None and self.filter_preset not in entry.presets:
+            raise OptionError(
+                "filter_preset",
+                f"Expected a preset of {method!r} in {sorted(entry.presets)}, "
+                f"got {self.filter_preset!r}",
+            )
+        base = entry.preset(self.filter_preset or "default", DataScale())
+        for name, value in self.filter_params.items():
+            try:
+                apply_overrides(base, {name: value})
+            except (InputError, TypeError, ValueError) as e:
+                raise OptionError(f"filter_params.{name}", f"{e} (filter {method!r})") from e
+            current: Any = base
+            for part in name.split("."):
+                current = getattr(current, part)
+            if not _same_kind(value, current):
+                raise OptionError(
+                    f"filter_params.{name}",
+                    f"Expected a finite {type(current).__name__} (filter {method!r}), "
+                    f"got {value!r}",
+                )
+
+    def check_take_kind(self, kind: str) -> None:
+        """Refuse options that do not suit a take of ``kind`` ("motion" or "keypoints").
+
+        Raises
+        ------
+        OptionError
+            Naming the option: a keypoint filter on a BVH, a rotation filter on keypoints,
+            or a preset or parameters with no filter to apply them to.
+        """
+        wanted = "rotations" if kind == "motion" else "keypoints"
+        if self.filter_method is None:
+            if kind == "motion" and (self.filter_preset or self.filter_params):
+                field_name = "filter_preset" if self.filter_preset else "filter_params"
+                raise OptionError(
+                    field_name,
+                    "Expected a filter_method with it: motion takes are not filtered by default",
+                )
+            return
+        entry = FILTERS[self.filter_method]
+        if entry.kind not in (wanted, "both"):
+            suits = sorted(n for n, e in FILTERS.items() if e.kind in (wanted, "both"))
+            raise OptionError(
+                "filter_method",
+                f"Expected a filter for {wanted} on a {kind} take ({suits}), "
+                f"got {self.filter_method!r}",
+            )
+        if kind == "motion" and self.filter_preset not in (None, "default"):
+            raise OptionError(
+                "filter_preset",
+                f"Expected no preset or 'default' for a motion take, got {self.filter_preset!r}",
+            )
 
     def to_json(self) -> dict[str, Any]:
         """The options as a JSON-ready dict."""
@@ -120,22 +196,22 @@ class AnalysisOptions:
         known |= {"filter_params", "max_points", "mapping"}
         extra = sorted(set(data) - known)
         if extra:
-            raise InputError(f"Expected option fields among {sorted(known)}, got {extra}")
+            raise OptionError(extra[0], f"Expected option fields among {sorted(known)}")
         params = data.get("filter_params") or {}
         if not isinstance(params, dict) or not all(
             isinstance(v, int | float | str) for v in params.values()
         ):
-            raise InputError(f"Expected filter_params to map names to values, got {params!r}")
+            raise OptionError("filter_params", f"Expected names mapped to values, got {params!r}")
         checks = data.get("checks", list(CHECKS))
         if not isinstance(checks, list | tuple) or not all(isinstance(c, str) for c in checks):
-            raise InputError(f"Expected checks to be a list of names, got {checks!r}")
+            raise OptionError("checks", f"Expected a list of names, got {checks!r}")
         max_points = data.get("max_points", 2000)
         if not isinstance(max_points, int) or isinstance(max_points, bool):
-            raise InputError(f"Expected max_points to be an integer, got {max_points!r}")
+            raise OptionError("max_points", f"Expected an integer, got {max_points!r}")
         for name in ("twist_method", "twist_apply", "filter_method", "filter_preset"):
             value = data.get(name)
             if value is not None and not isinstance(value, str):
-                raise InputError(f"Expected {name} to be a string, got {value!r}")
+                raise OptionError(name, f"Expected a string, got {value!r}")
         return cls(
             checks=tuple(checks),
             twist_method=data.get("twist_method") or "robust",

@@ -77,7 +77,23 @@ class FileStore:
         """Delete a take's files and its runs' outputs."""
         shutil.rmtree(self.take_dir(take_id), ignore_errors=True)
         for run_id in run_ids:
-            shutil.rmtree(self.run_dir(run_id), ignore_errors=True)
+            self.remove_run(run_id)
+
+    def remove_run(self, run_id: str) -> None:
+        """Delete a run's output folder (nothing when it has none)."""
+        shutil.rmtree(self.run_dir(run_id), ignore_errors=True)
+
+    def sweep_incoming(self) -> int:
+        """Remove what a stopped server left in ``incoming/`` (partial uploads); returns the
+        number of entries removed. Call before serving: every upload in progress is lost."""
+        removed = 0
+        for entry in (self.root / "incoming").iterdir():
+            if entry.is_dir() and not entry.is_symlink():
+                shutil.rmtree(entry, ignore_errors=True)
+            else:
+                entry.unlink(missing_ok=True)
+            removed += 1
+        return removed
 
 
 def _checked(identifier: str) -> str:

@@ -12,12 +12,23 @@ import uuid
 from datetime import UTC, datetime
 from typing import Any
 
-from sqlalchemy import Engine, create_engine, delete, event, func, insert, select, update
+from sqlalchemy import (
+    Engine,
+    create_engine,
+    delete,
+    event,
+    func,
+    insert,
+    inspect,
+    select,
+    text,
+    update,
+)
 from sqlalchemy.engine import Connection
 
 from mocapqa import __version__
 from mocapqa.errors import ConflictError, InputError, NotFoundError
-from mocapqa.store.tables import metadata, reviews, runs, takes
+from mocapqa.store.tables import ADDED_COLUMNS, metadata, reviews, runs, takes
 
 __all__ = ["REVIEW_STATUSES", "RUN_STATUSES", "Repository", "new_id", "utc_now"]
 
@@ -72,6 +83,16 @@ class Repository:
         if self.engine.dialect.name == "sqlite":
             event.listen(self.engine, "connect", _sqlite_pragmas)
         metadata.create_all(self.engine)
+        self._add_missing_columns()
+
+    def _add_missing_columns(self) -> None:
+        """Bring a database made by an earlier version up to :data:`ADDED_COLUMNS`."""
+        inspector = inspect(self.engine)
+        for table, column, sql_type in ADDED_COLUMNS:
+            present = {c["name"] for c in inspector.get_columns(table)}
+            if column not in present:
+                with self.engine.begin() as conn:
+                    conn.execute(text(f"ALTER TABLE {table} ADD COLUMN {column} {sql_type}"))
 
     def close(self) -> None:
         """Release the connection pool."""
@@ -257,7 +278,13 @@ class Repository:
             conn.execute(
                 update(runs)
                 .where(runs.c.id == run_id)
-                .values(status="running", progress=1, step="starting", started_at=utc_now())
+                .values(
+                    status="running",
+                    progress=1,
+                    step="starting",
+                    started_at=utc_now(),
+                    attempts=runs.c.attempts + 1,
+                )
             )
 
     def set_progress(self, run_id: str, percent: int, step: str) -> None:
@@ -292,22 +319,40 @@ class Repository:
                 )
             )
 
-    def recover_interrupted(self) -> list[str]:
-        """Re-queue the runs a stopped server left queued or running; returns their ids."""
+    def recover_interrupted(self, max_attempts: int = 2) -> list[str]:
+        """Re-queue the runs a stopped server left queued or running; returns their ids.
+
+        A run already started ``max_attempts`` times is failed with the reason instead (the
+        take may be what stops the server).
+        """
         with self.engine.begin() as conn:
-            ids = [
-                str(r)
-                for r in conn.execute(
-                    select(runs.c.id)
-                    .where(runs.c.status.in_(("queued", "running")))
-                    .order_by(runs.c.created_at)
-                ).scalars()
-            ]
+            rows = conn.execute(
+                select(runs.c.id, runs.c.attempts)
+                .where(runs.c.status.in_(("queued", "running")))
+                .order_by(runs.c.created_at)
+            ).all()
+            ids = [str(r.id) for r in rows if int(r.attempts or 0) < max_attempts]
+            exhausted = [str(r.id) for r in rows if int(r.attempts or 0) >= max_attempts]
             if ids:
                 conn.execute(
                     update(runs)
                     .where(runs.c.id.in_(ids))
                     .values(status="queued", progress=0, step="re-queued after a restart")
+                )
+            if exhausted:
+                conn.execute(
+                    update(runs)
+                    .where(runs.c.id.in_(exhausted))
+                    .values(
+                        status="failed",
+                        progress=100,
+                        step="failed",
+                        error=(
+                            f"Expected the run to finish, got the server stopped during it "
+                            f"{max_attempts} times; not started again"
+                        ),
+                        finished_at=utc_now(),
+                    )
                 )
         return ids
 

@@ -20,7 +20,7 @@ from sqlalchemy import (
     Text,
 )
 
-__all__ = ["metadata", "reviews", "runs", "takes"]
+__all__ = ["ADDED_COLUMNS", "metadata", "reviews", "runs", "takes"]
 
 metadata = MetaData()
 """The schema; ``metadata.create_all(engine)`` creates it."""
@@ -59,8 +59,17 @@ runs = Table(
     Column("created_at", DateTime(timezone=True), nullable=False),
     Column("started_at", DateTime(timezone=True), nullable=True),
     Column("finished_at", DateTime(timezone=True), nullable=True),
+    Column("attempts", Integer, nullable=False, default=0, server_default="0"),
 )
-"""One row per analysis run; several per take."""
+"""One row per analysis run; several per take. ``attempts`` counts its starts (a run
+interrupted by a server stop is started again, up to a limit)."""
+
+ADDED_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("runs", "attempts", "INTEGER NOT NULL DEFAULT 0"),
+)
+"""Columns added since the first schema: (table, column, SQL type and default). A database
+made before them gets them with ``ALTER TABLE ... ADD COLUMN`` when opened, until schema
+migrations take this over."""
 
 reviews = Table(
     "reviews",

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter
 
+from mocapqa.api.errors import responses
 from mocapqa.api.schemas import FilterInfo
 from mocapqa.pipeline.filtering import filter_catalog
 
@@ -13,7 +14,7 @@ router = APIRouter(tags=["filters"])
 """Routes of this resource, included under ``/api/v1``."""
 
 
-@router.get("/filters")
+@router.get("/filters", responses=responses())
 def list_filters() -> list[FilterInfo]:
     """Every registered filter (empty while the filters package is not installed)."""
     return [FilterInfo(**item) for item in filter_catalog()]

@@ -6,6 +6,7 @@ from fastapi import APIRouter
 
 from mocapqa import __version__
 from mocapqa.api.deps import ServicesDep
+from mocapqa.api.errors import responses
 from mocapqa.api.schemas import HealthOut
 
 __all__ = ["router"]
@@ -14,7 +15,7 @@ router = APIRouter(tags=["health"])
 """Routes of this resource, included under ``/api/v1``."""
 
 
-@router.get("/health")
+@router.get("/health", responses=responses())
 def health(services: ServicesDep) -> HealthOut:
     """The server is up; which version and database dialect it uses."""
     return HealthOut(version=__version__, database=services.repository.engine.dialect.name)

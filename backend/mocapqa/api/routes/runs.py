@@ -9,7 +9,8 @@ import numpy as np
 from fastapi import APIRouter, Query
 from fastapi.responses import FileResponse, Response
 
-from mocapqa.api.deps import ServicesDep, TakeDep
+from mocapqa.api.deps import ClientDep, ServicesDep, TakeDep, require_run_slot
+from mocapqa.api.errors import responses
 from mocapqa.api.schemas import AnalysisOptionsIn, RunOut
 from mocapqa.api.views import run_out
 from mocapqa.errors import InputError, NotFoundError
@@ -28,26 +29,40 @@ DOWNLOADS = {
     "report": ("report.json", "application/json", "report.json"),
 }
 MAX_WINDOW_VALUES = 3_000_000
+MAX_FRAME = 2**31 - 1
+"""Largest frame index or step a query may name (the schema refuses more with 422)."""
 
 
-@router.post("/takes/{take_id}/runs", status_code=201)
+@router.post("/takes/{take_id}/runs", status_code=201, responses=responses(403, 404, 413, 429))
 def start_run(
-    take: TakeDep, services: ServicesDep, options: AnalysisOptionsIn | None = None
+    take: TakeDep,
+    services: ServicesDep,
+    client: ClientDep,
+    options: AnalysisOptionsIn | None = None,
 ) -> RunOut:
-    """Start another analysis of a take with these options; earlier runs are kept."""
+    """Start another analysis of a take with these options; earlier runs are kept.
+
+    The options are checked here, against the filter registry and the take's kind (422
+    naming the field), not when the run executes.
+    """
     parsed = AnalysisOptions.from_json((options or AnalysisOptionsIn()).model_dump())
+    parsed.check_take_kind(str(take["kind"]))
+    require_run_slot(services, client)
     run_id = services.repository.add_run(str(take["id"]), parsed.to_json())
-    services.runner.submit(run_id)
+    services.runner.submit(run_id, client=client)
     return run_out(services.repository.get_run(run_id))
 
 
-@router.get("/runs/{run_id}")
+@router.get("/runs/{run_id}", responses=responses(404))
 def get_run(run_id: str, services: ServicesDep) -> RunOut:
     """A run's status (queued | running | done | failed), progress (0–100 %) and step."""
     return run_out(services.repository.get_run(run_id))
 
 
-@router.get("/runs/{run_id}/result")
+@router.get(
+    "/runs/{run_id}/result",
+    responses={200: {"content": {"application/json": {}}}, **responses(404, 409)},
+)
 def get_result(run_id: str, services: ServicesDep) -> Response:
     """The report: summary, steps, findings and the plotted series (409 until done)."""
     services.repository.require_done(run_id)
@@ -55,13 +70,16 @@ def get_result(run_id: str, services: ServicesDep) -> Response:
     return Response(path.read_bytes(), media_type="application/json")
 
 
-@router.get("/runs/{run_id}/frames")
+@router.get(
+    "/runs/{run_id}/frames",
+    responses={200: {"content": {"application/json": {}}}, **responses(404, 409)},
+)
 def get_frames(
     run_id: str,
     services: ServicesDep,
-    start: Annotated[int, Query(ge=0)] = 0,
-    stop: Annotated[int | None, Query(ge=1)] = None,
-    step: Annotated[int, Query(ge=1)] = 1,
+    start: Annotated[int, Query(ge=0, le=MAX_FRAME)] = 0,
+    stop: Annotated[int | None, Query(ge=1, le=MAX_FRAME)] = None,
+    step: Annotated[int, Query(ge=1, le=MAX_FRAME)] = 1,
     max_frames: Annotated[int, Query(ge=1, le=20_000)] = 1500,
 ) -> Response:
     """Raw and corrected point positions for frames ``start:stop:step`` (file units).
@@ -101,7 +119,11 @@ def get_frames(
     return Response(body, media_type="application/json")
 
 
-@router.get("/runs/{run_id}/download/report.html", response_class=Response)
+@router.get(
+    "/runs/{run_id}/download/report.html",
+    response_class=Response,
+    responses={200: {"content": {"text/html": {}}}, **responses(404, 409)},
+)
 def download_html_report(run_id: str, services: ServicesDep) -> Response:
     """The self-contained HTML QA report of a finished run (built on first request)."""
     run = services.repository.require_done(run_id)
@@ -115,7 +137,14 @@ def download_html_report(run_id: str, services: ServicesDep) -> Response:
     )
 
 
-@router.get("/runs/{run_id}/download/{kind}", response_class=FileResponse)
+@router.get(
+    "/runs/{run_id}/download/{kind}",
+    response_class=FileResponse,
+    responses={
+        200: {"content": {"text/plain": {}, "text/csv": {}, "application/json": {}}},
+        **responses(404, 409),
+    },
+)
 def download(
     run_id: str, kind: Literal["bvh", "csv", "trc", "report"], services: ServicesDep
 ) -> FileResponse:

@@ -5,16 +5,21 @@ optionally ``"length_unit"`` (m, cm, mm, in, px, normalized, unknown; default un
 ``"preset"`` (a preset of the adaptive filter; default ``default``), then
 one ``{"positions": [[x, y, z], ...], "confidence": [...]}`` per frame; the server answers each
 frame with ``{"frame": i, "positions": [...], "weights": {...}}``, or ``{"error": message}``
-and closes (code 1003) on bad input.
+and closes on bad input (code 1003), a message or keypoint count over the limits (1009) or
+frames faster than allowed (1008).
 """
 
 from __future__ import annotations
 
+import json
 from typing import Any
 
 from fastapi import APIRouter, WebSocket, WebSocketDisconnect
+from starlette.concurrency import run_in_threadpool
 
-from mocapqa.errors import MocapQAError
+from mocapqa.api.http_guards import RateWindow, origin_allowed
+from mocapqa.config import Settings
+from mocapqa.errors import MocapQAError, RateLimitError, TooLargeError
 from mocapqa.pipeline.filtering import StreamSession
 
 __all__ = ["router"]
@@ -37,20 +42,51 @@ def _text(message: dict[str, Any], key: str, default: str) -> str:
     return value
 
 
+def _receive_limit(text: str, max_bytes: int) -> Any:
+    if len(text) > max_bytes:
+        raise TooLargeError(
+            f"Expected messages of at most {max_bytes} bytes (setting stream_max_frame_bytes), "
+            f"got {len(text)}"
+        )
+    return json.loads(text)
+
+
+def _session(first: Any, settings: Settings) -> StreamSession:
+    if not isinstance(first, dict):
+        raise TypeError(f"Expected a JSON object first, got {type(first).__name__}")
+    n_keypoints = _number(first, "n_keypoints")
+    if not 1 <= n_keypoints <= settings.stream_max_keypoints:
+        raise TooLargeError(
+            f"Expected n_keypoints from 1 to {settings.stream_max_keypoints} (setting "
+            f"stream_max_keypoints), got {n_keypoints:g}"
+        )
+    return StreamSession(
+        _number(first, "fps"),
+        int(n_keypoints),
+        _text(first, "length_unit", "unknown"),
+        _text(first, "preset", "default"),
+    )
+
+
 @router.websocket("/stream/filter")
 async def stream_filter(websocket: WebSocket) -> None:
-    """Filter frames as they arrive with the streaming adaptive filter."""
+    """Filter frames as they arrive with the streaming adaptive filter.
+
+    A browser connection from another site (its ``Origin`` not this server's host nor in
+    ``cors_origins``) is refused before the handshake completes (403). The filter runs on a
+    worker thread, never on the event loop; ``stream_max_keypoints``,
+    ``stream_max_frame_bytes`` and ``stream_max_frames_per_s`` bound one stream's cost.
+    """
+    settings = websocket.app.state.services.settings
+    if not origin_allowed(websocket.headers, settings.cors_origins):
+        await websocket.close(code=1008, reason="cross-site connection refused")
+        return
     await websocket.accept()
+    max_bytes = settings.stream_max_frame_bytes
+    rate = RateWindow(max(1, int(settings.stream_max_frames_per_s)), window_s=1.0)
     try:
-        first = await websocket.receive_json()
-        if not isinstance(first, dict):
-            raise TypeError(f"Expected a JSON object first, got {type(first).__name__}")
-        session = StreamSession(
-            _number(first, "fps"),
-            int(_number(first, "n_keypoints")),
-            _text(first, "length_unit", "unknown"),
-            _text(first, "preset", "default"),
-        )
+        first = _receive_limit(await websocket.receive_text(), max_bytes)
+        session = await run_in_threadpool(_session, first, settings)
         await websocket.send_json(
             {
                 "ready": True,
@@ -60,14 +96,22 @@ async def stream_filter(websocket: WebSocket) -> None:
             }
         )
         while True:
-            message = await websocket.receive_json()
+            message = _receive_limit(await websocket.receive_text(), max_bytes)
+            if rate.admit("frames") > 0:
+                raise RateLimitError(
+                    f"Expected at most {settings.stream_max_frames_per_s:g} frames per second "
+                    "(setting stream_max_frames_per_s), got more",
+                    retry_after_s=1,
+                )
             if not isinstance(message, dict):
                 raise TypeError(f"Expected a JSON object per frame, got {type(message).__name__}")
-            await websocket.send_json(
-                session.update(message.get("positions"), message.get("confidence"))
+            answer = await run_in_threadpool(
+                session.update, message.get("positions"), message.get("confidence")
             )
+            await websocket.send_json(answer)
     except WebSocketDisconnect:
         return
-    except (MocapQAError, TypeError, ValueError, AttributeError) as e:
+    except (MocapQAError, TypeError, ValueError, AttributeError, RecursionError) as e:
         await websocket.send_json({"error": str(e)})
-        await websocket.close(code=1003)
+        code = 1009 if isinstance(e, TooLargeError) else 1003
+        await websocket.close(code=1008 if isinstance(e, RateLimitError) else code)

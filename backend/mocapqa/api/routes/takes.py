@@ -4,12 +4,19 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from fastapi import APIRouter, File, Form, Query, Request, Response, UploadFile
+from fastapi import APIRouter, File, Form, Query, Response, UploadFile
 
-from mocapqa.api.deps import ServicesDep, TakeDep
-from mocapqa.api.schemas import TakeCreatedOut, TakeDetailOut, TakeOut, TakePageOut
+from mocapqa.api.deps import ClientDep, ServicesDep, TakeDep, require_run_slot
+from mocapqa.api.errors import responses
+from mocapqa.api.schemas import (
+    ReviewStatus,
+    RunStatus,
+    TakeCreatedOut,
+    TakeDetailOut,
+    TakeOut,
+    TakePageOut,
+)
 from mocapqa.api.views import review_out, run_out, take_fields
-from mocapqa.errors import TooLargeError
 from mocapqa.jobs.intake import ingest_take, reading_of
 from mocapqa.jobs.rendered import THUMBNAIL_PNG
 from mocapqa.jobs.thumbnails import thumbnail_svg
@@ -19,12 +26,14 @@ __all__ = ["router"]
 
 router = APIRouter(prefix="/takes", tags=["takes"])
 """Routes of this resource, included under ``/api/v1``."""
+MAX_OFFSET = 2**31 - 1
+"""Largest page offset (the schema refuses more with 422)."""
 
 
-@router.post("", status_code=201)
+@router.post("", status_code=201, responses=responses(403, 413, 415, 429))
 def upload_take(
-    request: Request,
     services: ServicesDep,
+    client: ClientDep,
     file: Annotated[UploadFile, File()],
     fps: Annotated[
         float | None,
@@ -47,11 +56,13 @@ def upload_take(
     Optional form fields say how to read what the file leaves open: ``fps`` and
     ``length_unit`` (OpenPose, MediaPipe, NPY, CSV without times) and ``root_translation``
     (BVH). The take's ``reading`` says what was used and assumed.
+
+    Refused before the body is read: more than ``max_upload_mb`` (413), a cross-site browser
+    request (403), too many uploads or queued runs from this client (429, ``Retry-After``).
+    Refused before parsing: a take beyond the read limits (413, naming the setting).
     """
+    require_run_slot(services, client)
     max_bytes = int(services.settings.max_upload_mb * 1_000_000)
-    length = request.headers.get("content-length")
-    if length and length.isdigit() and int(length) > max_bytes + 64_000:
-        raise TooLargeError(f"Expected an upload of at most {max_bytes} bytes, got {length}")
     take_id, run_id = ingest_take(
         file.file,
         file.filename or "take",
@@ -60,19 +71,21 @@ def upload_take(
         services.runner,
         max_bytes,
         read=ReadOptions(fps, length_unit, root_translation),
+        limits=services.settings.read_limits,
+        client=client,
     )
     row = services.repository.get_take(take_id)
     reading = reading_of(services.files, take_id)
     return TakeCreatedOut(**take_fields(row), run_id=run_id, reading=reading)
 
 
-@router.get("")
+@router.get("", responses=responses())
 def list_takes(
     services: ServicesDep,
     limit: Annotated[int, Query(ge=1, le=500)] = 50,
-    offset: Annotated[int, Query(ge=0)] = 0,
-    status: str | None = None,
-    review_status: str | None = None,
+    offset: Annotated[int, Query(ge=0, le=MAX_OFFSET)] = 0,
+    status: RunStatus | None = None,
+    review_status: ReviewStatus | None = None,
 ) -> TakePageOut:
     """A page of takes, newest first, optionally filtered by run or review status."""
     rows, total = services.repository.list_takes(limit, offset, status, review_status)
@@ -80,7 +93,7 @@ def list_takes(
     return TakePageOut(items=items, total=total, limit=limit, offset=offset)
 
 
-@router.get("/{take_id}")
+@router.get("/{take_id}", responses=responses(404))
 def get_take(take: TakeDep, services: ServicesDep) -> TakeDetailOut:
     """One take with its runs (oldest first) and its review history (newest first)."""
     take_id = str(take["id"])
@@ -92,16 +105,24 @@ def get_take(take: TakeDep, services: ServicesDep) -> TakeDetailOut:
     )
 
 
-@router.delete("/{take_id}", status_code=204)
+@router.delete("/{take_id}", status_code=204, responses=responses(403, 404))
 def delete_take(take: TakeDep, services: ServicesDep) -> Response:
-    """Delete a take, its runs, reviews and files."""
+    """Delete a take, its runs (a queued or running one is stopped), reviews and files."""
     take_id = str(take["id"])
     run_ids = services.repository.delete_take(take_id)
+    services.runner.cancel(run_ids)
     services.files.remove_take(take_id, run_ids)
     return Response(status_code=204)
 
 
-@router.get("/{take_id}/thumbnail", response_class=Response)
+@router.get(
+    "/{take_id}/thumbnail",
+    response_class=Response,
+    responses={
+        200: {"content": {"image/png": {}, "image/svg+xml": {}}, "description": "A picture"},
+        **responses(404),
+    },
+)
 def thumbnail(take: TakeDep, services: ServicesDep) -> Response:
     """A small picture of the take: the rendered PNG of the latest run, else an SVG (a
     placeholder until a run has points; a line drawing when rendering is unavailable)."""

@@ -1,0 +1,250 @@
+"""What every HTTP request passes before a route: host, origin, body size, upload rate.
+
+One ASGI middleware (:class:`RequestGuard`), so each check answers before the body is read:
+
+* **Origin**: a state-changing request (POST, PUT, PATCH, DELETE) that a browser marks as
+  coming from another site (``Sec-Fetch-Site: cross-site``, or an ``Origin`` whose host is not
+  the request's ``Host`` nor in ``cors_origins``) gets 403 — no page elsewhere can upload or
+  delete through a visitor's browser. Clients that are not browsers send neither header.
+* **Body size**: counted while it streams (Content-Length or chunked), with Starlette's
+  :class:`~starlette.middleware.body_limit.RequestBodyLimitMiddleware`: the upload route allows
+  ``max_upload_mb`` (plus the multipart envelope), every other route ``max_request_kb``.
+  Over the limit the request gets 413 and no more of the body is read.
+* **Upload rate and queued runs per client**: an upload beyond
+  ``uploads_per_minute_per_client``, or from a client with ``max_queued_runs_per_client`` runs
+  waiting, gets 429 with ``Retry-After`` before its body is read.
+* **Security headers** on every answer: a Content-Security-Policy the dashboard satisfies (no
+  inline script; Plotly sets inline styles), ``frame-ancestors 'none'``, ``nosniff``,
+  ``Referrer-Policy: same-origin``.
+
+The ``Host`` header is checked by Starlette's ``TrustedHostMiddleware`` and CORS (off unless
+``cors_origins`` is set) by its ``CORSMiddleware``; :func:`install_http_guards` adds all three.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from urllib.parse import urlsplit
+
+from fastapi import FastAPI
+from starlette.datastructures import Headers
+from starlette.middleware.body_limit import RequestBodyLimitMiddleware
+from starlette.middleware.cors import CORSMiddleware
+from starlette.middleware.trustedhost import TrustedHostMiddleware
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from mocapqa.api.errors import error_body
+from mocapqa.config import Settings
+
+__all__ = [
+    "CONTENT_SECURITY_POLICY",
+    "MULTIPART_SLACK_BYTES",
+    "RateWindow",
+    "RequestGuard",
+    "client_key",
+    "install_http_guards",
+    "origin_allowed",
+]
+
+CONTENT_SECURITY_POLICY = (
+    "default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; "
+    "img-src 'self' data: blob:; connect-src 'self'; font-src 'self'; object-src 'none'; "
+    "base-uri 'none'; form-action 'self'; frame-ancestors 'none'"
+)
+"""The dashboard's policy: its scripts are files of this server; Plotly styles inline."""
+_DOCS_POLICY = (
+    "default-src 'self'; script-src 'self' 'unsafe-inline' https://cdn.jsdelivr.net; "
+    "style-src 'self' 'unsafe-inline' https://cdn.jsdelivr.net; "
+    "img-src 'self' data: https://fastapi.tiangolo.com; frame-ancestors 'none'"
+)
+_DOCS_PATHS = ("/docs", "/redoc")
+MULTIPART_SLACK_BYTES = 64_000
+"""Allowance for the multipart envelope around an upload's file."""
+_STATE_CHANGING = frozenset({"POST", "PUT", "PATCH", "DELETE"})
+
+
+def client_key(scope: Scope) -> str:
+    """Who is asking: the client's address (the user, once there are accounts)."""
+    client = scope.get("client")
+    return str(client[0]) if client else "unknown"
+
+
+def origin_allowed(headers: Headers, cors_origins: list[str]) -> bool:
+    """Whether a browser request comes from this site (or an allowed one).
+
+    ``Sec-Fetch-Site: cross-site`` is refused unless its ``Origin`` is in ``cors_origins``;
+    an ``Origin`` must name the request's own ``Host`` or be listed; no header at all (a
+    script, the CLI, curl) is allowed.
+    """
+    origin = headers.get("origin")
+    if origin and origin in cors_origins:
+        return True
+    if headers.get("sec-fetch-site") == "cross-site":
+        return False
+    if origin is None:
+        return True
+    if origin == "null":
+        return False
+    return urlsplit(origin).netloc.lower() == headers.get("host", "").lower()
+
+
+class RateWindow:
+    """Events per client in a sliding window (thread-safe).
+
+    Parameters
+    ----------
+    limit : int
+        Events allowed per window.
+    window_s : float
+        Window length, seconds.
+    clock : callable
+        Monotonic seconds (tests pass their own).
+    """
+
+    def __init__(
+        self, limit: int, window_s: float = 60.0, clock: Callable[[], float] = time.monotonic
+    ) -> None:
+        self.limit = limit
+        self.window_s = window_s
+        self._clock = clock
+        self._events: dict[str, deque[float]] = {}
+        self._lock = threading.Lock()
+
+    def admit(self, key: str) -> float:
+        """Record an event for ``key``; 0 when admitted, else seconds until one would be."""
+        now = self._clock()
+        with self._lock:
+            events = self._events.setdefault(key, deque())
+            while events and events[0] <= now - self.window_s:
+                events.popleft()
+            if len(events) >= self.limit:
+                return events[0] + self.window_s - now
+            events.append(now)
+            if len(self._events) > 10_000:  # forget idle clients
+                for idle in [k for k, v in self._events.items() if not v]:
+                    del self._events[idle]
+            return 0.0
+
+
+async def _send_json(send: Send, status: int, body: dict[str, object], retry: int = 0) -> None:
+    headers = [(b"content-type", b"application/json")]
+    if retry:
+        headers.append((b"retry-after", str(retry).encode()))
+    await send({"type": "http.response.start", "status": status, "headers": headers})
+    await send({"type": "http.response.body", "body": json.dumps(body).encode()})
+
+
+class RequestGuard:
+    """The origin, body-size, upload-rate and header checks (see the module notes)."""
+
+    def __init__(
+        self,
+        app: ASGIApp,
+        settings: Settings,
+        upload_path: str,
+        pending_runs: Callable[[str], int],
+    ) -> None:
+        self.app = app
+        self.settings = settings
+        self.upload_path = upload_path
+        self.pending_runs = pending_runs
+        self.uploads = RateWindow(settings.uploads_per_minute_per_client)
+        self.upload_bytes = int(settings.max_upload_mb * 1_000_000) + MULTIPART_SLACK_BYTES
+        self.request_bytes = int(settings.max_request_kb * 1000)
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        headers = Headers(scope=scope)
+        method = scope["method"]
+        is_upload = method == "POST" and scope["path"] == self.upload_path
+        secured = self._with_headers(send, scope["path"].startswith(_DOCS_PATHS), is_upload)
+        if method in _STATE_CHANGING and not origin_allowed(headers, self.settings.cors_origins):
+            detail = (
+                f"Expected a request from this site, got Origin {headers.get('origin')!r}, "
+                f"Sec-Fetch-Site {headers.get('sec-fetch-site')!r}"
+            )
+            await _send_json(secured, 403, error_body("ForbiddenError", detail))
+            return
+        if is_upload:
+            refused = self._upload_refusal(client_key(scope))
+            if refused is not None:
+                await _send_json(secured, 429, refused[0], refused[1])
+                return
+        limit = self.upload_bytes if is_upload else self.request_bytes
+        await RequestBodyLimitMiddleware(self.app, limit)(scope, receive, secured)
+
+    def _upload_refusal(self, client: str) -> tuple[dict[str, object], int] | None:
+        limit = self.settings.max_queued_runs_per_client
+        if self.pending_runs(client) >= limit:
+            detail = f"Expected at most {limit} queued runs per client (setting "
+            detail += "max_queued_runs_per_client), got that many waiting"
+            return error_body("RateLimitError", detail), 10
+        wait = self.uploads.admit(client)
+        if wait > 0:
+            per_minute = self.settings.uploads_per_minute_per_client
+            detail = f"Expected at most {per_minute} uploads per minute per client (setting "
+            detail += "uploads_per_minute_per_client), got more"
+            return error_body("RateLimitError", detail), int(wait) + 1
+        return None
+
+    def _with_headers(self, send: Send, docs: bool, upload: bool = False) -> Send:
+        policy = (_DOCS_POLICY if docs else CONTENT_SECURITY_POLICY).encode()
+        rewrite = [False]
+        if upload:
+            limit = int(self.settings.max_upload_mb * 1_000_000)
+            detail = f"Expected an upload of at most {limit} bytes (setting max_upload_mb)"
+        else:
+            detail = f"Expected a request body of at most {self.request_bytes} bytes "
+            detail += "(setting max_request_kb)"
+        too_large = json.dumps(error_body("TooLargeError", f"{detail}, got more")).encode()
+
+        async def secured(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                headers = list(message.get("headers", []))
+                if (
+                    message["status"] == 413
+                    and (b"content-type", b"text/plain; charset=utf-8") in headers
+                ):
+                    # Starlette's body limit answers in plain text: give it the error shape.
+                    rewrite[0] = True
+                    headers = [
+                        (b"content-type", b"application/json"),
+                        (b"content-length", str(len(too_large)).encode()),
+                    ]
+                extra = [
+                    (b"content-security-policy", policy),
+                    (b"x-content-type-options", b"nosniff"),
+                    (b"x-frame-options", b"DENY"),
+                    (b"referrer-policy", b"same-origin"),
+                ]
+                message = {**message, "headers": [*headers, *extra]}
+            elif message["type"] == "http.response.body" and rewrite[0]:
+                message = {**message, "body": too_large, "more_body": False}
+            await send(message)
+
+        return secured
+
+
+def install_http_guards(
+    app: FastAPI, settings: Settings, upload_path: str, pending_runs: Callable[[str], int]
+) -> None:
+    """Add the request guard, CORS (when ``cors_origins`` is set) and the Host check, in the
+    order that makes the Host check run first."""
+    app.add_middleware(
+        RequestGuard, settings=settings, upload_path=upload_path, pending_runs=pending_runs
+    )
+    if settings.cors_origins:
+        app.add_middleware(
+            CORSMiddleware,
+            allow_origins=settings.cors_origins,
+            allow_methods=["GET", "POST", "DELETE"],
+            allow_headers=["Content-Type", "Authorization"],
+            max_age=600,
+        )
+    app.add_middleware(TrustedHostMiddleware, allowed_hosts=settings.allowed_hosts)

@@ -1,0 +1,251 @@
+"""Cheap checks that refuse a hostile take before a reader pays for it.
+
+A reader's cost grows with what the file *claims* (a frame count, an array shape, a nesting
+depth, one enormous line), not only with its size on disk: a 467 KB ``.npz`` can unpack to
+half a gigabyte, a 100 MB BVH header can declare a million joints. :func:`check_take_input`
+looks at the bytes with C-speed scans (``bytes.find``/``count``, NumPy over fixed-size chunks,
+the ``.npy`` headers inside a zip directory) and raises :class:`~mocapqa.errors.TooLargeError`
+naming the limit before any reader runs; :func:`check_take_size` is the backstop after the
+read, for the formats whose frame count is only known by parsing.
+
+The limits are parameters (:class:`ReadLimits`); the server builds them from its settings.
+"""
+
+from __future__ import annotations
+
+import re
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO
+
+import numpy as np
+
+from mocapqa.errors import ParseError, TooLargeError
+
+__all__ = [
+    "JSON_FORMATS",
+    "TEXT_FORMATS",
+    "ReadLimits",
+    "check_json_depth",
+    "check_line_length",
+    "check_take_input",
+    "check_take_size",
+]
+
+TEXT_FORMATS = frozenset(
+    {"bvh", "trc", "csv", "mediapipe-csv", "mediapipe-json", "mediapipe-pbtxt", "json", "openpose"}
+)
+"""Formats read as text lines (their line length is limited)."""
+JSON_FORMATS = frozenset({"json", "mediapipe-json", "openpose"})
+"""Formats parsed as JSON documents (their nesting depth is limited)."""
+
+_CHUNK = 1 << 20
+_JOINT = re.compile(rb"^[ \t]*(?:ROOT|JOINT)[ \t]", re.MULTILINE)
+_OPEN = np.zeros(256, dtype=np.int8)
+_OPEN[[ord("["), ord("{")]] = 1
+_OPEN[[ord("]"), ord("}")]] = -1
+
+
+@dataclass(frozen=True, slots=True)
+class ReadLimits:
+    """Largest take a reader accepts.
+
+    Parameters
+    ----------
+    max_unpacked_bytes : int
+        Largest total size of the arrays inside an ``.npz``/``.npy``, bytes.
+    max_frame_points : int
+        Largest frames × points (joints or keypoints) of a take.
+    max_joints : int
+        Largest number of joints in a BVH hierarchy.
+    max_line_bytes : int
+        Longest line of a text format, bytes.
+    max_json_depth : int
+        Deepest nesting of arrays and objects in a JSON format.
+    """
+
+    max_unpacked_bytes: int = 200_000_000
+    max_frame_points: int = 5_000_000
+    max_joints: int = 500
+    max_line_bytes: int = 1_000_000
+    max_json_depth: int = 64
+
+
+def _files(path: Path) -> list[Path]:
+    if path.is_dir():
+        return sorted(p for p in path.iterdir() if p.suffix.lower() == ".json" and p.is_file())
+    return [path]
+
+
+def check_line_length(path: Path, max_line_bytes: int) -> None:
+    """Refuse a file holding a line longer than ``max_line_bytes``, reading 1 MB at a time.
+
+    Raises
+    ------
+    TooLargeError
+        Naming the line.
+    """
+    line, run = 1, 0
+    with path.open("rb") as handle:
+        while chunk := handle.read(_CHUNK):
+            start = 0
+            while True:
+                newline = chunk.find(b"\n", start)
+                run += (len(chunk) if newline < 0 else newline) - start
+                if run > max_line_bytes:
+                    raise TooLargeError(
+                        f"{path.name}, line {line}: Expected lines of at most {max_line_bytes} "
+                        "bytes (setting max_line_bytes), got a longer one"
+                    )
+                if newline < 0:
+                    break
+                line, run, start = line + 1, 0, newline + 1
+
+
+def check_json_depth(path: Path, max_depth: int) -> None:
+    """Refuse a JSON file nested deeper than ``max_depth``, without parsing it.
+
+    Brackets are counted in 1 MB chunks with NumPy; brackets inside strings count too, so
+    the estimate errs on the side of refusing (keypoint names hold no brackets).
+
+    Raises
+    ------
+    TooLargeError
+        Naming the setting.
+    """
+    depth = 0
+    with path.open("rb") as handle:
+        while chunk := handle.read(_CHUNK):
+            steps = _OPEN[np.frombuffer(chunk, dtype=np.uint8)]
+            if not steps.any():
+                continue
+            levels = depth + np.cumsum(steps, dtype=np.int64)
+            if int(levels.max()) > max_depth:
+                raise TooLargeError(
+                    f"{path.name}: Expected JSON nested at most {max_depth} deep "
+                    "(setting max_json_depth), got deeper"
+                )
+            depth = int(levels[-1])
+
+
+def _frame_points(shape: tuple[int, ...], itemsize: int, path: Path, limits: ReadLimits) -> int:
+    frame_points = int(shape[0]) * int(shape[1]) if len(shape) >= 2 else 0
+    if frame_points > limits.max_frame_points:
+        raise TooLargeError(
+            f"{path.name}: Expected at most {limits.max_frame_points} frames × points "
+            f"(setting max_frame_points), got {shape[0]} × {shape[1]}"
+        )
+    return int(np.prod(shape, dtype=np.int64)) * itemsize
+
+
+def _npy_header(handle: IO[bytes], path: Path) -> tuple[tuple[int, ...], int]:
+    try:
+        version = np.lib.format.read_magic(handle)
+        shape, _, dtype = np.lib.format._read_array_header(  # type: ignore[attr-defined]
+            handle, version, max_header_size=10_000
+        )
+    except (ValueError, OSError, EOFError) as e:
+        raise ParseError(f"Expected a NumPy array header, got unreadable data ({e})", path) from e
+    return tuple(int(n) for n in shape), int(dtype.itemsize)
+
+
+def _check_arrays(path: Path, kind: str, limits: ReadLimits) -> None:
+    total = 0
+    if kind == "npy":
+        with path.open("rb") as handle:
+            shape, itemsize = _npy_header(handle, path)
+        total = _frame_points(shape, itemsize, path, limits)
+    else:
+        try:
+            with zipfile.ZipFile(path) as archive:
+                members = archive.infolist()
+                declared = sum(m.file_size for m in members)
+                if declared > limits.max_unpacked_bytes:
+                    raise TooLargeError(
+                        f"{path.name}: Expected at most {limits.max_unpacked_bytes} bytes "
+                        f"unpacked (setting max_unpacked_bytes), got {declared}"
+                    )
+                for member in members:
+                    if member.filename.endswith(".npy"):
+                        with archive.open(member) as handle:
+                            shape, itemsize = _npy_header(handle, path)
+                        total += _frame_points(shape, itemsize, path, limits)
+        except (zipfile.BadZipFile, OSError, EOFError, ValueError) as e:
+            raise ParseError(f"Expected a readable .npz archive, got {e}", path) from e
+    if total > limits.max_unpacked_bytes:
+        raise TooLargeError(
+            f"{path.name}: Expected at most {limits.max_unpacked_bytes} bytes of arrays "
+            f"(setting max_unpacked_bytes), got {total}"
+        )
+
+
+def _check_bvh_header(path: Path, limits: ReadLimits) -> None:
+    data = path.read_bytes()
+    motion = data.find(b"MOTION")
+    header_end = len(data) if motion < 0 else motion
+    joints = sum(1 for _ in _JOINT.finditer(data, 0, header_end))
+    if joints > limits.max_joints:
+        raise TooLargeError(
+            f"{path.name}: Expected at most {limits.max_joints} joints (setting max_joints), "
+            f"got {joints}"
+        )
+    if motion < 0:
+        return
+    frames_at = data.find(b"Frames:", motion, motion + 200)
+    if frames_at < 0:
+        return
+    end = data.find(b"\n", frames_at)
+    try:
+        n_frames = int(data[frames_at + 7 : end if end >= 0 else None].strip())
+    except ValueError:
+        return  # the reader names the malformed line
+    if n_frames * max(joints, 1) > limits.max_frame_points:
+        raise TooLargeError(
+            f"{path.name}: Expected at most {limits.max_frame_points} frames × joints "
+            f"(setting max_frame_points), got {n_frames} × {joints}"
+        )
+
+
+def check_take_input(path: str | Path, kind: str, limits: ReadLimits) -> None:
+    """Refuse a take file (or OpenPose folder) that exceeds ``limits``, before reading it.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file or folder.
+    kind : str
+        Its format, as named by :func:`mocapqa.io.formats.detect_format`.
+    limits : ReadLimits
+        The limits.
+
+    Raises
+    ------
+    TooLargeError
+        Naming the file, the limit's setting and what was found.
+    """
+    path = Path(path)
+    if kind in ("npy", "npz"):
+        _check_arrays(path, kind, limits)
+        return
+    for file in _files(path):
+        if kind in TEXT_FORMATS:
+            check_line_length(file, limits.max_line_bytes)
+        if kind in JSON_FORMATS:
+            check_json_depth(file, limits.max_json_depth)
+    if kind == "bvh":
+        _check_bvh_header(path, limits)
+
+
+def check_take_size(n_frames: int, n_points: int, name: str, limits: ReadLimits) -> None:
+    """Refuse a read take larger than ``limits.max_frame_points`` (the check after parsing).
+
+    Raises
+    ------
+    TooLargeError
+    """
+    if n_frames * n_points > limits.max_frame_points:
+        raise TooLargeError(
+            f"{name}: Expected at most {limits.max_frame_points} frames × points "
+            f"(setting max_frame_points), got {n_frames} × {n_points}"
+        )
