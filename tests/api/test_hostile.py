@@ -1,0 +1,377 @@
+"""Hostile inputs against a real server: each is refused with its 4xx before its cost is paid.
+
+Every case is measured in this process (the server runs in a thread here): the time to the
+answer, the peak of traced memory (``tracemalloc``, which NumPy reports to), the slowest
+``/health`` answer while it ran (a poller thread), and that nothing was stored. The bounds are
+generous (a loaded 2-core machine); the point is the orders of magnitude: the unguarded server
+took 13–66 s and 3.3–3.8 GB for these. Sizes are smaller than the reports' (a 2 GB upload, a
+104 MB BVH), with the limits lowered to match, so each case still crosses its limit by far.
+The measured table is written to ``test-artifacts/hostile.md``.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import threading
+import time
+import tracemalloc
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import httpx
+import numpy as np
+import pytest
+from websockets.exceptions import InvalidStatus
+from websockets.sync.client import connect
+
+from mocapqa.config import Settings
+from tests.api.conftest import make_settings
+from tests.api.live_server import live_server
+
+ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts"
+MAX_SECONDS = 20.0
+"""Generous bound on a refusal (each takes well under a second on an idle machine)."""
+MAX_PEAK_MB = 150.0
+"""Generous bound on the traced memory of a refusal (inputs unpack to 80 MB to 3 GB)."""
+MAX_HEALTH_S = 5.0
+"""Slowest acceptable /health answer while a hostile request is handled."""
+
+
+@dataclass
+class Case:
+    """One measured refusal."""
+
+    name: str
+    status: int
+    seconds: float
+    peak_mb: float
+    health_s: float
+
+
+ROWS: list[Case] = []
+
+
+@pytest.fixture(scope="module")
+def data_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The server's data folder."""
+    return tmp_path_factory.mktemp("hostile")
+
+
+@pytest.fixture(scope="module")
+def settings(data_dir: Path) -> Settings:
+    """Lowered upload and unpacked limits, the other limits at their defaults."""
+    return make_settings(
+        "sqlite",
+        data_dir,
+        max_upload_mb=8.0,
+        max_unpacked_mb=20.0,
+        uploads_per_minute_per_client=1000,
+        allowed_hosts=["127.0.0.1", "localhost"],
+    )
+
+
+@pytest.fixture(scope="module")
+def url(settings: Settings) -> Iterator[str]:
+    """The server."""
+    with live_server(settings) as base:
+        yield base
+    ARTIFACTS.mkdir(exist_ok=True)
+    lines = ["| input | status | time (s) | peak memory (MB) | slowest /health (s) |"]
+    lines.append("|---|---|---|---|---|")
+    lines += [
+        f"| {r.name} | {r.status} | {r.seconds:.3f} | {r.peak_mb:.1f} | {r.health_s:.3f} |"
+        for r in ROWS
+    ]
+    (ARTIFACTS / "hostile.md").write_text("\n".join(lines) + "\n")
+
+
+def stored(settings: Settings, url: str) -> tuple[int, list[str]]:
+    """Takes in the database and files under takes/, runs/ and incoming/."""
+    total = int(httpx.get(f"{url}/api/v1/takes").json()["total"])
+    files = [
+        str(p.relative_to(settings.data_dir))
+        for sub in ("takes", "runs", "incoming")
+        for p in (settings.data_dir / sub).rglob("*")
+    ]
+    return total, files
+
+
+def measure(name: str, url: str, request: Callable[[], Any]) -> tuple[Any, Case]:
+    """Run ``request`` while polling ``/health``; time, traced peak and slowest health."""
+    latencies: list[float] = []
+    stop = threading.Event()
+
+    def poll() -> None:
+        with httpx.Client(timeout=60) as client:
+            while True:
+                clock = time.perf_counter()
+                assert client.get(f"{url}/api/v1/health").status_code == 200
+                latencies.append(time.perf_counter() - clock)
+                if stop.wait(0.02):
+                    return
+
+    poller = threading.Thread(target=poll, daemon=True)
+    poller.start()
+    tracemalloc.start()
+    tracemalloc.reset_peak()
+    clock = time.perf_counter()
+    try:
+        answer = request()
+    finally:
+        seconds = time.perf_counter() - clock
+        peak = tracemalloc.get_traced_memory()[1] / 1e6
+        tracemalloc.stop()
+        stop.set()
+        poller.join(timeout=120)
+    status = getattr(answer, "status_code", 0)
+    case = Case(name, status, seconds, peak, max(latencies, default=float("nan")))
+    ROWS.append(case)
+    assert latencies, "the server never answered /health"
+    assert case.health_s < MAX_HEALTH_S, case
+    assert case.seconds < MAX_SECONDS, case
+    assert case.peak_mb < MAX_PEAK_MB, case
+    return answer, case
+
+
+def upload(url: str, name: str, data: bytes, **headers: str) -> httpx.Response:
+    """POST a take."""
+    return httpx.post(
+        f"{url}/api/v1/takes", files={"file": (name, data)}, headers=headers, timeout=120
+    )
+
+
+def bvh_text(n_joints: int, chain: bool) -> str:
+    """A BVH of one root and ``n_joints - 1`` joints, all under the root or in one chain."""
+    parts = ["HIERARCHY", "ROOT Hips", "{", "OFFSET 0 0 0"]
+    parts.append("CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation")
+    for i in range(1, n_joints):
+        parts += [f"JOINT j{i}", "{", "OFFSET 0 1 0", "CHANNELS 3 Zrotation Xrotation Yrotation"]
+        if not chain:
+            parts.append("}")
+    parts += ["End Site", "{", "OFFSET 0 1 0", "}"]
+    parts += ["}"] * ((n_joints - 1 if chain else 0) + 1)
+    values = " ".join(["0"] * (6 + 3 * (n_joints - 1)))
+    parts += ["MOTION", "Frames: 2", "Frame Time: 0.0333333", values, values]
+    return "\n".join(parts) + "\n"
+
+
+def npz_bytes(n_frames: int, n_points: int) -> bytes:
+    """A small compressed ``.npz`` claiming ``(n_frames, n_points, 3)`` float32 zeros."""
+    buffer = io.BytesIO()
+    np.savez_compressed(
+        buffer, positions=np.zeros((n_frames, n_points, 3), np.float32), fps=np.float64(30)
+    )
+    return buffer.getvalue()
+
+
+HOSTILE_UPLOADS: dict[str, tuple[str, Callable[[], bytes], int, str]] = {
+    "400k-frame .npz (81 MB unpacked, 1.9 MB sent)": (
+        "bomb.npz",
+        lambda: npz_bytes(400_000, 17),
+        413,
+        "max_unpacked_bytes",
+    ),
+    "BVH with 20,000 joints": (
+        "wide.bvh",
+        lambda: bvh_text(20_000, chain=False).encode(),
+        413,
+        "max_joints",
+    ),
+    "999-joint BVH chain": (
+        "chain.bvh",
+        lambda: bvh_text(999, chain=True).encode(),
+        413,
+        "max_joints",
+    ),
+    "BVH claiming 10^7 frames": (
+        "frames.bvh",
+        lambda: bvh_text(2, chain=True).replace("Frames: 2", "Frames: 10000000").encode(),
+        413,
+        "max_frame_points",
+    ),
+    "CSV with one 5 MB line": (
+        "line.csv",
+        lambda: b"frame,time,a_x,a_y,a_z\n0,0," + b"1," * 2_500_000 + b"1\n",
+        413,
+        "max_line_bytes",
+    ),
+    "OpenPose JSON nested 100,000 deep": (
+        "deep_000000000000_keypoints.json",
+        lambda: b'{"people": ' + b"[" * 100_000 + b"]" * 100_000 + b"}",
+        413,
+        "max_json_depth",
+    ),
+    "MediaPipe JSON nested 100,000 deep": (
+        "deep_landmarks.json",
+        lambda: b'{"landmarks": ' + b"[" * 100_000 + b"]" * 100_000 + b"}",
+        413,
+        "max_json_depth",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(HOSTILE_UPLOADS))
+def test_hostile_upload_is_refused_before_parsing(case: str, url: str, settings: Settings) -> None:
+    name, make, status, setting = HOSTILE_UPLOADS[case]
+    data = make()
+    response, _ = measure(case, url, lambda: upload(url, name, data))
+    assert response.status_code == status, response.text
+    body = response.json()
+    assert setting in body["detail"]
+    assert body["error"] == "TooLargeError"
+    assert stored(settings, url) == (0, [])
+
+
+def test_upload_over_the_limit_is_refused_by_its_length(url: str, settings: Settings) -> None:
+    data = b"0" * 40_000_000
+    response, _ = measure("40 MB upload, Content-Length", url, lambda: upload(url, "a.bvh", data))
+    assert response.status_code == 413
+    assert "max_upload_mb" in response.json()["detail"]
+    assert stored(settings, url) == (0, [])
+
+
+def test_chunked_upload_over_the_limit_stops_at_the_limit(url: str, settings: Settings) -> None:
+    """No Content-Length: the body is counted as it arrives; past the limit the app stops
+    storing it and answers 413 (the server drains what the client still sends, unstored)."""
+    boundary = "hostileboundary"
+    sent = [0]
+
+    def body() -> Iterator[bytes]:
+        yield (
+            f'--{boundary}\r\nContent-Disposition: form-data; name="file"; '
+            'filename="big.bvh"\r\nContent-Type: application/octet-stream\r\n\r\n'
+        ).encode()
+        for _ in range(400):  # 400 MB if it were all read
+            sent[0] += 1 << 20
+            yield b"0" * (1 << 20)
+        yield f"\r\n--{boundary}--\r\n".encode()
+
+    def request() -> httpx.Response:
+        try:
+            return httpx.post(
+                f"{url}/api/v1/takes",
+                content=body(),
+                headers={"Content-Type": f"multipart/form-data; boundary={boundary}"},
+                timeout=120,
+            )
+        except httpx.HTTPError as e:  # the server may close while the client still sends
+            return httpx.Response(599, text=str(e))
+
+    response, _ = measure("chunked upload of 400 MB", url, request)
+    assert response.status_code in (413, 599), response.text
+    assert sent[0] > 8 << 20
+    assert stored(settings, url) == (0, [])
+
+
+@pytest.mark.parametrize(
+    "path",
+    [
+        "/api/v1/takes?offset=9223372036854775808",
+        "/api/v1/takes?limit=100000000000000000000000",
+        "/api/v1/runs/0123456789abcdef0123456789abcdef/frames?step=100000000000000000000000",
+        "/api/v1/runs/0123456789abcdef0123456789abcdef/frames?start=-1",
+        "/api/v1/takes?status=bogus",
+    ],
+)
+def test_query_integers_out_of_range_are_422(path: str, url: str) -> None:
+    response, _ = measure(f"GET {path.split('/api/v1')[1]}", url, lambda: httpx.get(url + path))
+    assert response.status_code == 422
+    body = response.json()
+    assert body["error"] == "ValidationError"
+    assert body["field"].startswith("query.")
+
+
+def test_cross_site_upload_is_403(url: str, settings: Settings, cmu_walk: Path) -> None:
+    data = cmu_walk.read_bytes()
+    headers = {"Origin": "https://elsewhere.example", "Sec-Fetch-Site": "cross-site"}
+    response, _ = measure(
+        "cross-site multipart upload", url, lambda: upload(url, "walk.bvh", data, **headers)
+    )
+    assert response.status_code == 403
+    assert response.json()["error"] == "ForbiddenError"
+    assert stored(settings, url) == (0, [])
+
+
+def test_unknown_host_is_400(url: str) -> None:
+    response, _ = measure(
+        "Host: evil.example",
+        url,
+        lambda: httpx.get(f"{url}/api/v1/health", headers={"Host": "evil.example"}),
+    )
+    assert response.status_code == 400
+
+
+def test_security_headers(url: str) -> None:
+    page = httpx.get(f"{url}/")
+    policy = page.headers["content-security-policy"]
+    assert "script-src 'self'" in policy
+    assert "frame-ancestors 'none'" in policy
+    assert page.headers["x-content-type-options"] == "nosniff"
+    assert page.headers["referrer-policy"] == "same-origin"
+    assert "<script>" not in page.text  # the policy allows no inline script
+    assert (
+        "access-control-allow-origin"
+        not in httpx.get(
+            f"{url}/api/v1/health", headers={"Origin": "https://elsewhere.example"}
+        ).headers
+    )
+
+
+def test_stream_refuses_huge_keypoint_count(url: str) -> None:
+    ws_url = url.replace("http", "ws") + "/api/v1/stream/filter"
+
+    def request() -> httpx.Response:
+        with connect(ws_url) as socket:
+            socket.send(json.dumps({"fps": 30, "n_keypoints": 10_000_000}))
+            answer = json.loads(socket.recv(timeout=60))
+        return httpx.Response(413 if "stream_max_keypoints" in answer.get("error", "") else 500)
+
+    response, _ = measure("WebSocket n_keypoints=10^7", url, request)
+    assert response.status_code == 413
+
+
+def test_stream_refuses_huge_frame(url: str) -> None:
+    ws_url = url.replace("http", "ws") + "/api/v1/stream/filter"
+
+    def request() -> httpx.Response:
+        with connect(ws_url, max_size=None) as socket:
+            socket.send(json.dumps({"fps": 30, "n_keypoints": 17}))
+            json.loads(socket.recv(timeout=60))
+            socket.send(json.dumps({"positions": [[0.0, 0.0, 0.0]] * 200_000}))
+            answer = json.loads(socket.recv(timeout=60))
+        return httpx.Response(413 if "stream_max_frame_bytes" in answer.get("error", "") else 500)
+
+    response, _ = measure("WebSocket 4 MB frame", url, request)
+    assert response.status_code == 413
+
+
+def test_stream_refuses_other_origins(url: str) -> None:
+    ws_url = url.replace("http", "ws") + "/api/v1/stream/filter"
+
+    def request() -> httpx.Response:
+        try:
+            with connect(ws_url, origin="https://elsewhere.example"):  # type: ignore[arg-type]
+                return httpx.Response(101)
+        except InvalidStatus as e:
+            return httpx.Response(e.response.status_code)
+
+    response, _ = measure("WebSocket from another Origin", url, request)
+    assert response.status_code == 403
+
+
+def test_upload_rate_is_limited_per_client(tmp_path: Path, cmu_walk: Path) -> None:
+    settings = make_settings(
+        "sqlite", tmp_path, uploads_per_minute_per_client=2, allowed_hosts=["127.0.0.1"]
+    )
+    data = cmu_walk.read_bytes()
+    with live_server(settings) as base:
+        statuses = [upload(base, "walk.bvh", data).status_code for _ in range(2)]
+        response, _ = measure(
+            "3rd upload in a minute (limit 2)", base, lambda: upload(base, "w.bvh", data)
+        )
+    assert statuses == [201, 201]
+    assert response.status_code == 429
+    assert 1 <= int(response.headers["retry-after"]) <= 61
