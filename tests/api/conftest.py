@@ -52,8 +52,14 @@ def client(settings: Settings, renderer: RenderService) -> Iterator[TestClient]:
         yield test_client
 
 
-def poll_run(client: TestClient, run_id: str, timeout_s: float = 60.0) -> dict[str, Any]:
-    """Poll a run until it is done or failed."""
+RUN_BOUND_S = 900.0
+"""Generous bound on one run: a render-heavy run that needs well under a minute on an idle
+machine has taken more than that on a loaded 2-core one. A failure to finish is a hang, not a
+slow machine."""
+
+
+def poll_run(client: TestClient, run_id: str, timeout_s: float = RUN_BOUND_S) -> dict[str, Any]:
+    """Poll a run until it is done or failed (at most ``timeout_s``, a generous bound)."""
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         run: dict[str, Any] = client.get(f"/api/v1/runs/{run_id}").json()

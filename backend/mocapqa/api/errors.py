@@ -26,6 +26,7 @@ from mocapqa.errors import (
     LimitsFileError,
     MocapQAError,
     NotFoundError,
+    OptionError,
     ParseError,
     RateLimitError,
     TooLargeError,
@@ -96,6 +97,8 @@ async def _handle(request: Request, error: Exception) -> JSONResponse:
     extra: dict[str, Any] = {}
     if isinstance(error, ParseError):
         extra.update(line=error.line, field=error.field, message=error.message)
+    if isinstance(error, OptionError):
+        extra.update(field=error.field, message=error.message)
     headers = None
     if isinstance(error, RateLimitError):
         headers = {"Retry-After": str(error.retry_after_s)}
