@@ -16,6 +16,7 @@ from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException
+from starlette.routing import compile_path
 
 from mocapqa.api.schemas import ErrorOut
 from mocapqa.errors import (
@@ -106,12 +107,24 @@ async def _handle(request: Request, error: Exception) -> JSONResponse:
     return JSONResponse(body, status_code=status_for(error), headers=headers)
 
 
+def _allowed_methods(request: Request) -> list[str]:
+    """Every method the OpenAPI documents at this path (Starlette's 405 names only the first
+    route that matched the path)."""
+    methods: set[str] = set()
+    for template, operations in request.app.openapi()["paths"].items():
+        if compile_path(template)[0].match(request.url.path):
+            methods |= {m.upper() for m in operations}
+    return sorted(methods)
+
+
 async def _handle_http(request: Request, error: Exception) -> JSONResponse:
-    del request
     if not isinstance(error, HTTPException):  # pragma: no cover - registered for HTTPException
         raise error
     body = error_body("HTTPError", str(error.detail))
-    return JSONResponse(body, status_code=error.status_code, headers=error.headers)
+    headers = dict(error.headers or {})
+    if error.status_code == 405:
+        headers["Allow"] = ", ".join(_allowed_methods(request)) or headers.get("Allow", "")
+    return JSONResponse(body, status_code=error.status_code, headers=headers or None)
 
 
 def _location(entry: dict[str, Any]) -> str:

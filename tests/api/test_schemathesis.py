@@ -1,0 +1,82 @@
+"""Schemathesis against the running app: every check, zero failures.
+
+The server runs in this process (uvicorn in a thread) with an analysed take; schemathesis
+(pinned in the dev extras) runs as its CLI with ``--checks all``: no server errors, no answer
+outside its schema, no undocumented status code, no undocumented header, valid data accepted
+and invalid data rejected (with the exceptions stated in ``schemathesis.toml``). Bounded by
+``--max-examples`` per operation: a few minutes on a loaded 2-core machine. The summary goes
+to ``test-artifacts/schemathesis.txt``.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import httpx
+import pytest
+
+from mocapqa.render.service import RenderService
+from tests.api.conftest import make_settings
+from tests.api.live_server import live_server
+
+pytestmark = pytest.mark.schemathesis
+
+CONFIG = Path(__file__).with_name("schemathesis.toml")
+ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts"
+MAX_EXAMPLES = 40
+"""Examples per operation and phase (15 operations)."""
+RUN_BOUND_S = 900.0
+"""Generous bound on the whole run (about 2 minutes on an idle machine)."""
+
+
+def test_schemathesis_finds_nothing(
+    tmp_path: Path, cmu_walk: Path, renderer: RenderService
+) -> None:
+    settings = make_settings(
+        "sqlite", tmp_path, allowed_hosts=["127.0.0.1"], uploads_per_minute_per_client=120
+    )
+    with live_server(settings, renderer) as url:
+        data = cmu_walk.read_bytes()
+        take, spare = (
+            httpx.post(f"{url}/api/v1/takes", files={"file": (name, data)}).json()
+            for name in ("walk.bvh", "spare.bvh")
+        )
+        deadline = time.monotonic() + RUN_BOUND_S
+        while httpx.get(f"{url}/api/v1/runs/{take['run_id']}").json()["status"] != "done":
+            assert time.monotonic() < deadline, "the take's analysis did not finish"
+            time.sleep(0.2)
+        env = {
+            **os.environ,
+            "MOCAPQA_ST_TAKE_ID": take["id"],
+            "MOCAPQA_ST_RUN_ID": take["run_id"],
+            "MOCAPQA_ST_SPARE_TAKE_ID": spare["id"],
+            "NO_COLOR": "1",
+        }
+        command = [
+            str(Path(sys.executable).with_name("schemathesis")),
+            "--config-file", str(CONFIG),
+            "run", f"{url}/openapi.json",
+            "--checks", "all",
+            "--max-examples", str(MAX_EXAMPLES),
+            "--workers", "1",
+            "--seed", "15",
+            "--phases", "examples,coverage,fuzzing",
+            "--no-color",
+        ]  # fmt: skip
+        done = subprocess.run(
+            command,
+            env=env,
+            cwd=tmp_path,  # its example database goes there, not into the checkout
+            capture_output=True,
+            text=True,
+            timeout=RUN_BOUND_S,
+            check=False,
+        )
+    ARTIFACTS.mkdir(exist_ok=True)
+    summary = done.stdout[done.stdout.find("WARNINGS") - 40 :]
+    (ARTIFACTS / "schemathesis.txt").write_text(summary)
+    assert done.returncode == 0, done.stdout[-6000:] + done.stderr[-2000:]
