@@ -142,9 +142,12 @@ def _frame_points(shape: tuple[int, ...], itemsize: int, path: Path, limits: Rea
 def _npy_header(handle: IO[bytes], path: Path) -> tuple[tuple[int, ...], int]:
     try:
         version = np.lib.format.read_magic(handle)
-        shape, _, dtype = np.lib.format._read_array_header(  # type: ignore[attr-defined]
-            handle, version, max_header_size=10_000
+        read_header = (
+            np.lib.format.read_array_header_1_0
+            if version == (1, 0)
+            else np.lib.format.read_array_header_2_0
         )
+        shape, _, dtype = read_header(handle, max_header_size=10_000)
     except (ValueError, OSError, EOFError) as e:
         raise ParseError(f"Expected a NumPy array header, got unreadable data ({e})", path) from e
     return tuple(int(n) for n in shape), int(dtype.itemsize)
