@@ -9,14 +9,14 @@ from typing import Any
 import pytest
 from fastapi.routing import APIRoute
 from fastapi.testclient import TestClient
+from tests.api.conftest import Uploader, Waiter, make_settings
+from tests.api.test_rendered import TRC
 
 from mocapqa.api.app import API_PREFIX, ROUTERS, create_app
 from mocapqa.api.errors import STATUS_MEANING
 from mocapqa.config import Settings
 from mocapqa.render.service import RenderService
 from mocapqa.store.repository import Repository
-from tests.api.conftest import Uploader, Waiter, make_settings
-from tests.api.test_rendered import TRC
 
 
 @pytest.mark.parametrize(

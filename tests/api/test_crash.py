@@ -19,7 +19,6 @@ from typing import Any
 
 import httpx
 import pytest
-
 from tests.api.live_server import free_port
 
 BOUND_S = 900.0

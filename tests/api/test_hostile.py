@@ -24,12 +24,12 @@ from typing import Any
 import httpx
 import numpy as np
 import pytest
+from tests.api.conftest import make_settings
+from tests.api.live_server import live_server
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
 from mocapqa.config import Settings
-from tests.api.conftest import make_settings
-from tests.api.live_server import live_server
 
 ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts"
 MAX_SECONDS = 20.0

@@ -18,10 +18,10 @@ from pathlib import Path
 
 import httpx
 import pytest
-
-from mocapqa.render.service import RenderService
 from tests.api.conftest import make_settings
 from tests.api.live_server import live_server
+
+from mocapqa.render.service import RenderService
 
 pytestmark = pytest.mark.schemathesis
 

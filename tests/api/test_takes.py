@@ -9,9 +9,10 @@ from typing import Any
 import numpy as np
 import pytest
 from fastapi.testclient import TestClient
+from tests.api.conftest import make_settings
 
 from mocapqa.api.app import create_app
-from tests.api.conftest import make_settings
+from mocapqa.config import Settings
 from mocapqa.io.bvh import parse_bvh, read_bvh
 from mocapqa.io.formats import read_take
 from mocapqa.jobs.demo import demo_paths

@@ -19,7 +19,9 @@ def serve(
     """Start the dashboard at http://HOST:PORT/ (API under /api/v1, OpenAPI at /docs).
 
     The data folder is ``MOCAPQA_DATA_DIR``; the database is SQLite there unless
-    ``MOCAPQA_DATABASE_URL`` names another.
+    ``MOCAPQA_DATABASE_URL`` names another. Requests must name this server in their
+    ``Host`` header: loopback names, the ``--host`` address, and ``MOCAPQA_ALLOWED_HOSTS``
+    (a JSON list) for anything else, such as the machine's name when serving on 0.0.0.0.
     """
     import uvicorn
 
@@ -29,5 +31,8 @@ def serve(
     settings = get_settings()
     if workers > 0:
         settings = settings.model_copy(update={"job_workers": workers})
+    if host not in ("0.0.0.0", "::", "") and host not in settings.allowed_hosts:
+        # The address served on is a name clients use; others go in MOCAPQA_ALLOWED_HOSTS.
+        settings = settings.model_copy(update={"allowed_hosts": [*settings.allowed_hosts, host]})
     typer.echo(f"mocapqa: data in {settings.data_dir}, dashboard at http://{host}:{port}/")
     uvicorn.run(create_app(settings, demo=demo), host=host, port=port, log_level="info")
