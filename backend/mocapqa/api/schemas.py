@@ -28,7 +28,9 @@ __all__ = [
 ]
 
 RunStatus = Literal["queued", "running", "done", "failed"]
+"""A run's status (an enum in the OpenAPI, also of the ``status`` query of the take list)."""
 ReviewStatus = Literal["unreviewed", "approved", "needs_fix", "rejected"]
+"""A take's review status."""
 
 
 class FieldError(BaseModel):
