@@ -171,3 +171,25 @@ def test_settings_document_every_limit() -> None:
     limits += ["uploads_per_minute_per_client", "allowed_hosts", "cors_origins"]
     missing = [name for name in limits if name not in docs]
     assert missing == []
+
+
+def test_queued_runs_per_client_are_limited(
+    tmp_path: Path, cmu_walk: Path, renderer: RenderService, upload: Uploader
+) -> None:
+    settings = make_settings("sqlite", tmp_path, max_queued_runs_per_client=2, job_workers=1)
+    with TestClient(create_app(settings, renderer=renderer)) as client:
+        runner = client.app.state.services.runner  # type: ignore[attr-defined]
+        take = upload(client, cmu_walk)
+        answers = [client.post(f"/api/v1/takes/{take['id']}/runs", json={}) for _ in range(4)]
+        statuses = [a.status_code for a in answers]
+        # the upload's run and the first extra one fill the quota while the worker is busy
+        assert 429 in statuses
+        refused = answers[statuses.index(429)]
+        assert refused.json()["error"] == "RateLimitError"
+        assert "max_queued_runs_per_client" in refused.json()["detail"]
+        assert int(refused.headers["retry-after"]) >= 1
+        for answer in answers:
+            if answer.status_code == 201:
+                runner.wait(answer.json()["id"], timeout_s=900)
+        runner.wait(take["run_id"], timeout_s=900)
+        assert client.post(f"/api/v1/takes/{take['id']}/runs", json={}).status_code == 201

@@ -29,13 +29,13 @@ def test_options_round_trip_and_name_bad_fields() -> None:
     assert AnalysisOptions.from_json(None) == AnalysisOptions()
     with pytest.raises(InputError, match="Expected option fields among"):
         AnalysisOptions.from_json({"speed": 1})
-    with pytest.raises(InputError, match="^checks: Expected names among"):
+    with pytest.raises(InputError, match=r"^checks: Expected names among"):
         AnalysisOptions(checks=("twist", "colour"))
-    with pytest.raises(InputError, match="^twist_method: Expected one of"):
+    with pytest.raises(InputError, match=r"^twist_method: Expected one of"):
         AnalysisOptions(twist_method="guess")
-    with pytest.raises(InputError, match="^filter_method: Expected one of"):
+    with pytest.raises(InputError, match=r"^filter_method: Expected one of"):
         AnalysisOptions(filter_method="median")
-    with pytest.raises(InputError, match="^max_points: Expected an integer"):
+    with pytest.raises(InputError, match=r"^max_points: Expected an integer"):
         AnalysisOptions.from_json({"max_points": "many"})
 
 
