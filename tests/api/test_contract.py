@@ -51,6 +51,10 @@ def test_keypoint_run_options_are_checked_at_the_request(
     bad = client.post(f"/api/v1/takes/{take['id']}/runs", json=params)
     assert bad.status_code == 422
     assert bad.json()["field"] == "filter_params.process_noise"
+    mapped = {"mapping": {"left_upper_arm": "LeftArm"}}
+    bad = client.post(f"/api/v1/takes/{take['id']}/runs", json=mapped)
+    assert bad.status_code == 422
+    assert bad.json()["field"] == "mapping"
     good = client.post(f"/api/v1/takes/{take['id']}/runs", json={"filter_preset": "note"})
     assert good.status_code == 201
 

@@ -143,9 +143,12 @@ class AnalysisOptions:
         ------
         OptionError
             Naming the option: a keypoint filter on a BVH, a rotation filter on keypoints,
-            or a preset or parameters with no filter to apply them to.
+            a preset or parameters with no filter to apply them to, a rig mapping for
+            keypoints.
         """
         wanted = "rotations" if kind == "motion" else "keypoints"
+        if kind != "motion" and self.mapping:
+            raise OptionError("mapping", "Expected the mapping option only for BVH takes")
         if self.filter_method is None:
             if kind == "motion" and (self.filter_preset or self.filter_params):
                 field_name = "filter_preset" if self.filter_preset else "filter_params"
