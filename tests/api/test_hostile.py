@@ -335,12 +335,13 @@ def test_stream_refuses_huge_keypoint_count(url: str) -> None:
 
 def test_stream_refuses_huge_frame(url: str) -> None:
     ws_url = url.replace("http", "ws") + "/api/v1/stream/filter"
+    frame = json.dumps({"positions": [[0.0, 0.0, 0.0]] * 200_000})
 
     def request() -> httpx.Response:
-        with connect(ws_url, max_size=None) as socket:
+        with connect(ws_url, max_size=None, compression=None) as socket:
             socket.send(json.dumps({"fps": 30, "n_keypoints": 17}))
             json.loads(socket.recv(timeout=60))
-            socket.send(json.dumps({"positions": [[0.0, 0.0, 0.0]] * 200_000}))
+            socket.send(frame)
             answer = json.loads(socket.recv(timeout=60))
         return httpx.Response(413 if "stream_max_frame_bytes" in answer.get("error", "") else 500)
 

@@ -35,4 +35,12 @@ def serve(
         # The address served on is a name clients use; others go in MOCAPQA_ALLOWED_HOSTS.
         settings = settings.model_copy(update={"allowed_hosts": [*settings.allowed_hosts, host]})
     typer.echo(f"mocapqa: data in {settings.data_dir}, dashboard at http://{host}:{port}/")
-    uvicorn.run(create_app(settings, demo=demo), host=host, port=port, log_level="info")
+    uvicorn.run(
+        create_app(settings, demo=demo),
+        host=host,
+        port=port,
+        log_level="info",
+        # A WebSocket message over the stream's limit is refused by the protocol (close 1009)
+        # before it is assembled; the app checks the same limit again.
+        ws_max_size=settings.stream_max_frame_bytes,
+    )
