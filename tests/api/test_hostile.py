@@ -376,3 +376,25 @@ def test_upload_rate_is_limited_per_client(tmp_path: Path, cmu_walk: Path) -> No
     assert statuses == [201, 201]
     assert response.status_code == 429
     assert 1 <= int(response.headers["retry-after"]) <= 61
+
+
+def test_stream_work_stays_off_the_event_loop(url: str) -> None:
+    """An allowed but heavy stream (1000 keypoints a frame) leaves /health answering."""
+    ws_url = url.replace("http", "ws") + "/api/v1/stream/filter"
+    rng = np.random.default_rng(15)
+    frames = [
+        json.dumps({"positions": rng.normal(size=(1000, 3)).round(4).tolist()}) for _ in range(30)
+    ]
+
+    def request() -> httpx.Response:
+        with connect(ws_url, max_size=None, compression=None) as socket:
+            socket.send(json.dumps({"fps": 30, "n_keypoints": 1000, "length_unit": "m"}))
+            assert json.loads(socket.recv(timeout=300))["ready"]
+            for frame in frames:
+                socket.send(frame)
+                answer = json.loads(socket.recv(timeout=300))
+                assert len(answer["positions"]) == 1000, answer
+        return httpx.Response(200)
+
+    response, _ = measure("WebSocket 30 frames × 1000 keypoints (allowed)", url, request)
+    assert response.status_code == 200
