@@ -398,3 +398,16 @@ def test_stream_work_stays_off_the_event_loop(url: str) -> None:
 
     response, _ = measure("WebSocket 30 frames × 1000 keypoints (allowed)", url, request)
     assert response.status_code == 200
+
+
+def test_large_unmarked_json_is_not_parsed_to_detect_it(url: str, settings: Settings) -> None:
+    """A 6 MB JSON with no format marker up front is told apart without parsing it (parsed,
+    its 1.8 million values would take about 70 MB of traced memory before any limit; it is
+    refused by its line length instead)."""
+    data = b"[" + b",".join([b"[0.5,0.5,0.5]"] * 450_000) + b"]"
+    response, case = measure(
+        "6 MB unmarked JSON array (450,000 numbers × 3)", url, lambda: upload(url, "a.json", data)
+    )
+    assert response.status_code == 413, response.text
+    assert case.peak_mb < 30
+    assert stored(settings, url) == (0, [])

@@ -63,6 +63,7 @@ TAKE_FORMATS: tuple[str, ...] = ("bvh", *KEYPOINT_FORMATS)
 KEYPOINT_WRITE_FORMATS: tuple[str, ...] = ("trc", "csv", "npy", "npz", "json")
 
 _SNIFF_BYTES = 4096
+_PARSE_TO_DETECT_BYTES = 1_000_000
 _BY_EXTENSION = {
     ".bvh": "bvh",
     ".trc": "trc",
@@ -90,6 +91,12 @@ def _json_kind(path: Path) -> str:
     if '"visibility"' in text or '"landmarks"' in text:
         return "mediapipe-json"
     try:
+        if path.stat().st_size > _PARSE_TO_DETECT_BYTES:
+            # Not parsed to be told apart (that would cost what the read limits guard):
+            # a list, or an object with no "keypoints" key anywhere, is MediaPipe's.
+            data = path.read_bytes()
+            top_is_list = data.lstrip(b"\xef\xbb\xbf \t\r\n")[:1] == b"["
+            return "mediapipe-json" if top_is_list or b'"keypoints"' not in data else "json"
         document: Any = json.loads(path.read_bytes())
     except (OSError, ValueError, RecursionError):
         return "json"
