@@ -6,12 +6,13 @@ The paper's protocol (methods §2): sample ``(s1, s2, τ)`` uniformly in ``[−�
 sample with the lookup map's ``isValid``, keep a balanced 50/50 set and split it 70/15/15 into
 training, validation and test sets. Valid samples are drawn uniformly over the valid region
 directly (a bin chosen in proportion to its twist interval, then a uniform point in the bin and
-the interval), which has the distribution of rejection sampling from the cube without its cost
-on sparse maps. A small ensemble, one network per hidden size (4–32 units; default 32 and 16)
-and seed, is trained with scikit-learn; the one with the best validation accuracy is kept and
-scored once on the test set. The first network's seed is drawn from the build's random stream
-and the other members' from a child stream, so the ensemble's size does not change the synthetic
-sets of the joints that follow.
+the interval, wrapped to ±180°; with interpolated bounds the interval is widened and the points
+the map rejects are dropped), which has the distribution of rejection sampling from the cube
+without its cost on sparse maps. A small ensemble, one network per hidden size (4–32 units;
+default 32 and 16) and seed, is trained with scikit-learn; the one with the best validation
+accuracy is kept and scored once on the test set. The first network's seed is drawn from the
+build's random stream and the other members' from a child stream, so the ensemble's size does
+not change the synthetic sets of the joints that follow.
 
 Training inputs are standardised: centred on the mean of the valid training samples and divided
 by twice their standard deviation, so the valid region spans about ``[−1, 1]`` on each axis
@@ -172,16 +173,24 @@ def synthetic_labels(
     """
     width = np.deg2rad(occupancy.bin_deg)
     i1, i2 = np.nonzero(occupancy.occupied)
-    spans = occupancy.tau_max[i1, i2] - occupancy.tau_min[i1, i2]
+    # Drawn from each bin's own arc, widened by a quarter turn when the bounds are
+    # interpolated (they vary inside a bin), then kept only where the map says valid.
+    extra = 0.25 * np.pi if occupancy.interpolate else 0.0
+    lows = occupancy.tau_min[i1, i2] - extra
+    spans = np.minimum(occupancy.tau_max[i1, i2] + extra - lows, 2.0 * np.pi)
     weights = np.maximum(spans, 1e-9)
-    pick = rng.choice(i1.size, size=n_valid, p=weights / weights.sum())
-    valid = np.column_stack(
-        (
-            -np.pi + (i1[pick] + rng.random(n_valid)) * width,
-            -np.pi + (i2[pick] + rng.random(n_valid)) * width,
-            occupancy.tau_min[i1[pick], i2[pick]] + rng.random(n_valid) * spans[pick],
+    valid = np.empty((0, 3))
+    while valid.shape[0] < n_valid:
+        pick = rng.choice(i1.size, size=n_valid, p=weights / weights.sum())
+        draw = np.column_stack(
+            (
+                -np.pi + (i1[pick] + rng.random(n_valid)) * width,
+                -np.pi + (i2[pick] + rng.random(n_valid)) * width,
+                (lows[pick] + rng.random(n_valid) * spans[pick] + np.pi) % (2.0 * np.pi) - np.pi,
+            )
         )
-    )
+        valid = np.concatenate((valid, draw[is_valid(occupancy, draw)]))
+    valid = valid[:n_valid]
     invalid = np.empty((0, 3))
     while invalid.shape[0] < n_valid:
         draw = rng.uniform(-np.pi, np.pi, size=(4 * n_valid, 3))
