@@ -16,13 +16,16 @@ import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.motion import Motion
+from mocapqa.core.rig import find_roles
 from mocapqa.errors import InputError, LimitsFileError
+from mocapqa.limits.canonical import CANONICAL_AXIS, CanonicalFrames, canonical_quats, rig_key
 from mocapqa.limits.discriminator import network_valid
 from mocapqa.limits.expmap import limit_params_from_quats
 from mocapqa.limits.model import LimitsModel, check_rig, load_default_model
-from mocapqa.limits.occupancy import is_valid, limit_distances
+from mocapqa.limits.occupancy import evaluate, limit_distances, signed_excess
+from mocapqa.limits.readout import violation_text
 
-__all__ = ["LimitsReport", "check_limits", "joint_map_json", "limit_params"]
+__all__ = ["LimitsReport", "charted", "check_limits", "joint_map_json", "limit_params"]
 
 _WORST = 5
 
@@ -47,6 +50,11 @@ class LimitsReport:
     fps : float
     rig_family : str
     method : {"map", "network"}
+    excess_deg : ndarray, shape (F, J, 3)
+        Signed excess of ``(s1, s2, τ)`` beyond the limits (0 inside), for the read-out.
+    not_checked : tuple of str
+        The take's joints this check does not cover (no role, or a role the model lacks),
+        and the model's roles missing from the take.
     """
 
     joint_names: tuple[str, ...]
@@ -59,6 +67,17 @@ class LimitsReport:
     fps: float
     rig_family: str
     method: str
+    excess_deg: FloatArray
+    not_checked: tuple[str, ...] = ()
+
+    def readout(self, frame: int, joint: int) -> str:
+        """Anatomical read-out of one frame and joint ("right knee hyperextended 14°").
+
+        Empty when the frame is valid or the joint has no role.
+        """
+        if self.valid[frame, joint]:
+            return ""
+        return violation_text(self.roles[joint], self.excess_deg[frame, joint].tolist())
 
     @property
     def flagged_fraction(self) -> float:
@@ -87,6 +106,7 @@ class LimitsReport:
                     "role": self.roles[j],
                     "flagged_fraction": float(1.0 - self.valid[:, j].mean()) if n else 0.0,
                     "max_score_deg": float(self.score_deg[:, j].max()) if n else 0.0,
+                    "readout": self.readout(int(order[0]), j) if n else "",
                     "worst_frames": [
                         {
                             "frame": f,
@@ -96,6 +116,7 @@ class LimitsReport:
                             "score_deg": round(float(self.score_deg[f, j]), 3),
                             "swing_deg": round(float(self.swing_deg[f, j]), 3),
                             "twist_deg": round(float(self.twist_deg[f, j]), 3),
+                            "readout": self.readout(f, j),
                         }
                         for f in worst
                     ],
@@ -113,11 +134,21 @@ class LimitsReport:
             "n_frames": n,
             "flagged_fraction": self.flagged_fraction,
             "joints": joints,
+            "not_checked": list(self.not_checked),
         }
 
 
-def limit_params(motion: Motion, model: LimitsModel) -> FloatArray:
-    """``(s1, s2, τ)`` in radians of the model's joints over ``motion``, shape (F, J, 3).
+def charted(motion: Motion, model: LimitsModel) -> tuple[FloatArray, list[int], tuple[str, ...]]:
+    """``(s1, s2, τ)`` of the model's joints found on the take, and what is not checked.
+
+    Returns
+    -------
+    params : ndarray, shape (F, K, 3)
+        Radians, for the K model joints present on the take.
+    columns : list of int
+        Index into ``model.joints`` of each of the K columns.
+    not_checked : tuple of str
+        Joint names of the take outside the check, then model roles missing from the take.
 
     Raises
     ------
@@ -125,10 +156,55 @@ def limit_params(motion: Motion, model: LimitsModel) -> FloatArray:
         If the model does not cover the take's rig.
     """
     check_rig(model, motion.skeleton)
-    index = [motion.skeleton.index(j.name) for j in model.joints]
-    axes = np.stack([j.axis for j in model.joints])
-    references = np.stack([j.reference for j in model.joints])
-    return limit_params_from_quats(motion.quats[:, index], axes, references)
+    if model.frame != "canonical":
+        index = [motion.skeleton.index(j.name) for j in model.joints]
+        axes = np.stack([j.axis for j in model.joints])
+        references = np.stack([j.reference for j in model.joints])
+        params = limit_params_from_quats(motion.quats[:, index], axes, references)
+        names = set(motion.skeleton.names) - {j.name for j in model.joints}
+        rest = tuple(n for n in motion.skeleton.names if n in names)
+        return params, list(range(len(model.joints))), rest
+    try:
+        frames, quats = canonical_quats(motion, known=_known_frames(motion, model))
+    except InputError as e:
+        raise LimitsFileError(f"Expected a skeleton the canonical frames apply to: {e}") from e
+    column = {role: k for k, role in enumerate(frames.roles)}
+    columns = [k for k, j in enumerate(model.joints) if j.role in column]
+    picked = [column[model.joints[k].role] for k in columns]
+    references = np.stack([model.joints[k].reference for k in columns])
+    params = limit_params_from_quats(quats[:, picked], CANONICAL_AXIS[None], references)
+    used = {int(frames.joints[c]) for c in picked}
+    unused = [n for i, n in enumerate(motion.skeleton.names) if i not in used]
+    missing = [j.role for j in model.joints if j.role not in column]
+    return params, columns, tuple(unused + missing)
+
+
+def _known_frames(motion: Motion, model: LimitsModel) -> CanonicalFrames | None:
+    """The model's stored frames of this take's rig, or None for a rig it has not seen."""
+    stored = model.rig_frames.get(rig_key(motion))
+    if stored is None:
+        return None
+    skeleton = motion.skeleton
+    try:
+        joints = np.array([skeleton.index(n) for n in stored.joints], dtype=np.intp)
+        parents = np.array([skeleton.index(n) for n in stored.parents], dtype=np.intp)
+    except KeyError:
+        return None
+    missing = tuple(j.role for j in model.joints if j.role not in stored.roles)
+    return CanonicalFrames(
+        stored.roles, joints, parents, stored.frames, stored.parent_frames, missing
+    )
+
+
+def limit_params(motion: Motion, model: LimitsModel) -> FloatArray:
+    """``(s1, s2, τ)`` in radians of the model's joints found on ``motion``, shape (F, K, 3).
+
+    Raises
+    ------
+    LimitsFileError
+        If the model does not cover the take's rig.
+    """
+    return charted(motion, model)[0]
 
 
 def check_limits(
@@ -159,23 +235,35 @@ def check_limits(
         raise InputError(f"Expected `method` 'map' or 'network', got {method!r}")
     if model is None:
         model = load_default_model(motion.skeleton)
-    params = limit_params(motion, model)
+    params, columns, not_checked = charted(motion, model)
     n_frames, n_joints = params.shape[:2]
     swing = np.zeros((n_frames, n_joints))
     twist = np.zeros((n_frames, n_joints))
+    excess = np.zeros((n_frames, n_joints, 3))
     valid = np.zeros((n_frames, n_joints), dtype=bool)
-    for j, joint in enumerate(model.joints):
-        swing[:, j], twist[:, j] = limit_distances(joint.occupancy, params[:, j])
+    joints = [model.joints[k] for k in columns]
+    for j, joint in enumerate(joints):
         if method == "map":
-            valid[:, j] = is_valid(joint.occupancy, params[:, j])
-        elif joint.network is None:
+            valid[:, j], swing[:, j], twist[:, j], excess[:, j] = evaluate(
+                joint.occupancy, params[:, j]
+            )
+            continue
+        swing[:, j], twist[:, j] = limit_distances(joint.occupancy, params[:, j])
+        excess[:, j] = signed_excess(joint.occupancy, params[:, j])
+        if joint.network is None:
             raise LimitsFileError(f"Expected a discriminator for joint {joint.name!r}, got none")
         else:
             valid[:, j] = network_valid(joint.network, params[:, j])
     score = np.where(valid & (method == "map"), 0.0, np.hypot(swing, twist))
+    excess = np.where(valid[..., None], 0.0, excess)
+    if model.frame == "canonical":
+        role_names = _role_joint_names(motion)
+        names = tuple(role_names.get(j.role, j.role) for j in joints)
+    else:
+        names = tuple(j.name for j in joints)
     return LimitsReport(
-        joint_names=tuple(j.name for j in model.joints),
-        roles=tuple(j.role for j in model.joints),
+        joint_names=names,
+        roles=tuple(j.role for j in joints),
         params_deg=np.rad2deg(params),
         valid=valid,
         score_deg=score,
@@ -184,7 +272,14 @@ def check_limits(
         fps=motion.fps,
         rig_family=model.rig_family,
         method=method,
+        excess_deg=excess,
+        not_checked=not_checked,
     )
+
+
+def _role_joint_names(motion: Motion) -> dict[str, str]:
+    rig = find_roles(motion.skeleton)
+    return {key: motion.skeleton.names[j] for key, j in rig.roles.items()}
 
 
 def joint_map_json(model: LimitsModel, joint: str) -> dict[str, Any]:

@@ -17,14 +17,35 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Motion
+from mocapqa.core.rig import SIDES, role_key
 from mocapqa.errors import InputError
+from mocapqa.limits.canonical import (
+    CANONICAL_AXIS,
+    CanonicalFrames,
+    canonical_quats,
+    rig_frames,
+    rig_key,
+)
 from mocapqa.limits.discriminator import DiscriminatorParams, train_discriminator
 from mocapqa.limits.expmap import limit_params_from_quats
-from mocapqa.limits.model import JointLimits, LimitsModel
+from mocapqa.limits.model import JointLimits, LimitsModel, StoredFrames
 from mocapqa.limits.occupancy import OccupancyParams, build_occupancy
-from mocapqa.limits.rig import bone_axis, fingerprint_mismatches, rig_family, rig_fingerprint
+from mocapqa.limits.rig import (
+    MODELLED_ROLES,
+    bone_axis,
+    fingerprint_mismatches,
+    rig_family,
+    rig_fingerprint,
+)
 
-__all__ = ["DEFAULT_BUILD", "PAPER_BUILD", "BuildParams", "build_model", "mean_rotation"]
+__all__ = [
+    "DEFAULT_BUILD",
+    "PAPER_BUILD",
+    "BuildParams",
+    "build_canonical_model",
+    "build_model",
+    "mean_rotation",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -52,9 +73,9 @@ class BuildParams:
             raise InputError(f"Expected `reference` 'mean' or 'identity', got {self.reference!r}")
 
 
-# The shipped models' setting, chosen by `mocapqa bench limits --sweep` (docs/limits.md).
+# The shipped models' setting, chosen on the build split (docs/limits.md).
 DEFAULT_BUILD = BuildParams(
-    occupancy=OccupancyParams(bin_deg=15.0, dilation_bins=2, tau_margin_deg=40.0)
+    occupancy=OccupancyParams(bin_deg=15.0, dilation_bins=2, tau_margin_deg=40.0, interpolate=True)
 )
 # The paper's setting: 1° bins, no dilation, no margin, identity reference.
 PAPER_BUILD = BuildParams(occupancy=OccupancyParams(bin_deg=1.0), reference="identity")
@@ -151,4 +172,111 @@ def build_model(
         corpus_hash=digest.hexdigest(),
         takes=tuple(take_names),
         n_frames=int(quats.shape[0]),
+    )
+
+
+def build_canonical_model(
+    motions: Sequence[Motion],
+    take_names: Sequence[str],
+    settings: BuildParams = DEFAULT_BUILD,
+    progress: Callable[[str], None] | None = None,
+) -> LimitsModel:
+    """Build one rig-independent model per role from takes of any rigs with roles.
+
+    Takes are grouped by rig (:func:`mocapqa.limits.canonical.rig_key`); each rig's canonical
+    frames are estimated over all its takes and stored in the model; every take's role joints
+    are charted in them, and a role's map pools every take that has the role.
+
+    Parameters
+    ----------
+    motions : sequence of Motion
+        Takes of any rigs whose roles are found.
+    take_names : sequence of str
+    settings : BuildParams
+    progress : callable, optional
+        Called with a role key after each role is built.
+
+    Returns
+    -------
+    LimitsModel
+        ``frame == "canonical"``; joint names are the role keys.
+
+    Raises
+    ------
+    InputError
+        If there are no takes, the names do not match, or a take has no limb roles.
+    """
+    if not motions or len(motions) != len(take_names):
+        raise InputError(
+            f"Expected one name per take and at least one take, got {len(motions)} takes and "
+            f"{len(take_names)} names"
+        )
+    groups: dict[str, list[int]] = {}
+    for i, motion in enumerate(motions):
+        groups.setdefault(rig_key(motion), []).append(i)
+    stored: dict[str, StoredFrames] = {}
+    known: dict[str, CanonicalFrames] = {}
+    for key, members in groups.items():
+        try:
+            frames = rig_frames([motions[i] for i in members])
+        except InputError as e:
+            raise InputError(f"{take_names[members[0]]}: {e}") from e
+        names = motions[members[0]].skeleton.names
+        known[key] = frames
+        stored[key] = StoredFrames(
+            family=rig_family(motions[members[0]].skeleton),
+            roles=frames.roles,
+            joints=tuple(names[j] for j in frames.joints),
+            parents=tuple(names[j] for j in frames.parents),
+            frames=frames.frames,
+            parent_frames=frames.parent_frames,
+        )
+    samples: dict[str, list[FloatArray]] = {}
+    digest = hashlib.sha256()
+    for motion, name in zip(motions, take_names, strict=True):
+        frames, quats = canonical_quats(motion, known=known[rig_key(motion)])
+        digest.update(name.encode("utf-8"))
+        digest.update(np.ascontiguousarray(quats).tobytes())
+        for k, role in enumerate(frames.roles):
+            samples.setdefault(role, []).append(quats[:, k])
+    order = [role_key(s, r) for s in SIDES for r in MODELLED_ROLES]
+    roles = [r for r in order if r in samples]
+    rng = np.random.default_rng(settings.seed)
+    joints = []
+    for role in roles:
+        quats = np.concatenate(samples[role], axis=0)
+        if settings.reference == "mean":
+            reference = mean_rotation(quats)
+        else:
+            reference = np.array([0.0, 0.0, 0.0, 1.0])
+        params = limit_params_from_quats(quats[:, None], CANONICAL_AXIS[None], reference[None])
+        occupancy = build_occupancy(params[:, 0], settings.occupancy)
+        network, scores = None, None
+        if settings.discriminator is not None:
+            network, scores = train_discriminator(occupancy, settings.discriminator, rng)
+        joints.append(
+            JointLimits(
+                role=role,
+                name=role,
+                axis=CANONICAL_AXIS.copy(),
+                reference=reference,
+                occupancy=occupancy,
+                network=network,
+                scores=scores,
+                n_samples=int(quats.shape[0]),
+            )
+        )
+        if progress is not None:
+            progress(role)
+    return LimitsModel(
+        rig_family="canonical",
+        fingerprint={},
+        joints=tuple(joints),
+        occupancy_params=settings.occupancy,
+        reference=settings.reference,
+        corpus_hash=digest.hexdigest(),
+        takes=tuple(take_names),
+        n_frames=int(sum(m.n_frames for m in motions)),
+        frame="canonical",
+        rig_frames=stored,
     )

@@ -28,7 +28,7 @@ import io
 import json
 import zipfile
 from collections.abc import Iterator
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -41,12 +41,14 @@ from mocapqa.core.motion import Skeleton
 from mocapqa.errors import LimitsFileError, MocapQAError
 from mocapqa.limits.discriminator import DiscriminatorScores, Network
 from mocapqa.limits.occupancy import OccupancyMap, OccupancyParams
-from mocapqa.limits.rig import fingerprint_mismatches, rig_family
+from mocapqa.limits.rig import fingerprint_mismatches, rig_family, rig_fingerprint
 
 __all__ = [
     "FORMAT_VERSION",
+    "PREFERRED_RIG_MODELS",
     "JointLimits",
     "LimitsModel",
+    "StoredFrames",
     "check_rig",
     "default_model_paths",
     "load_default_model",
@@ -55,6 +57,8 @@ __all__ = [
     "save_model",
 ]
 
+# Per-rig shipped models used instead of the canonical one on their own rig.
+PREFERRED_RIG_MODELS: frozenset[str] = frozenset()
 # Version of the .npz model layout; files of another version are refused.
 FORMAT_VERSION = 1
 _FORMAT = "mocapqa-limits"
@@ -94,6 +98,30 @@ class JointLimits:
 
 
 @dataclass(frozen=True, slots=True)
+class StoredFrames:
+    """Canonical frames of one rig a canonical model was built from.
+
+    Parameters
+    ----------
+    family : str
+        Readable rig label.
+    roles : tuple of str
+        Role keys.
+    joints, parents : tuple of str
+        Joint name per role, and the joint whose frame it is relative to.
+    frames, parent_frames : ndarray, shape (R, 4)
+        See :class:`mocapqa.limits.canonical.CanonicalFrames`.
+    """
+
+    family: str
+    roles: tuple[str, ...]
+    joints: tuple[str, ...]
+    parents: tuple[str, ...]
+    frames: FloatArray
+    parent_frames: FloatArray
+
+
+@dataclass(frozen=True, slots=True)
 class LimitsModel:
     """Learned joint limits for one rig family.
 
@@ -116,6 +144,13 @@ class LimitsModel:
         Frames in the build corpus.
     version : str
         mocapqa version that built the model.
+    frame : {"rig", "canonical"}
+        "rig": rotations in the rig's own joint frames (one rig, checked by fingerprint);
+        "canonical": rotations in the anatomical frames of :mod:`mocapqa.limits.canonical`,
+        so the model applies to any skeleton with roles.
+    rig_frames : dict
+        Canonical models only: :func:`mocapqa.limits.canonical.rig_key` → the
+        :class:`StoredFrames` of each rig the model was built from.
     """
 
     rig_family: str
@@ -127,6 +162,8 @@ class LimitsModel:
     takes: tuple[str, ...]
     n_frames: int
     version: str = __version__
+    frame: str = "rig"
+    rig_frames: dict[str, StoredFrames] = field(default_factory=dict)
 
     def joint(self, name_or_role: str) -> JointLimits:
         """The joint with this name or role key.
@@ -151,6 +188,13 @@ def check_rig(model: LimitsModel, skeleton: Skeleton) -> None:
     LimitsFileError
         Naming the model's rig family, the skeleton's and the first differences.
     """
+    if model.frame == "canonical":
+        if not rig_fingerprint(skeleton):
+            raise LimitsFileError(
+                f"Expected a skeleton with limb roles for the canonical limits model, got none "
+                f"among {list(skeleton.names[:6])}"
+            )
+        return
     problems = fingerprint_mismatches(model.fingerprint, skeleton)
     if problems:
         shown = "; ".join(problems[:3]) + (
@@ -175,6 +219,17 @@ def _meta(model: LimitsModel) -> dict[str, Any]:
         "corpus_hash": model.corpus_hash,
         "takes": list(model.takes),
         "n_frames": model.n_frames,
+        "frame": model.frame,
+        "rigs": [
+            {
+                "key": key,
+                "family": f.family,
+                "roles": list(f.roles),
+                "joints": list(f.joints),
+                "parents": list(f.parents),
+            }
+            for key, f in model.rig_frames.items()
+        ],
         "joints": [
             {
                 "role": j.role,
@@ -204,6 +259,9 @@ def model_bytes(model: LimitsModel) -> bytes:
             arrays[f"{k}/hidden_biases"] = j.network.hidden_biases
             arrays[f"{k}/output_weights"] = j.network.output_weights
             arrays[f"{k}/output_bias"] = np.array([j.network.output_bias])
+    for i, stored in enumerate(model.rig_frames.values()):
+        arrays[f"rig{i}/frames"] = stored.frames
+        arrays[f"rig{i}/parent_frames"] = stored.parent_frames
     buffer = io.BytesIO()
     np.savez_compressed(buffer, **arrays)
     return buffer.getvalue()
@@ -276,6 +334,30 @@ def _model_from_npz(data: Any, where: str) -> LimitsModel:
         takes=tuple(str(t) for t in meta["takes"]),
         n_frames=int(meta["n_frames"]),
         version=str(meta["mocapqa_version"]),
+        frame=str(meta.get("frame", "rig")),
+        rig_frames={
+            str(entry["key"]): _stored_frames(i, entry, data)
+            for i, entry in enumerate(meta.get("rigs", []))
+        },
+    )
+
+
+def _stored_frames(i: int, entry: dict[str, Any], data: Any) -> StoredFrames:
+    roles = tuple(str(r) for r in entry["roles"])
+    frames = np.asarray(data[f"rig{i}/frames"], dtype=np.float64)
+    parent_frames = np.asarray(data[f"rig{i}/parent_frames"], dtype=np.float64)
+    if frames.shape != (len(roles), 4) or parent_frames.shape != (len(roles), 4):
+        raise LimitsFileError(
+            f"Expected rig {i} frames of shape ({len(roles)}, 4), got {frames.shape} and "
+            f"{parent_frames.shape}"
+        )
+    return StoredFrames(
+        family=str(entry["family"]),
+        roles=roles,
+        joints=tuple(str(j) for j in entry["joints"]),
+        parents=tuple(str(j) for j in entry["parents"]),
+        frames=frames,
+        parent_frames=parent_frames,
     )
 
 
@@ -326,7 +408,10 @@ def _shipped_models() -> tuple[LimitsModel, ...]:
 
 
 def load_default_model(skeleton: Skeleton) -> LimitsModel:
-    """The shipped limits model that covers ``skeleton``'s rig.
+    """The shipped limits model for ``skeleton``: the canonical one, for any rig with roles.
+
+    A shipped per-rig model is preferred only when it is listed in :data:`PREFERRED_RIG_MODELS`
+    (measured better on its rig; none is today, see ``docs/limits.md``).
 
     Parameters
     ----------
@@ -339,10 +424,22 @@ def load_default_model(skeleton: Skeleton) -> LimitsModel:
     Raises
     ------
     LimitsFileError
-        If no shipped model covers the rig (the message lists the families that are covered).
+        If the skeleton has no limb roles (or no shipped model covers it).
     """
+    models = _shipped_models()
+    for model in models:
+        if (
+            model.frame == "rig"
+            and model.rig_family in PREFERRED_RIG_MODELS
+            and not fingerprint_mismatches(model.fingerprint, skeleton)
+        ):
+            return model
+    for model in models:
+        if model.frame == "canonical":
+            check_rig(model, skeleton)
+            return model
     families = []
-    for model in _shipped_models():
+    for model in models:
         families.append(model.rig_family)
         if not fingerprint_mismatches(model.fingerprint, skeleton):
             return model

@@ -1,0 +1,453 @@
+"""A canonical (anatomical) frame per role joint, so limits mean the same on every rig.
+
+Every rig bakes its own joint orientations into its rotations: Character Creator bones run
+along local +Y with the legs resting at a 180° swing, Bandai bones along ±X, CMU along the
+world axes of a T-pose. The same anatomical motion therefore gives different local rotations
+on each rig. This module finds, for each role joint ``j``, a constant rotation ``C_j`` from an
+anatomical frame to the joint's local frame, so that ``A_j = R_j C_j`` (``R_j`` the joint's
+world rotation) is the segment's anatomical frame:
+
+* ``y`` — the long axis, from the joint to the next role joint down the limb (upper arm →
+  forearm, ..., foot → toe); a hand (or a foot without a toe) points to the mean of its
+  children's OFFSETs (the knuckles), or, when they are all zero (CMU, Bandai), along its
+  parent's bone as seen from its own frame on average over the frames;
+* ``x`` — the flexion axis, the normal of the limb plane: ``y × u`` with ``u`` the neighbouring
+  segment (upper arm and upper leg: the forearm / lower leg; forearm, hand, lower leg and foot:
+  their parent segment; clavicle: the body's up axis). Its direction about the long axis in the
+  joint's frame is the weighted circular median over the take's frames (weights sin² of the
+  bend, so straight frames weigh nothing, and a burst of twist errors in less than half the
+  weight cannot move it), signed to point to the body's left (forward for the clavicle). When
+  the limb hardly bends in the take (mean sin² of the bend below sin² 10°), the body's left
+  axis is used;
+* ``z = x × y``.
+
+The body's left axis is the right→left hip vector (shoulders for the arms), the up axis runs
+from the hips' midpoint to the shoulders' midpoint. The parent frame of a clavicle or an upper
+leg is the body frame in its skeleton parent's frame: ``x`` left, ``y`` up (down for the legs,
+so that standing is near the identity), ``z = x × y``.
+The canonical local rotation of a role joint is ``Q_j = conj(A_parent) ⊗ A_j``, with the
+parent the previous role joint of the limb, so helper joints between them (twist bones, CMU's
+``LHipJoint``) do not matter.
+
+**Reference pose.** The frames come from the takes' own frames (world geometry of every frame),
+not from the OFFSET rest pose: the zero-rotation pose of Character Creator and Bandai points
+every limb the same way, so it holds no anatomy, and no take of those rigs starts in a T-pose
+except ``007_04`` / ``007_12``. For hinge-like joints (knee, elbow, ankle) the limb plane is
+the joint's hinge and is the same in every take of a rig; for the forearm and the hand it
+follows the take's mean pronation. Everything is computed from world positions and rotations,
+so re-expressing a rig with rotated joint frames (same world poses) gives identical ``Q_j``.
+
+A take's own frames follow it when most of its frames are damaged (a short clip with long
+bursts of twist errors), so a model stores the frames of every rig it was built from, estimated
+over all that rig's takes (:func:`rig_frames`, looked up by :func:`rig_key`); only a rig the
+model has not seen is framed from the take being checked.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from mocapqa.core.arrays import FloatArray
+from mocapqa.core.motion import Motion, Skeleton
+from mocapqa.core.rig import SIDES, RigMap, find_roles, role_key
+from mocapqa.errors import InputError
+from mocapqa.kinematics.forward import forward_kinematics
+from mocapqa.kinematics.quaternion import conjugate, multiply, rotate
+from mocapqa.limits.rig import MODELLED_ROLES, axis_label
+
+__all__ = [
+    "CANONICAL_AXIS",
+    "CanonicalFrames",
+    "canonical_frames",
+    "canonical_quats",
+    "canonical_rotations",
+    "rig_frames",
+    "rig_key",
+    "role_parent",
+]
+
+# The long axis of every canonical frame.
+CANONICAL_AXIS = np.array([0.0, 1.0, 0.0])
+
+_PARENT_ROLE = {
+    "upper_arm": "clavicle",
+    "forearm": "upper_arm",
+    "hand": "forearm",
+    "lower_leg": "upper_leg",
+    "foot": "lower_leg",
+}
+_DISTAL_ROLE = {
+    "clavicle": "upper_arm",
+    "upper_arm": "forearm",
+    "forearm": "hand",
+    "upper_leg": "lower_leg",
+    "lower_leg": "foot",
+    "foot": "toe",
+}
+_MIN_BEND_SIN2 = float(np.sin(np.deg2rad(10.0)) ** 2)
+_MEDIAN_FRAMES = 4000
+_ARM_ROLES = ("clavicle", "upper_arm", "forearm", "hand")
+
+
+def role_parent(role: str) -> str | None:
+    """The role whose anatomical frame a role's rotation is taken relative to (None: body)."""
+    return _PARENT_ROLE.get(role)
+
+
+@dataclass(frozen=True, slots=True)
+class CanonicalFrames:
+    """Canonical frames of one take's role joints.
+
+    Parameters
+    ----------
+    roles : tuple of str
+        Role keys found, in :data:`MODELLED_ROLES` order, left side first.
+    joints : ndarray of int, shape (R,)
+        Joint index per role.
+    parents : ndarray of int, shape (R,)
+        Joint index whose frame each role is relative to (the parent role's joint, or the
+        skeleton parent for a clavicle / upper leg).
+    frames : ndarray, shape (R, 4)
+        ``C_j``: anatomical → local joint frame, unit quaternions (scalar-last).
+    parent_frames : ndarray, shape (R, 4)
+        The same for the parents (the body frame for a clavicle / upper leg).
+    not_checked : tuple of str
+        Modelled role keys absent from the skeleton.
+    """
+
+    roles: tuple[str, ...]
+    joints: np.ndarray
+    parents: np.ndarray
+    frames: FloatArray
+    parent_frames: FloatArray
+    not_checked: tuple[str, ...]
+
+
+def _unit(v: FloatArray) -> FloatArray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return np.asarray(v / np.where(n > 1e-12, n, 1.0), dtype=np.float64)
+
+
+def _local(world_quats: FloatArray, vectors: FloatArray) -> FloatArray:
+    """World vectors ``(F, 3)`` in a joint's frame (``R^T v``), shape (F, 3)."""
+    return rotate(conjugate(world_quats), vectors)
+
+
+def _frame_quat(x: FloatArray, y: FloatArray) -> FloatArray:
+    """Quaternion of the frame with columns ``(x⊥, y, x⊥ × y)``, ``y`` taken exactly."""
+    y = _unit(y)
+    x = _unit(x - np.dot(x, y) * y)
+    matrix = np.stack((x, y, np.cross(x, y)), axis=1)
+    return np.asarray(Rotation.from_matrix(matrix).as_quat(), dtype=np.float64)
+
+
+def _median_direction(
+    vectors: FloatArray, axis: FloatArray, sign_ref: FloatArray
+) -> tuple[FloatArray, float]:
+    """Robust direction of ``vectors`` ``(F, 3)`` around ``axis``, and their mean squared norm.
+
+    The weighted circular median (weights = squared norms, so straight limbs weigh nothing)
+    of the vectors' azimuths about ``axis``, on a 1° grid: up to half the frames may point
+    anywhere (a burst of twist errors) without moving it. Signed like ``sign_ref``.
+    """
+    e1 = _unit(sign_ref - np.dot(sign_ref, axis) * axis)
+    if np.linalg.norm(e1) < 0.5:
+        e1 = _unit(np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0]))
+    e2 = np.cross(axis, e1)
+    weights = np.sum(vectors * vectors, axis=-1)
+    azimuth = np.arctan2(vectors @ e2, vectors @ e1)
+    best = 0.0
+    # Coarse to fine: 10° steps round the circle, then 1° steps around the best.
+    for grid in (np.deg2rad(np.arange(-180.0, 180.0, 10.0)), np.deg2rad(np.arange(-10.0, 11.0))):
+        candidates = best + grid
+        cost = np.abs((azimuth[None, :] - candidates[:, None] + np.pi) % (2 * np.pi) - np.pi)
+        best = float(candidates[int(np.argmin(cost @ weights))])
+    direction = np.cos(best) * e1 + np.sin(best) * e2
+    if np.dot(direction, sign_ref) < 0:
+        direction = -direction
+    return np.asarray(direction, dtype=np.float64), float(np.mean(weights))
+
+
+def _end_axis(skeleton: Skeleton, joint: int) -> FloatArray | None:
+    """Long axis of a segment without a next role joint (a hand): toward the mean of its
+    children and End Sites (the knuckles); None when they all sit at zero offset.
+
+    A sum, not the longest child, so two children of equal length cannot swap places.
+    """
+    offsets = [skeleton.offsets[c] for c in skeleton.children(joint)]
+    offsets += [np.asarray(o, dtype=np.float64) for o in skeleton.end_site_offsets(joint)]
+    total = np.sum(offsets, axis=0) if offsets else np.zeros(3)
+    if np.linalg.norm(total) > 1e-4:
+        return _unit(np.asarray(total, dtype=np.float64))
+    return None
+
+
+def _body_axes(rig: RigMap, positions: FloatArray, arms: bool) -> tuple[FloatArray, FloatArray]:
+    """Per-frame body left and up axes ``(F, 3)`` from the hips and shoulders."""
+    pairs = (
+        [("upper_arm", "clavicle"), ("upper_leg",)]
+        if arms
+        else [("upper_leg",), ("upper_arm", "clavicle")]
+    )
+    left = None
+    for group in pairs:
+        for role in group:
+            jl, jr = rig.joint("left", role), rig.joint("right", role)
+            if jl is not None and jr is not None:
+                left = positions[:, jl] - positions[:, jr]
+                break
+        if left is not None:
+            break
+    mids = []
+    for group in (("upper_leg",), ("upper_arm", "clavicle")):
+        for role in group:
+            jl, jr = rig.joint("left", role), rig.joint("right", role)
+            if jl is not None and jr is not None:
+                mids.append(0.5 * (positions[:, jl] + positions[:, jr]))
+                break
+    if left is None or len(mids) != 2:
+        raise InputError(
+            "Expected both hips and both shoulders (or clavicles) among the roles to find the "
+            f"body's axes, got roles {sorted(rig.roles)}"
+        )
+    return _unit(left), _unit(mids[1] - mids[0])
+
+
+def canonical_frames(
+    motion: Motion,
+    rig: RigMap | None = None,
+    world: tuple[FloatArray, FloatArray] | None = None,
+) -> CanonicalFrames:
+    """Canonical frame of every modelled role joint of a take.
+
+    Parameters
+    ----------
+    motion : Motion
+        Any rig whose roles are found by :func:`mocapqa.core.rig.find_roles`.
+    rig : RigMap, optional
+        Roles to use instead of the automatic ones.
+    world : (ndarray, ndarray), optional
+        The take's world rotations ``(F, J, 4)`` and positions ``(F, J, 3)``, when computed.
+
+    Returns
+    -------
+    CanonicalFrames
+
+    Raises
+    ------
+    InputError
+        If the skeleton has no modelled role, or lacks the hips and shoulders that give the
+        body's axes.
+    """
+    skeleton = motion.skeleton
+    rig = find_roles(skeleton) if rig is None else rig
+    keys = [(s, r) for s in SIDES for r in MODELLED_ROLES if rig.joint(s, r) is not None]
+    if not keys:
+        raise InputError(
+            f"Expected a skeleton with limb roles, got none among {skeleton.names[:8]}"
+        )
+    quats, positions = forward_kinematics(motion) if world is None else world
+    if quats.shape[0] > _MEDIAN_FRAMES:
+        # Evenly spaced frames: the medians are as stable and the cost stays bounded.
+        keep = np.linspace(0, quats.shape[0] - 1, _MEDIAN_FRAMES).astype(np.intp)
+        quats, positions = quats[keep], positions[keep]
+    body = {arms: _body_axes(rig, positions, arms) for arms in (True, False)}
+    roles, joints, parents, frames, parent_frames = [], [], [], [], []
+    cache: dict[int, FloatArray] = {}
+    long_axes: dict[int, FloatArray] = {}
+
+    def long_axis(side: str, role: str, joint: int) -> FloatArray:
+        distal = rig.joint(side, _DISTAL_ROLE[role]) if role in _DISTAL_ROLE else None  # type: ignore[arg-type]
+        if distal is None:
+            axis = _end_axis(skeleton, joint)
+            if axis is not None:
+                return axis
+            # No child offsets (CMU and Bandai hands): the segment continues its parent's
+            # bone, seen from its own frame, on average over the frames.
+            parent = int(skeleton.parents[joint])
+            direction = _local(quats[:, joint], positions[:, joint] - positions[:, parent])
+            return _unit(np.mean(_unit(direction), axis=0))
+        direction = _local(quats[:, joint], positions[:, distal] - positions[:, joint])
+        return _unit(np.mean(_unit(direction), axis=0))
+
+    def world_long(side: str, role: str, joint: int) -> FloatArray:
+        if joint not in long_axes:
+            long_axes[joint] = long_axis(side, role, joint)
+        return rotate(quats[:, joint], np.broadcast_to(long_axes[joint], (quats.shape[0], 3)))
+
+    def frame_of(side: str, role: str, joint: int) -> FloatArray:
+        if joint in cache:
+            return cache[joint]
+        left_w, up_w = body[role in _ARM_ROLES]
+        along = world_long(side, role, joint)
+        if role == "clavicle":
+            partner = up_w
+            sign_w = np.cross(left_w, up_w)
+        elif role in ("upper_arm", "upper_leg"):
+            child = rig.joint(side, _DISTAL_ROLE[role])  # type: ignore[arg-type]
+            partner = world_long(side, _DISTAL_ROLE[role], child) if child is not None else left_w
+            sign_w = left_w
+        else:
+            parent_role = _PARENT_ROLE[role]
+            parent = rig.joint(side, parent_role)  # type: ignore[arg-type]
+            partner = world_long(side, parent_role, parent) if parent is not None else left_w
+            sign_w = left_w
+        normals = _local(quats[:, joint], np.cross(along, partner))
+        sign_ref = np.mean(_local(quats[:, joint], sign_w), axis=0)
+        flexion, bend = _median_direction(normals, long_axes[joint], sign_ref)
+        if bend < _MIN_BEND_SIN2:
+            flexion = sign_ref
+        cache[joint] = _frame_quat(flexion, long_axes[joint])
+        return cache[joint]
+
+    for side, role in keys:
+        joint = rig.joint(side, role)
+        assert joint is not None
+        frames.append(frame_of(side, role, joint))
+        parent_role = _PARENT_ROLE.get(role)
+        parent = rig.joint(side, parent_role) if parent_role else None  # type: ignore[arg-type]
+        if parent is not None and parent_role is not None:
+            parent_frames.append(frame_of(side, parent_role, parent))
+        else:
+            parent = int(skeleton.parents[joint])
+            if parent < 0:
+                raise InputError(f"Expected role joint {skeleton.names[joint]!r} to have a parent")
+            left_w, up_w = body[role in _ARM_ROLES]
+            left_l = np.mean(_local(quats[:, parent], left_w), axis=0)
+            up_l = np.mean(_local(quats[:, parent], up_w), axis=0)
+            # Legs hang: their body frame's long axis points down, so standing is near identity.
+            parent_frames.append(_frame_quat(left_l, up_l if role in _ARM_ROLES else -up_l))
+        roles.append(role_key(side, role))
+        joints.append(joint)
+        parents.append(parent)
+    missing = tuple(
+        role_key(s, r) for s in SIDES for r in MODELLED_ROLES if rig.joint(s, r) is None
+    )
+    return CanonicalFrames(
+        roles=tuple(roles),
+        joints=np.asarray(joints, dtype=np.intp),
+        parents=np.asarray(parents, dtype=np.intp),
+        frames=np.stack(frames),
+        parent_frames=np.stack(parent_frames),
+        not_checked=missing,
+    )
+
+
+def _world_rotations(motion: Motion, joints: np.ndarray) -> FloatArray:
+    """World rotations ``(F, len(joints), 4)`` of some joints: their ancestors only are walked."""
+    parents = motion.skeleton.parents
+    needed: set[int] = set()
+    for joint in joints.tolist():
+        while joint >= 0 and joint not in needed:
+            needed.add(joint)
+            joint = int(parents[joint])
+    world: dict[int, FloatArray] = {}
+    for joint in sorted(needed):
+        parent = int(parents[joint])
+        local = motion.quats[:, joint]
+        world[joint] = local if parent < 0 else multiply(world[parent], local)
+    return np.stack([world[j] for j in joints.tolist()], axis=1)
+
+
+def _right_matrices(quats: FloatArray) -> FloatArray:
+    """Matrices ``M (..., 4, 4)`` with ``p ⊗ q = M(q) p`` (scalar-last quaternions)."""
+    x, y, z, w = quats[..., 0], quats[..., 1], quats[..., 2], quats[..., 3]
+    rows = (
+        (w, z, -y, x),
+        (-z, w, x, y),
+        (y, -x, w, z),
+        (-x, -y, -z, w),
+    )
+    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+
+
+def canonical_rotations(motion: Motion, frames: CanonicalFrames) -> FloatArray:
+    """Canonical local rotations ``Q_j = conj(R_parent C_parent) ⊗ R_j C_j``.
+
+    Parameters
+    ----------
+    motion : Motion
+    frames : CanonicalFrames
+        From :func:`canonical_frames` on the same skeleton.
+
+    Returns
+    -------
+    ndarray, shape (F, R, 4)
+        Unit quaternions, one column per role of ``frames``.
+    """
+    world = _world_rotations(motion, np.concatenate((frames.joints, frames.parents)))
+    n = len(frames.joints)
+    # Right products by constant frames as one matrix product each.
+    child = np.einsum("rij,frj->fri", _right_matrices(frames.frames), world[:, :n])
+    parent = np.einsum("rij,frj->fri", _right_matrices(frames.parent_frames), world[:, n:])
+    return multiply(conjugate(parent), child)
+
+
+def canonical_quats(
+    motion: Motion, rig: RigMap | None = None, known: CanonicalFrames | None = None
+) -> tuple[CanonicalFrames, FloatArray]:
+    """Canonical frames of a take and its canonical rotations ``(F, R, 4)``.
+
+    ``known`` (frames of the rig estimated over many takes, :func:`rig_frames`) is used as is;
+    otherwise the frames are estimated from this take (from at most 4,000 evenly spaced frames).
+    """
+    if known is None:
+        sample = motion
+        if motion.n_frames > _MEDIAN_FRAMES:
+            keep = np.linspace(0, motion.n_frames - 1, _MEDIAN_FRAMES).astype(np.intp)
+            sample = Motion(
+                motion.skeleton, motion.quats[keep], motion.translations[keep], motion.fps
+            )
+        known = canonical_frames(sample, rig)
+    return known, canonical_rotations(motion, known)
+
+
+def rig_key(motion: Motion) -> str:
+    """A key of a rig's joint conventions: joint names, parents, channels and OFFSET axes.
+
+    The axis label of each OFFSET (``"+y"``, ``"-x"``, ...) stands for the joint frames: takes
+    of one rig share it whatever the performer's proportions, while a rig re-expressed with
+    rotated joint frames gets another key.
+    """
+    import hashlib
+
+    skeleton = motion.skeleton
+    digest = hashlib.sha256()
+    for j, (name, parent, channels) in enumerate(
+        zip(skeleton.names, skeleton.parents.tolist(), skeleton.channels, strict=True)
+    ):
+        offset = skeleton.offsets[j]
+        label = axis_label(offset) if np.linalg.norm(offset) > 1e-4 else "0"
+        digest.update(f"{name}|{parent}|{','.join(channels)}|{label};".encode())
+    return digest.hexdigest()[:16]
+
+
+def rig_frames(motions: Sequence[Motion]) -> CanonicalFrames:
+    """Canonical frames of one rig estimated over several of its takes at once.
+
+    The world poses of every take are pooled, so the medians of
+    :func:`canonical_frames` run over all their frames: one short or damaged take cannot move
+    them. Every take must have the same :func:`rig_key`.
+
+    Raises
+    ------
+    InputError
+        If the takes are of different rigs (or none is given).
+    """
+    if not motions:
+        raise InputError("Expected at least one take, got none")
+    key = rig_key(motions[0])
+    worlds = []
+    for motion in motions:
+        if rig_key(motion) != key:
+            raise InputError("Expected takes of one rig (same joints and channels), got several")
+        worlds.append(forward_kinematics(motion))
+    pooled = (
+        np.concatenate([w[0] for w in worlds]),
+        np.concatenate([w[1] for w in worlds]),
+    )
+    return canonical_frames(motions[0], world=pooled)
