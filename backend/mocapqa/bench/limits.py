@@ -37,8 +37,10 @@ __all__ = [
     "RigFigures",
     "RigTakes",
     "bench_rig",
+    "canonical_takes",
     "corpus_rigs",
     "held_back",
+    "role_takes",
 ]
 
 
@@ -144,6 +146,39 @@ def corpus_rigs(corpus_dir: Path, families: tuple[str, ...] | None = None) -> li
         back = tuple(t for i, t in enumerate(takes) if held_back(i))
         rigs.append(RigTakes(str(key[0]), build, back))
     return sorted(rigs, key=lambda r: r.family)
+
+
+def role_takes(corpus_dir: Path) -> list[tuple[str, Motion]]:
+    """Every BVH take under ``corpus_dir`` whose skeleton has limb roles, sorted by file name.
+
+    Raises
+    ------
+    InputError
+        If a file cannot be read (naming it).
+    """
+    root = corpus_dir / "bvh" if (corpus_dir / "bvh").is_dir() else corpus_dir
+    takes = []
+    for path in sorted(root.rglob("*.bvh"), key=lambda p: p.name):
+        motion = read_bvh(path)
+        if rig_fingerprint(motion.skeleton):
+            takes.append((path.name, motion))
+    return takes
+
+
+def canonical_takes(
+    corpus_dir: Path, all_takes: bool = False, exclude: set[str] | frozenset[str] = frozenset()
+) -> tuple[tuple[str, Motion], ...]:
+    """The takes a canonical model is built from: every take with roles, of any rig.
+
+    Takes of a rig family with two or more takes follow the fixed split (only the build
+    takes, unless ``all_takes``); single takes of other rigs are all used. Names in
+    ``exclude`` are left out.
+    """
+    held = set()
+    if not all_takes:
+        for rig in corpus_rigs(corpus_dir):
+            held |= {n for n, _ in rig.held_back}
+    return tuple((n, m) for n, m in role_takes(corpus_dir) if n not in held and n not in exclude)
 
 
 def _speed(model: LimitsModel, motion: Motion, method: str, repeats: int) -> float:

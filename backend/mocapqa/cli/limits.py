@@ -50,7 +50,8 @@ def limits_build(
     corpus_dir: Annotated[Path, typer.Argument(help="Folder searched recursively for BVH takes.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Model file (.npz) to write.")],
     rig: Annotated[
-        str | None, typer.Option(help="Rig family to build (cmu, character_creator, bandai).")
+        str | None,
+        typer.Option(help="Build a per-rig model of this family (cmu, character_creator, bandai)."),
     ] = None,
     all_takes: Annotated[
         bool, typer.Option("--all-takes", help="Build on every take, not only the build split.")
@@ -64,22 +65,43 @@ def limits_build(
         bool, typer.Option(help="The paper's setting (1° bins, no widening).")
     ] = False,
     networks: Annotated[bool, typer.Option(help="Train the discriminators.")] = True,
+    n_valid: Annotated[
+        int | None, typer.Option(help="Valid synthetic samples per joint (default 20000).")
+    ] = None,
+    exclude: Annotated[
+        list[str] | None, typer.Option(help="Take file names to leave out (repeatable).")
+    ] = None,
 ) -> None:
-    """Build a joint-limits model from a corpus of BVH takes of one rig family."""
+    """Build a joint-limits model from a folder of BVH takes.
+
+    Without --rig: one rig-independent (canonical) model per role from the takes of every rig
+    with roles. With --rig: a model in that rig's own joint frames.
+    """
+    from dataclasses import replace
+
     from rich.progress import Progress
 
-    from mocapqa.bench.limits import corpus_rigs
-    from mocapqa.limits.build import build_model
+    from mocapqa.bench.limits import canonical_takes, corpus_rigs
+    from mocapqa.limits.build import build_canonical_model, build_model
     from mocapqa.limits.model import save_model
 
     settings = _build_params(bin_deg, dilation, margin_deg, paper, networks)
-    rigs = corpus_rigs(corpus_dir, (rig,) if rig else None)
-    if len(rigs) != 1:
-        found = [r.family for r in rigs]
-        raise InputError(
-            f"Expected takes of exactly one rig family in {corpus_dir} (use --rig), got {found}"
-        )
-    takes = rigs[0].build + (rigs[0].held_back if all_takes else ())
+    if n_valid is not None and settings.discriminator is not None:
+        settings = replace(settings, discriminator=replace(settings.discriminator, n_valid=n_valid))
+    left_out = set(exclude or ())
+    if rig is None:
+        takes = canonical_takes(corpus_dir, all_takes, left_out)
+        builder = build_canonical_model
+    else:
+        rigs = corpus_rigs(corpus_dir, (rig,))
+        if len(rigs) != 1:
+            found = [r.family for r in rigs]
+            raise InputError(f"Expected takes of the rig {rig!r} in {corpus_dir}, got {found}")
+        takes = rigs[0].build + (rigs[0].held_back if all_takes else ())
+        takes = tuple(t for t in takes if t[0] not in left_out)
+        builder = build_model
+    if not takes:
+        raise InputError(f"Expected BVH takes with limb roles in {corpus_dir}, got none")
     with Progress(console=console, transient=True) as progress:
         task = progress.add_task("building joints", total=None)
         n_done = [0]
@@ -88,7 +110,7 @@ def limits_build(
             n_done[0] += 1
             progress.update(task, completed=n_done[0], description=f"built {name}")
 
-        model = build_model([m for _, m in takes], [n for n, _ in takes], settings, advance)
+        model = builder([m for _, m in takes], [n for n, _ in takes], settings, advance)
     output.parent.mkdir(parents=True, exist_ok=True)
     save_model(model, output)
     console.print(
@@ -199,18 +221,156 @@ def _pct(value: float) -> str:
     return "—" if math.isnan(value) else f"{100 * value:.2f}"
 
 
+def _ci(value: float, interval: tuple[float, float]) -> str:
+    return f"{_pct(value)} [{_pct(interval[0])}–{_pct(interval[1])}]"
+
+
 @bench_app.command("limits")
 def bench_limits(
     corpus_dir: Annotated[Path, typer.Argument(help="Corpus folder (shared/data).")],
-    rig: Annotated[str | None, typer.Option(help="Only this rig family.")] = None,
+    rig: Annotated[str | None, typer.Option(help="Per-rig part: only this rig family.")] = None,
     networks: Annotated[bool, typer.Option(help="Train and measure the discriminators.")] = True,
     min_offset_deg: Annotated[float, typer.Option(help="Smallest injected offset.")] = 60.0,
     seed: Annotated[int, typer.Option(help="Seed of the injected errors.")] = 0,
     shipped: Annotated[
         bool, typer.Option(help="Measure the shipped models (built on the same split).")
     ] = True,
+    per_rig: Annotated[
+        bool,
+        typer.Option(help="Also the per-rig models' own benchmark (networks, speeds)."),
+    ] = False,
 ) -> None:
-    """Discriminator accuracy, false flags on held-back takes, injected-error recall, speed."""
+    """Canonical model per rig and leave-one-rig-out; optionally the per-rig models."""
+    _bench_canonical(corpus_dir, shipped, seed, min_offset_deg)
+    if per_rig:
+        _bench_per_rig(corpus_dir, rig, networks, min_offset_deg, seed, shipped)
+
+
+def _bench_canonical(corpus_dir: Path, shipped: bool, seed: int, min_offset_deg: float) -> None:
+    from dataclasses import replace
+
+    from mocapqa.bench.limits import canonical_takes, corpus_rigs, role_takes
+    from mocapqa.bench.limits_canonical import (
+        EVALUATION_ONLY,
+        bootstrap_interval,
+        canonical_speed,
+        count_takes,
+        leave_one_rig_out,
+    )
+    from mocapqa.core.motion import Motion
+    from mocapqa.limits.build import DEFAULT_BUILD, build_canonical_model, build_model
+    from mocapqa.limits.model import default_model_paths, load_model
+    from mocapqa.limits.rig import rig_family
+
+    build_takes = canonical_takes(corpus_dir, exclude=EVALUATION_ONLY)
+    names = tuple(n for n, _ in build_takes)
+    model = None
+    if shipped:
+        for path in default_model_paths():
+            candidate = load_model(path)
+            if candidate.frame == "canonical" and candidate.takes == names:
+                model = candidate
+    map_only = replace(DEFAULT_BUILD, discriminator=None)
+    if model is None:
+        console.print("canonical model: built now (map only)")
+        model = build_canonical_model([m for _, m in build_takes], list(names), map_only)
+    else:
+        console.print("canonical model: the shipped one (same build takes)")
+    occ = model.occupancy_params
+    console.print(
+        f"map: bin {occ.bin_deg}°, dilation {occ.dilation_bins}, twist margin "
+        f"{occ.tau_margin_deg}°, interpolated {occ.interpolate}; {len(names)} build takes; "
+        f"injected offsets {min_offset_deg:.0f}–180°, seed {seed}; [95 % bootstrap over takes]"
+    )
+    rigs = corpus_rigs(corpus_dir)
+    table = Table(title="held-back takes per rig: canonical model vs the rig's own map")
+    for column in (
+        "rig", "held-back takes", "canonical false flags %", "canonical injected flagged %",
+        "rig map false flags %", "rig map injected flagged %",
+    ):  # fmt: skip
+        table.add_column(column)
+    per_joint: dict[str, tuple[dict[str, float], dict[str, float]]] = {}
+    for rig_takes in rigs:
+        canon = count_takes(model, rig_takes.held_back, seed, min_offset_deg)
+        own_build = [t for t in rig_takes.build if t[0] not in EVALUATION_ONLY]
+        own = build_model([m for _, m in own_build], [n for n, _ in own_build], map_only)
+        mine = count_takes(own, rig_takes.held_back, seed, min_offset_deg)
+        table.add_row(
+            rig_takes.family,
+            str(sum(1 for n, _ in rig_takes.held_back if n not in EVALUATION_ONLY)),
+            _ci(canon.false_flag_rate, bootstrap_interval(canon.flagged, canon.joint_frames)),
+            _ci(canon.recall, bootstrap_interval(canon.hits, canon.injected))
+            + f" (n={int(canon.injected.sum())})",
+            _ci(mine.false_flag_rate, bootstrap_interval(mine.flagged, mine.joint_frames)),
+            _ci(mine.recall, bootstrap_interval(mine.hits, mine.injected)),
+        )
+        per_joint[rig_takes.family] = (
+            {r: canon.per_joint_flagged[r] / max(canon.per_joint_frames[r], 1)
+             for r in canon.per_joint_flagged},
+            {r: mine.per_joint_flagged[r] / max(mine.per_joint_frames[r], 1)
+             for r in mine.per_joint_flagged},
+        )  # fmt: skip
+    console.print(table)
+    joints = Table(title="false flags % per joint on held-back takes (canonical / rig map)")
+    joints.add_column("role")
+    for family in per_joint:
+        joints.add_column(family)
+    for role in (j.role for j in model.joints):
+        joints.add_row(
+            role,
+            *(
+                f"{_pct(c.get(role, float('nan')))} / {_pct(o.get(role, float('nan')))}"
+                for c, o in per_joint.values()
+            ),
+        )
+    console.print(joints)
+    grouped: dict[str, list[tuple[str, Motion]]] = {}
+    for name, motion in role_takes(corpus_dir):
+        grouped.setdefault(rig_family(motion.skeleton), []).append((name, motion))
+    groups = {family: tuple(takes) for family, takes in grouped.items()}
+    loro = leave_one_rig_out(groups, DEFAULT_BUILD, seed, min_offset_deg)
+    table = Table(title="leave one rig out: canonical map built without the rig, all its takes")
+    for column in ("left-out rig", "takes", "build takes", "false flags %", "injected flagged %"):
+        table.add_column(column)
+    for family, (left_model, counts) in loro.items():
+        table.add_row(
+            family,
+            str(len(counts.flagged)),
+            str(len(left_model.takes)),
+            _ci(counts.false_flag_rate, bootstrap_interval(counts.flagged, counts.joint_frames)),
+            _ci(counts.recall, bootstrap_interval(counts.hits, counts.injected))
+            + f" (n={int(counts.injected.sum())})",
+        )
+    rates = [c.false_flag_rate for _, c in loro.values()]
+    console.print(table)
+    console.print(f"mean false flags over left-out rigs: {_pct(float(sum(rates) / len(rates)))} %")
+    scores = Table(title="canonical discriminators: held-out synthetic test accuracy")
+    for column in ("role", "accuracy %", "precision %", "recall %", "hidden", "n test"):
+        scores.add_column(column)
+    for joint in model.joints:
+        sc = joint.scores
+        if sc is None:
+            scores.add_row(joint.role, "—", "—", "—", "—", "—")
+        else:
+            scores.add_row(
+                joint.role, _pct(sc.accuracy), _pct(sc.precision), _pct(sc.recall),
+                str(sc.hidden_size), str(sc.n_test),
+            )  # fmt: skip
+    console.print(scores)
+    for rig_takes in rigs:
+        longest = max((m for _, m in rig_takes.held_back), key=lambda m: m.n_frames)
+        speed = canonical_speed(model, longest)
+        console.print(
+            f"speed {rig_takes.family} ({longest.skeleton.n_joints} joints): "
+            f"{speed / 1e6:.2f} M joint-frames/s (map check, canonical frames included)"
+        )
+
+
+def _bench_per_rig(
+    corpus_dir: Path, rig: str | None, networks: bool, min_offset_deg: float, seed: int,
+    shipped: bool,
+) -> None:  # fmt: skip
+
     from mocapqa.bench.limits import bench_rig, corpus_rigs
     from mocapqa.limits.model import default_model_paths, load_model
 

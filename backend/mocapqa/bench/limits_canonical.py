@@ -1,0 +1,190 @@
+"""``mocapqa bench limits``, canonical part: the rig-independent model per rig and left out.
+
+Figures, all with 95 % intervals from a bootstrap over takes (1,000 resamples, seed 0; the
+frames of one take are not independent, so takes are resampled, not frames):
+
+* **per rig** — the shipped canonical model (built on the build split of every rig with roles,
+  ``005_05`` left out) on each rig's held-back takes (the fixed split of
+  :func:`mocapqa.bench.limits.corpus_rigs`): false flags (share of joint-frames outside the
+  limits on the clean takes), injected-error recall (share of injected error frames, offsets
+  ≥ 60°, flagged on the target joint or its compensating child), per joint false flags; and
+  beside it the same rig's own map (per-rig frame, map only) built on its build split;
+* **leave one rig out** — a canonical map built on every take of the other rigs (map only:
+  networks take ~75 s per joint), tested on every take of the left-out rig, whose canonical
+  frames the model has never seen (they are estimated from each take).
+
+``005_05`` (the only real twist errors) is in no build and no clean figure.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from mocapqa.core.motion import Motion
+from mocapqa.limits.analysis import check_limits
+from mocapqa.limits.build import DEFAULT_BUILD, BuildParams, build_canonical_model
+from mocapqa.limits.model import LimitsModel
+from mocapqa.twist.inject import inject_twist_errors
+
+__all__ = [
+    "EVALUATION_ONLY",
+    "TakeCounts",
+    "bootstrap_interval",
+    "canonical_speed",
+    "count_takes",
+    "leave_one_rig_out",
+]
+
+EVALUATION_ONLY = frozenset({"005_05.bvh"})
+"""Takes never used to build or to choose anything (real twist errors)."""
+
+
+@dataclass(frozen=True, slots=True)
+class TakeCounts:
+    """Counts per take: flagged and total joint-frames (clean), hits and injected frames.
+
+    Parameters
+    ----------
+    flagged, joint_frames, hits, injected : ndarray of int, shape (T,)
+    per_joint_flagged : dict
+        Role key → flagged frames summed over takes.
+    per_joint_frames : dict
+        Role key → frames summed over takes.
+    """
+
+    flagged: np.ndarray
+    joint_frames: np.ndarray
+    hits: np.ndarray
+    injected: np.ndarray
+    per_joint_flagged: dict[str, int]
+    per_joint_frames: dict[str, int]
+
+    @property
+    def false_flag_rate(self) -> float:
+        """Flagged share of clean joint-frames."""
+        return float(self.flagged.sum() / max(self.joint_frames.sum(), 1))
+
+    @property
+    def recall(self) -> float:
+        """Flagged share of injected error frames."""
+        return float(self.hits.sum() / max(self.injected.sum(), 1))
+
+
+def bootstrap_interval(
+    numerators: np.ndarray, denominators: np.ndarray, n: int = 1000, seed: int = 0
+) -> tuple[float, float]:
+    """95 % bootstrap interval of ``Σ num / Σ den`` resampling takes (entries) with replacement."""
+    if numerators.size == 0:
+        return float("nan"), float("nan")
+    rng = np.random.default_rng(seed)
+    picks = rng.integers(0, numerators.size, size=(n, numerators.size))
+    ratios = numerators[picks].sum(axis=1) / np.maximum(denominators[picks].sum(axis=1), 1)
+    low, high = np.percentile(ratios, [2.5, 97.5])
+    return float(low), float(high)
+
+
+def count_takes(
+    model: LimitsModel, takes: tuple[tuple[str, Motion], ...], seed: int = 0,
+    min_offset_deg: float = 60.0,
+) -> TakeCounts:  # fmt: skip
+    """Clean false flags and injected-error hits of ``model`` on each take.
+
+    Parameters
+    ----------
+    model : LimitsModel
+    takes : tuple of (str, Motion)
+        Takes in :data:`EVALUATION_ONLY` are skipped.
+    seed : int
+        Seed of the injected errors (one stream over the takes).
+    min_offset_deg : float
+        Smallest injected offset, degrees (up to 180°).
+    """
+    rng = np.random.default_rng(seed)
+    flagged, frames, hits, injected = [], [], [], []
+    per_flagged: dict[str, int] = {}
+    per_frames: dict[str, int] = {}
+    for name, motion in takes:
+        if name in EVALUATION_ONLY:
+            continue
+        report = check_limits(motion, model)
+        flagged.append(int((~report.valid).sum()))
+        frames.append(int(report.valid.size))
+        for k, role in enumerate(report.roles):
+            per_flagged[role] = per_flagged.get(role, 0) + int((~report.valid[:, k]).sum())
+            per_frames[role] = per_frames.get(role, 0) + motion.n_frames
+        corrupted, truth = inject_twist_errors(
+            motion, rng, min_offset_deg=min_offset_deg, max_offset_deg=180.0
+        )
+        bad = check_limits(corrupted, model)
+        column = {n: k for k, n in enumerate(bad.joint_names)}
+        take_hits, take_injected = 0, 0
+        for target, child in zip(truth.targets, truth.children, strict=True):
+            error_frames = np.flatnonzero(truth.error_mask[:, target])
+            found = np.zeros(error_frames.size, dtype=bool)
+            for joint in (target, child):
+                name_j = motion.skeleton.names[joint]
+                if name_j in column:
+                    found |= ~bad.valid[error_frames, column[name_j]]
+            take_hits += int(found.sum())
+            take_injected += int(error_frames.size)
+        hits.append(take_hits)
+        injected.append(take_injected)
+    return TakeCounts(
+        np.asarray(flagged), np.asarray(frames), np.asarray(hits), np.asarray(injected),
+        per_flagged, per_frames,
+    )  # fmt: skip
+
+
+def leave_one_rig_out(
+    rigs: dict[str, tuple[tuple[str, Motion], ...]],
+    settings: BuildParams = DEFAULT_BUILD,
+    seed: int = 0,
+    min_offset_deg: float = 60.0,
+) -> dict[str, tuple[LimitsModel, TakeCounts]]:
+    """For each rig, a canonical map built without it and its counts on all its takes.
+
+    Parameters
+    ----------
+    rigs : dict
+        Family → every take of that rig.
+    settings : BuildParams
+        The discriminator is dropped (map only).
+
+    Returns
+    -------
+    dict
+        Family → (model built without it, counts on its takes).
+    """
+    settings = replace(settings, discriminator=None)
+    out = {}
+    for family, takes in rigs.items():
+        train = [
+            t for other, ts in rigs.items() if other != family for t in ts
+            if t[0] not in EVALUATION_ONLY
+        ]  # fmt: skip
+        model = build_canonical_model([m for _, m in train], [n for n, _ in train], settings)
+        out[family] = (model, count_takes(model, takes, seed, min_offset_deg))
+    return out
+
+
+def canonical_speed(model: LimitsModel, motion: Motion, repeats: int = 3) -> float:
+    """Joint-frames per second of a full canonical check (FK, frames, map, scores).
+
+    On ``motion`` tiled to at least 50,000 frames.
+    """
+    tiles = max(1, -(-50_000 // motion.n_frames))
+    long = Motion(
+        motion.skeleton,
+        np.tile(motion.quats, (tiles, 1, 1)),
+        np.tile(motion.translations, (tiles, 1, 1)),
+        motion.fps,
+    )
+    n_joints = check_limits(long, model).valid.shape[1]
+    start = time.perf_counter()
+    for _ in range(repeats):
+        check_limits(long, model)
+    elapsed = time.perf_counter() - start
+    return float(repeats * long.n_frames * n_joints / max(elapsed, 1e-9))

@@ -1,0 +1,187 @@
+"""Canonical (anatomical) frames: rig-independent limits on real takes, re-rigged copies."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mocapqa.core.motion import EndSite, Motion, Skeleton
+from mocapqa.io.bvh import read_bvh
+from mocapqa.kinematics.forward import forward_kinematics
+from mocapqa.kinematics.quaternion import conjugate, geodesic_angle, multiply, rotate
+from mocapqa.limits.analysis import check_limits
+from mocapqa.limits.build import BuildParams, build_canonical_model
+from mocapqa.limits.canonical import CANONICAL_AXIS, canonical_quats, rig_frames, rig_key
+from mocapqa.limits.expmap import expmap_from_quats
+from mocapqa.limits.model import LimitsModel, load_model, model_bytes
+from mocapqa.limits.occupancy import OccupancyParams
+
+MAP_ONLY = BuildParams(
+    occupancy=OccupancyParams(bin_deg=15.0, dilation_bins=2, tau_margin_deg=40.0, interpolate=True),
+    discriminator=None,
+)
+# CMU names → Bandai-style names for the role joints (a renamed rig).
+RENAMES = {
+    "LeftShoulder": "Shoulder_L", "LeftArm": "UpperArm_L", "LeftForeArm": "LowerArm_L",
+    "LeftHand": "Hand_L", "LeftUpLeg": "UpperLeg_L", "LeftLeg": "LowerLeg_L",
+    "LeftFoot": "Foot_L", "LeftToeBase": "Toes_L", "RightShoulder": "Shoulder_R",
+    "RightArm": "UpperArm_R", "RightForeArm": "LowerArm_R", "RightHand": "Hand_R",
+    "RightUpLeg": "UpperLeg_R", "RightLeg": "LowerLeg_R", "RightFoot": "Foot_R",
+    "RightToeBase": "Toes_R",
+}  # fmt: skip
+
+
+def rerig(motion: Motion, seed: int, renames: dict[str, str] | None = None) -> Motion:
+    """The same world motion on a rig whose every joint frame is turned by a random rotation.
+
+    ``q'_j = conj(G_parent) ⊗ q_j ⊗ G_j``, OFFSETs re-expressed in the turned parent frames,
+    End Sites in the turned joint frames; position channels of non-root joints are turned too.
+    """
+    skeleton = motion.skeleton
+    rng = np.random.default_rng(seed)
+    turns = rng.normal(size=(skeleton.n_joints, 4))
+    turns /= np.linalg.norm(turns, axis=1, keepdims=True)
+    identity = np.array([0.0, 0.0, 0.0, 1.0])
+    parent_turns = np.stack([turns[p] if p >= 0 else identity for p in skeleton.parents.tolist()])
+    quats = multiply(multiply(conjugate(parent_turns)[None], motion.quats), turns[None])
+    offsets = rotate(conjugate(parent_turns), skeleton.offsets)
+    translations = motion.translations.copy()
+    for j in range(skeleton.n_joints):
+        if skeleton.parents[j] >= 0 and any(c.endswith("position") for c in skeleton.channels[j]):
+            translations[:, j] = rotate(conjugate(parent_turns[j])[None], translations[:, j])
+    end_sites = tuple(
+        EndSite(e.parent, tuple(rotate(conjugate(turns[e.parent]), np.asarray(e.offset))))  # type: ignore[arg-type]
+        for e in skeleton.end_sites
+    )
+    names = tuple((renames or {}).get(n, n) for n in skeleton.names)
+    turned = Skeleton(
+        names=names,
+        parents=skeleton.parents,
+        offsets=offsets,
+        channels=skeleton.channels,
+        end_sites=end_sites,
+        length_unit=skeleton.length_unit,
+        root_translation=skeleton.root_translation,
+    )
+    return Motion(turned, quats, translations, motion.fps)
+
+
+@pytest.fixture(scope="module")
+def cmu(corpus_dir: Path) -> Motion:
+    motion = read_bvh(corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh")
+    # Frame 0 is a synthetic T-pose that is not part of the walk.
+    return Motion(motion.skeleton, motion.quats[1:], motion.translations[1:], motion.fps)
+
+
+@pytest.fixture(scope="module")
+def bandai_model(corpus_dir: Path) -> LimitsModel:
+    names = ["dataset-1_walk_normal_001.bvh", "dataset-2_walk_normal_001.bvh"]
+    motions = [read_bvh(corpus_dir / "bvh" / "bandai" / n) for n in names]
+    return build_canonical_model(motions, names, MAP_ONLY)
+
+
+def test_a_rerigged_renamed_take_has_the_same_world_poses(cmu: Motion) -> None:
+    turned = rerig(cmu, seed=3, renames=RENAMES)
+    _, before = forward_kinematics(cmu)
+    _, after = forward_kinematics(turned)
+    np.testing.assert_allclose(after, before, atol=1e-6)
+    assert rig_key(turned) != rig_key(cmu)
+
+
+def test_canonical_rotations_do_not_depend_on_the_joint_frames(cmu: Motion) -> None:
+    frames, original = canonical_quats(cmu)
+    turned_frames, turned = canonical_quats(rerig(cmu, seed=3, renames=RENAMES))
+    assert turned_frames.roles == frames.roles
+    assert len(frames.roles) == 14
+    np.testing.assert_array_less(np.rad2deg(geodesic_angle(turned, original)), 1e-4)
+
+
+def test_a_rerigged_take_gets_identical_limits_results(
+    cmu: Motion, bandai_model: LimitsModel
+) -> None:
+    original = check_limits(cmu, bandai_model)
+    turned = check_limits(rerig(cmu, seed=11, renames=RENAMES), bandai_model)
+    assert turned.roles == original.roles
+    np.testing.assert_array_equal(turned.valid, original.valid)
+    np.testing.assert_allclose(turned.score_deg, original.score_deg, atol=1e-6)
+    np.testing.assert_allclose(turned.params_deg, original.params_deg, atol=1e-6)
+
+
+def test_the_same_anatomy_reads_alike_on_three_rigs(corpus_dir: Path) -> None:
+    # Walks of three rigs (no walk of the corpus exists on two rigs): the knee and the elbow
+    # flex the same way round, and the hinge joints hardly twist, on every rig.
+    for relative in (
+        "bvh/cmu/cmu_12_01_walk.bvh",
+        "bvh/cmu/iclone/003_02.bvh",
+        "bvh/bandai/dataset-1_walk_normal_001.bvh",
+    ):
+        motion = read_bvh(corpus_dir / relative)
+        frames, quats = canonical_quats(motion)
+        params = np.rad2deg(expmap_from_quats(quats, CANONICAL_AXIS))
+        for side in ("left", "right"):
+            knee = params[:, frames.roles.index(f"{side}_lower_leg")]
+            elbow = params[:, frames.roles.index(f"{side}_forearm")]
+            assert np.percentile(knee[:, 0], 90) > 40, relative  # flexion is +s1
+            assert np.percentile(elbow[:, 0], 50) < -5, relative  # flexion is −s1
+            assert np.percentile(np.abs(knee[:, 2]), 90) < 5, relative
+
+
+def test_rig_frames_pool_takes_and_a_model_stores_them(
+    corpus_dir: Path, bandai_model: LimitsModel
+) -> None:
+    names = ["dataset-1_walk_normal_001.bvh", "dataset-2_walk_normal_001.bvh"]
+    motions = [read_bvh(corpus_dir / "bvh" / "bandai" / n) for n in names]
+    pooled = rig_frames(motions)
+    stored = bandai_model.rig_frames[rig_key(motions[0])]
+    np.testing.assert_allclose(stored.frames, pooled.frames)
+    assert stored.family == "bandai"
+    again = load_model_from_bytes(model_bytes(bandai_model))
+    assert again.frame == "canonical"
+    np.testing.assert_allclose(again.rig_frames[rig_key(motions[0])].frames, pooled.frames)
+
+
+def load_model_from_bytes(content: bytes) -> LimitsModel:
+    import tempfile
+
+    with tempfile.NamedTemporaryFile(suffix=".npz") as handle:
+        handle.write(content)
+        handle.flush()
+        return load_model(handle.name)
+
+
+def test_a_canonical_model_checks_an_unseen_rig_and_names_what_it_does_not_check(
+    corpus_dir: Path, bandai_model: LimitsModel
+) -> None:
+    motion = read_bvh(corpus_dir / "bvh" / "cmu" / "iclone" / "003_02.bvh")
+    report = check_limits(motion, bandai_model)
+    assert report.joint_names[0] == "CC_Base_L_Clavicle"
+    assert len(report.roles) == 14
+    assert "CC_Base_Head" in report.not_checked
+    assert "CC_Base_L_Thigh" not in report.not_checked
+    data = report.to_json()
+    assert data["not_checked"] == list(report.not_checked)
+    flagged = [w for j in data["joints"] for w in j["worst_frames"]]
+    assert all(w["readout"] for w in flagged)
+
+
+def test_an_injected_knee_hyperextension_reads_as_such(
+    cmu: Motion, bandai_model: LimitsModel
+) -> None:
+    # Bend the right knee 80° the wrong way (about its flexion axis) on frames 100–109.
+    frames, _ = canonical_quats(cmu)
+    k = frames.roles.index("right_lower_leg")
+    joint = int(frames.joints[k])
+    axis = rotate(frames.frames[k], np.array([1.0, 0.0, 0.0]))  # flexion axis, local frame
+    half = np.deg2rad(-80.0) / 2
+    turn = np.concatenate((np.sin(half) * axis, [np.cos(half)]))
+    quats = cmu.quats.copy()
+    quats[100:110, joint] = multiply(quats[100:110, joint], turn[None])
+    bent = replace(cmu, quats=quats)
+    report = check_limits(bent, bandai_model)
+    column = report.roles.index("right_lower_leg")
+    texts = [report.readout(f, column) for f in range(100, 110) if not report.valid[f, column]]
+    assert texts, "the wrong-way knee was not flagged"
+    assert all(t.startswith("right knee hyperextended") for t in texts), texts
