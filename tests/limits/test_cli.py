@@ -45,3 +45,31 @@ def test_check_with_a_model_of_another_rig_exits_with_the_limits_code(
                  "--model", str(bandai)])  # fmt: skip
     assert code == 6
     assert "Expected a skeleton of the 'bandai' rig" in capsys.readouterr().err
+
+
+def test_build_takes_a_folder_of_several_rigs_and_check_reads_out_anatomy(
+    corpus_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    corpus = tmp_path / "mixed"
+    corpus.mkdir()
+    (corpus / "walk.bvh").symlink_to(
+        corpus_dir / "bvh" / "bandai" / "dataset-1_walk_normal_001.bvh"
+    )
+    (corpus / "jump.bvh").symlink_to(corpus_dir / "bvh" / "cmu" / "iclone" / "002_04.bvh")
+    model = tmp_path / "canonical.npz"
+    assert main(["limits", "build", str(corpus), "-o", str(model), "--no-networks"]) == 0
+    built = load_model(model)
+    assert built.frame == "canonical"
+    assert set(built.takes) == {"walk.bvh", "jump.bvh"}
+    assert {f.family for f in built.rig_frames.values()} == {"bandai", "character_creator"}
+    capsys.readouterr()
+    # A rig the model has not seen (CMU names, world-aligned T-pose offsets).
+    take = corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh"
+    assert main(["limits", "check", str(take), "--model", str(model), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["rig_family"] == "canonical"
+    assert "Head" in data["not_checked"]
+    assert {j["role"] for j in data["joints"]} >= {"left_forearm", "right_lower_leg"}
+    side_words = [w["readout"].split()[0] for j in data["joints"] for w in j["worst_frames"]]
+    assert side_words
+    assert set(side_words) <= {"left", "right"}

@@ -15,6 +15,7 @@ from mocapqa.limits.occupancy import (
     is_valid,
     limit_distances,
     swing_bins,
+    twist_bounds,
 )
 
 D = np.deg2rad
@@ -77,3 +78,32 @@ def test_bad_settings_and_samples_are_refused() -> None:
         OccupancyParams(bin_deg=7.0)
     with pytest.raises(ShapeError, match=r"Expected `params` to have shape \(N, 3\)"):
         build_occupancy(np.zeros((4, 2)), OccupancyParams())
+
+
+def test_twist_bounds_wrap_at_180_degrees() -> None:
+    # One swing bin whose twists straddle ±180°: the shortest covering arc, not its complement.
+    tau = np.deg2rad([170.0, 175.0, 179.0, -178.0, -172.0])
+    params = np.column_stack((np.zeros(5), np.zeros(5), tau))
+    occupancy = build_occupancy(params, OccupancyParams(bin_deg=15.0, tau_margin_deg=5.0))
+    probe = np.array([[0.0, 0.0, np.deg2rad(d)] for d in (179.9, -179.9, 168.0, -168.0, 0.0)])
+    np.testing.assert_array_equal(is_valid(occupancy, probe), [True, True, True, True, False])
+    # Outside by 10° the short way round (160° → arc from 165°), not 325° the long way.
+    _, twist = limit_distances(occupancy, np.array([[0.0, 0.0, np.deg2rad(155.0)]]))
+    np.testing.assert_allclose(twist, [10.0], atol=1e-6)
+
+
+def test_interpolated_bounds_are_continuous_across_bin_edges() -> None:
+    # Two neighbouring bins with twist ranges ±10° and ±50°.
+    rows = [(np.deg2rad(s1), 0.0, np.deg2rad(t)) for s1, t in
+            ((-7.0, -10.0), (-7.0, 10.0), (7.0, -50.0), (7.0, 50.0))]  # fmt: skip
+    params = np.array(rows)
+    for interpolate, jump in ((False, 40.0), (True, 0.0)):
+        settings = OccupancyParams(bin_deg=15.0, smooth=False, interpolate=interpolate)
+        occupancy = build_occupancy(params, settings)
+        edge = 0.0  # between the bins [−15°, 0°) and [0°, 15°)
+        probe = np.array([[edge - 1e-6, 0.0, 0.0], [edge + 1e-6, 0.0, 0.0]])
+        _, half = twist_bounds(occupancy, probe)
+        assert abs(np.rad2deg(half[1] - half[0]) - jump) < 1e-3
+    # Between the two bin centres (−7.5°, 7.5°) the half-width goes linearly from 10° to 50°.
+    probe = np.array([[np.deg2rad(s1), 0.0, 0.0] for s1 in (-7.5, -3.75, 3.75, 7.5)])
+    np.testing.assert_allclose(np.rad2deg(twist_bounds(occupancy, probe)[1]), [10, 20, 40, 50])

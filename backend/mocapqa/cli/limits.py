@@ -154,21 +154,23 @@ def limits_check(
     table = Table(
         title=f"{path.name}: {100 * report.flagged_fraction:.2f} % of frame×joints outside"
     )
-    for column in ("joint", "outside %", "max score °", "worst frames (s1, s2, τ)° → score°"):
+    for column in ("joint", "role", "outside %", "max score °", "worst frame: read-out"):
         table.add_column(column)
     for joint in data["joints"]:
-        worst = "; ".join(
-            f"{w['frame']}: ({w['s1_deg']:.0f}, {w['s2_deg']:.0f}, {w['tau_deg']:.0f}) → "
-            f"{w['score_deg']:.1f}"
-            for w in joint["worst_frames"][:3]
-        )
+        worst = joint["worst_frames"][:1]
         table.add_row(
             joint["name"],
+            joint["role"],
             f"{100 * joint['flagged_fraction']:.2f}",
             f"{joint['max_score_deg']:.1f}",
-            worst,
+            f"{worst[0]['frame']}: {worst[0]['readout']}" if worst else "",
         )
     console.print(table)
+    kind = "canonical frames" if report.rig_family == "canonical" else "rig frames"
+    console.print(
+        f"model: {report.rig_family} ({kind}); not checked ({len(report.not_checked)}): "
+        f"{', '.join(report.not_checked) or 'none'}"
+    )
 
 
 @limits_app.command("show")

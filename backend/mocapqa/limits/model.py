@@ -57,8 +57,12 @@ __all__ = [
     "save_model",
 ]
 
-# Per-rig shipped models used instead of the canonical one on their own rig.
-PREFERRED_RIG_MODELS: frozenset[str] = frozenset()
+# Per-rig shipped models used instead of the canonical one on their own rig: only where
+# measurably better (`mocapqa bench limits`, docs/limits.md). Character Creator's own model
+# flags 100 % of injected ≥ 60° errors on its held-back takes against the canonical model's
+# ~81 %: that rig keeps its forearm pronation on twist bones, so the pooled forearm and upper
+# leg twist ranges of the other rigs hide its errors.
+PREFERRED_RIG_MODELS: frozenset[str] = frozenset({"character_creator"})
 # Version of the .npz model layout; files of another version are refused.
 FORMAT_VERSION = 1
 _FORMAT = "mocapqa-limits"
@@ -411,7 +415,7 @@ def load_default_model(skeleton: Skeleton) -> LimitsModel:
     """The shipped limits model for ``skeleton``: the canonical one, for any rig with roles.
 
     A shipped per-rig model is preferred only when it is listed in :data:`PREFERRED_RIG_MODELS`
-    (measured better on its rig; none is today, see ``docs/limits.md``).
+    (measured better on its rig: Character Creator today, see ``docs/limits.md``).
 
     Parameters
     ----------

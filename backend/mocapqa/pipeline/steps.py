@@ -15,6 +15,7 @@ Every step returns a :class:`StepOutcome` whose ``findings`` share one shape
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -112,7 +113,10 @@ def run_twist(
 
 
 def violation_findings(
-    valid: BoolArray, score_deg: FloatArray, joints: list[str]
+    valid: BoolArray,
+    score_deg: FloatArray,
+    joints: list[str],
+    readout: Callable[[int, int], str] | None = None,
 ) -> list[dict[str, Any]]:
     """One finding per joint and run of consecutive frames outside the limits.
 
@@ -124,6 +128,10 @@ def violation_findings(
         Distance outside the limits, degrees.
     joints : list of str
         Joint names of the J columns.
+    readout : callable, optional
+        ``(frame, column) -> str``, the anatomical read-out
+        (:meth:`mocapqa.limits.analysis.LimitsReport.readout`); each finding then carries the
+        one of its worst frame as ``readout``.
     """
     findings: list[dict[str, Any]] = []
     for j, joint in enumerate(joints):
@@ -133,17 +141,19 @@ def violation_findings(
         edges = np.diff(np.concatenate(([0], bad.astype(np.int8), [0])))
         starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
         for start, stop in zip(starts, stops, strict=True):
-            findings.append(
-                {
-                    "kind": "limits",
-                    "joint": joint,
-                    "start_frame": int(start),
-                    "end_frame": int(stop - 1),
-                    "value": round(float(score_deg[start:stop, j].max()), 3),
-                    "unit": "deg",
-                    "confidence": None,
-                }
-            )
+            finding: dict[str, Any] = {
+                "kind": "limits",
+                "joint": joint,
+                "start_frame": int(start),
+                "end_frame": int(stop - 1),
+                "value": round(float(score_deg[start:stop, j].max()), 3),
+                "unit": "deg",
+                "confidence": None,
+            }
+            if readout is not None:
+                worst = int(start + np.argmax(score_deg[start:stop, j]))
+                finding["readout"] = readout(worst, j)
+            findings.append(finding)
     return findings
 
 
@@ -171,9 +181,11 @@ def run_limits(motion: Motion, frames: IntArray) -> StepOutcome:
         return StepOutcome("no_model", f"no model for this rig ({model})")
     report = check_limits(motion, model)
     joints = list(report.joint_names)
-    findings = violation_findings(report.valid, report.score_deg, joints)
+    findings = violation_findings(report.valid, report.score_deg, joints, report.readout)
     sampled = frames[frames < report.valid.shape[0]]
     heat = np.where(report.valid[sampled].T, 0.0, np.round(report.score_deg[sampled].T, 2))
+    # Hover text of the heat map: the anatomical read-out of each flagged cell ("" if valid).
+    readouts = [[report.readout(int(f), j) for f in sampled] for j in range(len(joints))]
     summary = report.to_json(max_points=1)
     for joint in summary["joints"]:
         joint.pop("frames", None)  # the heat map carries the per-frame values
@@ -185,6 +197,7 @@ def run_limits(motion: Motion, frames: IntArray) -> StepOutcome:
             "joints": joints,
             "frames": sampled.tolist(),
             "score_deg": heat.tolist(),
+            "readout": readouts,
             "summary": summary,
         },
     )

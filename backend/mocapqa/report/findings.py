@@ -11,7 +11,8 @@ decimated (``max_points``) a run covers the listed frames it spans. Inputs are t
 :class:`mocapqa.limits.analysis.LimitsReport`, or the pipeline's sampled limits heat map
 (``joints``, ``frames``, ``score_deg`` as joints × frames); unknown keys are ignored. The
 pipeline's own findings (``value`` and ``unit``) are mapped to the same keys by
-:func:`normalise_findings`.
+:func:`normalise_findings`. A limit finding may carry ``readout``, the anatomical read-out of
+its worst frame ("right knee hyperextended 14°"), when the input has one.
 """
 
 from __future__ import annotations
@@ -59,11 +60,17 @@ def limit_findings(limits: Mapping[str, Any] | None, min_frames: int = 1) -> lis
     if "score_deg" in limits and limits.get("joints") and isinstance(limits["joints"][0], str):
         frames = np.asarray(limits.get("frames", []), dtype=np.int64)
         heat = np.asarray(limits["score_deg"], dtype=np.float64).reshape(len(limits["joints"]), -1)
+        texts = limits.get("readout") or [[""] * heat.shape[1] for _ in limits["joints"]]
         limits = {
             "joints": [
                 {
                     "name": name,
-                    "frames": {"frame": frames, "valid": heat[j] <= 0, "score_deg": heat[j]},
+                    "frames": {
+                        "frame": frames,
+                        "valid": heat[j] <= 0,
+                        "score_deg": heat[j],
+                        "readout": texts[j],
+                    },
                 }
                 for j, name in enumerate(limits["joints"])
             ]
@@ -80,15 +87,17 @@ def limit_findings(limits: Mapping[str, Any] | None, min_frames: int = 1) -> lis
         for start, stop in zip(edges[::2], edges[1::2], strict=True):
             if stop - start < min_frames:
                 continue
-            found.append(
-                {
-                    "kind": "limit",
-                    "joint": str(joint.get("name")),
-                    "start_frame": int(frames[start]),
-                    "end_frame": int(frames[stop - 1]),
-                    "violation_deg": float(np.max(scores[start:stop])) if len(scores) else 0.0,
-                }
-            )
+            finding = {
+                "kind": "limit",
+                "joint": str(joint.get("name")),
+                "start_frame": int(frames[start]),
+                "end_frame": int(frames[stop - 1]),
+                "violation_deg": float(np.max(scores[start:stop])) if len(scores) else 0.0,
+            }
+            texts = series.get("readout")
+            if texts is not None and len(texts) == len(frames) and len(scores):
+                finding["readout"] = str(texts[start + int(np.argmax(scores[start:stop]))])
+            found.append(finding)
     return found
 
 

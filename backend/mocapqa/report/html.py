@@ -107,7 +107,7 @@ def _findings_table(findings: Sequence[Mapping[str, Any]], fps: float | None) ->
         return '<p class="muted">No flagged intervals.</p>'
     head = (
         "<tr><th>#</th><th>kind</th><th>joint</th><th>frames</th><th>time (s)</th>"
-        "<th>offset / violation (deg)</th><th>confidence</th></tr>"
+        "<th>offset / violation (deg)</th><th>confidence</th><th>read-out</th></tr>"
     )
     rows = []
     for k, f in enumerate(findings, start=1):
@@ -124,7 +124,8 @@ def _findings_table(findings: Sequence[Mapping[str, Any]], fps: float | None) ->
         rows.append(
             f"<tr><td class=num>{k}</td><td>{_esc(f['kind'])}</td><td>{_esc(f['joint'])}</td>"
             f"<td class=num>{start}–{end}</td><td class=num>{time_s}</td>"
-            f"<td class=num>{value_text}</td><td class=num>{confidence_text}</td></tr>"
+            f"<td class=num>{value_text}</td><td class=num>{confidence_text}</td>"
+            f"<td>{_esc(f.get('readout', ''))}</td></tr>"
         )
     return f"<table>{head}{''.join(rows)}</table>"
 
