@@ -88,6 +88,10 @@ def test_analyze_motion_reports_steps_and_progress() -> None:
         heat = np.asarray(report["series"]["limits"]["score_deg"])
         assert heat.shape == (len(report["series"]["limits"]["joints"]), 200)
         assert np.all(heat >= 0)
+        # The heat map's hover text: a read-out exactly where a cell is flagged.
+        readout = np.asarray(report["series"]["limits"]["readout"])
+        assert readout.shape == heat.shape
+        np.testing.assert_array_equal(readout != "", heat > 0)
     else:
         assert limits["state"] == "no_model"
         assert "no model for this rig" in limits["message"]

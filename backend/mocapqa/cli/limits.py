@@ -364,7 +364,8 @@ def _bench_canonical(corpus_dir: Path, shipped: bool, seed: int, min_offset_deg:
         speed = canonical_speed(model, longest)
         console.print(
             f"speed {rig_takes.family} ({longest.skeleton.n_joints} joints): "
-            f"{speed / 1e6:.2f} M joint-frames/s (map check, canonical frames included)"
+            f"{speed / 1e6:.2f} M joint-frames per CPU second (map check, canonical frames "
+            "included)"
         )
 
 
