@@ -131,9 +131,10 @@ def limits_check(
 ) -> None:
     """Check a take against joint limits: share of frames outside and the worst frames.
 
-    A limits model applies to the rig it was built on, matched by joint names and bone axes, so
-    ``--mapping`` does not change the check itself; it changes which roles are reported missing
-    (the warning line and ``missing_roles`` in the JSON).
+    With the canonical model (the default for every rig but Character Creator) ``--mapping``
+    decides which joints play which role, so it changes the check. A per-rig model matches its
+    joints by name and bone axis and ignores it; ``--mapping`` then only changes which roles
+    are reported missing (the warning line and ``missing_roles`` in the JSON).
     """
     from mocapqa.io.bvh import read_bvh
     from mocapqa.limits.analysis import check_limits
@@ -143,7 +144,7 @@ def limits_check(
     motion = read_bvh(path)
     missing = missing_roles(motion.skeleton, roles)
     model = load_model(model_path) if model_path is not None else None
-    report = check_limits(motion, model, method="network" if network else "map")
+    report = check_limits(motion, model, method="network" if network else "map", mapping=roles)
     data = report.to_json(max_points=0)
     for joint in data["joints"]:
         del joint["frames"]

@@ -9,6 +9,7 @@ documented in ``docs/limits.md``.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -138,8 +139,18 @@ class LimitsReport:
         }
 
 
-def charted(motion: Motion, model: LimitsModel) -> tuple[FloatArray, list[int], tuple[str, ...]]:
+def charted(
+    motion: Motion, model: LimitsModel, mapping: Mapping[str, str] | None = None
+) -> tuple[FloatArray, list[int], tuple[str, ...], tuple[str, ...]]:
     """``(s1, s2, τ)`` of the model's joints found on the take, and what is not checked.
+
+    Parameters
+    ----------
+    motion : Motion
+    model : LimitsModel
+    mapping : mapping, optional
+        Role key → joint name overriding the roles found (canonical models only; the take's
+        frames are then estimated from the take, not taken from the model).
 
     Returns
     -------
@@ -149,6 +160,8 @@ def charted(motion: Motion, model: LimitsModel) -> tuple[FloatArray, list[int], 
         Index into ``model.joints`` of each of the K columns.
     not_checked : tuple of str
         Joint names of the take outside the check, then model roles missing from the take.
+    names : tuple of str
+        The take's joint name of each of the K columns.
 
     Raises
     ------
@@ -161,11 +174,14 @@ def charted(motion: Motion, model: LimitsModel) -> tuple[FloatArray, list[int], 
         axes = np.stack([j.axis for j in model.joints])
         references = np.stack([j.reference for j in model.joints])
         params = limit_params_from_quats(motion.quats[:, index], axes, references)
-        names = set(motion.skeleton.names) - {j.name for j in model.joints}
-        rest = tuple(n for n in motion.skeleton.names if n in names)
-        return params, list(range(len(model.joints))), rest
+        modelled = {j.name for j in model.joints}
+        rest = tuple(n for n in motion.skeleton.names if n not in modelled)
+        return params, list(range(len(model.joints))), rest, tuple(j.name for j in model.joints)
     try:
-        frames, quats = canonical_quats(motion, known=_known_frames(motion, model))
+        if mapping:
+            frames, quats = canonical_quats(motion, rig=find_roles(motion.skeleton, mapping))
+        else:
+            frames, quats = canonical_quats(motion, known=_known_frames(motion, model))
     except InputError as e:
         raise LimitsFileError(f"Expected a skeleton the canonical frames apply to: {e}") from e
     column = {role: k for k, role in enumerate(frames.roles)}
@@ -176,7 +192,8 @@ def charted(motion: Motion, model: LimitsModel) -> tuple[FloatArray, list[int], 
     used = {int(frames.joints[c]) for c in picked}
     unused = [n for i, n in enumerate(motion.skeleton.names) if i not in used]
     missing = [j.role for j in model.joints if j.role not in column]
-    return params, columns, tuple(unused + missing)
+    names = tuple(motion.skeleton.names[int(frames.joints[c])] for c in picked)
+    return params, columns, tuple(unused + missing), names
 
 
 def _known_frames(motion: Motion, model: LimitsModel) -> CanonicalFrames | None:
@@ -208,7 +225,10 @@ def limit_params(motion: Motion, model: LimitsModel) -> FloatArray:
 
 
 def check_limits(
-    motion: Motion, model: LimitsModel | None = None, method: str = "map"
+    motion: Motion,
+    model: LimitsModel | None = None,
+    method: str = "map",
+    mapping: Mapping[str, str] | None = None,
 ) -> LimitsReport:
     """Check every frame of a take against joint limits.
 
@@ -219,6 +239,9 @@ def check_limits(
         Defaults to the shipped model covering the take's rig.
     method : {"map", "network"}
         Who decides validity: the lookup map or the discriminator.
+    mapping : mapping, optional
+        Role key → joint name overriding the roles found; with a canonical model it decides
+        which joints are checked (a per-rig model matches joints by name and ignores it).
 
     Returns
     -------
@@ -235,7 +258,7 @@ def check_limits(
         raise InputError(f"Expected `method` 'map' or 'network', got {method!r}")
     if model is None:
         model = load_default_model(motion.skeleton)
-    params, columns, not_checked = charted(motion, model)
+    params, columns, not_checked, names = charted(motion, model, mapping)
     n_frames, n_joints = params.shape[:2]
     swing = np.zeros((n_frames, n_joints))
     twist = np.zeros((n_frames, n_joints))
@@ -256,11 +279,6 @@ def check_limits(
             valid[:, j] = network_valid(joint.network, params[:, j])
     score = np.where(valid & (method == "map"), 0.0, np.hypot(swing, twist))
     excess = np.where(valid[..., None], 0.0, excess)
-    if model.frame == "canonical":
-        role_names = _role_joint_names(motion)
-        names = tuple(role_names.get(j.role, j.role) for j in joints)
-    else:
-        names = tuple(j.name for j in joints)
     return LimitsReport(
         joint_names=names,
         roles=tuple(j.role for j in joints),
@@ -275,11 +293,6 @@ def check_limits(
         excess_deg=excess,
         not_checked=not_checked,
     )
-
-
-def _role_joint_names(motion: Motion) -> dict[str, str]:
-    rig = find_roles(motion.skeleton)
-    return {key: motion.skeleton.names[j] for key, j in rig.roles.items()}
 
 
 def joint_map_json(model: LimitsModel, joint: str) -> dict[str, Any]:
