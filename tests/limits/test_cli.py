@@ -73,3 +73,22 @@ def test_build_takes_a_folder_of_several_rigs_and_check_reads_out_anatomy(
     side_words = [w["readout"].split()[0] for j in data["joints"] for w in j["worst_frames"]]
     assert side_words
     assert set(side_words) <= {"left", "right"}
+
+
+def test_a_mapping_decides_which_joint_the_canonical_model_checks(
+    corpus_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    take = corpus_dir / "bvh" / "bandai" / "dataset-1_walk_normal_001.bvh"
+    assert main(["limits", "check", str(take), "--json"]) == 0
+    before = json.loads(capsys.readouterr().out)
+    assert before["rig_family"] == "canonical"
+    names = {j["role"]: j["name"] for j in before["joints"]}
+    assert names["left_hand"] == "Hand_L"
+    # Declare the toes the left foot: the canonical model then checks Toes_L, not Foot_L.
+    mapping = tmp_path / "roles.json"
+    mapping.write_text(json.dumps({"left_foot": "Toes_L"}), encoding="utf-8")
+    assert main(["limits", "check", str(take), "--json", "--mapping", str(mapping)]) == 0
+    after = json.loads(capsys.readouterr().out)
+    mapped = {j["role"]: j["name"] for j in after["joints"]}
+    assert mapped["left_foot"] == "Toes_L"
+    assert "Foot_L" in after["not_checked"]

@@ -109,7 +109,7 @@ def _analyze_motion(
     if "limits" in options.checks:
         progress(55, "joint-limit check")
         clock = time.perf_counter()
-        outcome = run_limits(motion, frames)
+        outcome = run_limits(motion, frames, options.mapping)
         timings["limits_s"] = time.perf_counter() - clock
         outcomes["limits"] = outcome
         series["limits"] = outcome.series

@@ -171,15 +171,21 @@ def _model_for_rig(key: RigKey) -> LimitsModel | str:
         return str(e)
 
 
-def run_limits(motion: Motion, frames: IntArray) -> StepOutcome:
-    """Check joint limits with the shipped model of the rig (loaded once per rig layout)."""
+def run_limits(
+    motion: Motion, frames: IntArray, mapping: dict[str, str] | None = None
+) -> StepOutcome:
+    """Check joint limits with the shipped model of the rig (loaded once per rig layout).
+
+    ``mapping`` (role key → joint name) decides the roles the canonical model checks; the
+    message counts the joints that are not checked and ``summary.not_checked`` names them.
+    """
     skeleton = motion.skeleton
     key = (skeleton.names, skeleton.parents.tobytes(), skeleton.offsets.tobytes())
     _RIGS.setdefault(key, skeleton)
     model = _model_for_rig(key)
     if isinstance(model, str):
         return StepOutcome("no_model", f"no model for this rig ({model})")
-    report = check_limits(motion, model)
+    report = check_limits(motion, model, mapping=mapping)
     joints = list(report.joint_names)
     findings = violation_findings(report.valid, report.score_deg, joints, report.readout)
     sampled = frames[frames < report.valid.shape[0]]
@@ -191,7 +197,8 @@ def run_limits(motion: Motion, frames: IntArray) -> StepOutcome:
         joint.pop("frames", None)  # the heat map carries the per-frame values
     return StepOutcome(
         "done",
-        f"{len(findings)} violation interval(s), rig {report.rig_family}",
+        f"{len(findings)} violation interval(s), model {report.rig_family}; "
+        f"{len(report.not_checked)} joint(s) not checked (listed in summary.not_checked)",
         findings,
         {
             "joints": joints,
