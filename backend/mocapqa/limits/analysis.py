@@ -10,7 +10,7 @@ documented in ``docs/limits.md``.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -19,9 +19,16 @@ from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles
 from mocapqa.errors import InputError, LimitsFileError
-from mocapqa.limits.canonical import CANONICAL_AXIS, CanonicalFrames, canonical_quats, rig_key
+from mocapqa.kinematics.quaternion import multiply
+from mocapqa.limits.canonical import (
+    CANONICAL_AXIS,
+    CanonicalFrames,
+    canonical_rotations,
+    rig_key,
+    take_frames,
+)
 from mocapqa.limits.discriminator import network_valid
-from mocapqa.limits.expmap import limit_params_from_quats
+from mocapqa.limits.expmap import expmap_from_quats, limit_params_from_quats
 from mocapqa.limits.model import LimitsModel, check_rig, load_default_model
 from mocapqa.limits.occupancy import evaluate, limit_distances, signed_excess
 from mocapqa.limits.readout import violation_text
@@ -179,16 +186,26 @@ def charted(
         return params, list(range(len(model.joints))), rest, tuple(j.name for j in model.joints)
     try:
         if mapping:
-            frames, quats = canonical_quats(motion, rig=find_roles(motion.skeleton, mapping))
+            frames = take_frames(motion, rig=find_roles(motion.skeleton, mapping))
         else:
-            frames, quats = canonical_quats(motion, known=_known_frames(motion, model))
+            frames = take_frames(motion, known=_known_frames(motion, model))
     except InputError as e:
         raise LimitsFileError(f"Expected a skeleton the canonical frames apply to: {e}") from e
     column = {role: k for k, role in enumerate(frames.roles)}
     columns = [k for k, j in enumerate(model.joints) if j.role in column]
     picked = [column[model.joints[k].role] for k in columns]
     references = np.stack([model.joints[k].reference for k in columns])
-    params = limit_params_from_quats(quats[:, picked], CANONICAL_AXIS[None], references)
+    # conj(reference) ⊗ conj(A_parent) ⊗ A_child = conj(A_parent ⊗ reference) ⊗ A_child: the
+    # reference joins the parent's constant frame, saving one product per frame.
+    charted_frames = replace(
+        frames,
+        roles=tuple(frames.roles[c] for c in picked),
+        joints=frames.joints[picked],
+        parents=frames.parents[picked],
+        frames=frames.frames[picked],
+        parent_frames=multiply(frames.parent_frames[picked], references),
+    )
+    params = expmap_from_quats(canonical_rotations(motion, charted_frames), CANONICAL_AXIS)
     used = {int(frames.joints[c]) for c in picked}
     unused = [n for i, n in enumerate(motion.skeleton.names) if i not in used]
     missing = [j.role for j in model.joints if j.role not in column]

@@ -68,6 +68,7 @@ __all__ = [
     "rig_frames",
     "rig_key",
     "role_parent",
+    "take_frames",
 ]
 
 # The long axis of every canonical frame.
@@ -387,23 +388,27 @@ def canonical_rotations(motion: Motion, frames: CanonicalFrames) -> FloatArray:
     return multiply(conjugate(parent), child)
 
 
+def take_frames(
+    motion: Motion, rig: RigMap | None = None, known: CanonicalFrames | None = None
+) -> CanonicalFrames:
+    """``known`` (frames of the rig estimated over many takes, :func:`rig_frames`) if given,
+    else the take's own frames, estimated from at most 4,000 evenly spaced frames."""
+    if known is not None:
+        return known
+    sample = motion
+    if motion.n_frames > _MEDIAN_FRAMES:
+        keep = np.linspace(0, motion.n_frames - 1, _MEDIAN_FRAMES).astype(np.intp)
+        sample = Motion(motion.skeleton, motion.quats[keep], motion.translations[keep], motion.fps)
+    return canonical_frames(sample, rig)
+
+
 def canonical_quats(
     motion: Motion, rig: RigMap | None = None, known: CanonicalFrames | None = None
 ) -> tuple[CanonicalFrames, FloatArray]:
-    """Canonical frames of a take and its canonical rotations ``(F, R, 4)``.
-
-    ``known`` (frames of the rig estimated over many takes, :func:`rig_frames`) is used as is;
-    otherwise the frames are estimated from this take (from at most 4,000 evenly spaced frames).
-    """
-    if known is None:
-        sample = motion
-        if motion.n_frames > _MEDIAN_FRAMES:
-            keep = np.linspace(0, motion.n_frames - 1, _MEDIAN_FRAMES).astype(np.intp)
-            sample = Motion(
-                motion.skeleton, motion.quats[keep], motion.translations[keep], motion.fps
-            )
-        known = canonical_frames(sample, rig)
-    return known, canonical_rotations(motion, known)
+    """Canonical frames of a take (:func:`take_frames`) and its canonical rotations
+    ``(F, R, 4)``."""
+    frames = take_frames(motion, rig, known)
+    return frames, canonical_rotations(motion, frames)
 
 
 def rig_key(motion: Motion) -> str:
