@@ -3,7 +3,10 @@
 The lookup map decides validity (the fast path); the score is the distance outside the valid
 region, ``√(swing_deg² + twist_deg²)``, so violations can be ranked, not only flagged (see
 :func:`mocapqa.limits.occupancy.limit_distances`). The discriminator can be asked instead of the
-map with ``method="network"``; the score always comes from the map. The JSON forms are
+map with ``method="network"``; the score always comes from the map. With a canonical model
+the take's role joints are charted in their anatomical frames (:mod:`mocapqa.limits.canonical`),
+so any rig with roles is checked; the report lists the joints it does not check and reads each
+violation out in anatomical terms (:mod:`mocapqa.limits.readout`). The JSON forms are
 documented in ``docs/limits.md``.
 """
 

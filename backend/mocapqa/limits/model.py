@@ -17,8 +17,12 @@ network was trained ``k/hidden_weights`` (3, H), ``k/hidden_biases`` (H,),
 ``k/output_weights`` (H,), ``k/output_bias`` (1,). Anything else, a missing array, a bad shape
 or another format version raises :class:`~mocapqa.errors.LimitsFileError`.
 
-A model applies to a skeleton only when the skeleton matches its fingerprint
-(:mod:`mocapqa.limits.rig`); :func:`check_rig` refuses any other rig.
+A per-rig model (``frame == "rig"``) applies to a skeleton only when the skeleton matches its
+fingerprint (:mod:`mocapqa.limits.rig`); :func:`check_rig` refuses any other rig. A canonical
+model (``frame == "canonical"``, :mod:`mocapqa.limits.canonical`) applies to any skeleton with
+limb roles; it also stores the canonical frames of the rigs it was built from (``"rigs"`` in
+``meta``, arrays ``rig{i}/frames`` and ``rig{i}/parent_frames``). :func:`load_default_model`
+picks the canonical model except for the rigs in :data:`PREFERRED_RIG_MODELS`.
 """
 
 from __future__ import annotations
