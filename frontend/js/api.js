@@ -53,7 +53,8 @@ export function uploadTake(file, onProgress) {
   return new Promise((resolve, reject) => {
     const xhr = new XMLHttpRequest();
     xhr.open("POST", `${BASE}/takes`);
-    xhr.upload.onprogress = (e) => { if (e.lengthComputable) onProgress(e.loaded / e.total); };
+    // Bytes of this file sent so far (the request's own overhead is left out).
+    xhr.upload.onprogress = (e) => { if (e.lengthComputable) onProgress(Math.min(file.size, e.loaded * (file.size / e.total))); };
     xhr.onload = () => {
       if (xhr.status === 201) resolve(JSON.parse(xhr.responseText));
       else reject(apiError(xhr.status, xhr.responseText));

@@ -108,8 +108,7 @@ def test_upload_view_scrub_jump_review_and_download(
         " s.dispatchEvent(new Event('input')); }"
     )
     assert page.inner_text("#frame-label").startswith("frame 300 /")
-    title = page.evaluate("() => document.getElementById('view-raw').layout.title.text")
-    assert title == "raw — frame 300"
+    assert page.inner_text("#panel-raw .view-title") == "raw — frame 300"
 
     # The demo take (CMU walk with injected twist errors): click a flagged interval.
     upload_through_page(page, demo_paths()[0])

@@ -57,11 +57,15 @@ def write_outputs(files: FileStore, run_id: str, result: AnalysisResult) -> list
     folder = files.run_dir(run_id)
     kinds = ["report"]
     buffer = io.BytesIO()
-    np.savez(
-        buffer,
-        raw=result.raw_points.astype(np.float32),
-        corrected=result.corrected_points.astype(np.float32),
-    )
+    arrays = {
+        "raw": result.raw_points.astype(np.float32),
+        "corrected": result.corrected_points.astype(np.float32),
+    }
+    if result.raw_rotations is not None and result.corrected_rotations is not None:
+        # Half precision (about 1e-3 per component) is finer than a drawn bone can show.
+        arrays["raw_rotations"] = result.raw_rotations.astype(np.float16)
+        arrays["corrected_rotations"] = result.corrected_rotations.astype(np.float16)
+    np.savez(buffer, **arrays)
     files.write_bytes(folder / "points.npz", buffer.getvalue())
     if result.corrected_motion is not None:
         files.write_bytes(folder / "corrected.bvh", format_bvh(result.corrected_motion).encode())

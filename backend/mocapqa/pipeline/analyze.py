@@ -25,7 +25,7 @@ from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles
 from mocapqa.errors import InputError
-from mocapqa.pipeline.frames import motion_points, sample_frames
+from mocapqa.pipeline.frames import motion_pose, sample_frames
 from mocapqa.pipeline.loading import Take
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.pipeline.steps import (
@@ -58,6 +58,9 @@ class AnalysisResult:
         Positions drawn in the raw 3D view, file units.
     corrected_points : ndarray, shape (F, P, 3)
         Positions drawn in the corrected 3D view, file units.
+    raw_rotations, corrected_rotations : ndarray, shape (F, P, 4), optional
+        World unit quaternions (scalar-last) of the points, for motion takes: the 3D view
+        orients each bone by its parent's rotation.
     """
 
     report: dict[str, Any]
@@ -65,6 +68,8 @@ class AnalysisResult:
     filtered_keypoints: KeypointSequence | None
     raw_points: FloatArray
     corrected_points: FloatArray
+    raw_rotations: FloatArray | None = None
+    corrected_rotations: FloatArray | None = None
 
 
 def _no_progress(percent: int, step: str) -> None:
@@ -87,7 +92,7 @@ def _analyze_motion(
     rig = find_roles(motion.skeleton, options.mapping)  # a bad mapping fails the run here
     progress(10, "forward kinematics (raw)")
     clock = time.perf_counter()
-    names, parents, raw_points = motion_points(motion)
+    names, parents, raw_points, raw_rotations = motion_pose(motion)
     timings["fk_raw_s"] = time.perf_counter() - clock
 
     corrected = motion
@@ -130,7 +135,7 @@ def _analyze_motion(
 
     progress(85, "forward kinematics (corrected)")
     clock = time.perf_counter()
-    _, _, corrected_points = motion_points(corrected)
+    _, _, corrected_points, corrected_rotations = motion_pose(corrected)
     timings["fk_corrected_s"] = time.perf_counter() - clock
     skeleton = motion.skeleton
     report = {
@@ -155,7 +160,15 @@ def _analyze_motion(
         "points": {"names": names, "parents": parents, "n_joints": skeleton.n_joints},
         "series": {"frames": frames.tolist(), "fps": motion.fps, **series},
     }
-    return AnalysisResult(report, corrected, None, raw_points, corrected_points)
+    return AnalysisResult(
+        report,
+        corrected,
+        None,
+        raw_points,
+        corrected_points,
+        raw_rotations,
+        corrected_rotations,
+    )
 
 
 def _analyze_keypoints(

@@ -12,7 +12,7 @@ from mocapqa.core.arrays import FloatArray, IntArray
 from mocapqa.core.motion import Motion
 from mocapqa.kinematics.forward import end_site_positions, forward_kinematics
 
-__all__ = ["motion_points", "sample_frames"]
+__all__ = ["motion_points", "motion_pose", "sample_frames"]
 
 
 def motion_points(motion: Motion) -> tuple[list[str], list[int], FloatArray]:
@@ -27,12 +27,31 @@ def motion_points(motion: Motion) -> tuple[list[str], list[int], FloatArray]:
     positions : ndarray, shape (F, P, 3)
         World positions, file units.
     """
+    names, parents, positions, _ = motion_pose(motion)
+    return names, parents, positions
+
+
+def motion_pose(motion: Motion) -> tuple[list[str], list[int], FloatArray, FloatArray]:
+    """:func:`motion_points` plus the world rotation of every point.
+
+    The 3D view draws each bone in its parent joint's frame, so a roll about the bone shows.
+
+    Returns
+    -------
+    names, parents, positions
+        As :func:`motion_points`.
+    rotations : ndarray, shape (F, P, 4)
+        World unit quaternions, scalar-last ``(x, y, z, w)``; an End Site carries its parent's.
+    """
     world_quats, world_positions = forward_kinematics(motion)
     ends = end_site_positions(motion, world_quats, world_positions)
     skeleton = motion.skeleton
     names = list(skeleton.names) + [f"{skeleton.names[e.parent]} end" for e in skeleton.end_sites]
-    parents = [int(p) for p in skeleton.parents] + [int(e.parent) for e in skeleton.end_sites]
-    return names, parents, np.concatenate([world_positions, ends], axis=1)
+    site_parents = [int(e.parent) for e in skeleton.end_sites]
+    parents = [int(p) for p in skeleton.parents] + site_parents
+    positions = np.concatenate([world_positions, ends], axis=1)
+    rotations = np.concatenate([world_quats, world_quats[:, site_parents]], axis=1)
+    return names, parents, positions, rotations
 
 
 def sample_frames(n_frames: int, max_points: int) -> IntArray:

@@ -84,6 +84,9 @@ def get_frames(
 ) -> Response:
     """Raw and corrected point positions for frames ``start:stop:step`` (file units).
 
+    Motion takes also carry ``raw_rotations`` and ``corrected_rotations``: each point's world
+    unit quaternion (scalar-last), by which the 3D view orients the bones.
+
     A missing point (a keypoint not detected in that frame) is ``[null, null, null]``.
 
     The step grows so that at most ``max_frames`` frames come back; the answer states the
@@ -93,6 +96,7 @@ def get_frames(
     path = services.files.existing(services.files.run_dir(run_id) / "points.npz", "the points")
     with np.load(path) as data:
         raw, corrected = data["raw"], data["corrected"]
+        rotations = {k: data[k] for k in ("raw_rotations", "corrected_rotations") if k in data}
     n_frames = int(raw.shape[0])
     stop = n_frames if stop is None else min(stop, n_frames)
     if start >= stop:
@@ -101,7 +105,7 @@ def get_frames(
     if count > max_frames:
         step = -(-(stop - start) // max_frames)
     frames = np.arange(start, stop, step)
-    if frames.size * raw.shape[1] * 6 > MAX_WINDOW_VALUES:
+    if frames.size * raw.shape[1] * (6 + 4 * len(rotations)) > MAX_WINDOW_VALUES:
         raise InputError(
             f"Expected a window of at most {MAX_WINDOW_VALUES} values, got {frames.size} frames"
         )
@@ -112,6 +116,8 @@ def get_frames(
         "raw": np.round(raw[frames].astype(np.float64), 3).tolist(),
         "corrected": np.round(corrected[frames].astype(np.float64), 3).tolist(),
     }
+    for key, values in rotations.items():
+        payload[key] = np.round(values[frames].astype(np.float64), 3).tolist()
     # Plain json.dumps: FastAPI's encoder would walk each of the ~10^5 numbers in Python.
     # Missing points are NaN in the store; JSON has no NaN, so they go out as null (no number
     # literal contains "NaN", so the replacement touches nothing else).

@@ -1,0 +1,27 @@
+// Tiny DOM helpers shared by the views. Event handlers are attached with addEventListener
+// (never inline attributes: the Content-Security-Policy forbids inline script).
+
+export const h = (tag, attrs = {}, ...children) => {
+  const el = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) {
+    if (k.startsWith("on")) el.addEventListener(k.slice(2), v);
+    else if (v === true) el.setAttribute(k, "");
+    else if (v !== false && v != null) el.setAttribute(k, v);
+  }
+  for (const c of children.flat()) if (c != null) el.append(c instanceof Node ? c : String(c));
+  return el;
+};
+
+export const badge = (text, cls) => h("span", { class: `badge ${cls || text}` }, text);
+
+export const REVIEW = { unreviewed: "unreviewed", approved: "approved", needs_fix: "needs fix", rejected: "rejected" };
+
+/** Make a row or header act like a button: focusable, Enter/space activate it. */
+export function activatable(el, action) {
+  el.setAttribute("tabindex", "0");
+  el.addEventListener("click", action);
+  el.addEventListener("keydown", (e) => {
+    if (e.key === "Enter" || (e.key === " " && e.target === el)) { e.preventDefault(); e.stopPropagation(); action(e); }
+  });
+  return el;
+}

@@ -1,0 +1,58 @@
+// Pure formatting and ordering helpers shared by the views (no DOM).
+
+export const fmt = (v, digits = 1) => (v == null || Number.isNaN(v) ? "–" : Number(v).toFixed(digits));
+
+/** Seconds shown with the precision one frame needs at `fps` (30 fps -> 2 decimals). */
+export function seconds(frame, fps) {
+  const digits = Math.min(3, Math.max(1, Math.ceil(Math.log10(Math.max(fps, 1)))));
+  return `${(frame / fps).toFixed(digits)} s`;
+}
+
+/** Sort keys of the findings table: "value" sorts by magnitude (−77° is larger than +2°). */
+export const FINDING_KEYS = {
+  kind: (f) => f.kind,
+  joint: (f) => f.joint,
+  start_frame: (f) => f.start_frame,
+  duration: (f) => f.end_frame - f.start_frame + 1,
+  value: (f) => (f.value == null ? null : Math.abs(f.value)),
+  confidence: (f) => f.confidence,
+};
+
+/** A sorted copy of `rows` by `key` (FINDING_KEYS), `dir` 1 ascending or −1; missing last. */
+export function sortFindings(rows, key, dir) {
+  const get = FINDING_KEYS[key];
+  return [...rows].sort((a, b) => {
+    const x = get(a), y = get(b);
+    if (x == null && y == null) return a.start_frame - b.start_frame;
+    if (x == null) return 1;
+    if (y == null) return -1;
+    if (x < y) return -dir;
+    if (x > y) return dir;
+    return a.start_frame - b.start_frame;
+  });
+}
+
+/** The steps of a run that actually ran ("twist+limits"), from its summary; options before. */
+export function stepsRan(run) {
+  const steps = run.summary && run.summary.steps;
+  if (!steps) return run.status === "done" ? run.options.checks.join("+") : "";
+  const ran = Object.entries(steps).filter(([, state]) => state === "done").map(([name]) => name);
+  return ran.length ? ran.join("+") : "no step ran";
+}
+
+/** Run checks a take of this kind can run (twist and limits need joint rotations). */
+export const checksFor = (kind) => (kind === "motion" ? ["twist", "limits", "filter"] : ["filter"]);
+
+/** The start frames of findings, sorted and unique: the stops of N/P navigation. */
+export const findingStops = (findings) => [...new Set(findings.map((f) => f.start_frame))].sort((a, b) => a - b);
+
+/** The next (dir 1) or previous (dir −1) stop from `frame`, or null at the end. */
+export function nextStop(stops, frame, dir) {
+  if (dir > 0) return stops.find((s) => s > frame) ?? null;
+  for (let k = stops.length - 1; k >= 0; k--) if (stops[k] < frame) return stops[k];
+  return null;
+}
+
+/** One colour per chain/joint name, stable for a given order of names. */
+export const PALETTE = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
+export const colorOf = (names) => new Map(names.map((n, k) => [n, PALETTE[k % PALETTE.length]]));

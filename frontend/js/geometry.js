@@ -1,0 +1,225 @@
+// Pure skeleton geometry for the 3D views: oriented (octahedral) bones, axis triads, framing.
+// Data arrive Y-up in file units; the views are Plotly scenes (Z-up), so every drawn point goes
+// through `toScene` (x, y, z) -> (x, -z, y), a rotation (not a mirror) about the x axis.
+
+export const present = (p) => p != null && p[0] != null && p[1] != null && p[2] != null;
+export const toScene = (p) => [p[0], -p[2], p[1]];
+
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const scale = (a, s) => [a[0] * s, a[1] * s, a[2] * s];
+const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+const norm = (a) => Math.hypot(a[0], a[1], a[2]);
+
+/** Rotate vector v by the unit quaternion q = [x, y, z, w] (scalar-last, active). */
+export function rotate(q, v) {
+  const u = [q[0], q[1], q[2]];
+  const t = scale(cross(u, v), 2);
+  return add(add(v, scale(t, q[3])), cross(u, t));
+}
+const conjugate = (q) => [-q[0], -q[1], -q[2], q[3]];
+
+/** Bones as [parent, child] point pairs, in point order (roots have no bone). */
+export const bonesOf = (parents) => parents.flatMap((p, c) => (p >= 0 ? [[p, c]] : []));
+
+/**
+ * Per bone, the side of the bone that is marked, as a unit vector in the parent joint's frame:
+ * the local axis most perpendicular to the bone, made exactly perpendicular. Chosen once from
+ * one frame so it never jumps between frames (a BVH bone's direction is fixed in its parent).
+ */
+export function boneSides(points, rotations, bones) {
+  return bones.map(([p, c]) => {
+    const d = sub(points[c], points[p]);
+    const length = norm(d);
+    if (!(length > 1e-9) || !rotations[p]) return [1, 0, 0];
+    const local = rotate(conjugate(rotations[p]), scale(d, 1 / length));
+    const axis = [0, 1, 2].reduce((best, a) => (Math.abs(local[a]) < Math.abs(local[best]) ? a : best), 0);
+    const e = [0, 0, 0]; e[axis] = 1;
+    const side = sub(e, scale(local, dot(e, local)));
+    return scale(side, 1 / norm(side));
+  });
+}
+
+// Vertices of one octahedral bone: head, four corners of the widest square, tail. Corner 1 is
+// the marked side (+u), corner 2 is +v = bone × u.
+export const BONE_FACES = [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1], [5, 2, 1], [5, 3, 2], [5, 4, 3], [5, 1, 4]];
+/** Faces that touch the marked corner: drawn in the marking colour. */
+export const MARKED_FACES = new Set([0, 3, 4, 7]);
+const WIDEST = 0.15; // the square sits at this fraction of the bone's length (Blender: 0.1)
+const WIDTH = 0.16; // half-width of the square as a fraction of the bone's length (Blender: 0.1)
+
+/**
+ * Octahedral bones of one frame as Plotly mesh3d arrays (scene coordinates).
+ *
+ * @param points   (P, 3) positions, Y-up
+ * @param rotations (P, 4) world unit quaternions, scalar-last
+ * @param bones    [parent, child] pairs (bonesOf)
+ * @param sides    marked side per bone in the parent's frame (boneSides)
+ * @returns {{x: number[], y: number[], z: number[]}} 6 vertices per bone; a degenerate bone
+ *          (zero length or a missing end) collapses onto its head so the faces stay the same.
+ */
+export function boneVertices(points, rotations, bones, sides) {
+  const x = [], y = [], z = [];
+  const put = (p) => { const s = toScene(p); x.push(s[0]); y.push(s[1]); z.push(s[2]); };
+  bones.forEach(([p, c], b) => {
+    const head = points[p], tail = points[c];
+    if (!present(head) || !present(tail)) { for (let k = 0; k < 6; k++) put(present(head) ? head : [0, 0, 0]); return; }
+    const d = sub(tail, head);
+    const length = norm(d);
+    if (!(length > 1e-9)) { for (let k = 0; k < 6; k++) put(head); return; }
+    const along = scale(d, 1 / length);
+    let u = rotate(rotations[p], sides[b]);
+    u = sub(u, scale(along, dot(u, along)));
+    const n = norm(u);
+    u = n > 1e-9 ? scale(u, 1 / n) : [0, 0, 0];
+    const v = cross(along, u);
+    const mid = add(head, scale(d, WIDEST));
+    const w = WIDTH * length;
+    put(head);
+    put(add(mid, scale(u, w))); put(add(mid, scale(v, w)));
+    put(sub(mid, scale(u, w))); put(sub(mid, scale(v, w)));
+    put(tail);
+  });
+  return { x, y, z };
+}
+
+/** Face index arrays (i, j, k) of `count` bones, 6 vertices and 8 faces each. */
+export function boneFaces(count) {
+  const i = [], j = [], k = [];
+  for (let b = 0; b < count; b++) for (const [a, c, e] of BONE_FACES) { i.push(6 * b + a); j.push(6 * b + c); k.push(6 * b + e); }
+  return { i, j, k };
+}
+
+/**
+ * Colour of every face: the marked side in `marked`, the rest in `body`; bones whose parent
+ * joint is in `flagged` (a Map joint index -> colour) take that colour for the body.
+ */
+export function faceColors(bones, flagged, body, marked) {
+  const colors = [];
+  for (const [p] of bones) {
+    const own = flagged.get(p) || body;
+    for (let f = 0; f < 8; f++) colors.push(MARKED_FACES.has(f) ? marked : own);
+  }
+  return colors;
+}
+
+const AXIS_COLORS = ["#d62728", "#2ca02c", "#1f77b4"]; // x red, y green, z blue (as in Blender)
+
+/** Per-joint axis triads as one line trace: 3 segments per joint with per-vertex colours. */
+export function triads(points, rotations, joints, length) {
+  const x = [], y = [], z = [], color = [];
+  for (let j = 0; j < joints; j++) {
+    const o = points[j], q = rotations[j];
+    for (let a = 0; a < 3; a++) {
+      const e = [0, 0, 0]; e[a] = length;
+      const ok = present(o) && q;
+      const s = ok ? toScene(o) : [null, null, null];
+      const t = ok ? toScene(add(o, rotate(q, e))) : [null, null, null];
+      x.push(s[0], t[0], null); y.push(s[1], t[1], null); z.push(s[2], t[2], null);
+      color.push(AXIS_COLORS[a], AXIS_COLORS[a], AXIS_COLORS[a]);
+    }
+  }
+  return { x, y, z, color };
+}
+
+/** Bones as line segments (keypoint takes, or the raw ghost), scene coordinates. */
+export function boneLines(points, bones) {
+  const x = [], y = [], z = [];
+  for (const [p, c] of bones) {
+    const a = points[p], b = points[c];
+    if (!present(a) || !present(b)) continue;
+    const s = toScene(a), t = toScene(b);
+    x.push(s[0], t[0], null); y.push(s[1], t[1], null); z.push(s[2], t[2], null);
+  }
+  return { x, y, z };
+}
+
+/** Joint markers in scene coordinates (missing points as null: Plotly leaves them out). */
+export function markers(points) {
+  const x = [], y = [], z = [];
+  for (const p of points) {
+    const s = present(p) ? toScene(p) : [null, null, null];
+    x.push(s[0]); y.push(s[1]); z.push(s[2]);
+  }
+  return { x, y, z };
+}
+
+/**
+ * Scene ranges that hold every frame given (the whole take's motion), padded by `pad` of the
+ * largest extent, with the floor at the lowest point: [[x0, x1], [y0, y1], [z0, z1]] in scene
+ * coordinates, and the aspect ratio that keeps metres square.
+ */
+export function frameTake(frameSets, pad = 0.08) {
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (const frames of frameSets) for (const points of frames) for (const p of points) {
+    if (!present(p)) continue;
+    const s = toScene(p);
+    for (let a = 0; a < 3; a++) { if (s[a] < lo[a]) lo[a] = s[a]; if (s[a] > hi[a]) hi[a] = s[a]; }
+  }
+  if (!Number.isFinite(lo[0])) return { ranges: [[-1, 1], [-1, 1], [0, 2]], aspect: { x: 1, y: 1, z: 1 } };
+  const extent = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
+  const margin = pad * extent;
+  const ranges = [0, 1, 2].map((a) => [lo[a] - (a === 2 ? 0 : margin), hi[a] + margin]);
+  const sizes = ranges.map(([a, b]) => b - a);
+  const largest = Math.max(...sizes);
+  return { ranges, aspect: { x: sizes[0] / largest, y: sizes[1] / largest, z: sizes[2] / largest } };
+}
+
+/**
+ * The size of the box that follows the body: the largest extent of the body in any frame, and
+ * the floor and ceiling over the take (scene coordinates).
+ */
+export function bodyBox(frameSets, pad = 0.15) {
+  let extent = 0, floor = Infinity, ceiling = -Infinity;
+  for (const frames of frameSets) for (const points of frames) {
+    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    for (const p of points) {
+      if (!present(p)) continue;
+      const s = toScene(p);
+      for (let a = 0; a < 3; a++) { if (s[a] < lo[a]) lo[a] = s[a]; if (s[a] > hi[a]) hi[a] = s[a]; }
+    }
+    if (!Number.isFinite(lo[0])) continue;
+    extent = Math.max(extent, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    floor = Math.min(floor, lo[2]); ceiling = Math.max(ceiling, hi[2]);
+  }
+  if (!Number.isFinite(floor)) return { half: 1, floor: 0, ceiling: 2 };
+  return { half: (extent || 1) * (0.5 + pad), floor, ceiling };
+}
+
+/** The centre of the present points (scene coordinates), or null when none is present. */
+export function centreOf(points) {
+  const sum = [0, 0, 0];
+  let n = 0;
+  for (const p of points) if (present(p)) { const s = toScene(p); sum[0] += s[0]; sum[1] += s[1]; sum[2] += s[2]; n += 1; }
+  return n ? sum.map((v) => v / n) : null;
+}
+
+/**
+ * Scene ranges of a box of half-size `box.half` around `centre` horizontally, from the floor
+ * up: the skeleton fills the view and keeps its scale over the take.
+ */
+export function followRanges(centre, box) {
+  const half = Math.max(box.half, (box.ceiling - box.floor) / 2);
+  return [[centre[0] - half, centre[0] + half], [centre[1] - half, centre[1] + half], [box.floor, box.floor + 2 * half]];
+}
+
+/** Whether `centre` has drifted from the middle of `ranges` by more than `share` of the half-size. */
+export function drifted(centre, ranges, share = 0.25) {
+  return [0, 1].some((a) => {
+    const [lo, hi] = ranges[a];
+    return Math.abs(centre[a] - (lo + hi) / 2) > share * ((hi - lo) / 2);
+  });
+}
+
+/** The root's path on the floor (scene coordinates, z at `floor`). */
+export function groundPath(frames, root, floor) {
+  const x = [], y = [], z = [];
+  for (const points of frames) {
+    const p = points[root];
+    if (!present(p)) continue;
+    const s = toScene(p);
+    x.push(s[0]); y.push(s[1]); z.push(floor);
+  }
+  return { x, y, z };
+}

@@ -1,0 +1,239 @@
+// The take view: two 3D views with one camera, the player, findings, charts, review, re-run.
+import * as api from "./api.js";
+import * as charts from "./charts.js";
+import { activatable, badge, h } from "./dom.js";
+import { findingStops, fmt, nextStop, seconds, sortFindings, stepsRan } from "./format.js";
+import { createPlayer } from "./player.js";
+import { loadPlotly } from "./plotly.js";
+import * as store from "./state.js";
+import { createTimeline } from "./timeline.js";
+import { createViews } from "./view3d.js";
+import { reviewPanel } from "./review.js";
+import { rerunPanel } from "./rerun.js";
+
+const OVERVIEW_FRAMES = 800; // frames of a take drawn before any window is loaded
+const LIMITS_COLOR = "#e67e22";
+
+export async function takeView(main, takeId, params, onTeardown) {
+  const runParam = params.get("run");
+  const [take, Plotly] = await Promise.all([api.getTake(takeId), loadPlotly()]);
+  performance.mark("take-data");
+  const runs = take.runs;
+  const run = runs.find((r) => r.id === runParam) || runs[runs.length - 1];
+  const header = h("div", {}, h("h1", {}, take.name, " ", badge(run ? run.status : "none")),
+    h("p", { class: "muted" }, `${take.format.toUpperCase()} · ${take.n_frames} frames at ${fmt(take.fps, 2)} fps · ${take.n_joints} ${take.kind === "motion" ? "joints" : "keypoints"} · sha256 ${take.sha256.slice(0, 12)}…`));
+  main.replaceChildren(header);
+  if (!run) return;
+  if (run.status !== "done") {
+    const bar = h("progress", { max: 100, value: run.progress }), text = h("span", {}, run.step);
+    main.append(h("p", {}, bar, " ", text));
+    const final = await api.waitForRun(run.id, (r) => { bar.value = r.progress; text.textContent = `${r.step} (${r.progress} %)`; });
+    if (final.status === "failed") { main.append(h("p", { class: "error" }, final.error)); return; }
+    window.dispatchEvent(new HashChangeEvent("hashchange")); return;
+  }
+  const [result, filters, overview] = await Promise.all([
+    api.getResult(run.id), api.listFilters(), api.getFrames(run.id, { maxFrames: OVERVIEW_FRAMES })]);
+  const fps = result.summary.fps;
+  const nFrames = result.summary.n_frames;
+  const names = result.points.names;
+  const parents = result.points.parents;
+  const jointIndex = new Map(names.map((n, i) => [n, i]));
+  const oriented = Array.isArray(overview.raw_rotations);
+  store.reset();
+  store.set({ frame: Math.max(0, Math.min(nFrames - 1, Number(params.get("frame")) || 0)) });
+  const chainColor = result.series.twist ? charts.chainColors(result.series.twist) : new Map();
+  const findingColor = (f) => (f.kind === "twist" ? chainColor.get(f.joint) || "#c0392b" : LIMITS_COLOR);
+  let detail = null;
+
+  // Layout
+  const frameLabel = h("span", { id: "frame-label" });
+  const scrubber = h("input", { type: "range", id: "scrubber", min: 0, max: nFrames - 1, value: 0, step: 1, "aria-label": "frame" });
+  const playButton = h("button", { id: "play", class: "primary", "aria-keyshortcuts": "Space" }, "▶ play");
+  const speed = h("select", { id: "speed", "aria-label": "speed" }, [0.25, 0.5, 1, 2].map((s) => h("option", { value: s, selected: s === 1 }, `${s}×`)));
+  const rawDiv = h("div", { id: "view-raw", class: "view3d" });
+  const corrDiv = h("div", { id: "view-corrected", class: "view3d" });
+  const rawTitle = h("h3", { class: "view-title" }, "raw");
+  const corrTitle = h("h3", { class: "view-title" }, "corrected");
+  const rawPanel = h("div", { class: "col panel", id: "panel-raw" }, rawTitle, rawDiv);
+  const presets = ["front", "side", "top"].map((name) => h("button", { id: `camera-${name}`, class: "small" }, name));
+  const triadsBox = h("input", { type: "checkbox", id: "show-axes", disabled: !oriented });
+  const overlayBox = h("input", { type: "checkbox", id: "overlay" });
+  const viewsRow = h("div", { class: "row", id: "views" }, rawPanel, h("div", { class: "col panel" }, corrTitle, corrDiv));
+  main.append(
+    runPicker(take, run),
+    h("div", { class: "controls view-options" }, "camera ", presets,
+      h("label", {}, triadsBox, " joint axes"), h("label", {}, overlayBox, " overlay (raw as ghost)"),
+      h("span", { class: "muted" }, oriented ? "bones are drawn in their parent joint's frame; the orange side marks the roll" : "")),
+    viewsRow,
+    h("div", { class: "controls panel player", id: "player" }, playButton, "speed ", speed, scrubber, frameLabel),
+  );
+  const help = h("p", { class: "muted", id: "keys-help" },
+    "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · Enter on a row opens it");
+  const timelines = h("div", {});
+  main.append(help, findingsTable(result.findings, (f) => { jump(f.start_frame); store.set({ joint: f.joint }); viewsRow.scrollIntoView({ block: "start" }); }),
+    timelines, reviewPanel(take, main), stepsPanel(result), downloadsPanel(run, result), rerunPanel(take, run, filters));
+
+  // Frames: the overview (whole take, decimated) or, when paused, a full-rate window around.
+  const pick = (source, f) => {
+    const k = Math.max(0, Math.min(source.frames.length - 1, Math.round((f - source.frames[0]) / source.step)));
+    return k;
+  };
+  const intervals = result.findings.filter((f) => jointIndex.has(f.joint));
+  const flaggedAt = (f) => {
+    const flagged = new Map();
+    for (const i of intervals) if (f >= i.start_frame && f <= i.end_frame) flagged.set(jointIndex.get(i.joint), findingColor(i));
+    return flagged;
+  };
+  const frameAt = (f) => {
+    const source = detail && f >= detail.frames[0] && f <= detail.frames[detail.frames.length - 1] ? detail : overview;
+    const k = pick(source, f);
+    return {
+      shown: source.frames[k], raw: source.raw[k], corrected: source.corrected[k],
+      rawRotations: oriented ? source.raw_rotations[k] : null, correctedRotations: oriented ? source.corrected_rotations[k] : null,
+      flagged: flaggedAt(f),
+    };
+  };
+
+  const views = await createViews(Plotly, { raw: rawDiv, corrected: corrDiv }, { names, parents, nJoints: result.points.n_joints, oriented }, overview);
+  const timeline = createTimeline(Plotly, timelines, (f) => jump(f));
+  const render = () => {
+    const f = store.state.frame;
+    const frame = frameAt(f);
+    views.show(frame);
+    frameLabel.textContent = `frame ${f} / ${nFrames - 1} · ${seconds(f, fps)} · ${frame.flagged.size} flagged joint(s)`;
+    rawTitle.textContent = `raw — frame ${frame.shown}`;
+    corrTitle.textContent = store.state.overlay ? `corrected (solid) and raw (ghost) — frame ${frame.shown}` : `corrected — frame ${frame.shown}`;
+    scrubber.value = f;
+    timeline.setFrame(f);
+  };
+  const remember = () => {
+    const query = new URLSearchParams({ run: run.id, frame: store.state.frame });
+    if (store.state.joint) query.set("joint", store.state.joint);
+    history.replaceState(null, "", `#/take/${take.id}?${query}`);
+  };
+  const loadDetail = async () => {
+    if (overview.step === 1) return;
+    const f = store.state.frame;
+    const part = await api.getFrames(run.id, { start: Math.max(0, f - 200), stop: Math.min(nFrames, f + 200), maxFrames: 401 });
+    detail = part;
+    if (!player.playing) render();
+  };
+  const jump = (f) => {
+    store.set({ frame: Math.max(0, Math.min(nFrames - 1, Math.round(f))) });
+    render(); remember(); loadDetail();
+  };
+  const player = createPlayer({ fps, nFrames, getFrame: () => store.state.frame, onFrame: (f) => { store.state.frame = f; render(); } });
+  const togglePlay = () => {
+    if (player.playing) { player.pause(); remember(); loadDetail(); } else { detail = null; player.play(); }
+    playButton.textContent = player.playing ? "❚❚ pause" : "▶ play";
+    playButton.setAttribute("aria-pressed", String(player.playing));
+  };
+  window.mocapqaPlayer = player; // read by the browser tests' timing figures
+  window.mocapqaViews = views;
+  playButton.addEventListener("click", togglePlay);
+  scrubber.addEventListener("input", () => { store.state.frame = Number(scrubber.value); render(); });
+  scrubber.addEventListener("change", () => { remember(); loadDetail(); });
+  speed.addEventListener("change", () => player.setSpeed(Number(speed.value)));
+  presets.forEach((button) => button.addEventListener("click", () => views.setCamera(button.textContent)));
+  triadsBox.addEventListener("change", () => views.setTriads(triadsBox.checked, frameAt(store.state.frame)));
+  overlayBox.addEventListener("change", () => {
+    store.set({ overlay: overlayBox.checked });
+    rawPanel.hidden = overlayBox.checked;
+    views.setOverlay(overlayBox.checked, frameAt(store.state.frame));
+    render();
+  });
+
+  const stops = findingStops(result.findings);
+  const onKey = (e) => {
+    const target = e.target;
+    const typing = target instanceof HTMLElement && (target.matches("input, textarea, select, [contenteditable]") || target.isContentEditable);
+    if (typing || e.ctrlKey || e.metaKey || e.altKey) return;
+    if (e.key === " " && !target.matches("button, a, [tabindex]")) { e.preventDefault(); togglePlay(); }
+    else if (e.key === "ArrowRight" || e.key === "ArrowLeft") {
+      e.preventDefault();
+      if (player.playing) togglePlay();
+      jump(store.state.frame + (e.key === "ArrowRight" ? 1 : -1) * (e.shiftKey ? 10 : 1));
+    } else if (e.key === "n" || e.key === "N" || e.key === "p" || e.key === "P") {
+      const stop = nextStop(stops, store.state.frame, e.key.toLowerCase() === "n" ? 1 : -1);
+      if (stop != null) { if (player.playing) togglePlay(); jump(stop); }
+    }
+  };
+  document.addEventListener("keydown", onKey);
+  onTeardown(() => { player.pause(); document.removeEventListener("keydown", onKey); });
+
+  render();
+  performance.mark("skeletons");
+
+  const series = result.series;
+  if (series.twist) {
+    await timeline.add("chart-twist", `Twist θP and removed offset (${series.twist.intervals.length} flagged interval(s))`,
+      charts.twistFigure(series.twist), (p) => {
+        if (p.customdata) return p.customdata[0];
+        const inside = series.twist.intervals.find((i) => i.start_frame <= p.x && p.x <= i.end_frame + 1);
+        return inside ? inside.start_frame : p.x;
+      });
+  }
+  if (series.limits) {
+    await timeline.add("chart-limits", "Joint-limit violations (joint × frame, degrees outside the limits)", charts.limitsFigure(series.limits), (p) => p.x);
+  } else if (result.steps.limits && result.steps.limits.state !== "skipped") {
+    timelines.append(h("p", { class: "muted", id: "limits-note" }, `Joint limits: ${result.steps.limits.message}`));
+  }
+  if (result.kind === "keypoints") {
+    const choice = h("select", { id: "keypoint-pick", "aria-label": "keypoint" }, names.map((n, i) => h("option", { value: i }, n)));
+    timelines.append(h("div", { class: "controls" }, "keypoint ", choice));
+    const k = () => Number(choice.value);
+    const trajectory = () => charts.trajectoryFigure(overview.frames, overview.raw.map((p) => p[k()]), overview.corrected.map((p) => p[k()]), result.summary.length_unit);
+    await timeline.add("chart-trajectory", "Raw vs filtered trajectory (one panel per axis)", trajectory(), (p) => p.x);
+    const weights = series.filter && Object.keys(series.filter.weights).length ? series.filter.weights : null;
+    if (weights) await timeline.add("chart-weights", "Filter weights (stacked: Kalman / One Euro / EMA)", charts.weightsFigure(series.frames, weights, k()), (p) => p.x);
+    choice.addEventListener("change", () => {
+      const t = trajectory(); Plotly.react("chart-trajectory", t.data, t.layout);
+      if (weights) { const w = charts.weightsFigure(series.frames, weights, k()); Plotly.react("chart-weights", w.data, w.layout); }
+    });
+  }
+  timeline.setFrame(store.state.frame);
+  if (store.state.frame) loadDetail();
+  main.dataset.ready = "1";
+}
+
+function runPicker(take, run) {
+  const select = h("select", { id: "run-pick", "aria-label": "run", onchange: (e) => { location.hash = api.takeLink(take.id, e.target.value); } },
+    take.runs.map((r, i) => h("option", { value: r.id, selected: r.id === run.id },
+      `run ${i + 1} · ${r.status} · ${stepsRan(r)}${r.options.filter_method ? ` · ${r.options.filter_method}` : ""}`)));
+  return h("div", { class: "controls" }, "Run ", select,
+    run.server_time_s != null ? h("span", { class: "muted" }, `server time ${fmt(run.server_time_s, 2)} s`) : null,
+    h("a", { href: `#/compare?a=${run.id}` }, "compare…"));
+}
+
+function findingsTable(findings, onOpen) {
+  const columns = [["kind", "kind"], ["joint", "joint"], ["start_frame", "frames"], ["duration", "frames long"], ["value", "offset / outside"], ["confidence", "confidence"]];
+  let key = "start_frame", dir = 1;
+  const body = h("tbody");
+  const render = () => {
+    body.replaceChildren(...sortFindings(findings, key, dir).map((f) => activatable(h("tr", { class: "clickable finding", "data-start": f.start_frame },
+      h("td", {}, f.kind), h("td", {}, f.joint), h("td", {}, `${f.start_frame}–${f.end_frame}`), h("td", {}, f.end_frame - f.start_frame + 1),
+      h("td", {}, f.value == null ? "–" : `${fmt(f.value, 1)} ${f.unit === "deg" ? "°" : f.unit}`), h("td", {}, fmt(f.confidence, 2))), () => onOpen(f))));
+  };
+  const head = h("tr", {}, columns.map(([k, label]) => activatable(h("th", { class: "sortable", "data-key": k, "aria-sort": "none" }, label), (e) => {
+    dir = key === k ? -dir : 1; key = k;
+    for (const th of e.currentTarget.parentNode.children) th.setAttribute("aria-sort", "none");
+    e.currentTarget.setAttribute("aria-sort", dir > 0 ? "ascending" : "descending");
+    render();
+  })));
+  render();
+  return h("div", { class: "panel" }, h("h2", {}, `Findings (${findings.length})`),
+    findings.length ? h("table", { id: "findings" }, h("thead", {}, head), body) : h("p", { class: "muted" }, "No findings."));
+}
+
+function downloadsPanel(run, result) {
+  const labels = { bvh: "corrected BVH", csv: "filtered keypoints (CSV)", trc: "filtered keypoints (TRC)", report: "JSON report", "report.html": "HTML report" };
+  const kinds = [...(result.downloads || ["report"]), "report.html"];
+  return h("div", { class: "panel" }, h("h2", {}, "Downloads"),
+    kinds.map((k) => h("a", { href: api.downloadUrl(run.id, k), download: "", id: `download-${k.replace(".", "-")}`, class: "download" }, labels[k] || k)));
+}
+
+function stepsPanel(result) {
+  return h("div", { class: "panel" }, h("h2", {}, "Steps"),
+    h("ul", { class: "steps" }, Object.entries(result.steps).map(([name, s]) => h("li", {}, h("b", {}, name), " ", badge(s.state, s.state === "done" ? "done" : ""), " ", s.message))));
+}
+

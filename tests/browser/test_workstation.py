@@ -1,0 +1,225 @@
+"""The reviewer's workstation in headless Chromium, on real takes of the corpus.
+
+Each test drives the page the way a reviewer would (mouse drags, key presses, clicks) and checks
+that the page keeps answering. Time bounds are generous (a loaded 2-core machine must pass);
+the figures measured on the way are written to ``tests/artifacts/workstation-timings.json`` and
+the screenshots to ``tests/artifacts/`` (gitignored).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import httpx
+import numpy as np
+import pytest
+from PIL import Image
+
+pytestmark = pytest.mark.browser
+
+ARTIFACTS = Path(__file__).resolve().parents[1] / "artifacts"
+KNEES_TAKE = "bvh/cmu/iclone/005_05.bvh"  # 100 joints, real knee twist errors
+TRC_TAKE = "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d/S00_P00_T01_BalancingTrial_0-100.trc"
+ANSWER_S = 5.0  # "the page still answers": a round trip far above 100 ms, far below a freeze
+TIMINGS: dict[str, Any] = {}
+
+
+def upload(server: str, path: Path) -> dict[str, Any]:
+    """Upload a take through the API and wait for its first run."""
+    with path.open("rb") as stream:
+        created = httpx.post(f"{server}/api/v1/takes", files={"file": (path.name, stream)}, timeout=120)
+    created.raise_for_status()
+    take = created.json()
+    deadline = time.monotonic() + 300
+    while True:
+        run = httpx.get(f"{server}/api/v1/runs/{take['run_id']}", timeout=30).json()
+        if run["status"] in ("done", "failed"):
+            break
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"analysis of {path.name} did not finish")
+        time.sleep(0.3)
+    assert run["status"] == "done", run
+    result = httpx.get(f"{server}/api/v1/runs/{take['run_id']}/result", timeout=30).json()
+    return {"id": take["id"], "run": take["run_id"], "result": result}
+
+
+@pytest.fixture(scope="module")
+def takes(live_server: str, corpus_dir: Path) -> dict[str, dict[str, Any]]:
+    return {
+        "knees": upload(live_server, corpus_dir / KNEES_TAKE),
+        "trc": upload(live_server, corpus_dir / TRC_TAKE),
+    }
+
+
+@pytest.fixture(scope="module", autouse=True)
+def write_timings() -> Iterator[None]:
+    yield
+    ARTIFACTS.mkdir(exist_ok=True)
+    (ARTIFACTS / "workstation-timings.json").write_text(json.dumps(TIMINGS, indent=2))
+
+
+class Page:
+    """A Playwright page that records console errors."""
+
+    def __init__(self, chromium: Any, width: int = 1400, height: int = 1000) -> None:
+        self.page = chromium.new_page(viewport={"width": width, "height": height})
+        self.errors: list[str] = []
+        self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
+        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
+
+    def open_take(self, server: str, take: dict[str, Any], frame: int | None = None) -> None:
+        query = f"?run={take['run']}" + (f"&frame={frame}" if frame is not None else "")
+        self.page.goto(f"{server}/#/take/{take['id']}{query}")
+        self.page.wait_for_selector("main[data-ready='1']", timeout=60_000)
+        self.settle()
+
+    def settle(self) -> None:
+        """Wait until the 3D views have drawn what was asked and the page painted twice."""
+        self.page.wait_for_function("() => window.mocapqaViews && !window.mocapqaViews.busy", timeout=30_000)
+        self.page.evaluate("() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))")
+
+    def answers_within(self) -> float:
+        """Seconds the page takes to run a script and paint (raises when frozen)."""
+        start = time.monotonic()
+        self.page.wait_for_function("() => true", timeout=ANSWER_S * 4 * 1000, polling="raf")
+        return time.monotonic() - start
+
+    def frame(self) -> int:
+        return int(self.page.inner_text("#frame-label").split()[1])
+
+    def close(self) -> None:
+        assert self.errors == []
+        self.page.close()
+
+
+@pytest.fixture
+def page(chromium: Any) -> Iterator[Page]:
+    opened = Page(chromium)
+    yield opened
+    opened.close()
+
+
+def scrub(page: Page, frame: int) -> None:
+    page.page.evaluate(
+        "(f) => { const s = document.getElementById('scrubber'); s.value = f;"
+        " s.dispatchEvent(new Event('input')); s.dispatchEvent(new Event('change')); }",
+        frame,
+    )
+    page.settle()
+
+
+def view_pixels(page: Page, selector: str) -> np.ndarray:
+    png = page.page.locator(selector).screenshot()
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=np.int16)
+
+
+def test_dragging_either_camera_keeps_the_page_answering(
+    live_server: str, takes: dict[str, Any], page: Page
+) -> None:
+    page.open_take(live_server, takes["knees"])
+    page.page.evaluate(
+        "() => { window.cameraEvents = 0; for (const id of ['view-raw', 'view-corrected'])"
+        " document.getElementById(id).on('plotly_relayout', () => { window.cameraEvents += 1; }); }"
+    )
+    answers = []
+    for view in ("#view-raw", "#view-corrected"):
+        box = page.page.locator(view).bounding_box()
+        x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+        page.page.mouse.move(x, y)
+        page.page.mouse.down()
+        for step in range(1, 13):
+            page.page.mouse.move(x + 12 * step, y + 3 * step)
+        page.page.mouse.up()
+        answers.append(page.answers_within())
+        assert answers[-1] < ANSWER_S
+        # A button still works at once after the drag.
+        page.page.click("#show-axes", timeout=ANSWER_S * 1000)
+        assert page.page.is_checked("#show-axes")
+        page.page.click("#show-axes", timeout=ANSWER_S * 1000)
+        page.settle()
+    # The echo of a shared camera ends: once the mouse is up, the views fall quiet.
+    during = page.page.evaluate("() => { const n = window.cameraEvents; window.cameraEvents = 0; return n; }")
+    time.sleep(1.0)
+    events = page.page.evaluate("() => window.cameraEvents")
+    assert events == 0, (during, events)
+    cameras = page.page.evaluate(
+        "() => ['view-raw', 'view-corrected'].map((id) =>"
+        " document.getElementById(id)._fullLayout.scene.camera.eye)"
+    )
+    assert cameras[0] == pytest.approx(cameras[1], abs=1e-6)
+    assert cameras[0] != pytest.approx({"x": 0, "y": -2.1, "z": 0.35}, abs=1e-3)  # it moved
+    TIMINGS["camera_drag_answer_s"] = [round(a, 3) for a in answers]
+    TIMINGS["camera_events_during_two_drags"] = during
+    ARTIFACTS.mkdir(exist_ok=True)
+    page.page.screenshot(path=str(ARTIFACTS / "workstation-camera-shared.png"))
+
+
+def test_playback_keeps_the_true_rate_and_pauses_at_once(
+    live_server: str, takes: dict[str, Any], page: Page
+) -> None:
+    fps = takes["knees"]["result"]["summary"]["fps"]
+    page.open_take(live_server, takes["knees"])
+    before = page.frame()
+    page.page.click("#play")
+    started = time.monotonic()
+    time.sleep(3.0)
+    clicked = time.monotonic()
+    # Space on the focused play button: a real key press through the browser's input queue.
+    page.page.keyboard.press("Space")
+    page.page.wait_for_function(
+        "() => document.getElementById('play').textContent.endsWith('play')", timeout=ANSWER_S * 4000
+    )
+    pause_s = time.monotonic() - clicked
+    played_s = time.monotonic() - started
+    stopped = page.frame()
+    stats = page.page.evaluate("() => ({ ...window.mocapqaPlayer.stats, drawn: window.mocapqaViews.drawn })")
+    time.sleep(0.8)
+    assert page.frame() == stopped  # paused means paused
+    assert page.page.inner_text("#play").endswith("play")
+    assert pause_s < ANSWER_S
+    advanced = stopped - before
+    # Time runs at the take's rate (frames are dropped, never slowed): at least half of it.
+    assert advanced >= 0.5 * fps * 3.0, (advanced, fps)
+    TIMINGS["playback"] = {
+        "take": KNEES_TAKE,
+        "fps": fps,
+        "played_s": round(played_s, 2),
+        "frames_advanced": advanced,
+        "rate_vs_real_time": round(advanced / (fps * played_s), 2),
+        "redraws_per_s": round(stats["drawn"] / played_s, 1),
+        "pause_click_s": round(pause_s, 3),
+    }
+
+
+def test_a_knee_twist_error_shows_in_the_oriented_bones(
+    live_server: str, takes: dict[str, Any], page: Page
+) -> None:
+    result = takes["knees"]["result"]
+    knees = [f for f in result["findings"] if f["kind"] == "twist" and "Calf" in f["joint"]]
+    assert knees, [f["joint"] for f in result["findings"]]
+    flagged = max(knees, key=lambda f: abs(f["value"]))
+    page.open_take(live_server, takes["knees"])
+    kinds = page.page.evaluate("() => document.getElementById('view-raw').data.map((t) => t.type)")
+    assert kinds[0] == "mesh3d"  # octahedral bones, not a stick figure
+    # A clean frame (no finding anywhere near) and the worst frame of a flagged knee interval.
+    busy = set()
+    for f in result["findings"]:
+        busy.update(range(f["start_frame"] - 5, f["end_frame"] + 6))
+    clean = next(k for k in range(20, result["summary"]["n_frames"]) if k not in busy)
+    differences = {}
+    for name, frame in (("clean", clean), ("flagged", flagged["start_frame"])):
+        scrub(page, frame)
+        raw, corrected = view_pixels(page, "#view-raw"), view_pixels(page, "#view-corrected")
+        height = min(raw.shape[0], corrected.shape[0])
+        width = min(raw.shape[1], corrected.shape[1])
+        changed = np.abs(raw[:height, :width] - corrected[:height, :width]).sum(axis=2) > 60
+        differences[name] = int(changed.sum())
+        page.page.screenshot(path=str(ARTIFACTS / f"workstation-knee-{name}-frame{frame}.png"))
+    TIMINGS["knee_pixels_changed"] = {"flagged_interval": flagged, "clean_frame": clean, **differences}
+    assert differences["flagged"] > 150, differences
+    assert differences["flagged"] > 3 * differences["clean"], differences
