@@ -8,7 +8,7 @@ HOST ?= 127.0.0.1
 PORT ?= 8000
 APT_PACKAGES := chromium libegl1 libegl-mesa0 libgl1-mesa-dri postgresql
 
-.PHONY: run test venv install install-dev system-deps lint typecheck unit serve clean
+.PHONY: run test venv install install-dev system-deps js-deps lint typecheck unit serve clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -32,10 +32,18 @@ system-deps:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing >/dev/null; \
 	fi
 
+# The dashboard's JavaScript lint and unit tests (ESLint, node --test) need Node >= 20 and the
+# npm packages pinned in package-lock.json, installed from the npm registry.
+node_modules/.package-lock.json: package.json package-lock.json
+	npm ci --no-audit --no-fund
+
+js-deps: node_modules/.package-lock.json
+
 run: install system-deps
 	$(BIN)/mocapqa serve --host $(HOST) --port $(PORT) --demo
 
-lint: install-dev
+lint: install-dev js-deps
+	npx eslint frontend/js tests/js
 	$(BIN)/ruff check backend tests
 	$(BIN)/ruff format --check backend tests
 	$(BIN)/lint-imports
@@ -44,10 +52,11 @@ lint: install-dev
 typecheck: install-dev
 	$(BIN)/mypy
 
-unit: install-dev system-deps
+unit: install-dev system-deps js-deps
+	node --test tests/js/
 	bash scripts/with-postgres.sh $(BIN)/python -m pytest -q --cov --cov-report=term:skip-covered
 
 test: install-dev system-deps lint typecheck unit
 
 clean:
-	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache
+	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache node_modules

@@ -1,0 +1,38 @@
+// Unit tests of the pure formatting and ordering helpers (node --test).
+import assert from "node:assert/strict";
+import { test } from "node:test";
+import * as format from "../../frontend/js/format.js";
+
+const finding = (start, value) => ({ kind: "twist", joint: "knee", start_frame: start, end_frame: start + 2, value, confidence: 0.5 });
+
+test("offsets sort by magnitude: −77° is larger than +2°", () => {
+  const rows = [finding(1, 2), finding(2, -77), finding(3, 10), finding(4, null)];
+  assert.deepEqual(format.sortFindings(rows, "value", 1).map((f) => f.value), [2, 10, -77, null]);
+  assert.deepEqual(format.sortFindings(rows, "value", -1).map((f) => f.value), [-77, 10, 2, null]);
+});
+
+test("seconds carry the precision one frame needs", () => {
+  assert.equal(format.seconds(61, 60), "1.02 s");
+  assert.equal(format.seconds(5, 10), "0.5 s");
+  assert.equal(format.seconds(1, 240), "0.004 s");
+});
+
+test("the run label names the steps that ran, not the ones requested", () => {
+  const run = { status: "done", options: { checks: ["twist", "limits", "filter"] }, summary: { steps: { twist: "done", limits: "skipped", filter: "skipped" } } };
+  assert.equal(format.stepsRan(run), "twist");
+  assert.equal(format.stepsRan({ ...run, summary: { steps: { twist: "skipped" } } }), "no step ran");
+});
+
+test("keypoint takes are offered the filter only", () => {
+  assert.deepEqual(format.checksFor("keypoints"), ["filter"]);
+  assert.deepEqual(format.checksFor("motion"), ["twist", "limits", "filter"]);
+});
+
+test("N/P stops go to the next and previous finding start", () => {
+  const stops = format.findingStops([finding(30, 1), finding(10, 1), finding(30, 2)]);
+  assert.deepEqual(stops, [10, 30]);
+  assert.equal(format.nextStop(stops, 10, 1), 30);
+  assert.equal(format.nextStop(stops, 30, 1), null);
+  assert.equal(format.nextStop(stops, 30, -1), 10);
+  assert.equal(format.nextStop(stops, 5, -1), null);
+});

@@ -1,0 +1,79 @@
+// Unit tests of the pure drawing functions (node --test).
+import assert from "node:assert/strict";
+import { test } from "node:test";
+import * as geo from "../../frontend/js/geometry.js";
+
+const close = (a, b, tol = 1e-9) => a.forEach((v, k) => assert.ok(Math.abs(v - b[k]) < tol, `${a} vs ${b}`));
+const quarterAboutY = [0, Math.SQRT1_2, 0, Math.SQRT1_2]; // 90° about +Y (scalar-last)
+
+test("rotate turns x into -z by a quarter turn about y", () => {
+  close(geo.rotate(quarterAboutY, [1, 0, 0]), [0, 0, -1]);
+  close(geo.rotate([0, 0, 0, 1], [1, 2, 3]), [1, 2, 3]);
+});
+
+test("toScene is a rotation (keeps handedness): x × y = z holds after it", () => {
+  const [x, y, z] = [[1, 0, 0], [0, 1, 0], [0, 0, 1]].map(geo.toScene);
+  const cross = [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
+  close(cross, z);
+});
+
+test("a 90° roll about the bone moves the marked corner of its octahedron", () => {
+  // Parent at the origin, child 1 unit up (+Y); the bone is drawn in the parent's frame.
+  const points = [[0, 0, 0], [0, 1, 0]];
+  const bones = geo.bonesOf([-1, 0]);
+  assert.deepEqual(bones, [[0, 1]]);
+  const identity = [[0, 0, 0, 1], [0, 0, 0, 1]];
+  const sides = geo.boneSides(points, identity, bones);
+  const still = geo.boneVertices(points, identity, bones, sides);
+  const rolled = geo.boneVertices(points, [quarterAboutY, quarterAboutY], bones, sides);
+  assert.equal(still.x.length, 6);
+  // Head and tail stay where they are: a stick figure would show nothing.
+  for (const k of [0, 5]) close([rolled.x[k], rolled.y[k], rolled.z[k]], [still.x[k], still.y[k], still.z[k]]);
+  // The marked corner (vertex 1) moves by the bone's half-width times √2.
+  const moved = Math.hypot(rolled.x[1] - still.x[1], rolled.y[1] - still.y[1], rolled.z[1] - still.z[1]);
+  assert.ok(Math.abs(moved - 0.16 * Math.SQRT2) < 1e-9, moved);
+});
+
+test("a missing or zero-length bone collapses and keeps 6 vertices", () => {
+  const points = [[0, 0, 0], [null, null, null], [0, 0, 0]];
+  const bones = geo.bonesOf([-1, 0, 0]);
+  const rotations = [[0, 0, 0, 1], [0, 0, 0, 1], [0, 0, 0, 1]];
+  const v = geo.boneVertices(points, rotations, bones, [[1, 0, 0], [1, 0, 0]]);
+  assert.equal(v.x.length, 12);
+  assert.ok(v.x.every((x) => x === 0));
+});
+
+test("faces index 6 vertices per bone; the marked faces touch corner 1", () => {
+  const f = geo.boneFaces(2);
+  assert.equal(f.i.length, 16);
+  assert.equal(Math.max(...f.i, ...f.j, ...f.k), 11);
+  for (const face of geo.MARKED_FACES) assert.ok(geo.BONE_FACES[face].includes(1));
+  const colors = geo.faceColors([[0, 1], [1, 2]], new Map([[1, "red"]]), "blue", "orange");
+  assert.equal(colors.length, 16);
+  assert.equal(colors[1], "blue");
+  assert.equal(colors[9], "red");
+  assert.equal(colors[8], "orange");
+});
+
+test("triads draw three coloured axes per joint", () => {
+  const t = geo.triads([[0, 0, 0]], [[0, 0, 0, 1]], 1, 2);
+  assert.equal(t.x.length, 9);
+  close([t.x[1], t.y[1], t.z[1]], geo.toScene([2, 0, 0]));
+  assert.deepEqual([t.color[0], t.color[3], t.color[6]], ["#d62728", "#2ca02c", "#1f77b4"]);
+});
+
+test("the follow box keeps its size, sits on the floor and re-centres only on drift", () => {
+  const frames = [[[0, 0, 0], [0, 2, 0]], [[10, 0, 0], [10, 2, 0]]];
+  const box = geo.bodyBox([frames], 0);
+  assert.equal(box.half, 1);
+  assert.equal(box.floor, 0);
+  const ranges = geo.followRanges([0, 0, 1], box);
+  assert.deepEqual(ranges[2], [0, 2]);
+  assert.equal(geo.drifted([0.1, 0, 1], ranges), false);
+  assert.equal(geo.drifted([0.5, 0, 1], ranges), true);
+});
+
+test("frameTake holds every frame and keeps the floor at the lowest point", () => {
+  const { ranges } = geo.frameTake([[[[0, 0, 0], [1, 2, 3]]]], 0);
+  assert.deepEqual(ranges, [[0, 1], [-3, 0], [0, 2]]);
+});
