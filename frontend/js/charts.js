@@ -4,7 +4,7 @@
 
 import { PALETTE } from "./format.js";
 
-export const MARGIN = { l: 170, r: 90, t: 10, b: 40 };
+export const MARGIN = { l: 170, r: 120, t: 10, b: 40 };
 const frameAxis = () => ({ title: { text: "frame" }, tickformat: "d" });
 
 function intervalBars(intervals, yBase, yTop, yaxis, color, name) {

@@ -223,3 +223,118 @@ def test_a_knee_twist_error_shows_in_the_oriented_bones(
     TIMINGS["knee_pixels_changed"] = {"flagged_interval": flagged, "clean_frame": clean, **differences}
     assert differences["flagged"] > 150, differences
     assert differences["flagged"] > 3 * differences["clean"], differences
+
+
+def test_keyboard_only_review_from_the_take_list(
+    live_server: str, takes: dict[str, Any], page: Page
+) -> None:
+    p = page.page
+    p.goto(f"{live_server}/#/")
+    p.wait_for_selector(f"#take-list tr[data-take='{takes['knees']['id']}']")
+    # The take list does not load the charting library.
+    assert p.evaluate("() => window.Plotly === undefined && !document.querySelector('script[src*=plotly]')")
+    # Tab to the take's row and open it with Enter.
+    for _ in range(40):
+        p.keyboard.press("Tab")
+        if p.evaluate("(id) => document.activeElement.dataset.take === id", takes["knees"]["id"]):
+            break
+    else:
+        raise AssertionError("the take's row never took the focus")
+    p.keyboard.press("Enter")
+    p.wait_for_selector("main[data-ready='1']", timeout=60_000)
+    page.settle()
+    # No invisible toolbar button sits in the tab order.
+    assert p.evaluate("() => [...document.querySelectorAll('.modebar-btn')].every((b) => b.tabIndex === -1)")
+    # Space plays and pauses; arrows step; N/P go from finding to finding.
+    p.evaluate("() => document.activeElement.blur()")
+    p.keyboard.press("Space")
+    p.wait_for_function("() => document.getElementById('play').textContent.endsWith('pause')")
+    p.keyboard.press("Space")
+    p.wait_for_function("() => document.getElementById('play').textContent.endsWith('play')")
+    scrub(page, 100)
+    p.keyboard.press("ArrowRight")
+    assert page.frame() == 101
+    p.keyboard.press("Shift+ArrowLeft")
+    assert page.frame() == 91
+    starts = sorted({f["start_frame"] for f in takes["knees"]["result"]["findings"]})
+    p.keyboard.press("n")
+    assert page.frame() == next(s for s in starts if s > 91)
+    p.keyboard.press("p")
+    assert page.frame() == max(s for s in starts if s < next(s for s in starts if s > 91))
+    # The "offset / outside" header sorts by magnitude from the keyboard.
+    header = p.locator("#findings th[data-key='value']")
+    header.focus()
+    p.keyboard.press("Enter")
+    values = [
+        float(t.split()[0]) for t in p.locator("#findings tbody td:nth-child(5)").all_inner_texts()
+    ]
+    assert [abs(v) for v in values] == sorted(abs(v) for v in values)
+    assert any(v < 0 for v in values)
+    # A focused finding opens with Enter: its frame, and the 3D views scrolled into sight.
+    row = p.locator("#findings tbody tr").last
+    start = int(row.get_attribute("data-start"))
+    row.focus()
+    p.keyboard.press("Enter")
+    assert page.frame() == start
+    top = p.evaluate("() => document.getElementById('view-raw').getBoundingClientRect().top")
+    assert 0 <= top < p.viewport_size["height"] / 2, top
+    page.settle()
+    # Saving a review keeps the frame and the player where they are.
+    p.locator("#review-status").select_option("needs_fix")
+    p.fill("#reviewer", "keyboard")
+    p.locator("#review-save").focus()
+    p.keyboard.press("Enter")
+    p.wait_for_selector("#review-history li")
+    assert page.frame() == start
+    assert f"frame={start}" in p.evaluate("() => location.hash")
+    # A joint names itself on hover.
+    joints = p.evaluate("() => document.getElementById('view-raw').data[1]")
+    assert "CC_Base_L_Calf" in joints["text"] and "%{text}" in joints["hovertemplate"]
+    p.screenshot(path=str(ARTIFACTS / "workstation-keyboard-review.png"), full_page=True)
+
+
+def test_linked_zoom_resets_together(live_server: str, takes: dict[str, Any], page: Page) -> None:
+    page.open_take(live_server, takes["knees"])
+    p = page.page
+    p.evaluate("() => Plotly.relayout('chart-twist', {'xaxis.range[0]': 100, 'xaxis.range[1]': 200})")
+    p.wait_for_function("() => document.getElementById('chart-limits').layout.xaxis.range[1] === 200")
+    # Double-click the twist chart's plot area: both charts reset.
+    p.locator("#chart-twist .nsewdrag").first.dblclick()
+    p.wait_for_function(
+        "() => ['chart-twist', 'chart-limits'].every((id) =>"
+        " document.getElementById(id)._fullLayout.xaxis.range[1] > 400)",
+        timeout=10_000,
+    )
+    # The two charts' plot areas start and end at the same x: their time cursors line up.
+    edges = p.evaluate(
+        "() => ['chart-twist', 'chart-limits'].map((id) => { const a ="
+        " document.getElementById(id)._fullLayout.xaxis; return [a._offset, a._length]; })"
+    )
+    assert edges[0] == edges[1]
+
+
+def test_narrow_window_and_a_keypoint_take(
+    live_server: str, takes: dict[str, Any], chromium: Any
+) -> None:
+    narrow = Page(chromium, width=900, height=900)
+    p = narrow.page
+    p.goto(f"{live_server}/#/")
+    p.wait_for_selector("#take-list tbody tr")
+    assert p.evaluate("() => document.documentElement.scrollWidth <= window.innerWidth")
+    p.screenshot(path=str(ARTIFACTS / "workstation-list-900px.png"), full_page=True)
+    narrow.open_take(live_server, takes["knees"])
+    assert p.evaluate("() => document.documentElement.scrollWidth <= window.innerWidth")
+    # Play is on screen without scrolling, and the two views sit side by side above it.
+    play = p.locator("#play").bounding_box()
+    views = [p.locator(v).bounding_box() for v in ("#view-raw", "#view-corrected")]
+    assert play["y"] + play["height"] <= 900
+    assert views[0]["y"] == views[1]["y"] and views[0]["x"] < views[1]["x"]
+    assert all(v["y"] + v["height"] <= play["y"] for v in views)
+    p.screenshot(path=str(ARTIFACTS / "workstation-take-900px.png"))
+    # A TRC take: the re-run form offers only the filter; the run picker names what ran.
+    narrow.open_take(live_server, takes["trc"])
+    offered = p.evaluate("() => [...document.querySelectorAll('#rerun-panel input[name=check]')].map((c) => c.value)")
+    assert offered == ["filter"]
+    assert "twist" not in p.inner_text("#run-pick")
+    p.screenshot(path=str(ARTIFACTS / "workstation-keypoints.png"), full_page=True)
+    narrow.close()
