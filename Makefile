@@ -34,12 +34,17 @@ system-deps:
 
 # The dashboard's JavaScript lint and unit tests (ESLint, node --test) need Node >= 20 and the
 # npm packages pinned in package-lock.json, installed from the npm registry.
+# three.js (the 3D views) is served from frontend/vendor/, copied from the npm package.
 node_modules/.package-lock.json: package.json package-lock.json
 	npm ci --no-audit --no-fund
 
-js-deps: node_modules/.package-lock.json
+frontend/vendor/three/three.module.min.js: node_modules/.package-lock.json
+	mkdir -p frontend/vendor/three
+	cp node_modules/three/build/three.module.min.js node_modules/three/build/three.core.min.js node_modules/three/LICENSE frontend/vendor/three/
 
-run: install system-deps
+js-deps: frontend/vendor/three/three.module.min.js
+
+run: install system-deps js-deps
 	$(BIN)/mocapqa serve --host $(HOST) --port $(PORT) --demo
 
 lint: install-dev js-deps
@@ -59,4 +64,4 @@ unit: install-dev system-deps js-deps
 test: install-dev system-deps lint typecheck unit
 
 clean:
-	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache node_modules
+	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache node_modules frontend/vendor

@@ -4,6 +4,8 @@
 
 export const present = (p) => p != null && p[0] != null && p[1] != null && p[2] != null;
 export const toScene = (p) => [p[0], -p[2], p[1]];
+/** Data coordinates unchanged (three.js scenes are Y-up like the data). */
+export const identity = (p) => p;
 
 const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
 const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -44,8 +46,9 @@ export function boneSides(points, rotations, bones) {
 // Vertices of one octahedral bone: head, four corners of the widest square, tail. Corner 1 is
 // the marked side (+u), corner 2 is +v = bone × u.
 export const BONE_FACES = [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1], [5, 2, 1], [5, 3, 2], [5, 4, 3], [5, 1, 4]];
-/** Faces that touch the marked corner: drawn in the marking colour. */
-export const MARKED_FACES = new Set([0, 3, 4, 7]);
+/** The two faces between the marked corner (+u) and +v, head side and tail side: one quarter
+ * of the bone in the marking colour, so a roll about the bone turns the stripe away. */
+export const MARKED_FACES = new Set([0, 4]);
 const WIDEST = 0.15; // the square sits at this fraction of the bone's length (Blender: 0.1)
 const WIDTH = 0.16; // half-width of the square as a fraction of the bone's length (Blender: 0.1)
 
@@ -59,9 +62,9 @@ const WIDTH = 0.16; // half-width of the square as a fraction of the bone's leng
  * @returns {{x: number[], y: number[], z: number[]}} 6 vertices per bone; a degenerate bone
  *          (zero length or a missing end) collapses onto its head so the faces stay the same.
  */
-export function boneVertices(points, rotations, bones, sides) {
+export function boneVertices(points, rotations, bones, sides, map = toScene) {
   const x = [], y = [], z = [];
-  const put = (p) => { const s = toScene(p); x.push(s[0]); y.push(s[1]); z.push(s[2]); };
+  const put = (p) => { const s = map(p); x.push(s[0]); y.push(s[1]); z.push(s[2]); };
   bones.forEach(([p, c], b) => {
     const head = points[p], tail = points[c];
     if (!present(head) || !present(tail)) { for (let k = 0; k < 6; k++) put(present(head) ? head : [0, 0, 0]); return; }
@@ -107,15 +110,15 @@ export function faceColors(bones, flagged, body, marked) {
 const AXIS_COLORS = ["#d62728", "#2ca02c", "#1f77b4"]; // x red, y green, z blue (as in Blender)
 
 /** Per-joint axis triads as one line trace: 3 segments per joint with per-vertex colours. */
-export function triads(points, rotations, joints, length) {
+export function triads(points, rotations, joints, length, map = toScene) {
   const x = [], y = [], z = [], color = [];
   for (let j = 0; j < joints; j++) {
     const o = points[j], q = rotations[j];
     for (let a = 0; a < 3; a++) {
       const e = [0, 0, 0]; e[a] = length;
       const ok = present(o) && q;
-      const s = ok ? toScene(o) : [null, null, null];
-      const t = ok ? toScene(add(o, rotate(q, e))) : [null, null, null];
+      const s = ok ? map(o) : [null, null, null];
+      const t = ok ? map(add(o, rotate(q, e))) : [null, null, null];
       x.push(s[0], t[0], null); y.push(s[1], t[1], null); z.push(s[2], t[2], null);
       color.push(AXIS_COLORS[a], AXIS_COLORS[a], AXIS_COLORS[a]);
     }
@@ -124,22 +127,22 @@ export function triads(points, rotations, joints, length) {
 }
 
 /** Bones as line segments (keypoint takes, or the raw ghost), scene coordinates. */
-export function boneLines(points, bones) {
+export function boneLines(points, bones, map = toScene) {
   const x = [], y = [], z = [];
   for (const [p, c] of bones) {
     const a = points[p], b = points[c];
     if (!present(a) || !present(b)) continue;
-    const s = toScene(a), t = toScene(b);
+    const s = map(a), t = map(b);
     x.push(s[0], t[0], null); y.push(s[1], t[1], null); z.push(s[2], t[2], null);
   }
   return { x, y, z };
 }
 
 /** Joint markers in scene coordinates (missing points as null: Plotly leaves them out). */
-export function markers(points) {
+export function markers(points, map = toScene) {
   const x = [], y = [], z = [];
   for (const p of points) {
-    const s = present(p) ? toScene(p) : [null, null, null];
+    const s = present(p) ? map(p) : [null, null, null];
     x.push(s[0]); y.push(s[1]); z.push(s[2]);
   }
   return { x, y, z };
@@ -222,4 +225,32 @@ export function groundPath(frames, root, floor) {
     x.push(s[0]); y.push(s[1]); z.push(floor);
   }
   return { x, y, z };
+}
+
+/**
+ * Where an orbiting camera sits (data coordinates, Y up): `azimuth` about the vertical from +Z
+ * towards +X, `elevation` above the floor plane, both in radians, at `distance` from `target`.
+ */
+export function orbitPosition(target, azimuth, elevation, distance) {
+  const flat = Math.cos(elevation) * distance;
+  return [target[0] + flat * Math.sin(azimuth), target[1] + Math.sin(elevation) * distance, target[2] + flat * Math.cos(azimuth)];
+}
+
+/** Camera presets as orbit angles (radians): front looks along −Z, side along −X, top down. */
+export const PRESETS = {
+  front: { azimuth: 0, elevation: 0.3 },
+  side: { azimuth: Math.PI / 2, elevation: 0.3 },
+  top: { azimuth: 0, elevation: 1.55 },
+};
+
+/** Expand per-vertex arrays of bones (6 vertices each) into triangle soup (24 vertices each). */
+export function triangleSoup(vertices, bones, out) {
+  let o = 0;
+  for (let b = 0; b < bones; b++) {
+    for (const face of BONE_FACES) for (const v of face) {
+      const k = 6 * b + v;
+      out[o++] = vertices.x[k]; out[o++] = vertices.y[k]; out[o++] = vertices.z[k];
+    }
+  }
+  return out;
 }

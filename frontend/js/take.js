@@ -7,7 +7,7 @@ import { createPlayer } from "./player.js";
 import { loadPlotly } from "./plotly.js";
 import * as store from "./state.js";
 import { createTimeline } from "./timeline.js";
-import { createViews } from "./view3d.js";
+import { createViews } from "./scene3d.js";
 import { reviewPanel } from "./review.js";
 import { rerunPanel } from "./rerun.js";
 
@@ -16,7 +16,8 @@ const LIMITS_COLOR = "#e67e22";
 
 export async function takeView(main, takeId, params, onTeardown) {
   const runParam = params.get("run");
-  const [take, Plotly] = await Promise.all([api.getTake(takeId), loadPlotly()]);
+  const plotly = loadPlotly(); // in parallel: the 3D views do not need it
+  const take = await api.getTake(takeId);
   performance.mark("take-data");
   const runs = take.runs;
   const run = runs.find((r) => r.id === runParam) || runs[runs.length - 1];
@@ -94,7 +95,8 @@ export async function takeView(main, takeId, params, onTeardown) {
     };
   };
 
-  const views = await createViews(Plotly, { raw: rawDiv, corrected: corrDiv }, { names, parents, nJoints: result.points.n_joints, oriented }, overview);
+  const views = createViews({ raw: rawDiv, corrected: corrDiv }, { names, parents, nJoints: result.points.n_joints, oriented }, overview);
+  const Plotly = await plotly;
   const timeline = createTimeline(Plotly, timelines, (f) => jump(f));
   const render = () => {
     const f = store.state.frame;
@@ -135,11 +137,11 @@ export async function takeView(main, takeId, params, onTeardown) {
   scrubber.addEventListener("change", () => { remember(); loadDetail(); });
   speed.addEventListener("change", () => player.setSpeed(Number(speed.value)));
   presets.forEach((button) => button.addEventListener("click", () => views.setCamera(button.textContent)));
-  triadsBox.addEventListener("change", () => views.setTriads(triadsBox.checked, frameAt(store.state.frame)));
+  triadsBox.addEventListener("change", () => views.setTriads(triadsBox.checked));
   overlayBox.addEventListener("change", () => {
     store.set({ overlay: overlayBox.checked });
     rawPanel.hidden = overlayBox.checked;
-    views.setOverlay(overlayBox.checked, frameAt(store.state.frame));
+    views.setOverlay(overlayBox.checked);
     render();
   });
 
@@ -159,7 +161,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     }
   };
   document.addEventListener("keydown", onKey);
-  onTeardown(() => { player.pause(); document.removeEventListener("keydown", onKey); });
+  onTeardown(() => { player.pause(); views.dispose(); document.removeEventListener("keydown", onKey); });
 
   render();
   performance.mark("skeletons");

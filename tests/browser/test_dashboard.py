@@ -57,6 +57,12 @@ def browser() -> Iterator[object]:
         chromium.close()
 
 
+def drawn_points(page: object) -> int:
+    """Points (joints and End Sites) the 3D views draw."""
+    count = page.evaluate("() => window.mocapqaViews.points")  # type: ignore[attr-defined]
+    return int(count)
+
+
 def plotted_points(page: object, element_id: str, trace: int) -> int:
     count = page.evaluate(  # type: ignore[attr-defined]
         f"() => {{ const d = document.getElementById('{element_id}').data;"
@@ -97,8 +103,7 @@ def test_upload_view_scrub_jump_review_and_download(
     # A real corpus take: both 3D views and the twist timeline are drawn.
     upload_through_page(page, cmu_walk)
     n_points = len(read_bvh(cmu_walk).skeleton.names) + len(read_bvh(cmu_walk).skeleton.end_sites)
-    assert plotted_points(page, "view-raw", 1) == n_points
-    assert plotted_points(page, "view-corrected", 1) == n_points
+    assert drawn_points(page) == n_points
     assert plotted_points(page, "chart-twist", 0) > 100
     page.screenshot(path=str(ARTIFACTS / "take-view.png"), full_page=True)
 

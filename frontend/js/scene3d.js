@@ -1,0 +1,241 @@
+// The two 3D views drawn with three.js: one camera (one orbit state, one THREE camera) renders
+// both views, so they cannot drift apart nor re-trigger each other. A frame update rewrites
+// vertex buffers and asks for one render on the next animation frame; nothing queues.
+import * as THREE from "/static/vendor/three/three.module.min.js";
+import * as geo from "./geometry.js";
+
+const BODY = new THREE.Color("#5b84b1");
+const MARKED = new THREE.Color("#f39c12");
+const JOINT = new THREE.Color("#1f4e79");
+const AXES = ["#d62728", "#2ca02c", "#1f77b4"].map((c) => new THREE.Color(c));
+
+function viewScene(bonesCount, nPoints, nJoints, oriented) {
+  const scene = new THREE.Scene();
+  scene.background = new THREE.Color("#ffffff");
+  scene.add(new THREE.AmbientLight(0xffffff, 1.6));
+  const light = new THREE.DirectionalLight(0xffffff, 1.6);
+  light.position.set(1, 2, 3);
+  scene.add(light);
+  const soup = new THREE.BufferGeometry();
+  soup.setAttribute("position", new THREE.BufferAttribute(new Float32Array(bonesCount * 24 * 3), 3));
+  soup.setAttribute("color", new THREE.BufferAttribute(new Float32Array(bonesCount * 24 * 3), 3));
+  const bones = oriented
+    ? new THREE.Mesh(soup, new THREE.MeshLambertMaterial({ vertexColors: true, flatShading: true, side: THREE.DoubleSide }))
+    : new THREE.LineSegments(lineGeometry(bonesCount * 2), new THREE.LineBasicMaterial({ color: BODY }));
+  const jointsGeometry = new THREE.BufferGeometry();
+  jointsGeometry.setAttribute("position", new THREE.BufferAttribute(new Float32Array(nPoints * 3), 3));
+  jointsGeometry.setAttribute("color", new THREE.BufferAttribute(new Float32Array(nPoints * 3), 3));
+  const joints = new THREE.Points(jointsGeometry, new THREE.PointsMaterial({ size: oriented ? 4 : 7, sizeAttenuation: false, vertexColors: true }));
+  const axes = new THREE.LineSegments(lineGeometry(nJoints * 6, true), new THREE.LineBasicMaterial({ vertexColors: true }));
+  axes.visible = false;
+  const ghost = new THREE.LineSegments(lineGeometry(bonesCount * 2), new THREE.LineBasicMaterial({ color: 0x7f8c8d, transparent: true, opacity: 0.45 }));
+  ghost.visible = false;
+  for (const o of [bones, joints, axes, ghost]) { o.frustumCulled = false; scene.add(o); }
+  return { scene, bones, joints, axes, ghost };
+}
+
+function lineGeometry(vertices, colored = false) {
+  const g = new THREE.BufferGeometry();
+  g.setAttribute("position", new THREE.BufferAttribute(new Float32Array(vertices * 3), 3));
+  if (colored) g.setAttribute("color", new THREE.BufferAttribute(new Float32Array(vertices * 3), 3));
+  return g;
+}
+
+function writeLines(attribute, points, pairs) {
+  const a = attribute.array;
+  let o = 0;
+  for (const [p, c] of pairs) {
+    for (const q of [points[p], points[c]]) {
+      const ok = geo.present(points[p]) && geo.present(points[c]);
+      a[o++] = ok ? q[0] : 0; a[o++] = ok ? q[1] : 0; a[o++] = ok ? q[2] : 0;
+    }
+  }
+  attribute.needsUpdate = true;
+}
+
+/**
+ * @param divs     {raw, corrected} containers
+ * @param skeleton {names, parents, nJoints, oriented}
+ * @param overview {raw, corrected, raw_rotations?, corrected_rotations?}
+ */
+export function createViews(divs, skeleton, overview) {
+  const { names, parents, nJoints, oriented } = skeleton;
+  const bones = geo.bonesOf(parents);
+  const sides = oriented ? geo.boneSides(overview.raw[0], overview.raw_rotations[0], bones) : null;
+  // bodyBox answers in Z-up terms: its floor is the lowest data Y, its half the body's size.
+  const box = geo.bodyBox([overview.raw, overview.corrected], 0.1);
+  const floorY = box.floor;
+  const size = 2 * box.half;
+  const orbit = { ...geo.PRESETS.front, distance: size * 1.5, target: [0, floorY + size * 0.4, 0] };
+  const camera = new THREE.PerspectiveCamera(35, 1, size / 100, size * 200);
+  const views = {};
+  for (const [name, div] of Object.entries(divs)) {
+    const canvas = document.createElement("canvas");
+    canvas.className = "view-canvas";
+    canvas.setAttribute("aria-label", `${name} skeleton, drag to orbit, wheel to zoom`);
+    div.append(canvas);
+    const renderer = new THREE.WebGLRenderer({ canvas, antialias: true });
+    renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
+    const parts = viewScene(bones.length, names.length, nJoints, oriented);
+    const grid = new THREE.GridHelper(size * 3, 12, 0xc0c7cf, 0xe3e7ec);
+    grid.position.y = floorY;
+    parts.scene.add(grid);
+    if (oriented) {
+      const path = overview.raw.map((points) => points[parents.indexOf(-1)]).filter(geo.present);
+      const line = new THREE.Line(new THREE.BufferGeometry().setFromPoints(path.map((p) => new THREE.Vector3(p[0], floorY + size * 0.002, p[2]))),
+        new THREE.LineBasicMaterial({ color: 0x95a5a6 }));
+      parts.scene.add(line);
+    }
+    views[name] = { div, canvas, renderer, ...parts };
+  }
+  const tooltip = document.createElement("div");
+  tooltip.className = "joint-tooltip";
+  tooltip.hidden = true;
+  document.body.append(tooltip);
+
+  let frame = null, triadsOn = false, overlayOn = false, renders = 0, drawn = 0, scheduled = 0;
+  const sizeOf = (view) => [view.div.clientWidth, view.div.clientHeight];
+  const render = () => {
+    scheduled = 0;
+    camera.position.set(...geo.orbitPosition(orbit.target, orbit.azimuth, orbit.elevation, orbit.distance));
+    camera.up.set(0, 1, 0);
+    camera.lookAt(...orbit.target);
+    for (const view of Object.values(views)) {
+      if (view.div.offsetParent === null) continue;
+      const [w, h] = sizeOf(view);
+      if (view.canvas.width !== Math.round(w * view.renderer.getPixelRatio()) || view.canvas.height !== Math.round(h * view.renderer.getPixelRatio())) view.renderer.setSize(w, h, true);
+      camera.aspect = w / Math.max(1, h);
+      camera.updateProjectionMatrix();
+      view.renderer.render(view.scene, camera);
+    }
+    renders += 1;
+  };
+  const requestRender = () => { if (!scheduled) scheduled = requestAnimationFrame(render); };
+  new ResizeObserver(requestRender).observe(divs.raw.parentNode.parentNode);
+
+  const soupScratch = new Float32Array(bones.length * 24 * 3);
+  const write = (view, points, rotations, flagged) => {
+    const colorOf = (j) => (flagged.has(j) ? new THREE.Color(flagged.get(j)) : null);
+    if (oriented) {
+      const vertices = geo.boneVertices(points, rotations, bones, sides, geo.identity);
+      const position = view.bones.geometry.attributes.position;
+      position.array.set(geo.triangleSoup(vertices, bones.length, soupScratch));
+      position.needsUpdate = true;
+      const color = view.bones.geometry.attributes.color;
+      let o = 0;
+      bones.forEach(([p]) => {
+        const own = colorOf(p) || BODY;
+        for (let f = 0; f < 8; f++) {
+          const c = geo.MARKED_FACES.has(f) ? MARKED : own;
+          for (let v = 0; v < 3; v++) { color.array[o++] = c.r; color.array[o++] = c.g; color.array[o++] = c.b; }
+        }
+      });
+      color.needsUpdate = true;
+      view.bones.geometry.computeVertexNormals();
+    } else {
+      writeLines(view.bones.geometry.attributes.position, points, bones);
+    }
+    const jp = view.joints.geometry.attributes.position, jc = view.joints.geometry.attributes.color;
+    points.forEach((p, j) => {
+      const ok = geo.present(p);
+      jp.array[3 * j] = ok ? p[0] : NaN; jp.array[3 * j + 1] = ok ? p[1] : NaN; jp.array[3 * j + 2] = ok ? p[2] : NaN;
+      const c = colorOf(j) || JOINT;
+      jc.array[3 * j] = c.r; jc.array[3 * j + 1] = c.g; jc.array[3 * j + 2] = c.b;
+    });
+    jp.needsUpdate = true; jc.needsUpdate = true;
+    if (triadsOn && oriented) {
+      const t = geo.triads(points, rotations, nJoints, 0.05 * size, geo.identity);
+      const ap = view.axes.geometry.attributes.position, ac = view.axes.geometry.attributes.color;
+      let o = 0, n = 0;
+      for (let k = 0; k < t.x.length; k++) {
+        if (t.x[k] === null && k % 3 === 2) continue;
+        ap.array[o++] = t.x[k] ?? 0; ap.array[o++] = t.y[k] ?? 0; ap.array[o++] = t.z[k] ?? 0;
+        const c = AXES[Math.floor(n / 2) % 3]; n += 1;
+        ac.array[3 * (n - 1)] = c.r; ac.array[3 * (n - 1) + 1] = c.g; ac.array[3 * (n - 1) + 2] = c.b;
+      }
+      ap.needsUpdate = true; ac.needsUpdate = true;
+    }
+  };
+  const show = (next) => {
+    frame = next;
+    write(views.raw, next.raw, next.rawRotations, next.flagged);
+    write(views.corrected, next.corrected, next.correctedRotations, next.flagged);
+    if (overlayOn) writeLines(views.corrected.ghost.geometry.attributes.position, next.raw, bones);
+    // Auto-framing: the orbit's target follows the body over the floor.
+    const centre = geo.centreOf(next.corrected); // Z-up: (x, −z, y)
+    if (centre) { orbit.target[0] = centre[0]; orbit.target[2] = -centre[1]; }
+    drawn += 1;
+    if (drawn === 1) performance.mark("skeletons-drawn");
+    requestRender();
+  };
+
+  // Orbit: drag to turn, wheel to zoom; both views move the one camera.
+  for (const view of Object.values(views)) {
+    let last = null;
+    view.canvas.addEventListener("pointerdown", (e) => { last = [e.clientX, e.clientY]; view.canvas.setPointerCapture(e.pointerId); });
+    view.canvas.addEventListener("pointerup", (e) => { last = null; view.canvas.releasePointerCapture(e.pointerId); });
+    view.canvas.addEventListener("pointermove", (e) => {
+      if (last) {
+        orbit.azimuth -= (e.clientX - last[0]) * 0.01;
+        orbit.elevation = Math.max(-0.2, Math.min(1.55, orbit.elevation + (e.clientY - last[1]) * 0.01));
+        last = [e.clientX, e.clientY];
+        requestRender();
+      } else hover(view, e);
+    });
+    view.canvas.addEventListener("pointerleave", () => { tooltip.hidden = true; });
+    view.canvas.addEventListener("wheel", (e) => {
+      e.preventDefault();
+      orbit.distance = Math.max(size * 0.3, Math.min(size * 8, orbit.distance * Math.exp(e.deltaY * 0.001)));
+      requestRender();
+    }, { passive: false });
+  }
+  // Hover: the joint nearest the pointer (within 10 px) names itself.
+  const project = (view, point) => {
+    const v = new THREE.Vector3(point[0], point[1], point[2]).project(camera);
+    const rect = view.canvas.getBoundingClientRect();
+    return [rect.left + ((v.x + 1) / 2) * rect.width, rect.top + ((1 - v.y) / 2) * rect.height];
+  };
+  const aspectFor = (view) => { const [w, h] = sizeOf(view); camera.aspect = w / Math.max(1, h); camera.updateProjectionMatrix(); };
+  const hover = (view, e) => {
+    if (!frame) return;
+    aspectFor(view);
+    const points = view === views.raw ? frame.raw : frame.corrected;
+    let best = null, bestDistance = 10;
+    points.forEach((p, j) => {
+      if (!geo.present(p)) return;
+      const [x, y] = project(view, p);
+      const d = Math.hypot(x - e.clientX, y - e.clientY);
+      if (d < bestDistance) { best = j; bestDistance = d; }
+    });
+    tooltip.hidden = best == null;
+    if (best != null) {
+      tooltip.textContent = names[best];
+      tooltip.style.left = `${e.pageX + 12}px`;
+      tooltip.style.top = `${e.pageY + 12}px`;
+    }
+  };
+
+  return {
+    show,
+    requestRender,
+    get busy() { return scheduled !== 0; },
+    get drawn() { return drawn; },
+    get renders() { return renders; },
+    get orbit() { return { ...orbit, target: [...orbit.target] }; },
+    get cameraPosition() { return camera.position.toArray(); },
+    get bones() { return oriented ? bones.length : 0; },
+    get points() { return names.length; },
+    /** Screen position of a point of the shown frame in one view (for tests and focus). */
+    screenOf(viewName, index) {
+      const view = views[viewName];
+      aspectFor(view);
+      camera.position.set(...geo.orbitPosition(orbit.target, orbit.azimuth, orbit.elevation, orbit.distance));
+      camera.lookAt(...orbit.target);
+      return project(view, (viewName === "raw" ? frame.raw : frame.corrected)[index]);
+    },
+    setCamera(name) { Object.assign(orbit, geo.PRESETS[name]); requestRender(); },
+    setTriads(on) { triadsOn = on && oriented; for (const v of Object.values(views)) v.axes.visible = triadsOn; if (frame) show(frame); },
+    setOverlay(on) { overlayOn = on; views.corrected.ghost.visible = on; if (frame) show(frame); },
+    dispose() { tooltip.remove(); for (const v of Object.values(views)) v.renderer.dispose(); },
+  };
+}
