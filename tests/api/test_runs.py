@@ -75,9 +75,15 @@ def test_frames_come_in_windows_matching_forward_kinematics(
     run_id = analysed["run_id"]
     window = client.get(f"/api/v1/runs/{run_id}/frames?start=100&stop=110").json()
     assert window["frames"] == list(range(100, 110))
-    _, positions = forward_kinematics(read_bvh(cmu_walk))
+    quats, positions = forward_kinematics(read_bvh(cmu_walk))
     raw = np.asarray(window["raw"])
     np.testing.assert_allclose(raw[:, :31], positions[100:110], atol=2e-3)
+    # World rotations orient the drawn bones (half precision, rounded to 3 decimals).
+    rotations = np.asarray(window["raw_rotations"])
+    assert rotations.shape == (10, raw.shape[1], 4)
+    same_sign = np.sign(np.sum(rotations[:, :31] * quats[100:110], axis=-1, keepdims=True))
+    np.testing.assert_allclose(rotations[:, :31] * same_sign, quats[100:110], atol=3e-3)
+    assert np.asarray(window["corrected_rotations"]).shape == rotations.shape
     overview = client.get(f"/api/v1/runs/{run_id}/frames?max_frames=50").json()
     assert len(overview["frames"]) <= 50
     assert overview["step"] == 11
@@ -187,11 +193,17 @@ def test_frontend_and_plotly_are_served(client: TestClient) -> None:
     page = client.get("/")
     assert page.status_code == 200
     assert "/vendor/plotly-" in page.text
-    script = page.text.split('src="')[1].split('"')[0]
+    # Plotly's address is in a <meta>: the views that draw charts load it on demand.
+    script = page.text.split('name="plotly-src" content="')[1].split('"')[0]
     plotly = client.get(script, headers={"Accept-Encoding": "gzip"})
     assert plotly.status_code == 200
     assert plotly.headers["content-encoding"] == "gzip"
-    for path in ("/static/js/app.js", "/static/js/api.js", "/static/js/charts.js"):
+    for path in (
+        "/static/js/app.js",
+        "/static/js/api.js",
+        "/static/js/charts.js",
+        "/static/js/scene3d.js",
+    ):
         assert client.get(path).status_code == 200
     assert client.get("/docs").status_code == 200
 

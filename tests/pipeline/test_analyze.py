@@ -15,7 +15,7 @@ from mocapqa.jobs.demo import demo_paths
 from mocapqa.jobs.runner import write_outputs
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.pipeline.analyze import analyze
-from mocapqa.pipeline.frames import motion_points, sample_frames
+from mocapqa.pipeline.frames import motion_points, motion_pose, sample_frames
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.pipeline.steps import violation_findings
 from mocapqa.store.files import FileStore
@@ -56,6 +56,16 @@ def test_motion_points_are_fk_joints_then_end_sites(cmu_walk: Path) -> None:
     assert points.shape == (motion.n_frames, n_joints + n_sites, 3)
     np.testing.assert_array_equal(points[:, :n_joints], positions)
     assert names[n_joints] == f"{motion.skeleton.names[parents[n_joints]]} end"
+
+
+def test_motion_pose_gives_end_sites_their_parents_rotation(cmu_walk: Path) -> None:
+    motion = read_bvh(cmu_walk)
+    _, parents, points, rotations = motion_pose(motion)
+    quats, _ = forward_kinematics(motion)
+    n_joints = motion.skeleton.n_joints
+    assert rotations.shape == (*points.shape[:2], 4)
+    np.testing.assert_array_equal(rotations[:, :n_joints], quats)
+    np.testing.assert_array_equal(rotations[:, n_joints:], quats[:, parents[n_joints:]])
 
 
 def test_violation_findings_cover_each_run_of_bad_frames() -> None:

@@ -57,7 +57,7 @@ def write_outputs(files: FileStore, run_id: str, result: AnalysisResult) -> list
     folder = files.run_dir(run_id)
     kinds = ["report"]
     buffer = io.BytesIO()
-    arrays = {
+    arrays: dict[str, Any] = {
         "raw": result.raw_points.astype(np.float32),
         "corrected": result.corrected_points.astype(np.float32),
     }
