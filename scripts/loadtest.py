@@ -140,14 +140,17 @@ def big_take(base: str, corpus: Path, folder: Path, paint: bool = False) -> None
         print(f"  upload → analysed              {total:.2f} s")
         gzip = {"Accept-Encoding": "gzip"}
         page = client.get("/", headers=gzip)
-        plotly = page.text.split('<script src="')[1].split('"')[0]
+        plotly = page.text.split('name="plotly-src" content="')[1].split('"')[0]
+        modules = sorted(
+            p.name for p in (Path(__file__).parents[1] / "frontend" / "js").glob("*.js")
+        )
         urls = [
             "/",
             plotly,
             "/static/css/app.css",
-            "/static/js/app.js",
-            "/static/js/api.js",
-            "/static/js/charts.js",
+            *(f"/static/js/{name}" for name in modules),
+            "/static/vendor/three/three.module.min.js",
+            "/static/vendor/three/three.core.min.js",
             f"/api/v1/takes/{created['id']}",
             f"/api/v1/runs/{created['run_id']}/result",
             "/api/v1/filters",
@@ -168,10 +171,10 @@ def first_paint(url: str) -> None:
     """Open ``url`` in a fresh headless Chromium; print paint and 3D-ready times (cold cache)."""
     from playwright.sync_api import sync_playwright
 
+    # The take view marks "skeletons-drawn" when both 3D views hold the first frame.
     script = """() => new Promise((resolve) => {
-      const ready = () => ['view-raw', 'view-corrected'].every((id) => {
-        const d = document.getElementById(id); return d && d.data && d.data.length > 0; });
-      const tick = () => ready() ? resolve(performance.now()) : setTimeout(tick, 20);
+      const mark = () => performance.getEntriesByName('skeletons-drawn')[0];
+      const tick = () => mark() ? resolve(mark().startTime) : setTimeout(tick, 20);
       tick(); })"""
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=CHROMIUM_PATH, args=CHROMIUM_ARGS)

@@ -93,7 +93,7 @@ export function createViews(divs, skeleton, overview) {
   tooltip.hidden = true;
   document.body.append(tooltip);
 
-  let frame = null, triadsOn = false, overlayOn = false, renders = 0, drawn = 0, scheduled = 0;
+  let frame = null, triadsOn = false, overlayOn = false, renders = 0, drawn = 0, scheduled = 0, marked = false;
   const sizeOf = (view) => [view.div.clientWidth, view.div.clientHeight];
   const render = () => {
     scheduled = 0;
@@ -108,6 +108,7 @@ export function createViews(divs, skeleton, overview) {
       camera.updateProjectionMatrix();
       view.renderer.render(view.scene, camera);
     }
+    if (frame && !marked) { marked = true; performance.mark("skeletons-drawn"); }
     renders += 1;
   };
   const requestRender = () => { if (!scheduled) scheduled = requestAnimationFrame(render); };
@@ -165,7 +166,6 @@ export function createViews(divs, skeleton, overview) {
     const centre = geo.centreOf(next.corrected); // Z-up: (x, −z, y)
     if (centre) { orbit.target[0] = centre[0]; orbit.target[2] = -centre[1]; }
     drawn += 1;
-    if (drawn === 1) performance.mark("skeletons-drawn");
     requestRender();
   };
 
@@ -218,6 +218,8 @@ export function createViews(divs, skeleton, overview) {
   return {
     show,
     requestRender,
+    /** Draw now (the first frame must not wait behind the charts' set-up). */
+    renderNow() { if (scheduled) cancelAnimationFrame(scheduled); render(); },
     get busy() { return scheduled !== 0; },
     get drawn() { return drawn; },
     get renders() { return renders; },

@@ -7,18 +7,19 @@ import { createPlayer } from "./player.js";
 import { loadPlotly } from "./plotly.js";
 import * as store from "./state.js";
 import { createTimeline } from "./timeline.js";
-import { createViews } from "./scene3d.js";
 import { reviewPanel } from "./review.js";
 import { rerunPanel } from "./rerun.js";
 
 const OVERVIEW_FRAMES = 800; // frames of a take drawn before any window is loaded
+const FIRST_FRAMES = 100; // a first, light overview: the skeletons do not wait for the full one
 const LIMITS_COLOR = "#e67e22";
 
 export async function takeView(main, takeId, params, onTeardown) {
   const runParam = params.get("run");
   const plotly = loadPlotly(); // in parallel: the 3D views do not need it
+  const scene = import("./scene3d.js"); // three.js: only the take view loads it
   const take = await api.getTake(takeId);
-  performance.mark("take-data");
+  performance.mark("take-fetched");
   const runs = take.runs;
   const run = runs.find((r) => r.id === runParam) || runs[runs.length - 1];
   const header = h("div", {}, h("h1", {}, take.name, " ", badge(run ? run.status : "none")),
@@ -32,8 +33,11 @@ export async function takeView(main, takeId, params, onTeardown) {
     if (final.status === "failed") { main.append(h("p", { class: "error" }, final.error)); return; }
     window.dispatchEvent(new HashChangeEvent("hashchange")); return;
   }
-  const [result, filters, overview] = await Promise.all([
-    api.getResult(run.id), api.listFilters(), api.getFrames(run.id, { maxFrames: OVERVIEW_FRAMES })]);
+  const [result, filters, first] = await Promise.all([
+    api.getResult(run.id).then((r) => { performance.mark("result-fetched"); return r; }), api.listFilters(),
+    api.getFrames(run.id, { maxFrames: FIRST_FRAMES }).then((f) => { performance.mark("frames-fetched"); return f; })]);
+  let overview = first;
+  const fuller = first.step > 1 ? api.getFrames(run.id, { maxFrames: OVERVIEW_FRAMES }) : Promise.resolve(first);
   const fps = result.summary.fps;
   const nFrames = result.summary.n_frames;
   const names = result.points.names;
@@ -95,9 +99,10 @@ export async function takeView(main, takeId, params, onTeardown) {
     };
   };
 
+  const { createViews } = await scene;
+  performance.mark("views-start");
   const views = createViews({ raw: rawDiv, corrected: corrDiv }, { names, parents, nJoints: result.points.n_joints, oriented }, overview);
-  const Plotly = await plotly;
-  const timeline = createTimeline(Plotly, timelines, (f) => jump(f));
+  let timeline = null; // the charts come after the skeletons are on screen
   const render = () => {
     const f = store.state.frame;
     const frame = frameAt(f);
@@ -106,7 +111,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     rawTitle.textContent = `raw — frame ${frame.shown}`;
     corrTitle.textContent = store.state.overlay ? `corrected (solid) and raw (ghost) — frame ${frame.shown}` : `corrected — frame ${frame.shown}`;
     scrubber.value = f;
-    timeline.setFrame(f);
+    if (timeline) timeline.setFrame(f);
   };
   const remember = () => {
     const query = new URLSearchParams({ run: run.id, frame: store.state.frame });
@@ -164,7 +169,10 @@ export async function takeView(main, takeId, params, onTeardown) {
   onTeardown(() => { player.pause(); views.dispose(); document.removeEventListener("keydown", onKey); });
 
   render();
-  performance.mark("skeletons");
+  views.renderNow();
+  fuller.then((more) => { overview = more; if (!player.playing) render(); });
+  const Plotly = await plotly;
+  timeline = createTimeline(Plotly, timelines, (f) => jump(f));
 
   const series = result.series;
   if (series.twist) {
@@ -184,6 +192,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     const choice = h("select", { id: "keypoint-pick", "aria-label": "keypoint" }, names.map((n, i) => h("option", { value: i }, n)));
     timelines.append(h("div", { class: "controls" }, "keypoint ", choice));
     const k = () => Number(choice.value);
+    overview = await fuller;
     const trajectory = () => charts.trajectoryFigure(overview.frames, overview.raw.map((p) => p[k()]), overview.corrected.map((p) => p[k()]), result.summary.length_unit);
     await timeline.add("chart-trajectory", "Raw vs filtered trajectory (one panel per axis)", trajectory(), (p) => p.x);
     const weights = series.filter && Object.keys(series.filter.weights).length ? series.filter.weights : null;

@@ -362,3 +362,91 @@ def test_narrow_window_and_a_keypoint_take(
     assert "twist" not in p.inner_text("#run-pick")
     p.screenshot(path=str(ARTIFACTS / "workstation-keypoints.png"), full_page=True)
     narrow.close()
+
+
+def tiled_walk(corpus_dir: Path, folder: Path, n_frames: int = 10_000) -> Path:
+    """The CMU walk (31 joints) repeated to ``n_frames`` frames, as the load test does."""
+    from dataclasses import replace
+
+    from mocapqa.io.bvh import read_bvh
+    from mocapqa.io.bvh_write import format_bvh
+
+    walk = read_bvh(corpus_dir / "bvh/cmu/cmu_12_01_walk.bvh")
+    reps = int(np.ceil(n_frames / (walk.n_frames - 1)))
+    quats = np.concatenate([walk.quats[1:]] * reps)[:n_frames]
+    translations = np.concatenate([walk.translations[1:]] * reps)[:n_frames]
+    big = replace(walk, quats=quats, translations=translations, euler_hint_deg=None)
+    path = folder / "cmu_walk_10000_frames.bvh"
+    path.write_text(format_bvh(big))
+    return path
+
+
+def test_timings_overlay_and_upload_progress(
+    live_server: str, takes: dict[str, Any], chromium: Any, corpus_dir: Path, tmp_path: Path
+) -> None:
+    # Upload progress counts bytes: the bar's maximum is the file's size.
+    page = Page(chromium)
+    p = page.page
+    path = tiled_walk(corpus_dir, tmp_path)
+    p.goto(f"{live_server}/#/upload")
+    p.set_input_files("#file-input", str(path))
+    p.wait_for_selector("#open-take", timeout=300_000)
+    assert p.get_attribute("#upload-progress", "max") == str(path.stat().st_size)
+    assert p.evaluate("() => document.getElementById('upload-progress').value") == path.stat().st_size
+    href = p.get_attribute("#open-take", "href")
+    page.close()
+
+    # A fresh page on the 10,000-frame take: skeletons after the first paint.
+    fresh = Page(chromium)
+    fresh.page.goto(f"{live_server}/{href}")
+    fresh.page.wait_for_selector("main[data-ready='1']", timeout=60_000)
+    fresh.settle()
+    marks = fresh.page.evaluate(
+        "() => Object.fromEntries(['first-contentful-paint', 'take-fetched', 'result-fetched',"
+        " 'frames-fetched', 'views-start', 'skeletons-drawn'].map((n) =>"
+        " [n, performance.getEntriesByName(n)[0].startTime]))"
+    )
+    marks["fcp"], marks["skeletons"] = marks["first-contentful-paint"], marks["skeletons-drawn"]
+    # Scrubbing: 60 scrubber moves, each drawn before the next.
+    scrub_s = fresh.page.evaluate(
+        """async () => {
+          const s = document.getElementById('scrubber');
+          const t0 = performance.now();
+          for (let k = 0; k < 60; k++) {
+            s.value = 1000 + 37 * k; s.dispatchEvent(new Event('input'));
+            await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+          }
+          return (performance.now() - t0) / 1000; }"""
+    )
+    fresh.close()
+    TIMINGS["big_take"] = {
+        "frames": 10_000,
+        "joints": 31,
+        "first_contentful_paint_s": round(marks["fcp"] / 1000, 3),
+        "skeletons_after_first_paint_s": round((marks["skeletons"] - marks["fcp"]) / 1000, 3),
+        "scrub_frames_per_s": round(60 / scrub_s, 1),
+        "marks_s": {k: round(v / 1000, 3) for k, v in marks.items()},
+    }
+    assert marks["skeletons"] > marks["fcp"]
+
+    # Overlay: one view, corrected solid and raw as a ghost, at a flagged knee frame.
+    overlay = Page(chromium)
+    result = takes["knees"]["result"]
+    knee = max(
+        (f for f in result["findings"] if f["kind"] == "twist" and "Calf" in f["joint"]),
+        key=lambda f: abs(f["value"]),
+    )
+    overlay.open_take(live_server, takes["knees"], frame=knee["start_frame"])
+    assert overlay.frame() == knee["start_frame"]  # the URL carries the frame
+    alone = view_pixels(overlay, "#view-corrected")
+    overlay.page.check("#overlay")
+    overlay.settle()
+    assert overlay.page.is_hidden("#panel-raw")
+    ghosted = view_pixels(overlay, "#view-corrected")
+    overlay.page.screenshot(path=str(ARTIFACTS / "workstation-overlay.png"))
+    if alone.shape == ghosted.shape:
+        assert (np.abs(alone - ghosted).sum(axis=2) > 60).sum() > 100
+    overlay.page.check("#show-axes")
+    overlay.settle()
+    overlay.page.screenshot(path=str(ARTIFACTS / "workstation-overlay-axes.png"))
+    overlay.close()
