@@ -71,7 +71,7 @@ export function trajectoryFigure(frames, raw, filtered, unit) {
     data.push({ type: "scatter", mode: "lines", x: frames, y: raw.map((p) => p[a]), name: `raw ${axis}`, yaxis, line: { color: PALETTE[a], width: 1, dash: "dot" } });
     data.push({ type: "scatter", mode: "lines", x: frames, y: filtered.map((p) => p[a]), name: `filtered ${axis}`, yaxis, line: { color: PALETTE[a], width: 2 } });
   });
-  const layout = { margin: MARGIN, xaxis: frameAxis(), legend: { orientation: "h", y: -0.25 },
+  const layout = { margin: MARGIN, xaxis: { ...frameAxis(), anchor: "y3" }, legend: { orientation: "h", y: -0.25 },
     yaxis: { domain: [0.68, 1], title: { text: `x (${unit})` } },
     yaxis2: { domain: [0.34, 0.64], title: { text: `y (${unit})` } },
     yaxis3: { domain: [0, 0.3], title: { text: `z (${unit})` } } };
