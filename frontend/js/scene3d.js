@@ -55,12 +55,13 @@ function writeLines(attribute, points, pairs) {
 
 /**
  * @param divs     {raw, corrected} containers
- * @param skeleton {names, parents, nJoints, oriented}
+ * @param skeleton {names, parents, bones?, nJoints, oriented}
  * @param overview {raw, corrected, raw_rotations?, corrected_rotations?}
  */
 export function createViews(divs, skeleton, overview) {
   const { names, parents, nJoints, oriented } = skeleton;
-  const bones = geo.bonesOf(parents);
+  // Keypoint takes of a known layout come with their bones; others are joined by parents.
+  const bones = skeleton.bones && skeleton.bones.length ? skeleton.bones : geo.bonesOf(parents);
   const sides = oriented ? geo.boneSides(overview.raw[0], overview.raw_rotations[0], bones) : null;
   // bodyBox answers in Z-up terms: its floor is the lowest data Y, its half the body's size.
   const box = geo.bodyBox([overview.raw, overview.corrected], 0.1);
@@ -227,6 +228,7 @@ export function createViews(divs, skeleton, overview) {
     get cameraPosition() { return camera.position.toArray(); },
     get bones() { return oriented ? bones.length : 0; },
     get points() { return names.length; },
+    get lines() { return bones.length; },
     /** Screen position of a point of the shown frame in one view (for tests and focus). */
     screenOf(viewName, index) {
       const view = views[viewName];

@@ -101,7 +101,7 @@ export async function takeView(main, takeId, params, onTeardown) {
 
   const { createViews } = await scene;
   performance.mark("views-start");
-  const views = createViews({ raw: rawDiv, corrected: corrDiv }, { names, parents, nJoints: result.points.n_joints, oriented }, overview);
+  const views = createViews({ raw: rawDiv, corrected: corrDiv }, { names, parents, bones: result.points.bones, nJoints: result.points.n_joints, oriented }, overview);
   let timeline = null; // the charts come after the skeletons are on screen
   const render = () => {
     const f = store.state.frame;

@@ -359,6 +359,8 @@ def test_narrow_window_and_a_keypoint_take(
         "() => [...document.querySelectorAll('#rerun-panel input[name=check]')].map((c) => c.value)"
     )
     assert offered == ["filter"]
+    # Pose2Sim's markers are joined by the bones of their layout, not drawn as loose dots.
+    assert p.evaluate("() => window.mocapqaViews.lines") >= 20
     assert "twist" not in p.inner_text("#run-pick")
     p.screenshot(path=str(ARTIFACTS / "workstation-keypoints.png"), full_page=True)
     narrow.close()

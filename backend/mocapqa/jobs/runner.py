@@ -37,6 +37,7 @@ from mocapqa.pipeline.loading import (
     write_keypoints_file,
 )
 from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.render.layouts import bones_for_keypoints
 from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
@@ -83,7 +84,11 @@ def write_outputs(files: FileStore, run_id: str, result: AnalysisResult) -> list
                 kinds.append(suffix)
             except MocapQAError as e:
                 log.info("no %s output for run %s: %s", suffix, run_id, e)
-    report = {**result.report, "downloads": kinds}
+    points = result.report["points"]
+    if result.report["kind"] == "keypoints":
+        # The 3D views join the keypoints of a known layout (BODY_25B, MediaPipe 33, Pose2Sim).
+        points = {**points, "bones": bones_for_keypoints(tuple(points["names"])).tolist()}
+    report = {**result.report, "points": points, "downloads": kinds}
     files.write_bytes(folder / "report.json", json.dumps(report, allow_nan=False).encode())
     return kinds
 
