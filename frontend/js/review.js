@@ -22,6 +22,8 @@ export function reviewPanel(take) {
     } catch (e) { message.textContent = e.message; message.className = "error"; }
   } }, "save review");
   showHistory(take.reviews);
+  /** Record a decision from the keyboard (A/F/R): set it and save. */
+  panel.decide = (decision) => { status.value = decision; save.click(); };
   panel.append(h("h2", {}, "Review"), h("div", { class: "controls" }, status, reviewer, save, message), notes, history);
   return panel;
 }

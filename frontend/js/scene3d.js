@@ -7,6 +7,7 @@ import * as geo from "./geometry.js";
 const BODY = new THREE.Color("#5b84b1");
 const MARKED = new THREE.Color("#f39c12");
 const JOINT = new THREE.Color("#1f4e79");
+const SELECTED = new THREE.Color("#f1c40f");
 const AXES = ["#d62728", "#2ca02c", "#1f77b4"].map((c) => new THREE.Color(c));
 
 function viewScene(bonesCount, nPoints, nJoints, oriented) {
@@ -58,7 +59,7 @@ function writeLines(attribute, points, pairs) {
  * @param skeleton {names, parents, bones?, nJoints, oriented}
  * @param overview {raw, corrected, raw_rotations?, corrected_rotations?}
  */
-export function createViews(divs, skeleton, overview) {
+export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   const { names, parents, nJoints, oriented } = skeleton;
   // Keypoint takes of a known layout come with their bones; others are joined by parents.
   const bones = skeleton.bones && skeleton.bones.length ? skeleton.bones : geo.bonesOf(parents);
@@ -116,8 +117,8 @@ export function createViews(divs, skeleton, overview) {
   new ResizeObserver(requestRender).observe(divs.raw.parentNode.parentNode);
 
   const soupScratch = new Float32Array(bones.length * 24 * 3);
-  const write = (view, points, rotations, flagged) => {
-    const colorOf = (j) => (flagged.has(j) ? new THREE.Color(flagged.get(j)) : null);
+  const write = (view, points, rotations, flagged, selected) => {
+    const colorOf = (j) => (j === selected ? SELECTED : flagged.has(j) ? new THREE.Color(flagged.get(j)) : null);
     if (oriented) {
       const vertices = geo.boneVertices(points, rotations, bones, sides, geo.identity);
       const position = view.bones.geometry.attributes.position;
@@ -160,8 +161,8 @@ export function createViews(divs, skeleton, overview) {
   };
   const show = (next) => {
     frame = next;
-    write(views.raw, next.raw, next.rawRotations, next.flagged);
-    write(views.corrected, next.corrected, next.correctedRotations, next.flagged);
+    write(views.raw, next.raw, next.rawRotations, next.flagged, next.selected);
+    write(views.corrected, next.corrected, next.correctedRotations, next.flagged, next.selected);
     if (overlayOn) writeLines(views.corrected.ghost.geometry.attributes.position, next.raw, bones);
     // Auto-framing: the orbit's target follows the body over the floor.
     const centre = geo.centreOf(next.corrected); // Z-up: (x, −z, y)
@@ -172,11 +173,16 @@ export function createViews(divs, skeleton, overview) {
 
   // Orbit: drag to turn, wheel to zoom; both views move the one camera.
   for (const view of Object.values(views)) {
-    let last = null;
-    view.canvas.addEventListener("pointerdown", (e) => { last = [e.clientX, e.clientY]; view.canvas.setPointerCapture(e.pointerId); });
-    view.canvas.addEventListener("pointerup", (e) => { last = null; view.canvas.releasePointerCapture(e.pointerId); });
+    let last = null, travelled = 0;
+    view.canvas.addEventListener("pointerdown", (e) => { last = [e.clientX, e.clientY]; travelled = 0; view.canvas.setPointerCapture(e.pointerId); });
+    view.canvas.addEventListener("pointerup", (e) => {
+      last = null;
+      view.canvas.releasePointerCapture(e.pointerId);
+      if (travelled < 4) { const j = nearest(view, e); if (j != null) onSelect(j); } // a click, not a drag
+    });
     view.canvas.addEventListener("pointermove", (e) => {
       if (last) {
+        travelled += Math.abs(e.clientX - last[0]) + Math.abs(e.clientY - last[1]);
         orbit.azimuth -= (e.clientX - last[0]) * 0.01;
         orbit.elevation = Math.max(-0.2, Math.min(1.55, orbit.elevation + (e.clientY - last[1]) * 0.01));
         last = [e.clientX, e.clientY];
@@ -197,8 +203,8 @@ export function createViews(divs, skeleton, overview) {
     return [rect.left + ((v.x + 1) / 2) * rect.width, rect.top + ((1 - v.y) / 2) * rect.height];
   };
   const aspectFor = (view) => { const [w, h] = sizeOf(view); camera.aspect = w / Math.max(1, h); camera.updateProjectionMatrix(); };
-  const hover = (view, e) => {
-    if (!frame) return;
+  const nearest = (view, e) => {
+    if (!frame) return null;
     aspectFor(view);
     const points = view === views.raw ? frame.raw : frame.corrected;
     let best = null, bestDistance = 10;
@@ -208,6 +214,10 @@ export function createViews(divs, skeleton, overview) {
       const d = Math.hypot(x - e.clientX, y - e.clientY);
       if (d < bestDistance) { best = j; bestDistance = d; }
     });
+    return best;
+  };
+  const hover = (view, e) => {
+    const best = nearest(view, e);
     tooltip.hidden = best == null;
     if (best != null) {
       tooltip.textContent = names[best];

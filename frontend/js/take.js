@@ -13,6 +13,7 @@ import { rerunPanel } from "./rerun.js";
 const OVERVIEW_FRAMES = 800; // frames of a take drawn before any window is loaded
 const FIRST_FRAMES = 100; // a first, light overview: the skeletons do not wait for the full one
 const LIMITS_COLOR = "#e67e22";
+const DECISIONS = { a: "approved", f: "needs_fix", r: "rejected" }; // review keys
 
 export async function takeView(main, takeId, params, onTeardown) {
   const runParam = params.get("run");
@@ -45,13 +46,14 @@ export async function takeView(main, takeId, params, onTeardown) {
   const jointIndex = new Map(names.map((n, i) => [n, i]));
   const oriented = Array.isArray(overview.raw_rotations);
   store.reset();
-  store.set({ frame: Math.max(0, Math.min(nFrames - 1, Number(params.get("frame")) || 0)) });
+  store.set({ frame: Math.max(0, Math.min(nFrames - 1, Number(params.get("frame")) || 0)), joint: params.get("joint") });
   const chainColor = result.series.twist ? charts.chainColors(result.series.twist) : new Map();
   const findingColor = (f) => (f.kind === "twist" ? chainColor.get(f.joint) || "#c0392b" : LIMITS_COLOR);
   let detail = null;
 
   // Layout
   const frameLabel = h("span", { id: "frame-label" });
+  const jointLabel = h("span", { id: "joint-label", class: "muted" });
   const scrubber = h("input", { type: "range", id: "scrubber", min: 0, max: nFrames - 1, value: 0, step: 1, "aria-label": "frame" });
   const playButton = h("button", { id: "play", class: "primary", "aria-keyshortcuts": "Space" }, "▶ play");
   const speed = h("select", { id: "speed", "aria-label": "speed" }, [0.25, 0.5, 1, 2].map((s) => h("option", { value: s, selected: s === 1 }, `${s}×`)));
@@ -70,13 +72,14 @@ export async function takeView(main, takeId, params, onTeardown) {
       h("label", {}, triadsBox, " joint axes"), h("label", {}, overlayBox, " overlay (raw as ghost)"),
       h("span", { class: "muted" }, oriented ? "bones are drawn in their parent joint's frame; the orange side marks the roll" : "")),
     viewsRow,
-    h("div", { class: "controls panel player", id: "player" }, playButton, "speed ", speed, scrubber, frameLabel),
+    h("div", { class: "controls panel player", id: "player" }, playButton, "speed ", speed, scrubber, frameLabel, jointLabel),
   );
   const help = h("p", { class: "muted", id: "keys-help" },
-    "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · Enter on a row opens it");
+    "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · A/F/R approve, needs fix, reject (saves) · Enter on a row opens it · ? shows or hides this line");
   const timelines = h("div", {});
+  const review = reviewPanel(take);
   main.append(help, findingsTable(result.findings, (f) => { jump(f.start_frame); store.set({ joint: f.joint }); viewsRow.scrollIntoView({ block: "start" }); }),
-    timelines, reviewPanel(take, main), stepsPanel(result), downloadsPanel(run, result), rerunPanel(take, run, filters));
+    timelines, review, stepsPanel(result), downloadsPanel(run, result), rerunPanel(take, run, filters));
 
   // Frames: the overview (whole take, decimated) or, when paused, a full-rate window around.
   const pick = (source, f) => {
@@ -95,19 +98,21 @@ export async function takeView(main, takeId, params, onTeardown) {
     return {
       shown: source.frames[k], raw: source.raw[k], corrected: source.corrected[k],
       rawRotations: oriented ? source.raw_rotations[k] : null, correctedRotations: oriented ? source.corrected_rotations[k] : null,
-      flagged: flaggedAt(f),
+      flagged: flaggedAt(f), selected: jointIndex.get(store.state.joint),
     };
   };
 
   const { createViews } = await scene;
   performance.mark("views-start");
-  const views = createViews({ raw: rawDiv, corrected: corrDiv }, { names, parents, bones: result.points.bones, nJoints: result.points.n_joints, oriented }, overview);
+  const views = createViews({ raw: rawDiv, corrected: corrDiv }, { names, parents, bones: result.points.bones, nJoints: result.points.n_joints, oriented }, overview,
+    (j) => { store.set({ joint: names[j] }); render(); remember(); });
   let timeline = null; // the charts come after the skeletons are on screen
   const render = () => {
     const f = store.state.frame;
     const frame = frameAt(f);
     views.show(frame);
     frameLabel.textContent = `frame ${f} / ${nFrames - 1} · ${seconds(f, fps)} · ${frame.flagged.size} flagged joint(s)`;
+    jointLabel.textContent = store.state.joint ? `selected: ${store.state.joint}` : "click a joint to select it";
     rawTitle.textContent = `raw — frame ${frame.shown}`;
     corrTitle.textContent = store.state.overlay ? `corrected (solid) and raw (ghost) — frame ${frame.shown}` : `corrected — frame ${frame.shown}`;
     scrubber.value = f;
@@ -163,6 +168,10 @@ export async function takeView(main, takeId, params, onTeardown) {
     } else if (e.key === "n" || e.key === "N" || e.key === "p" || e.key === "P") {
       const stop = nextStop(stops, store.state.frame, e.key.toLowerCase() === "n" ? 1 : -1);
       if (stop != null) { if (player.playing) togglePlay(); jump(stop); }
+    } else if (DECISIONS[e.key.toLowerCase()]) {
+      review.decide(DECISIONS[e.key.toLowerCase()]);
+    } else if (e.key === "?") {
+      help.hidden = !help.hidden;
     }
   };
   document.addEventListener("keydown", onKey);

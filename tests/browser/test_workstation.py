@@ -290,12 +290,12 @@ def test_keyboard_only_review_from_the_take_list(
     top = p.evaluate("() => document.getElementById('view-raw').getBoundingClientRect().top")
     assert 0 <= top < p.viewport_size["height"] / 2, top
     page.settle()
-    # Saving a review keeps the frame and the player where they are.
-    p.locator("#review-status").select_option("needs_fix")
+    # A decision from the keyboard (F: needs fix) is saved; the frame stays where it was.
     p.fill("#reviewer", "keyboard")
-    p.locator("#review-save").focus()
-    p.keyboard.press("Enter")
+    p.evaluate("() => document.activeElement.blur()")
+    p.keyboard.press("f")
     p.wait_for_selector("#review-history li")
+    assert "needs fix" in p.inner_text("#review-history")
     assert page.frame() == start
     assert f"frame={start}" in p.evaluate("() => location.hash")
     # A joint names itself on hover.
@@ -306,7 +306,12 @@ def test_keyboard_only_review_from_the_take_list(
     x, y = p.evaluate("(j) => window.mocapqaViews.screenOf('raw', j)", knee)
     p.mouse.move(x, y)
     p.wait_for_selector(".joint-tooltip:not([hidden])")
-    assert p.inner_text(".joint-tooltip") in names
+    named = p.inner_text(".joint-tooltip")
+    assert named in names
+    # A click on it selects it: named in the player bar and in the URL.
+    p.mouse.click(x, y)
+    assert p.inner_text("#joint-label") == f"selected: {named}"
+    assert f"joint={named}" in p.evaluate("() => location.hash")
     p.screenshot(path=str(ARTIFACTS / "workstation-keyboard-review.png"), full_page=True)
 
 
