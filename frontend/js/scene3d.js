@@ -76,7 +76,9 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
     canvas.className = "view-canvas";
     canvas.setAttribute("aria-label", `${name} skeleton, drag to orbit, wheel to zoom`);
     div.append(canvas);
-    const renderer = new THREE.WebGLRenderer({ canvas, antialias: true });
+    // No multisampling: on a CPU rasteriser (SwiftShader, headless) it cost 40 % of the frame
+    // rate (15.6 → 25.7 frames/s in playback); the pixel ratio still smooths HiDPI screens.
+    const renderer = new THREE.WebGLRenderer({ canvas, antialias: false });
     renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
     const parts = viewScene(bones.length, names.length, nJoints, oriented);
     const grid = new THREE.GridHelper(size * 3, 12, 0xc0c7cf, 0xe3e7ec);
