@@ -1,7 +1,9 @@
 // Compare two runs: their counts and options side by side.
 import * as api from "./api.js";
 import { h } from "./dom.js";
-import { fmt } from "./format.js";
+import { MARGIN } from "./charts.js";
+import { fmt, matchFindings, optionsDiff } from "./format.js";
+import { loadPlotly, untabbableModebar } from "./plotly.js";
 
 export async function compareView(main, params) {
   const page = await api.listTakes({ limit: 500 });
@@ -30,6 +32,46 @@ export async function compareView(main, params) {
       metric("twist intervals", (x) => x.summary.findings_by_kind.twist || 0), metric("largest removed offset", maxOffset),
       metric("joint-limit intervals", (x) => (x.steps.limits.state === "done" ? x.summary.findings_by_kind.limits || 0 : x.steps.limits.state)),
       metric("filter", (x) => (x.steps.filter.state === "done" ? x.series.filter?.method || x.options.filter_method : x.steps.filter.state)),
-      metric("server time (s)", (x, run) => fmt(run.server_time_s, 3)),
-      metric("options", (x) => JSON.stringify(x.options)))));
+      metric("server time (s)", (x, run) => fmt(run.server_time_s, 3)))));
+  if (results.length < 2 || !results[0].result || !results[1].result) return;
+  const [a, b] = results.map((r) => r.result);
+  const diff = optionsDiff(a.options, b.options);
+  main.append(h("h2", {}, "Options that differ"),
+    diff.length ? h("table", { class: "kv", id: "compare-options" }, h("thead", {}, h("tr", {}, h("th", {}, "option"), h("th", {}, "A"), h("th", {}, "B"))),
+      h("tbody", {}, diff.map(([k, x, y]) => h("tr", {}, h("td", {}, k), h("td", {}, x), h("td", {}, y)))))
+      : h("p", { class: "muted", id: "compare-options" }, "Same options."));
+  const matched = matchFindings(a.findings, b.findings);
+  const span = (f) => `${f.start_frame}–${f.end_frame}`;
+  const rows = [
+    ...matched.both.map(([x, y]) => [x, "both", span(x), span(y)]),
+    ...matched.onlyA.map((x) => [x, "only in A", span(x), "–"]),
+    ...matched.onlyB.map((y) => [y, "only in B", "–", span(y)]),
+  ].sort((p, q) => p[0].start_frame - q[0].start_frame);
+  main.append(h("h2", {}, `Findings: ${matched.both.length} in both, ${matched.onlyA.length} only in A, ${matched.onlyB.length} only in B`),
+    h("table", { id: "compare-findings" }, h("thead", {}, h("tr", {}, ["kind", "joint", "in", "frames (A)", "frames (B)"].map((c) => h("th", {}, c)))),
+      h("tbody", {}, rows.map(([f, where, x, y]) => h("tr", { "data-match": where }, h("td", {}, f.kind), h("td", {}, f.joint), h("td", {}, where), h("td", {}, x), h("td", {}, y))))));
+  const chainsA = a.series.twist ? a.series.twist.chains : [];
+  const chainsB = new Map((b.series.twist ? b.series.twist.chains : []).map((c) => [c.joint, c]));
+  const common = chainsA.filter((c) => chainsB.has(c.joint));
+  if (!common.length) return;
+  const flagged = new Set([...a.findings, ...b.findings].filter((f) => f.kind === "twist").map((f) => f.joint));
+  const joint = h("select", { id: "compare-joint", "aria-label": "joint" }, common.map((c) => h("option", { value: c.joint, selected: c.joint === [...flagged][0] }, c.joint)));
+  const chart = h("div", { id: "compare-twist", class: "chart" });
+  main.append(h("h2", {}, "Twist θP and removed offset, A solid, B dashed"), h("div", { class: "controls" }, "joint ", joint), h("div", { class: "panel" }, chart));
+  const Plotly = await loadPlotly();
+  const draw = () => {
+    const x = chainsA.find((c) => c.joint === joint.value), y = chainsB.get(joint.value);
+    const line = (series, frames, name, dash, color, yaxis) => ({ type: "scatter", mode: "lines", x: frames, y: series, name, yaxis, line: { dash, color, width: 1.4 } });
+    const data = [
+      line(x.theta_p_deg, a.series.twist.frames, "A θP", "solid", "#1f77b4", "y"), line(y.theta_p_deg, b.series.twist.frames, "B θP", "dash", "#ff7f0e", "y"),
+      line(x.offset_deg, a.series.twist.frames, "A offset", "solid", "#1f77b4", "y2"), line(y.offset_deg, b.series.twist.frames, "B offset", "dash", "#ff7f0e", "y2"),
+    ];
+    const layout = { margin: MARGIN, xaxis: { title: { text: "frame" }, anchor: "y2" },
+      yaxis: { domain: [0.52, 1], title: { text: "θP (°)" } }, yaxis2: { domain: [0, 0.45], title: { text: "offset (°)" } }, legend: { orientation: "h", y: -0.25 } };
+    return Plotly.react(chart, data, layout, { displaylogo: false, responsive: true });
+  };
+  await draw();
+  untabbableModebar(chart);
+  joint.addEventListener("change", draw);
+  main.dataset.ready = "1";
 }

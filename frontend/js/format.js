@@ -56,3 +56,31 @@ export function nextStop(stops, frame, dir) {
 /** One colour per chain/joint name, stable for a given order of names. */
 export const PALETTE = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
 export const colorOf = (names) => new Map(names.map((n, k) => [n, PALETTE[k % PALETTE.length]]));
+
+/** Whether two findings are the same: same kind and joint, overlapping frames. */
+const sameFinding = (a, b) => a.kind === b.kind && a.joint === b.joint && a.start_frame <= b.end_frame && b.start_frame <= a.end_frame;
+
+/**
+ * Findings of two runs matched: those in both (as [a, b] pairs), only in A, only in B.
+ * Each finding of B matches at most one of A.
+ */
+export function matchFindings(a, b) {
+  const free = new Set(b.map((_, k) => k));
+  const both = [], onlyA = [];
+  for (const f of a) {
+    const k = [...free].find((j) => sameFinding(f, b[j]));
+    if (k === undefined) onlyA.push(f);
+    else { free.delete(k); both.push([f, b[k]]); }
+  }
+  return { both, onlyA, onlyB: [...free].map((k) => b[k]) };
+}
+
+/** Options that differ between two runs, flattened to dotted keys: [key, a, b] rows. */
+export function optionsDiff(a, b) {
+  const flat = (o, prefix = "") => Object.entries(o || {}).flatMap(([k, v]) =>
+    (v && typeof v === "object" && !Array.isArray(v) ? flat(v, `${prefix}${k}.`) : [[`${prefix}${k}`, v]]));
+  const left = new Map(flat(a)), right = new Map(flat(b));
+  const keys = [...new Set([...left.keys(), ...right.keys()])].sort();
+  const show = (v) => (v === undefined ? "–" : Array.isArray(v) ? v.join(", ") : String(v));
+  return keys.filter((k) => JSON.stringify(left.get(k)) !== JSON.stringify(right.get(k))).map((k) => [k, show(left.get(k)), show(right.get(k))]);
+}

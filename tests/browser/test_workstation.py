@@ -458,3 +458,34 @@ def test_timings_overlay_and_upload_progress(
     overlay.settle()
     overlay.page.screenshot(path=str(ARTIFACTS / "workstation-overlay-axes.png"))
     overlay.close()
+
+
+def test_compare_matches_findings_and_diffs_options(
+    live_server: str, takes: dict[str, Any], page: Page
+) -> None:
+    knees = takes["knees"]
+    created = httpx.post(
+        f"{live_server}/api/v1/takes/{knees['id']}/runs",
+        json={"checks": ["twist"], "twist_method": "paper"},
+        timeout=30,
+    )
+    created.raise_for_status()
+    other = created.json()["id"]
+    deadline = time.monotonic() + 300
+    while httpx.get(f"{live_server}/api/v1/runs/{other}", timeout=30).json()["status"] != "done":
+        assert time.monotonic() < deadline
+        time.sleep(0.3)
+    p = page.page
+    p.goto(f"{live_server}/#/compare?a={knees['run']}&b={other}")
+    p.wait_for_selector("main[data-ready='1']", timeout=60_000)
+    options = p.inner_text("#compare-options")
+    assert "twist_method" in options
+    assert "paper" in options
+    assert "checks" in options
+    matches = set(
+        p.locator("#compare-findings tbody tr").evaluate_all("rs => rs.map(r => r.dataset.match)")
+    )
+    # B ran no limits check: A's limits findings are only in A.
+    assert "only in A" in matches
+    assert p.evaluate("() => document.getElementById('compare-twist').data.length") == 4
+    p.screenshot(path=str(ARTIFACTS / "workstation-compare.png"), full_page=True)

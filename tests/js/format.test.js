@@ -36,3 +36,22 @@ test("N/P stops go to the next and previous finding start", () => {
   assert.equal(format.nextStop(stops, 30, -1), 10);
   assert.equal(format.nextStop(stops, 5, -1), null);
 });
+
+test("findings of two runs are matched by kind, joint and overlapping frames", () => {
+  const a = [finding(10, 5), { ...finding(40, 2), joint: "hip" }, finding(100, 1)];
+  const b = [finding(11, 4), finding(60, 3)];
+  const m = format.matchFindings(a, b);
+  assert.deepEqual(m.both.map(([x, y]) => [x.start_frame, y.start_frame]), [[10, 11]]);
+  assert.deepEqual(m.onlyA.map((f) => f.start_frame), [40, 100]);
+  assert.deepEqual(m.onlyB.map((f) => f.start_frame), [60]);
+});
+
+test("the options diff lists only what differs, as readable values", () => {
+  const a = { checks: ["twist", "limits"], twist_method: "robust", filter_params: { beta: 1 } };
+  const b = { checks: ["twist"], twist_method: "robust", filter_params: { beta: 2 }, filter_method: "butterworth" };
+  assert.deepEqual(format.optionsDiff(a, b), [
+    ["checks", "twist, limits", "twist"],
+    ["filter_method", "–", "butterworth"],
+    ["filter_params.beta", "1", "2"],
+  ]);
+});
