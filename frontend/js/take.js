@@ -78,7 +78,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · A/F/R approve, needs fix, reject (saves) · Enter on a row opens it · ? shows or hides this line");
   const timelines = h("div", {});
   const review = reviewPanel(take);
-  main.append(help, findingsTable(result.findings, (f) => { jump(f.start_frame); store.set({ joint: f.joint }); viewsRow.scrollIntoView({ block: "start" }); }),
+  main.append(help, findingsTable(result.findings, (f) => { store.set({ joint: f.joint }); focusCharts(); jump(f.start_frame); viewsRow.scrollIntoView({ block: "start" }); }),
     timelines, review, stepsPanel(result), downloadsPanel(run, result), rerunPanel(take, run, filters));
 
   // Frames: the overview (whole take, decimated) or, when paused, a full-rate window around.
@@ -105,8 +105,17 @@ export async function takeView(main, takeId, params, onTeardown) {
   const { createViews } = await scene;
   performance.mark("views-start");
   const views = createViews({ raw: rawDiv, corrected: corrDiv }, { names, parents, bones: result.points.bones, nJoints: result.points.n_joints, oriented }, overview,
-    (j) => { store.set({ joint: names[j] }); render(); remember(); });
+    (j) => { store.set({ joint: names[j] }); focusCharts(); render(); remember(); });
+  let Plotly = null;
   let timeline = null; // the charts come after the skeletons are on screen
+  // The selected joint's twist chain is the one the twist chart shows (when it has one).
+  const focusCharts = () => {
+    const chart = document.getElementById("chart-twist");
+    const chains = result.series.twist ? result.series.twist.chains : [];
+    if (!chart || !chains.some((c) => c.joint === store.state.joint)) return;
+    const visible = chart.data.map((trace) => (trace.type === "bar" ? true : trace.legendgroup === store.state.joint ? true : "legendonly"));
+    Plotly.restyle(chart, { visible });
+  };
   const render = () => {
     const f = store.state.frame;
     const frame = frameAt(f);
@@ -180,7 +189,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   render();
   views.renderNow();
   fuller.then((more) => { overview = more; if (!player.playing) render(); });
-  const Plotly = await plotly;
+  Plotly = await plotly;
   timeline = createTimeline(Plotly, timelines, (f) => jump(f));
 
   const series = result.series;
@@ -193,7 +202,9 @@ export async function takeView(main, takeId, params, onTeardown) {
       });
   }
   if (series.limits) {
-    await timeline.add("chart-limits", "Joint-limit violations (joint × frame, degrees outside the limits)", charts.limitsFigure(series.limits), (p) => p.x);
+    // A heat-map cell selects its joint as well as its frame.
+    await timeline.add("chart-limits", "Joint-limit violations (joint × frame, degrees outside the limits)", charts.limitsFigure(series.limits),
+      (p) => { if (jointIndex.has(p.y)) { store.set({ joint: p.y }); focusCharts(); } return p.x; });
   } else if (result.steps.limits && result.steps.limits.state !== "skipped") {
     timelines.append(h("p", { class: "muted", id: "limits-note" }, `Joint limits: ${result.steps.limits.message}`));
   }
@@ -212,6 +223,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     });
   }
   timeline.setFrame(store.state.frame);
+  focusCharts();
   if (store.state.frame) loadDetail();
   main.dataset.ready = "1";
 }

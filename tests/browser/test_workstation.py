@@ -290,6 +290,18 @@ def test_keyboard_only_review_from_the_take_list(
     top = p.evaluate("() => document.getElementById('view-raw').getBoundingClientRect().top")
     assert 0 <= top < p.viewport_size["height"] / 2, top
     page.settle()
+    # A twist finding focuses its joint: the twist chart shows that chain only.
+    twist_row = p.locator("#findings tbody tr", has_text="twist").first
+    chain = twist_row.locator("td").nth(1).inner_text()
+    twist_row.focus()
+    p.keyboard.press("Enter")
+    shown = p.evaluate(
+        "() => document.getElementById('chart-twist').data"
+        ".filter((t) => t.type !== 'bar' && t.visible === true).map((t) => t.legendgroup)"
+    )
+    assert set(shown) == {chain}
+    start = page.frame()
+    page.settle()
     # A decision from the keyboard (F: needs fix) is saved; the frame stays where it was.
     p.fill("#reviewer", "keyboard")
     p.evaluate("() => document.activeElement.blur()")
