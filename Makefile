@@ -23,9 +23,12 @@ install-dev: venv
 	$(BIN)/pip install --quiet -e ".[dev]"
 
 # Debian packages the tests use: chromium (browser tests), Mesa EGL (off-screen pyvista),
-# PostgreSQL (store and API tests against a real server). Installed only when missing.
+# PostgreSQL (store and API tests against a real server), and Node.js with npm when the machine
+# has no node (three.js for the 3D views, ESLint, node --test). Installed only when missing.
 system-deps:
 	@missing=""; for p in $(APT_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	command -v node >/dev/null 2>&1 || missing="$$missing nodejs"; \
+	command -v npm >/dev/null 2>&1 || missing="$$missing npm"; \
 	if [ -n "$$missing" ]; then \
 	  echo "installing Debian packages:$$missing"; \
 	  SUDO=""; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
