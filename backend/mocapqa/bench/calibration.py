@@ -67,8 +67,9 @@ def fit_on_fit_takes(records: Sequence[IntervalRecord], path: Path | None = None
         "bursts of flips, and their clean versions"
     )
     return fit_calibration(
-        np.array([r.features for r in fit]), [r.right for r in fit], description, path
-    )
+        np.array([r.features for r in fit]), [r.right for r in fit], description, path,
+        [f"{r.rig}/{r.take}" for r in fit],
+    )  # fmt: skip
 
 
 def reliability(

@@ -18,7 +18,7 @@ import numpy as np
 from mocapqa.core.arrays import FloatArray
 from mocapqa.errors import InputError
 from mocapqa.twist.angles import ChainGeometry
-from mocapqa.twist.confidence import APPLY_THRESHOLD
+from mocapqa.twist.confidence import APPLY_THRESHOLD, has_evidence
 from mocapqa.twist.detect import DetectedInterval
 
 __all__ = ["APPLY_CHOICES", "TwistInterval", "choose_intervals", "parse_apply"]
@@ -151,7 +151,7 @@ def choose_intervals(
         if isinstance(choice, frozenset):
             applied = k in choice
         elif choice == "confident" and calibrated:
-            applied = i.confidence >= APPLY_THRESHOLD
+            applied = i.confidence >= APPLY_THRESHOLD and has_evidence(i.features)
         else:
             applied = choice != "none"
         rows = slice(i.start_frame, i.end_frame + 1)

@@ -4,20 +4,25 @@ Conventions
 -----------
 The model is a logistic regression on the features of
 :data:`mocapqa.twist.intervals.FEATURES`, standardised with the means and scales stored beside
-the coefficients in ``data/twist/calibration.json``. That file is written by
+the coefficients in ``data/twist/calibration.json``, followed by an isotonic map of its score
+fitted on out-of-fold scores (folds by take), which corrects the logistic model where its
+linear form is over- or under-confident (bursts in the middle range). That file is written by
 ``mocapqa bench twist --fit-calibration`` from injected errors on the *fit* takes of the corpus
 only (never the held-out takes and never ``005_05``, the take with real errors). An interval is
 labelled right when applying it alone removes at least 80 % of the twist error on its frames
 and raises no frame's error by more than 1°.
 
-``APPLY_THRESHOLD`` is the probability from which ``apply="confident"`` applies an interval.
+``APPLY_THRESHOLD`` is the probability from which ``apply="confident"`` applies an interval, and
+:func:`has_evidence` the minimum-evidence rule it also requires: the interval's largest level
+must be at least ``MIN_LEVEL_DEG``, so a small interval inside the natural roll noise is reported
+but not applied.
 """
 
 from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -31,13 +36,18 @@ from mocapqa.twist.intervals import FEATURES
 __all__ = [
     "APPLY_THRESHOLD",
     "CALIBRATION_FILE",
+    "MIN_LEVEL_DEG",
     "Calibration",
     "default_calibration",
     "fit_calibration",
+    "has_evidence",
 ]
 
 APPLY_THRESHOLD = 0.5
 """Smallest calibrated probability at which ``apply="confident"`` applies an interval."""
+MIN_LEVEL_DEG = 5.0
+"""Smallest largest level, degrees, of an interval that ``apply="confident"`` applies: the
+smallest offset of the injection protocol (no interval on the fit takes is smaller)."""
 CALIBRATION_FILE = "calibration.json"
 """Name of the stored calibration in the package's ``data/twist`` folder."""
 
@@ -57,6 +67,9 @@ class Calibration:
     intercept : float
     fitted_on : str
         What the model was fitted on (written to the docs and the bench).
+    isotonic_x, isotonic_y : ndarray, shape (M,)
+        Increasing logistic scores and the calibrated probability at each (linear in between,
+        clipped outside); empty for the logistic score itself.
     """
 
     features: tuple[str, ...]
@@ -65,11 +78,21 @@ class Calibration:
     coef: FloatArray
     intercept: float
     fitted_on: str
+    isotonic_x: FloatArray = field(default_factory=lambda: np.zeros(0))
+    isotonic_y: FloatArray = field(default_factory=lambda: np.zeros(0))
+
+    def score(self, features: FloatArray) -> FloatArray:
+        """The logistic score of each interval, shape (N,) from features (N, K)."""
+        x = (np.asarray(features, dtype=np.float64) - self.mean) / self.scale
+        result: FloatArray = 1.0 / (1.0 + np.exp(-(x @ self.coef + self.intercept)))
+        return result
 
     def probability(self, features: FloatArray) -> FloatArray:
         """Probability that each interval is right, shape (N,) from features (N, K)."""
-        x = (np.asarray(features, dtype=np.float64) - self.mean) / self.scale
-        result: FloatArray = 1.0 / (1.0 + np.exp(-(x @ self.coef + self.intercept)))
+        score = self.score(features)
+        if len(self.isotonic_x) == 0:
+            return score
+        result: FloatArray = np.interp(score, self.isotonic_x, self.isotonic_y)
         return result
 
     def to_json(self) -> dict[str, Any]:
@@ -81,6 +104,8 @@ class Calibration:
             "coef": self.coef.tolist(),
             "intercept": self.intercept,
             "fitted_on": self.fitted_on,
+            "isotonic_x": self.isotonic_x.tolist(),
+            "isotonic_y": self.isotonic_y.tolist(),
         }
 
     @classmethod
@@ -97,13 +122,31 @@ class Calibration:
             arrays = [np.asarray(data[k], dtype=np.float64) for k in ("mean", "scale", "coef")]
             intercept = float(data["intercept"])
             fitted_on = str(data.get("fitted_on", ""))
+            isotonic = [np.asarray(data.get(k, []), dtype=np.float64)
+                        for k in ("isotonic_x", "isotonic_y")]  # fmt: skip
         except (KeyError, TypeError, ValueError) as error:
             raise InputError(f"Expected a twist calibration in {source}, got {error!r}") from error
         if names != FEATURES or any(a.shape != (len(FEATURES),) for a in arrays):
             raise InputError(
                 f"Expected calibration features {list(FEATURES)} in {source}, got {list(names)}"
             )
-        return cls(names, arrays[0], arrays[1], arrays[2], intercept, fitted_on)
+        if isotonic[0].shape != isotonic[1].shape or isotonic[0].ndim != 1:
+            raise InputError(f"Expected isotonic_x and isotonic_y of one length in {source}")
+        return cls(names, arrays[0], arrays[1], arrays[2], intercept, fitted_on, *isotonic)
+
+
+def has_evidence(features: Sequence[float]) -> bool:
+    """Whether an interval's largest level reaches :data:`MIN_LEVEL_DEG`.
+
+    Parameters
+    ----------
+    features : sequence of float
+        The interval's features (:data:`mocapqa.twist.intervals.FEATURES`); empty (no
+        calibrated features, the paper's method) counts as evidence.
+    """
+    if not features:
+        return True
+    return bool(features[FEATURES.index("log_level_deg")] >= np.log(MIN_LEVEL_DEG))
 
 
 _LOADED: dict[str, Calibration] = {}
@@ -119,9 +162,16 @@ def default_calibration() -> Calibration:
 
 
 def fit_calibration(
-    features: FloatArray, labels: Sequence[bool], fitted_on: str, path: Path | None = None
+    features: FloatArray,
+    labels: Sequence[bool],
+    fitted_on: str,
+    path: Path | None = None,
+    groups: Sequence[str] | None = None,
 ) -> Calibration:
-    """Fit the logistic model (scikit-learn, L2, C = 1) and optionally write it.
+    """Fit the logistic model (scikit-learn, L2, C = 1), its isotonic map, optionally write it.
+
+    The isotonic map is fitted on the logistic scores of 5 folds (by ``groups``, e.g. takes,
+    when given), each scored by a model fitted on the other folds.
 
     Parameters
     ----------
@@ -132,6 +182,8 @@ def fit_calibration(
         Description of the data, stored with the model.
     path : Path, optional
         Where to write the JSON.
+    groups : sequence of str, optional
+        Group of each interval (its take), so that no fold scores a take it was fitted on.
 
     Returns
     -------
@@ -142,7 +194,9 @@ def fit_calibration(
     InputError
         With fewer than two classes among the labels.
     """
+    from sklearn.isotonic import IsotonicRegression
     from sklearn.linear_model import LogisticRegression
+    from sklearn.model_selection import GroupKFold
 
     x = np.asarray(features, dtype=np.float64)
     y = np.asarray(labels, dtype=bool)
@@ -150,10 +204,22 @@ def fit_calibration(
         raise InputError("Expected right and wrong intervals to fit a calibration, got one class")
     mean = x.mean(axis=0)
     scale = np.where(x.std(axis=0) > 1e-9, x.std(axis=0), 1.0)
-    model = LogisticRegression(C=1.0, max_iter=1000).fit((x - mean) / scale, y)
+    z = (x - mean) / scale
+    model = LogisticRegression(C=1.0, max_iter=1000).fit(z, y)
+    fold_of = np.asarray(groups if groups is not None else np.arange(len(y)) % 5)
+    scores = np.zeros(len(y))
+    for fit_rows, score_rows in GroupKFold(n_splits=5).split(z, y, fold_of):
+        if len(set(y[fit_rows].tolist())) < 2:
+            scores[score_rows] = y[fit_rows].mean()
+            continue
+        fold = LogisticRegression(C=1.0, max_iter=1000).fit(z[fit_rows], y[fit_rows])
+        scores[score_rows] = fold.predict_proba(z[score_rows])[:, 1]
+    isotonic = IsotonicRegression(y_min=0.0, y_max=1.0, out_of_bounds="clip").fit(scores, y)
     calibration = Calibration(
-        FEATURES, mean, scale, model.coef_[0].copy(), float(model.intercept_[0]), fitted_on
-    )
+        FEATURES, mean, scale, model.coef_[0].copy(), float(model.intercept_[0]), fitted_on,
+        np.asarray(isotonic.X_thresholds_, dtype=np.float64),
+        np.asarray(isotonic.y_thresholds_, dtype=np.float64),
+    )  # fmt: skip
     if path is not None:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(calibration.to_json(), indent=2) + "\n", encoding="utf-8")

@@ -115,6 +115,9 @@ class RobustParams:
     burst_gap_s: float = 0.1
     agreement: float = 0.5
     min_fps: float = 10.0
+    speed_factor: float = 1.0
+    tail_s: float = 0.1
+    tail_factor: float = 0.1
     parent_source: str = "increment"
     child_source: str = "increment"
     min_conditioning: float = 0.4
@@ -328,7 +331,10 @@ def detect_robust(
         threshold = np.maximum(floor, params.noise_factor * scale)  # (C,)
         mismatch = np.abs(wrap_angle(rp + rc)) if params.modular else np.abs(rp + rc)
         allowed = params.consistency * smaller
-        events = (smaller > threshold) & (mismatch <= allowed)
+        # A step must also stand out against the roll's own local speed: a fast natural roll
+        # that reverses moves by about its speed in one frame.
+        local = params.speed_factor * np.maximum(np.abs(natural_p), np.abs(natural_c))
+        events = (smaller > np.maximum(threshold, local)) & (mismatch <= allowed)
         if not params.modular:
             events &= rp * rc < 0
         if done == params.passes:
@@ -350,6 +356,11 @@ def detect_robust(
     rows, cols = np.nonzero(events)
     jumps = np.zeros_like(dp)
     jumps[rows, cols] = np.angle(np.exp(1j * rp[rows, cols]) + np.exp(-1j * rc[rows, cols]))
+    # Counter-rotated steps below the threshold: where a burst's decay tail shows.
+    small = np.zeros_like(dp)
+    weak = (smaller > params.tail_factor * threshold) & (mismatch <= allowed) & ~events
+    rows_w, cols_w = np.nonzero(weak)
+    small[rows_w, cols_w] = np.angle(np.exp(1j * rp[weak]) + np.exp(-1j * rc[weak]))
     ratio = np.zeros_like(dp)
     ratio[rows, cols] = mismatch[rows, cols] / np.maximum(smaller[rows, cols], 1e-12)
     # The chain's natural roll per frame: noise or typical velocity, whichever is larger.
@@ -366,7 +377,8 @@ def detect_robust(
             offsets[:, c], estimates = chain_intervals(
                 frames, jumps[frames, c], ratio[frames, c], dp[:, c], natural_p[:, c],
                 float(threshold[c]), float(roll_scale[c]), fps, params.closure_fraction,
-                params.agreement, params.burst_gap_s, params.max_interval_s,
+                params.agreement, params.burst_gap_s, params.max_interval_s, small[:, c],
+                params.tail_s,
             )  # fmt: skip
         else:
             steps = np.zeros(n_frames)

@@ -156,6 +156,8 @@ def chain_intervals(
     agreement: float,
     burst_gap_s: float,
     max_interval_s: float,
+    small_steps: FloatArray | None = None,
+    tail_s: float = 0.0,
 ) -> tuple[FloatArray, list[IntervalEstimate]]:
     """Offsets and intervals of one chain.
 
@@ -184,6 +186,14 @@ def chain_intervals(
         left at level 0.
     burst_gap_s, max_interval_s : float
         Largest gap inside a cluster and longest level shift, seconds.
+    small_steps : ndarray, shape (F,), optional
+        Counter-rotated roll steps below the event threshold (0 elsewhere), radians: the
+        frames of a decay tail.
+    tail_s : float
+        Longest decay tail after an interval's last event, seconds: the run of small steps
+        right after the last event, in the direction of its jump and adding up to less than
+        it, is the roll returning to its natural level; its frames get the level still to
+        go. 0 (or no ``small_steps``) disables tails.
 
     Returns
     -------
@@ -202,6 +212,7 @@ def chain_intervals(
         return offsets, found
     burst_gap = max(1, round(burst_gap_s * fps))
     max_frames = max(2, round(max_interval_s * fps))
+    tail_frames = max(0, round(tail_s * fps)) if small_steps is not None else 0
     roll = np.cumsum(increments)
     groups = _groups(frames, jumps, threshold, closure_fraction, burst_gap, max_frames)
     # Anchors must sit where the roll is at its natural level: outside every interval and
@@ -216,7 +227,21 @@ def chain_intervals(
     for group in groups:
         events = frames[group]
         first, last = int(events[0]), int(events[-1])
-        before, after = first - 1, last
+        steps = jumps[group]
+        # A decay tail: small counter-rotated steps right after the last event, in the
+        # direction of its jump, before the next event.
+        later = frames[frames > last]
+        stop = min(int(later[0]) if len(later) else n_frames, last + tail_frames + 1, n_frames)
+        end = last
+        while (
+            end + 1 < stop
+            and small_steps is not None
+            and small_steps[end + 1] * steps[-1] > 0
+            and abs(small_steps[last + 1 : end + 2].sum()) < abs(steps[-1])
+        ):
+            end += 1
+        tail = small_steps[last + 1 : end + 1] if small_steps is not None else np.zeros(0)
+        before, after = first - 1, end
         while before > 0 and forbidden[before]:
             before -= 1
         while after < n_frames - 1 and forbidden[after]:
@@ -235,8 +260,7 @@ def chain_intervals(
             + h11 * span * natural[after]
         )
         deviation = wrap_angle(roll[before : after + 1] - continuation)
-        steps = jumps[group]
-        net = float(wrap_angle(np.array(np.sum(steps))))
+        net = float(wrap_angle(np.array(np.sum(steps) + np.sum(tail))))
         closed = _closes(net, float(np.max(np.abs(steps))), threshold, closure_fraction)
         accumulated = wrap_angle(np.cumsum(steps - net / len(steps)))[:-1]
         disagreement = 0.0
@@ -254,7 +278,10 @@ def chain_intervals(
                 level = jumped
             if abs(level) >= threshold:
                 offsets[lo:hi] = level
-        applied = offsets[first:last]
+        if len(tail) and offsets[last - 1] != 0.0:
+            # The level still to go on each tail frame, measured from the tail's end.
+            offsets[last:end] = -np.cumsum(tail[::-1])[::-1]
+        applied = offsets[first:end]
         nonzero = np.flatnonzero(applied)
         if len(nonzero) == 0:
             continue

@@ -1,0 +1,161 @@
+"""Decay tails of bursts, the local-speed rule, the minimum-evidence rule and the isotonic map."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mocapqa.errors import InputError
+from mocapqa.twist.choice import choose_intervals
+from mocapqa.twist.confidence import (
+    MIN_LEVEL_DEG,
+    Calibration,
+    default_calibration,
+    fit_calibration,
+    has_evidence,
+)
+from mocapqa.twist.detect import DetectedInterval, RobustParams, detect_robust
+from mocapqa.twist.intervals import FEATURES, chain_intervals
+
+FPS = 60.0
+
+
+def _burst_with_tail() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A roll at 0.5°/frame with 0.2° noise, with a flip of 60° at frames 100–101 that returns
+    to 6° and then decays by 1.5° per frame over frames 103–106, below the event threshold (the
+    offset per frame, the parent's increments and the child's counter-increments, radians)."""
+    n = 200
+    rng = np.random.default_rng(3)
+    offset = np.zeros(n)
+    offset[100:102] = 60.0
+    offset[102:106] = [6.0, 4.5, 3.0, 1.5]
+    step = np.diff(offset, prepend=0.0)
+    parent = np.deg2rad(0.5 + rng.normal(0.0, 0.2, n) + step)
+    child = np.deg2rad(-0.2 + rng.normal(0.0, 0.2, n) - step)
+    return np.deg2rad(offset), parent, child
+
+
+def test_a_decay_tail_after_a_burst_gets_the_level_still_to_go() -> None:
+    truth, parent, child = _burst_with_tail()
+    with_tail = detect_robust(parent[:, None], child[:, None], FPS, RobustParams())
+    without = detect_robust(parent[:, None], child[:, None], FPS, RobustParams(tail_s=0.0))
+    assert np.flatnonzero(with_tail.candidates[:, 0]).tolist() == [100, 102]
+    found = np.rad2deg(with_tail.offsets[:, 0])
+    assert np.allclose(found, np.rad2deg(truth), atol=1.0)
+    # Without tails the tail frames are left as they are, and the flip's level is off by
+    # half the tail's start (the ends do not quite cancel).
+    assert np.allclose(np.rad2deg(without.offsets[100:102, 0]), 57.0, atol=1.0)
+    assert np.all(without.offsets[102:, 0] == 0.0)
+    (interval,) = with_tail.intervals
+    assert (interval.start_frame, interval.end_frame) == (100, 105)
+
+
+def test_a_tail_never_reaches_past_its_length_or_into_the_next_interval() -> None:
+    n = 40
+    frames = np.array([10, 12, 14, 16])
+    jumps = np.deg2rad([40.0, -37.0, 40.0, -37.0])
+    small = np.zeros(n)
+    small[13] = np.deg2rad(-3.0)  # the first flip's tail, cut by the event at frame 14
+    small[17:30] = np.deg2rad(-0.5)  # steps in the release's direction for 13 frames
+    increments = small.copy()
+    increments[frames] = jumps
+    offsets, found = chain_intervals(
+        frames, jumps, np.zeros(4), increments, np.zeros(n), np.deg2rad(2.0),
+        np.deg2rad(0.1), FPS, 0.2, 0.5, 0.01, 2.0, small, 0.1,
+    )  # fmt: skip
+    assert [(f.start_frame, f.end_frame) for f in found] == [(10, 12), (14, 21)]
+    assert np.allclose(np.rad2deg(offsets[10:14]), [40.0, 40.0, 3.0, 0.0])
+    # The second flip's tail: at most round(0.1 s × 60) = 6 frames.
+    assert np.allclose(np.rad2deg(offsets[16:22]), [3.0, 2.5, 2.0, 1.5, 1.0, 0.5])
+    assert np.all(offsets[22:] == 0.0)
+    without, _ = chain_intervals(
+        frames, jumps, np.zeros(4), increments, np.zeros(n), np.deg2rad(2.0),
+        np.deg2rad(0.1), FPS, 0.2, 0.5, 0.01, 2.0, small, 0.0,
+    )  # fmt: skip
+    assert np.all(without[12:14] == 0.0)
+    assert np.all(without[16:] == 0.0)
+
+
+def test_a_step_within_the_local_roll_speed_is_not_an_event() -> None:
+    # The parent rolls at 6°/frame and slows to 1°/frame for one frame while the child
+    # (rolling the other way) takes the 5° up: against the 2° floor an event, against the
+    # local roll speed of 6°/frame none.
+    parent = np.full(120, np.deg2rad(-6.0))
+    child = np.full(120, np.deg2rad(4.8))
+    parent[60] += np.deg2rad(5.0)
+    child[60] -= np.deg2rad(5.0)
+    off = RobustParams(speed_factor=0.0)
+    assert detect_robust(parent[:, None], child[:, None], 30.0, off).candidates[60, 0]
+    assert not detect_robust(parent[:, None], child[:, None], 30.0, RobustParams()).candidates.any()
+    # A real flip on top of the fast roll is still found.
+    flip = np.zeros(120)
+    flip[30], flip[31] = np.deg2rad(40.0), np.deg2rad(-40.0)
+    found = detect_robust((parent + flip)[:, None], (child - flip)[:, None], 30.0, RobustParams())
+    assert found.candidates[30, 0]
+    assert found.candidates[31, 0]
+
+
+def _interval(level_deg: float, confidence: float) -> DetectedInterval:
+    features = (5.0, 0.0, 0.0, 0.0, -2.0, float(np.log(level_deg)))
+    return DetectedInterval(0, 10, 12, np.deg2rad(level_deg), confidence, features)
+
+
+def test_small_intervals_are_reported_but_not_applied_by_default() -> None:
+    small, large = _interval(0.8 * MIN_LEVEL_DEG, 0.99), _interval(2 * MIN_LEVEL_DEG, 0.99)
+    assert not has_evidence(small.features)
+    assert has_evidence(large.features)
+    assert has_evidence(())
+    detected = np.zeros((20, 1))
+    detected[10:13, 0] = np.deg2rad(4.0)
+
+    class _Chain:
+        parent, side, segment = 0, "left", "upper_arm"
+
+    class _Geometry:
+        chain = _Chain()
+
+    for interval, expected in ((small, False), (large, True)):
+        _, (entry,) = choose_intervals(
+            [interval], detected, [_Geometry()], ["UpperArm_L"], "confident", True
+        )  # type: ignore[list-item]
+        assert entry.applied is expected
+        _, (forced,) = choose_intervals(
+            [interval], detected, [_Geometry()], ["UpperArm_L"], "all", True
+        )  # type: ignore[list-item]
+        assert forced.applied
+
+
+def test_the_isotonic_map_is_monotone_fitted_out_of_fold_and_round_trips(
+    tmp_path: Path,
+) -> None:
+    rng = np.random.default_rng(1)
+    features = rng.normal(size=(400, len(FEATURES)))
+    # Right when the first feature is large, but only about 60 % of the time in the middle:
+    # the logistic score is over-confident there and the isotonic map corrects it.
+    right = (features[:, 0] > 1.0) | ((features[:, 0] > -0.5) & (rng.random(400) < 0.6))
+    groups = [f"take{k % 20}" for k in range(400)]
+    fitted = fit_calibration(features, right.tolist(), "test", tmp_path / "c.json", groups)
+    assert len(fitted.isotonic_x) >= 2
+    assert np.all(np.diff(fitted.isotonic_x) >= 0)
+    assert np.all(np.diff(fitted.isotonic_y) >= 0)
+    again = Calibration.from_json(json.loads((tmp_path / "c.json").read_text()))
+    p = again.probability(features)
+    assert np.allclose(p, fitted.probability(features))
+    assert np.all((p >= 0) & (p <= 1))
+    middle = (features[:, 0] > -0.5) & (features[:, 0] <= 1.0)
+    assert abs(float(p[middle].mean()) - float(right[middle].mean())) < 0.15
+    # A calibration without an isotonic map (an older file) is the logistic score itself.
+    plain = {k: v for k, v in again.to_json().items() if not k.startswith("isotonic")}
+    logistic = Calibration.from_json(plain)
+    assert np.allclose(logistic.probability(features), again.score(features))
+    with pytest.raises(InputError, match="isotonic"):
+        Calibration.from_json({**plain, "isotonic_x": [0.1, 0.2], "isotonic_y": [0.5]})
+
+
+def test_the_shipped_calibration_has_an_isotonic_map() -> None:
+    shipped = default_calibration()
+    assert len(shipped.isotonic_x) >= 2
+    assert shipped.isotonic_y[0] <= shipped.isotonic_y[-1]
