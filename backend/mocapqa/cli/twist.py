@@ -143,6 +143,7 @@ def _ablations() -> dict[str, tuple[str, Any]]:
         "sign test, not modulo 360°": ("robust", replace(base, modular=False)),
         "one pass": ("robust", replace(base, passes=1)),
         "consistency 0.35": ("robust", replace(base, consistency=0.35)),
+        "no local-speed rule": ("robust", replace(base, speed_factor=0.0)),
     }
 
 
