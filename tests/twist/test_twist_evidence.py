@@ -159,3 +159,35 @@ def test_the_shipped_calibration_has_an_isotonic_map() -> None:
     shipped = default_calibration()
     assert len(shipped.isotonic_x) >= 2
     assert shipped.isotonic_y[0] <= shipped.isotonic_y[-1]
+
+
+def test_a_jump_is_read_mostly_from_the_quieter_of_parent_and_child() -> None:
+    # A jittery parent roll (1.5° per frame) next to a still child: a 12° shift held for 20
+    # frames is read from the child's exact counter-step, so onset and release cancel.
+    rng = np.random.default_rng(5)
+    n = 200
+    parent = np.deg2rad(rng.normal(0.0, 1.5, n))
+    child = np.deg2rad(rng.normal(0.0, 0.05, n))
+    shift = np.zeros(n)
+    shift[100:120] = np.deg2rad(12.0)
+    step = np.diff(shift, prepend=0.0)
+    dp, dc = (parent + step)[:, None], (child - step)[:, None]
+    params = RobustParams(min_threshold_deg=2.0, noise_factor=0.0)
+    weighted = detect_robust(dp, dc, FPS, params)
+    rows = weighted.candidates[:, 0]
+    assert rows[100]
+    assert rows[120]
+    assert np.allclose(np.rad2deg(weighted.offsets[100:120, 0]), 12.0, atol=0.3)
+    # The child's residuals are nearly exact; the parent's carry its jitter.
+    plain = detect_robust(dp, dc, FPS, RobustParams(min_threshold_deg=2.0, noise_factor=0.0,
+                                                    weighted_jumps=False))  # fmt: skip
+    error_weighted = np.abs(np.rad2deg(weighted.offsets[100:120, 0]) - 12.0).max()
+    error_plain = np.abs(np.rad2deg(plain.offsets[100:120, 0]) - 12.0).max(initial=12.0)
+    assert error_weighted <= error_plain
+
+
+def test_new_parameters_are_checked() -> None:
+    with pytest.raises(InputError, match="speed_factor"):
+        RobustParams(speed_factor=-1.0)
+    with pytest.raises(InputError, match="tail_s"):
+        RobustParams(tail_s=-0.1)

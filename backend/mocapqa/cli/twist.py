@@ -144,6 +144,7 @@ def _ablations() -> dict[str, tuple[str, Any]]:
         "one pass": ("robust", replace(base, passes=1)),
         "consistency 0.35": ("robust", replace(base, consistency=0.35)),
         "no local-speed rule": ("robust", replace(base, speed_factor=0.0)),
+        "jump = plain mean of parent and child": ("robust", replace(base, weighted_jumps=False)),
     }
 
 

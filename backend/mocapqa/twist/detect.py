@@ -104,6 +104,18 @@ class RobustParams:
     passes : int
         Detection passes; each later pass re-estimates the natural velocities with the events of
         the previous pass left out.
+    speed_factor : float
+        A step must also exceed this times the local natural roll speed per frame of the parent
+        and of the child (a fast natural roll that reverses moves by about its speed in one
+        frame); 0 disables the rule.
+    tail_s : float
+        Longest decay tail after an interval's last event, seconds (0 disables tails).
+    tail_factor : float
+        A tail step is a counter-rotated step whose residuals both exceed this times the
+        chain's threshold.
+    weighted_jumps : bool
+        Read each jump as the inverse-variance weighted mean of the parent's step and the
+        child's counter-step (True) or as their plain circular mean (False).
     """
 
     min_threshold_deg: float = 2.0
@@ -118,6 +130,7 @@ class RobustParams:
     speed_factor: float = 1.0
     tail_s: float = 0.1
     tail_factor: float = 0.1
+    weighted_jumps: bool = True
     parent_source: str = "increment"
     child_source: str = "increment"
     min_conditioning: float = 0.4
@@ -138,6 +151,11 @@ class RobustParams:
             raise InputError(
                 "Expected neighbour_s > 0, max_interval_s > 0 and passes ≥ 1, got "
                 f"{self.neighbour_s}, {self.max_interval_s}, {self.passes}"
+            )
+        if self.speed_factor < 0 or self.tail_s < 0 or self.tail_factor < 0:
+            raise InputError(
+                "Expected speed_factor, tail_s and tail_factor ≥ 0, got "
+                f"{self.speed_factor}, {self.tail_s}, {self.tail_factor}"
             )
         if self.burst_gap_s <= 0 or self.agreement < 0 or self.min_fps < 0:
             raise InputError(
@@ -352,10 +370,20 @@ def detect_robust(
         natural_c = natural_c.copy()
         natural_p[near] = _clean_median(dp, outliers, stride, near, natural_p[near])
         natural_c[near] = _clean_median(dc, outliers, stride, near, natural_c[near])
-    # The jump is the circular mean of the parent's step and the child's counter-step.
     rows, cols = np.nonzero(events)
     jumps = np.zeros_like(dp)
-    jumps[rows, cols] = np.angle(np.exp(1j * rp[rows, cols]) + np.exp(-1j * rc[rows, cols]))
+    if params.weighted_jumps:
+        # Two measurements of one jump: the parent's step and the child's counter-step, each
+        # weighted by the inverse variance of its chain's residuals (a jittery parent roll
+        # next to a still child is read mostly from the child).
+        var_p = (1.4826 * np.median(np.abs(rp), axis=0)) ** 2 + 1e-8
+        var_c = (1.4826 * np.median(np.abs(rc), axis=0)) ** 2 + 1e-8
+        weight_c = (var_p / (var_p + var_c))[cols]
+        gap = wrap_angle(-rc[rows, cols] - rp[rows, cols])
+        jumps[rows, cols] = wrap_angle(rp[rows, cols] + weight_c * gap)
+    else:
+        # The circular mean of the parent's step and the child's counter-step.
+        jumps[rows, cols] = np.angle(np.exp(1j * rp[rows, cols]) + np.exp(-1j * rc[rows, cols]))
     # Counter-rotated steps below the threshold: where a burst's decay tail shows.
     small = np.zeros_like(dp)
     weak = (smaller > params.tail_factor * threshold) & (mismatch <= allowed) & ~events
