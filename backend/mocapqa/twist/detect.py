@@ -116,6 +116,9 @@ class RobustParams:
     weighted_jumps : bool
         Read each jump as the inverse-variance weighted mean of the parent's step and the
         child's counter-step (True) or as their plain circular mean (False).
+    mismatch_noise : float
+        Widen the counter-rotation check by this many robust noise scales of ``rP`` and
+        ``rC`` combined (0: off; more events are found in noisy chains, and more false ones).
     """
 
     min_threshold_deg: float = 2.0
@@ -131,6 +134,7 @@ class RobustParams:
     tail_s: float = 0.1
     tail_factor: float = 0.1
     weighted_jumps: bool = True
+    mismatch_noise: float = 0.0
     parent_source: str = "increment"
     child_source: str = "increment"
     min_conditioning: float = 0.4
@@ -152,10 +156,10 @@ class RobustParams:
                 "Expected neighbour_s > 0, max_interval_s > 0 and passes ≥ 1, got "
                 f"{self.neighbour_s}, {self.max_interval_s}, {self.passes}"
             )
-        if self.speed_factor < 0 or self.tail_s < 0 or self.tail_factor < 0:
+        if min(self.speed_factor, self.tail_s, self.tail_factor, self.mismatch_noise) < 0:
             raise InputError(
-                "Expected speed_factor, tail_s and tail_factor ≥ 0, got "
-                f"{self.speed_factor}, {self.tail_s}, {self.tail_factor}"
+                "Expected speed_factor, tail_s, tail_factor and mismatch_noise ≥ 0, got "
+                f"{self.speed_factor}, {self.tail_s}, {self.tail_factor}, {self.mismatch_noise}"
             )
         if self.burst_gap_s <= 0 or self.agreement < 0 or self.min_fps < 0:
             raise InputError(
@@ -349,6 +353,10 @@ def detect_robust(
         threshold = np.maximum(floor, params.noise_factor * scale)  # (C,)
         mismatch = np.abs(wrap_angle(rp + rc)) if params.modular else np.abs(rp + rc)
         allowed = params.consistency * smaller
+        if params.mismatch_noise > 0:
+            # The counter-rotation is read through both rolls' noise: allow that much more.
+            noise = 1.4826 * np.hypot(np.median(np.abs(rp), axis=0), np.median(np.abs(rc), axis=0))
+            allowed = allowed + params.mismatch_noise * noise
         # A step must also stand out against the roll's own local speed: a fast natural roll
         # that reverses moves by about its speed in one frame.
         local = params.speed_factor * np.maximum(np.abs(natural_p), np.abs(natural_c))
