@@ -191,3 +191,23 @@ def test_new_parameters_are_checked() -> None:
         RobustParams(speed_factor=-1.0)
     with pytest.raises(InputError, match="tail_s"):
         RobustParams(tail_s=-0.1)
+
+
+def test_the_noise_allowance_admits_a_shift_read_through_a_noisy_child() -> None:
+    # A quiet parent and a child rolling with 4° of noise per frame: the child's counter-step
+    # of a 10° shift is off by its noise, which the plain 0.5 × step allowance rejects at
+    # one end or the other; one noise scale more admits both.
+    rng = np.random.default_rng(11)
+    n = 300
+    parent = np.deg2rad(rng.normal(0.0, 0.05, n))
+    child = np.deg2rad(rng.normal(0.0, 4.0, n))
+    shift = np.zeros(n)
+    shifts = [(40 + 40 * k, 60 + 40 * k) for k in range(6)]
+    for start, end in shifts:
+        shift[start:end] = np.deg2rad(10.0)
+    step = np.diff(shift, prepend=0.0)
+    dp, dc = (parent + step)[:, None], (child - step)[:, None]
+    strict = detect_robust(dp, dc, FPS, RobustParams(noise_factor=0.0))
+    loose = detect_robust(dp, dc, FPS, RobustParams(noise_factor=0.0, mismatch_noise=1.0))
+    ends = [f for pair in shifts for f in pair]
+    assert loose.candidates[ends, 0].sum() > strict.candidates[ends, 0].sum()
