@@ -172,7 +172,7 @@ def test_a_jump_is_read_mostly_from_the_quieter_of_parent_and_child() -> None:
     shift[100:120] = np.deg2rad(12.0)
     step = np.diff(shift, prepend=0.0)
     dp, dc = (parent + step)[:, None], (child - step)[:, None]
-    params = RobustParams(min_threshold_deg=2.0, noise_factor=0.0)
+    params = RobustParams(min_threshold_deg=2.0, noise_factor=0.0, weighted_jumps=True)
     weighted = detect_robust(dp, dc, FPS, params)
     rows = weighted.candidates[:, 0]
     assert rows[100]

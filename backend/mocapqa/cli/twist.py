@@ -144,7 +144,7 @@ def _ablations() -> dict[str, tuple[str, Any]]:
         "one pass": ("robust", replace(base, passes=1)),
         "consistency 0.35": ("robust", replace(base, consistency=0.35)),
         "no local-speed rule": ("robust", replace(base, speed_factor=0.0)),
-        "jump = plain mean of parent and child": ("robust", replace(base, weighted_jumps=False)),
+        "jump weighted by parent/child noise": ("robust", replace(base, weighted_jumps=True)),
         "mismatch allowance + 1 noise scale": ("robust", replace(base, mismatch_noise=1.0)),
     }
 

@@ -133,7 +133,7 @@ class RobustParams:
     speed_factor: float = 1.0
     tail_s: float = 0.1
     tail_factor: float = 0.1
-    weighted_jumps: bool = True
+    weighted_jumps: bool = False
     mismatch_noise: float = 0.0
     parent_source: str = "increment"
     child_source: str = "increment"
