@@ -23,8 +23,8 @@ __all__ = ["bench_twist", "detect", "refine"]
 
 _METHOD_HELP = "Detector: robust (default) or paper (the published rule as written)."
 _APPLY_HELP = (
-    "Intervals to remove: confident (calibrated probability ≥ 0.5, the default), all, none, "
-    "or interval ids from the report such as 0,3."
+    "Intervals to remove: confident (calibrated probability ≥ 0.5 and a level of at least 5°, "
+    "the default), all, none, or interval ids from the report such as 0,3."
 )
 
 

@@ -2,8 +2,9 @@
 
 ``apply`` is one of :data:`APPLY_CHOICES` or a set of interval ids. Ids number the intervals of
 a take in chain, then frame order. ``confident`` applies intervals whose calibrated probability
-is at least :data:`mocapqa.twist.confidence.APPLY_THRESHOLD` (methods without a calibrated
-confidence apply all). Each :class:`TwistInterval` lists its ``levels``: the stretches of
+is at least :data:`mocapqa.twist.confidence.APPLY_THRESHOLD` and that pass the minimum-evidence
+rule :func:`mocapqa.twist.confidence.has_evidence` (methods without a calibrated confidence apply
+all). Each :class:`TwistInterval` lists its ``levels``: the stretches of
 constant offset, so the refined take is exactly the raw one with the applied levels removed.
 """
 
@@ -25,8 +26,8 @@ __all__ = ["APPLY_CHOICES", "TwistInterval", "choose_intervals", "parse_apply"]
 
 APPLY_CHOICES = ("confident", "all", "none")
 """Which intervals a refinement applies, besides an explicit list of interval ids:
-``confident`` (calibrated probability ≥ :data:`mocapqa.twist.confidence.APPLY_THRESHOLD`, the
-default), ``all`` or ``none``."""
+``confident`` (calibrated probability ≥ :data:`mocapqa.twist.confidence.APPLY_THRESHOLD` and the
+minimum-evidence rule, the default), ``all`` or ``none``."""
 
 
 def parse_apply(value: str | frozenset[int]) -> str | frozenset[int]:
