@@ -69,6 +69,14 @@ class Settings(BaseSettings):
         Largest WebSocket message of a live-filter stream, bytes.
     stream_max_frames_per_s : float
         Most frames per second a live-filter stream may send (averaged over a second).
+    dask_scheduler : str, optional
+        ``tcp://host:8786`` of a Dask scheduler: the server's runs and ``mocapqa batch`` go
+        to that cluster (see ``docs/batch.md``).
+    archive_max_members : int
+        Most members an uploaded archive may hold (checked before extracting).
+    archive_max_unpacked_mb : float
+        Most MB an uploaded archive may unpack to (declared sizes checked before extracting,
+        written bytes while extracting).
     """
 
     model_config = SettingsConfigDict(env_prefix="MOCAPQA_", extra="ignore")
@@ -107,6 +115,9 @@ class Settings(BaseSettings):
             max_line_bytes=self.max_line_bytes,
             max_json_depth=self.max_json_depth,
         )
+    dask_scheduler: str | None = None
+    archive_max_members: int = 10_000
+    archive_max_unpacked_mb: float = 2_000.0
 
     @property
     def resolved_database_url(self) -> str:

@@ -25,7 +25,7 @@ from mocapqa import __version__
 from mocapqa.api.deps import Services
 from mocapqa.api.errors import install_error_handlers
 from mocapqa.api.http_guards import install_http_guards
-from mocapqa.api.routes import filters, health, reviews, runs, stream, takes
+from mocapqa.api.routes import filters, health, reviews, runs, shoots, stream, takes
 from mocapqa.config import Settings
 from mocapqa.jobs.demo import load_demo
 from mocapqa.jobs.runner import JobRunner
@@ -45,6 +45,7 @@ ROUTERS: tuple[tuple[APIRouter, Sequence[Any]], ...] = (
     (reviews.router, ()),
     (filters.router, ()),
     (stream.router, ()),
+    (shoots.router, ()),
 )
 """Every router with the dependencies that guard all its routes (``Depends(...)`` items):
 the one place where a router gets, for example, a sign-in requirement."""

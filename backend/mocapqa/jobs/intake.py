@@ -61,6 +61,7 @@ def ingest_take(
     read: ReadOptions | None = None,
     limits: ReadLimits | None = None,
     client: str = "local",
+    shoot_id: str | None = None,
 ) -> tuple[str, str]:
     """Store an uploaded take and queue its analysis.
 
@@ -81,6 +82,8 @@ def ingest_take(
         Take size limits, checked before parsing where the bytes tell (none when None).
     client : str
         Who uploads (for the runner's fair queue).
+    shoot_id : str, optional
+        Shoot the take joins.
 
     Returns
     -------
@@ -147,6 +150,7 @@ def ingest_take(
                     "fps": fps,
                     "n_joints": n_points,
                     "file_name": file_name,
+                    "shoot_id": shoot_id,
                 },
                 (options or AnalysisOptions()).to_json(),
             )

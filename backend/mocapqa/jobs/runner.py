@@ -37,12 +37,13 @@ from mocapqa.pipeline.loading import (
     write_keypoints_file,
 )
 from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.pipeline.summary import qa_summary
 from mocapqa.render.layouts import bones_for_keypoints
 from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
 
-__all__ = ["JobRunner", "write_outputs"]
+__all__ = ["JobRunner", "run_summary", "write_outputs"]
 
 log = logging.getLogger(__name__)
 
@@ -100,6 +101,15 @@ def _reading(folder: Path) -> ReadOptions:
         return ReadOptions.from_json(data.get("read_options"))
     except (OSError, ValueError, AttributeError, InputError):
         return ReadOptions()
+
+
+def run_summary(result: AnalysisResult) -> dict[str, Any]:
+    """What a run stores as its summary: the report's summary, step states and QA summary."""
+    return {
+        **result.report["summary"],
+        "steps": {k: v["state"] for k, v in result.report["steps"].items()},
+        "qa": qa_summary(result),
+    }
 
 
 class _RunCancelledError(Exception):
@@ -256,10 +266,7 @@ class JobRunner:
                 render_thumbnail(
                     self.files, run_id, result.report, result.raw_points, self.renderer
                 )
-            summary: dict[str, Any] = {
-                **result.report["summary"],
-                "steps": {k: v["state"] for k, v in result.report["steps"].items()},
-            }
+            summary = run_summary(result)
             self.repository.finish_run(run_id, summary, None, time.perf_counter() - started)
         except _RunCancelledError:
             log.info("run %s cancelled: its take was deleted", run_id)

@@ -76,6 +76,10 @@ class FileStore:
     def remove_take(self, take_id: str, run_ids: list[str]) -> None:
         """Delete a take's files and its runs' outputs."""
         shutil.rmtree(self.take_dir(take_id), ignore_errors=True)
+        self.remove_runs(run_ids)
+
+    def remove_runs(self, run_ids: list[str]) -> None:
+        """Delete these runs' outputs."""
         for run_id in run_ids:
             self.remove_run(run_id)
 

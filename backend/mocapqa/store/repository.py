@@ -28,7 +28,9 @@ from sqlalchemy.engine import Connection
 
 from mocapqa import __version__
 from mocapqa.errors import ConflictError, InputError, NotFoundError
-from mocapqa.store.tables import ADDED_COLUMNS, metadata, reviews, runs, takes
+from mocapqa.store.qa import sync_take
+from mocapqa.store.tables import ADDED_COLUMNS, metadata, reviews, runs, take_qa, takes
+from mocapqa.store.upgrade import upgrade_schema
 
 __all__ = ["REVIEW_STATUSES", "RUN_STATUSES", "Repository", "new_id", "utc_now"]
 
@@ -84,6 +86,7 @@ class Repository:
             event.listen(self.engine, "connect", _sqlite_pragmas)
         metadata.create_all(self.engine)
         self._add_missing_columns()
+        upgrade_schema(self.engine)
 
     def _add_missing_columns(self) -> None:
         """Bring a database made by an earlier version up to :data:`ADDED_COLUMNS`."""
@@ -110,6 +113,7 @@ class Repository:
         with self.engine.begin() as conn:
             conn.execute(insert(takes).values(**{**values, "id": take_id, "created_at": utc_now()}))
             run_id = self._insert_run(conn, take_id, str(values["sha256"]), options)
+            sync_take(conn, take_id)
         return take_id, run_id
 
     def get_take(self, take_id: str) -> dict[str, Any]:
@@ -213,6 +217,7 @@ class Repository:
                 str(r)
                 for r in conn.execute(select(runs.c.id).where(runs.c.take_id == take_id)).scalars()
             ]
+            conn.execute(delete(take_qa).where(take_qa.c.take_id == take_id))
             conn.execute(delete(reviews).where(reviews.c.take_id == take_id))
             conn.execute(delete(runs).where(runs.c.take_id == take_id))
             conn.execute(delete(takes).where(takes.c.id == take_id))
@@ -242,7 +247,9 @@ class Repository:
         """Queue a new run of a take with the given options; earlier runs are kept."""
         take = self.get_take(take_id)
         with self.engine.begin() as conn:
-            return self._insert_run(conn, take_id, str(take["sha256"]), options)
+            run_id = self._insert_run(conn, take_id, str(take["sha256"]), options)
+            sync_take(conn, take_id)
+            return run_id
 
     def get_run(self, run_id: str) -> dict[str, Any]:
         """One run.
@@ -286,6 +293,7 @@ class Repository:
                     attempts=runs.c.attempts + 1,
                 )
             )
+            self._sync_run_take(conn, run_id)
 
     def set_progress(self, run_id: str, percent: int, step: str) -> None:
         """Record a running run's progress (0–100) and current step."""
@@ -318,6 +326,12 @@ class Repository:
                     finished_at=utc_now(),
                 )
             )
+            self._sync_run_take(conn, run_id)
+
+    def _sync_run_take(self, conn: Connection, run_id: str) -> None:
+        take_id = conn.execute(select(runs.c.take_id).where(runs.c.id == run_id)).scalar()
+        if take_id is not None:
+            sync_take(conn, str(take_id))
 
     def recover_interrupted(self, max_attempts: int = 2) -> list[str]:
         """Re-queue the runs a stopped server left queued or running; returns their ids.
@@ -354,6 +368,12 @@ class Repository:
                         finished_at=utc_now(),
                     )
                 )
+            for take_id in set(
+                conn.execute(
+                    select(runs.c.take_id).where(runs.c.id.in_(ids + exhausted))
+                ).scalars()
+            ):
+                sync_take(conn, str(take_id))
         return ids
 
     # reviews ---------------------------------------------------------------------------
@@ -374,7 +394,9 @@ class Repository:
                 )
                 .returning(reviews)
             )
-            return _row(result.mappings().one())
+            row = _row(result.mappings().one())
+            sync_take(conn, take_id)
+            return row
 
     def list_reviews(self, take_id: str) -> list[dict[str, Any]]:
         """A take's review history, newest first."""

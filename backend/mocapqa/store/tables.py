@@ -13,6 +13,7 @@ from sqlalchemy import (
     DateTime,
     Float,
     ForeignKey,
+    Index,
     Integer,
     MetaData,
     String,
@@ -20,10 +21,19 @@ from sqlalchemy import (
     Text,
 )
 
-__all__ = ["ADDED_COLUMNS", "metadata", "reviews", "runs", "takes"]
+__all__ = ["ADDED_COLUMNS", "metadata", "reviews", "runs", "shoots", "take_qa", "takes"]
 
 metadata = MetaData()
 """The schema; ``metadata.create_all(engine)`` creates it."""
+
+shoots = Table(
+    "shoots",
+    metadata,
+    Column("id", String(32), primary_key=True),
+    Column("name", String(255), nullable=False, unique=True),
+    Column("created_at", DateTime(timezone=True), nullable=False),
+)
+"""Named collections of takes; a take belongs to at most one."""
 
 takes = Table(
     "takes",
@@ -39,6 +49,9 @@ takes = Table(
     Column("n_joints", Integer, nullable=False),
     Column("file_name", String(255), nullable=False),
     Column("created_at", DateTime(timezone=True), nullable=False),
+    # Added after the first release: :func:`mocapqa.store.upgrade.upgrade_schema` adds it to
+    # databases made before it.
+    Column("shoot_id", String(32), ForeignKey("shoots.id"), nullable=True, index=True),
 )
 """One row per uploaded take."""
 
@@ -82,3 +95,36 @@ reviews = Table(
     Column("created_at", DateTime(timezone=True), nullable=False),
 )
 """Review decisions per take, kept as history."""
+
+take_qa = Table(
+    "take_qa",
+    metadata,
+    Column("take_id", String(32), ForeignKey("takes.id", ondelete="CASCADE"), primary_key=True),
+    Column("shoot_id", String(32), nullable=True),
+    Column("name", String(255), nullable=False),
+    Column("kind", String(16), nullable=False),
+    Column("created_at", DateTime(timezone=True), nullable=False),
+    Column("run_id", String(32), nullable=True),
+    Column("status", String(16), nullable=True),
+    Column("review_status", String(16), nullable=False),
+    Column("reviewer", String(255), nullable=True),
+    Column("score", Float, nullable=True),
+    Column("n_frames", Integer, nullable=True),
+    Column("duration_s", Float, nullable=True),
+    Column("rig", String(64), nullable=True),
+    Column("twist_intervals", Integer, nullable=True),
+    Column("corrected_joint_frames", Integer, nullable=True),
+    Column("violation_share", Float, nullable=True),
+    Column("worst_joint", String(255), nullable=True),
+    Column("filter_residual_mm", Float, nullable=True),
+    Column("missing_share", Float, nullable=True),
+    Column("n_findings", Integer, nullable=True),
+    Column("joint_violations", JSON, nullable=True),
+    Index("ix_take_qa_shoot_score", "shoot_id", "score"),
+    Index("ix_take_qa_shoot_status", "shoot_id", "status"),
+    Index("ix_take_qa_shoot_review", "shoot_id", "review_status"),
+    Index("ix_take_qa_shoot_created", "shoot_id", "created_at"),
+    Index("ix_take_qa_shoot_name", "shoot_id", "name"),
+)
+"""One row per take: its latest run's status and QA summary and its latest review, kept in step
+by the repository so that a shoot's take table sorts and filters on indexed columns."""

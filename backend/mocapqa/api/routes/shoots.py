@@ -1,0 +1,230 @@
+"""Shoots: create, list, rename, delete; import files and archives; the take table, heat map,
+review queue, progress and summary export."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from collections.abc import Iterator
+from typing import Annotated, Any, Literal
+
+from fastapi import APIRouter, File, Query, Response, UploadFile
+from fastapi.responses import StreamingResponse
+
+from mocapqa.api.deps import ServicesDep
+from mocapqa.api.shoot_schemas import (
+    HeatmapOut,
+    ImportOut,
+    NextTakeOut,
+    ProgressOut,
+    ShootIn,
+    ShootOut,
+    ShootTakeOut,
+    ShootTakePageOut,
+)
+from mocapqa.errors import InputError
+from mocapqa.jobs.batch_output import COLUMNS
+from mocapqa.jobs.shoot_import import ImportLimits, import_uploads
+from mocapqa.store.shoots import SORT_COLUMNS, ShootStore, TakeFilter
+
+__all__ = ["EXPORT_COLUMNS", "router"]
+
+router = APIRouter(prefix="/shoots", tags=["shoots"])
+"""Routes of this resource, included under ``/api/v1``."""
+
+_ERRORS: dict[int, str] = {
+    404: "No shoot with this id",
+    409: "The name is taken by another shoot",
+    413: "An upload or archive passes a size or member limit",
+    415: "Not a recognised format",
+    422: "Invalid parameters or body",
+}
+
+
+def _errors(*codes: int) -> dict[int | str, dict[str, Any]]:
+    return {code: {"description": _ERRORS[code]} for code in codes}
+
+
+def _store(services: ServicesDep) -> ShootStore:
+    return ShootStore(services.repository.engine)
+
+
+ShootSort = Literal[SORT_COLUMNS]  # type: ignore[valid-type]
+
+
+@router.post("", status_code=201, responses=_errors(409, 422))
+def create_shoot(body: ShootIn, services: ServicesDep) -> ShootOut:
+    """Create an empty shoot."""
+    return ShootOut(**_store(services).create(body.name))
+
+
+@router.get("", responses=_errors(422))
+def list_shoots(services: ServicesDep) -> list[ShootOut]:
+    """Every shoot, by name, with its take counts per run status and per review status."""
+    return [ShootOut(**row) for row in _store(services).list_all()]
+
+
+@router.get("/{shoot_id}", responses=_errors(404, 422))
+def get_shoot(shoot_id: str, services: ServicesDep) -> ShootOut:
+    """One shoot with its counts."""
+    return ShootOut(**_store(services).get(shoot_id))
+
+
+@router.patch("/{shoot_id}", responses=_errors(404, 409, 422))
+def rename_shoot(shoot_id: str, body: ShootIn, services: ServicesDep) -> ShootOut:
+    """Rename a shoot."""
+    return ShootOut(**_store(services).rename(shoot_id, body.name))
+
+
+@router.delete("/{shoot_id}", status_code=204, responses=_errors(404, 422))
+def delete_shoot(
+    shoot_id: str,
+    services: ServicesDep,
+    confirm: Annotated[str, Query(description="The shoot's exact name, to confirm")] = "",
+) -> Response:
+    """Delete a shoot **with all its takes**, their runs, reviews and files.
+
+    ``confirm`` must repeat the shoot's name (422 otherwise, nothing deleted).
+    """
+    store = _store(services)
+    shoot = store.get(shoot_id)
+    if confirm != shoot["name"]:
+        raise InputError(
+            f"Expected confirm={shoot['name']!r} to delete the shoot and its "
+            f"{shoot['n_takes']} take(s), got {confirm!r}"
+        )
+    take_ids, run_ids = store.delete(shoot_id)
+    for take_id in take_ids:
+        services.files.remove_take(take_id, [])
+    services.files.remove_runs(run_ids)
+    return Response(status_code=204)
+
+
+@router.post("/{shoot_id}/takes", status_code=201, responses=_errors(404, 413, 422))
+def import_takes(
+    shoot_id: str,
+    services: ServicesDep,
+    files: Annotated[list[UploadFile], File(description="Takes, .zip or .tar.gz archives")],
+) -> ImportOut:
+    """Import takes into a shoot: many files at once (multipart field ``files``, repeated),
+    archives unpacked member by member. Each take's analysis starts with default options.
+
+    Non-motion archive members are listed as skipped, unreadable or unsafe ones (links,
+    names leaving the archive) as failed with their error; the rest are kept.
+    """
+    _store(services).get(shoot_id)
+    settings = services.settings
+    limits = ImportLimits(
+        max_upload_bytes=int(settings.max_upload_mb * 1_000_000),
+        max_members=settings.archive_max_members,
+        max_unpacked_bytes=int(settings.archive_max_unpacked_mb * 1_000_000),
+    )
+    report = import_uploads(
+        [(f.file, f.filename or "take") for f in files],
+        shoot_id,
+        services.repository,
+        services.files,
+        services.runner,
+        limits,
+    )
+    return ImportOut(created=report.created, skipped=report.skipped, failed=report.failed)
+
+
+@router.get("/{shoot_id}/takes", responses=_errors(404, 422))
+def list_shoot_takes(
+    shoot_id: str,
+    services: ServicesDep,
+    limit: Annotated[int, Query(ge=1, le=500)] = 50,
+    offset: Annotated[int, Query(ge=0)] = 0,
+    sort: ShootSort = "score",
+    order: Literal["asc", "desc"] = "asc",
+    status: Literal["queued", "running", "done", "failed"] | None = None,
+    review_status: Literal["unreviewed", "approved", "needs_fix", "rejected"] | None = None,
+    rig: str | None = None,
+    min_score: Annotated[float | None, Query(ge=0, le=100)] = None,
+    max_score: Annotated[float | None, Query(ge=0, le=100)] = None,
+    has_findings: bool | None = None,
+    search: Annotated[str | None, Query(max_length=255)] = None,
+) -> ShootTakePageOut:
+    """A page of the shoot's take table, sorted and filtered on the server."""
+    filters = TakeFilter(status, review_status, rig, min_score, max_score, has_findings, search)
+    rows, total = _store(services).page(shoot_id, limit, offset, sort, order == "desc", filters)
+    return ShootTakePageOut(
+        items=[ShootTakeOut(**r) for r in rows], total=total, limit=limit, offset=offset
+    )
+
+
+@router.get("/{shoot_id}/progress", responses=_errors(404, 422))
+def shoot_progress(shoot_id: str, services: ServicesDep) -> ProgressOut:
+    """Takes per status and frames analysed; ``finished`` once nothing is queued or running."""
+    return ProgressOut(**_store(services).progress(shoot_id))
+
+
+@router.get("/{shoot_id}/heatmap", responses=_errors(404, 422))
+def shoot_heatmap(
+    shoot_id: str,
+    services: ServicesDep,
+    limit: Annotated[int, Query(ge=1, le=1000)] = 200,
+    offset: Annotated[int, Query(ge=0)] = 0,
+    sort: ShootSort = "score",
+) -> HeatmapOut:
+    """Joint × take share of frames outside the joint limits, for a page of takes."""
+    return HeatmapOut(**_store(services).heatmap(shoot_id, limit, offset, sort))
+
+
+@router.get("/{shoot_id}/next", responses=_errors(404, 422))
+def next_take(
+    shoot_id: str,
+    services: ServicesDep,
+    after: Annotated[str | None, Query(description="Skip this take id")] = None,
+) -> NextTakeOut:
+    """The next take needing review: unreviewed, analysed, lowest QA score first."""
+    row, remaining = _store(services).next_for_review(shoot_id, after)
+    return NextTakeOut(take=ShootTakeOut(**row) if row else None, remaining=remaining)
+
+
+EXPORT_COLUMNS = (
+    "name",
+    "status",
+    *(name for name, _ in COLUMNS if name not in ("source", "status", "error")),
+    "reviewer",
+)
+"""Columns of the shoot summary export, in order."""
+
+
+def _export_rows(store: ShootStore, shoot_id: str) -> Iterator[dict[str, Any]]:
+    for row in store.rows(shoot_id):
+        yield {column: row.get(column) for column in EXPORT_COLUMNS}
+
+
+@router.get(
+    "/{shoot_id}/summary.{kind}",
+    responses={
+        **_errors(404, 422),
+        200: {"content": {"text/csv": {}, "application/json": {}}},
+    },
+    response_class=Response,
+)
+def export_summary(shoot_id: str, kind: Literal["csv", "json"], services: ServicesDep) -> Response:
+    """The shoot's QA summary, one row per take (columns in docs/qa-summary.md)."""
+    store = _store(services)
+    shoot = store.get(shoot_id)
+    stem = "".join(c if c.isalnum() or c in "-_" else "_" for c in shoot["name"])
+    disposition = {"Content-Disposition": f'attachment; filename="{stem}.summary.{kind}"'}
+    if kind == "json":
+        rows = list(_export_rows(store, shoot_id))
+        body = json.dumps({"shoot": shoot["name"], "takes": rows}, default=str)
+        return Response(body, media_type="application/json", headers=disposition)
+
+    def lines() -> Iterator[str]:
+        buffer = io.StringIO()
+        writer = csv.DictWriter(buffer, list(EXPORT_COLUMNS))
+        writer.writeheader()
+        for row in _export_rows(store, shoot_id):
+            writer.writerow(row)
+            yield buffer.getvalue()
+            buffer.seek(0)
+            buffer.truncate()
+
+    return StreamingResponse(lines(), media_type="text/csv", headers=disposition)

@@ -1,0 +1,110 @@
+"""Request and response models of the shoot routes (pydantic)."""
+
+from __future__ import annotations
+
+from datetime import datetime
+from typing import Literal
+
+from pydantic import BaseModel, Field
+
+__all__ = [
+    "HeatmapOut",
+    "ImportOut",
+    "NextTakeOut",
+    "ProgressOut",
+    "ShootIn",
+    "ShootOut",
+    "ShootTakeOut",
+    "ShootTakePageOut",
+]
+
+
+class ShootIn(BaseModel):
+    """A shoot's name (create or rename)."""
+
+    model_config = {"extra": "forbid"}
+
+    name: str = Field(min_length=1, max_length=255)
+
+
+class ShootOut(BaseModel):
+    """A shoot with its counts."""
+
+    id: str
+    name: str
+    created_at: datetime
+    n_takes: int
+    n_frames: int
+    status_counts: dict[str, int] = Field(description="Takes per latest run status")
+    review_counts: dict[str, int] = Field(description="Takes per review status")
+
+
+class ShootTakeOut(BaseModel):
+    """One row of a shoot's take table: the QA summary (docs/qa-summary.md) and review."""
+
+    take_id: str
+    name: str
+    kind: Literal["motion", "keypoints"]
+    format: str
+    fps: float
+    n_joints: int
+    created_at: datetime
+    run_id: str | None
+    status: Literal["queued", "running", "done", "failed"] | None
+    review_status: Literal["unreviewed", "approved", "needs_fix", "rejected"]
+    reviewer: str | None
+    score: float | None = Field(description="QA score, 0–100 (100: nothing found)")
+    n_frames: int | None
+    duration_s: float | None
+    rig: str | None
+    twist_intervals: int | None
+    corrected_joint_frames: int | None
+    violation_share: float | None
+    worst_joint: str | None
+    filter_residual_mm: float | None
+    missing_share: float | None
+    n_findings: int | None
+    joint_violations: dict[str, float] | None
+
+
+class ShootTakePageOut(BaseModel):
+    """A page of a shoot's take table."""
+
+    items: list[ShootTakeOut]
+    total: int
+    limit: int
+    offset: int
+
+
+class ImportOut(BaseModel):
+    """What an import did."""
+
+    created: list[dict[str, str]]
+    skipped: list[dict[str, str]]
+    failed: list[dict[str, str]]
+
+
+class ProgressOut(BaseModel):
+    """Analysis progress of a shoot's takes."""
+
+    shoot_id: str
+    n_takes: int
+    status_counts: dict[str, int]
+    frames_done: int
+    finished: bool
+
+
+class HeatmapOut(BaseModel):
+    """Joint × take share of frames outside the joint limits, for a page of takes."""
+
+    joints: list[str]
+    takes: list[dict[str, str | float | None]]
+    values: list[list[float | None]]
+    total: int
+
+
+class NextTakeOut(BaseModel):
+    """The next take needing review (None when none is left) and how many remain."""
+
+    take: ShootTakeOut | None
+    remaining: int

@@ -1,0 +1,269 @@
+"""Batch analysis of every motion file under some paths, on Dask or in this process.
+
+:func:`run_batch` finds the takes (:func:`discover`), hashes each (reading it in chunks), skips
+those whose content, options and mocapqa version already have a done run, sends the rest to
+the workers (:func:`mocapqa.jobs.take_task.analyse_path`, a bounded number in flight) and, as
+each finishes, stores its take and done run in one transaction and writes its result row.
+Nothing is stored for a take until its run is complete, so an interrupted batch (Ctrl-C, a
+lost scheduler) leaves no half-made rows, and running it again finishes the rest without
+duplicates (an interrupted task may leave an orphan output folder behind, never a row).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from mocapqa.errors import InputError, MocapQAError
+from mocapqa.jobs.engine import Engine
+from mocapqa.jobs.take_task import analyse_path, content_sha256
+from mocapqa.pipeline.loading import detect_take_format as detect_format
+from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.store.repository import new_id
+from mocapqa.store.shoots import ShootStore
+
+__all__ = ["MOTION_SUFFIXES", "BatchCounts", "discover", "run_batch"]
+
+MOTION_SUFFIXES = (".bvh", ".trc", ".csv", ".json", ".npy", ".npz", ".pbtxt")
+"""File suffixes a batch analyses; other files under a folder are ignored."""
+
+Row = dict[str, Any]
+Task = Callable[[str, dict[str, Any], str, str, str | None], dict[str, Any]]
+
+
+@dataclass
+class BatchCounts:
+    """Tallies of a batch, updated as rows come in."""
+
+    total: int = 0
+    done: int = 0
+    failed: int = 0
+    skipped: int = 0
+    frames: int = 0
+    started: float = field(default_factory=time.perf_counter)
+
+    def add(self, row: Row) -> None:
+        """Count one result row."""
+        status = str(row["status"])
+        setattr(self, status, getattr(self, status) + 1)
+        if status == "done":
+            self.frames += int(row.get("n_frames") or 0)
+
+
+def _is_frame_folder(folder: Path, names: list[str]) -> bool:
+    if sum(n.lower().endswith(".json") for n in names) < 2:
+        return False
+    try:
+        return detect_format(folder) == "openpose"
+    except MocapQAError:
+        return False
+
+
+def discover(paths: Iterable[Path]) -> Iterator[tuple[Path, str | None]]:
+    """Every take under ``paths``, in a stable order, with a reason when it is skipped.
+
+    A file named on the command line is a take when its suffix is in :data:`MOTION_SUFFIXES`
+    (else it is skipped, with the reason); under a folder, such files are takes and other
+    files are ignored. A folder of OpenPose JSON frames is one take.
+
+    Raises
+    ------
+    InputError
+        When a path does not exist.
+    """
+    for path in paths:
+        if not path.exists():
+            raise InputError(f"Expected an existing file or folder, got nothing at {path}")
+        if path.is_file():
+            ok = path.suffix.lower() in MOTION_SUFFIXES
+            yield path, None if ok else "not a motion file"
+            continue
+        for folder, dirs, names in os.walk(path):
+            dirs.sort()
+            here = Path(folder)
+            if _is_frame_folder(here, names):
+                yield here, None
+                names = [n for n in names if not n.endswith(".json")]
+            for name in sorted(names):
+                if Path(name).suffix.lower() in MOTION_SUFFIXES:
+                    yield here / name, None
+
+
+def _summary_row(qa: dict[str, Any]) -> Row:
+    return {key: value for key, value in qa.items() if key != "joint_violations"}
+
+
+def run_batch(
+    paths: Iterable[Path],
+    shoots: ShootStore,
+    options: AnalysisOptions,
+    on_row: Callable[[Row], None],
+    engine: Engine | None = None,
+    data_dir: Path | None = None,
+    shoot_id: str | None = None,
+    on_total: Callable[[int], None] | None = None,
+    task: Task = analyse_path,
+) -> BatchCounts:
+    """Analyse every take under ``paths``; ``on_row`` receives one result row per take.
+
+    Parameters
+    ----------
+    paths : iterable of Path
+        Files and folders.
+    shoots : ShootStore
+        Where takes and runs are stored (the dashboard's database).
+    options : AnalysisOptions
+        Options of every run.
+    on_row : callable
+        Called with each result row (``source``, ``status``, ``error``, ``take_id`` and the
+        QA summary columns) as soon as it is known.
+    engine : Engine, optional
+        Where tasks run; None runs them one after another in this process.
+    data_dir : Path, optional
+        The data folder the workers write run outputs and take copies to; None stores rows
+        only.
+    shoot_id : str, optional
+        Shoot of the new takes.
+    on_total : callable, optional
+        Called once with the number of rows to come.
+    task : callable
+        The per-take function (the default analyses and stores; tests pass wrappers).
+
+    Returns
+    -------
+    BatchCounts
+    """
+    counts = BatchCounts()
+    options_json = options.to_json()
+    items = list(discover(paths))
+    counts.total = len(items)
+    if on_total is not None:
+        on_total(len(items))
+
+    def emit(row: Row) -> None:
+        counts.add(row)
+        on_row(row)
+
+    todo: list[tuple[Path, str]] = []
+    seen: dict[str, Path] = {}
+    for path, reason in items:
+        if reason is not None:
+            emit({"source": str(path), "status": "skipped", "error": reason})
+            continue
+        sha = content_sha256(path)
+        if sha in seen:
+            emit(
+                {"source": str(path), "status": "skipped", "error": f"same content as {seen[sha]}"}
+            )
+            continue
+        seen[sha] = path
+        todo.append((path, sha))
+
+    finished = shoots.finished([sha for _, sha in todo], options_json)
+    stored = shoots.qa_rows(list(finished.values()))
+    pending: list[tuple[Path, str]] = []
+    for path, sha in todo:
+        take_id = finished.get(sha)
+        if take_id is None:
+            pending.append((path, sha))
+            continue
+        emit(
+            {
+                **_summary_row(stored.get(take_id, {})),
+                "source": str(path),
+                "status": "skipped",
+                "error": "already analysed with these options and this version",
+                "take_id": take_id,
+            }
+        )
+
+    folder = str(data_dir) if data_dir is not None else None
+
+    def finish(path: Path, sha: str, take_id: str, run_id: str, outcome: dict[str, Any]) -> None:
+        if outcome["status"] != "done":
+            emit({"source": str(path), "status": "failed", "error": outcome["error"]})
+            return
+        values = {**outcome["take"], "sha256": sha, "shoot_id": shoot_id}
+        summary = outcome["summary"]
+        shoots.record_done(values, run_id, options_json, summary, float(outcome["time_s"]))
+        emit(
+            {
+                **_summary_row(summary["qa"]),
+                "source": str(path),
+                "status": "done",
+                "error": None,
+                "take_id": take_id,
+                "review_status": "unreviewed",
+            }
+        )
+
+    if engine is None:
+        for path, sha in pending:
+            take_id, run_id = new_id(), new_id()
+            finish(
+                path, sha, take_id, run_id, task(str(path), options_json, take_id, run_id, folder)
+            )
+        return counts
+    _run_on_dask(engine, pending, options_json, folder, task, finish, emit)
+    return counts
+
+
+def _run_on_dask(
+    engine: Engine,
+    pending: list[tuple[Path, str]],
+    options_json: dict[str, Any],
+    folder: str | None,
+    task: Task,
+    finish: Callable[[Path, str, str, str, dict[str, Any]], None],
+    emit: Callable[[Row], None],
+) -> None:
+    from distributed import as_completed
+
+    client = engine.client()
+    in_flight = max(8, 4 * max(1, engine.n_workers()))
+    queue = iter(pending)
+    meta: dict[str, tuple[Path, str, str, str]] = {}
+
+    def submit() -> Any:
+        item = next(queue, None)
+        if item is None:
+            return None
+        path, sha = item
+        take_id, run_id = new_id(), new_id()
+        future = client.submit(
+            task,
+            str(path),
+            options_json,
+            take_id,
+            run_id,
+            folder,
+            key=f"analyse-{sha[:16]}-{run_id[:8]}",
+            pure=False,
+        )
+        meta[future.key] = (path, sha, take_id, run_id)
+        return future
+
+    first = [f for f in (submit() for _ in range(in_flight)) if f is not None]
+    waiting = as_completed(first)  # type: ignore[no-untyped-call]
+    for future in waiting:
+        path, sha, take_id, run_id = meta.pop(future.key)
+        try:
+            outcome = future.result()
+        except Exception as e:  # a crashed worker (KilledWorker) or a bug in one take
+            name = type(e).__name__
+            reason = (
+                f"worker died while analysing this take ({name}: {e})"
+                if name == "KilledWorker"
+                else f"internal error: {name}: {e}"
+            )
+            emit({"source": str(path), "status": "failed", "error": reason})
+        else:
+            finish(path, sha, take_id, run_id, outcome)
+        future.release()
+        following = submit()
+        if following is not None:
+            waiting.add(following)  # type: ignore[no-untyped-call]

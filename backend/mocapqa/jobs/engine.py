@@ -1,0 +1,108 @@
+"""The one Dask execution layer of the server and the CLI.
+
+With no address, :class:`Engine` starts a ``distributed.LocalCluster`` of worker *processes*
+(one thread each, as many as the machine has cores unless told) the first time work is sent;
+with ``MOCAPQA_DASK_SCHEDULER`` / ``--scheduler`` (``tcp://host:8786``) it connects to an
+existing cluster instead. Work sent here runs in other processes, so it must read its inputs
+itself (paths on storage the workers share) and return small results.
+
+A task whose worker dies is retried on another worker; on the local cluster the scheduler's
+``allowed-failures`` is 1, so a take that kills two workers fails with ``KilledWorker`` and
+the batch goes on (an existing cluster keeps its own setting, Dask's default being 3).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import threading
+from typing import Any
+
+__all__ = ["ALLOWED_FAILURES", "Engine", "default_workers"]
+
+ALLOWED_FAILURES = 1
+"""Worker deaths a task may cause on the local cluster before it is failed (Dask: 3)."""
+log = logging.getLogger(__name__)
+
+
+def default_workers() -> int:
+    """Worker processes of the local cluster: the cores this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+class Engine:
+    """A lazily connected Dask client.
+
+    Parameters
+    ----------
+    scheduler : str, optional
+        Address of an existing scheduler (``tcp://host:8786``); None starts a local cluster.
+    workers : int, optional
+        Worker processes of the local cluster (default: :func:`default_workers`).
+    """
+
+    def __init__(self, scheduler: str | None = None, workers: int | None = None) -> None:
+        self.scheduler = scheduler or None
+        self.workers = workers if workers and workers > 0 else default_workers()
+        self._client: Any = None
+        self._cluster: Any = None
+        self._lock = threading.Lock()
+
+    @property
+    def started(self) -> bool:
+        """Whether the client is connected."""
+        return self._client is not None
+
+    def client(self) -> Any:
+        """The ``distributed.Client``, connecting (or starting the local cluster) on first use."""
+        with self._lock:
+            if self._client is None:
+                import dask
+                from distributed import Client, LocalCluster
+
+                if self.scheduler:
+                    log.info("connecting to the Dask scheduler at %s", self.scheduler)
+                    self._client = Client(self.scheduler, timeout="30s")  # type: ignore[no-untyped-call]
+                else:
+                    dask.config.set(
+                        {
+                            "distributed.scheduler.allowed-failures": ALLOWED_FAILURES,
+                            "distributed.worker.daemon": False,
+                        }
+                    )
+                    self._cluster = LocalCluster(  # type: ignore[no-untyped-call]
+                        n_workers=self.workers,
+                        threads_per_worker=1,
+                        processes=True,
+                        dashboard_address=None,
+                        silence_logs=logging.WARNING,
+                    )
+                    self._client = Client(self._cluster)  # type: ignore[no-untyped-call]
+            return self._client
+
+    def n_workers(self) -> int:
+        """Workers connected now."""
+        return len(self.client().scheduler_info(n_workers=-1)["workers"])
+
+    def close(self) -> None:
+        """Disconnect, and stop the local cluster if this engine started it."""
+        with self._lock:
+            if self._client is not None:
+                try:
+                    self._client.close()
+                finally:
+                    self._client = None
+            if self._cluster is not None:
+                try:
+                    self._cluster.close()
+                finally:
+                    self._cluster = None
+
+    def __enter__(self) -> Engine:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

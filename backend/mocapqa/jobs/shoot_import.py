@@ -1,0 +1,126 @@
+"""Importing many files into a shoot: plain takes and archives of takes, each member alone.
+
+Every file or archive member becomes a take of the shoot when it reads; members that are not
+motion files are listed as skipped, members that fail (unsafe names, links, unreadable or
+malformed content) are listed with their error, and the rest are kept. Limits on the archive
+as a whole (size, member count, unpacked size) reject it entirely, before extracting.
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path, PurePosixPath
+from typing import Any, BinaryIO
+
+from mocapqa.errors import MocapQAError, TooLargeError
+from mocapqa.jobs.archive import archive_kind, unpack
+from mocapqa.jobs.batch import MOTION_SUFFIXES
+from mocapqa.jobs.intake import CHUNK_BYTES, ingest_take
+from mocapqa.jobs.runner import JobRunner
+from mocapqa.store.files import FileStore
+from mocapqa.store.repository import Repository
+
+__all__ = ["ImportLimits", "ImportReport", "import_uploads"]
+
+
+@dataclass(frozen=True, slots=True)
+class ImportLimits:
+    """Size limits of one import.
+
+    Parameters
+    ----------
+    max_upload_bytes : int
+        Largest file or archive received.
+    max_members : int
+        Most members of an archive.
+    max_unpacked_bytes : int
+        Most bytes an archive may unpack to.
+    """
+
+    max_upload_bytes: int
+    max_members: int
+    max_unpacked_bytes: int
+
+
+@dataclass
+class ImportReport:
+    """What an import did: created takes, skipped and failed files (or members)."""
+
+    created: list[dict[str, Any]] = field(default_factory=list)
+    skipped: list[dict[str, str]] = field(default_factory=list)
+    failed: list[dict[str, str]] = field(default_factory=list)
+
+
+def _receive(source: BinaryIO, target: Path, name: str, max_bytes: int) -> None:
+    size = 0
+    with target.open("wb") as out:
+        while chunk := source.read(CHUNK_BYTES):
+            size += len(chunk)
+            if size > max_bytes:
+                raise TooLargeError(
+                    f"Expected an upload of at most {max_bytes} bytes, got more ({name!r})"
+                )
+            out.write(chunk)
+
+
+def _is_motion_name(name: str) -> bool:
+    return PurePosixPath(name.replace("\\", "/")).suffix.lower() in MOTION_SUFFIXES
+
+
+def import_uploads(
+    uploads: list[tuple[BinaryIO, str]],
+    shoot_id: str,
+    repository: Repository,
+    files: FileStore,
+    runner: JobRunner,
+    limits: ImportLimits,
+) -> ImportReport:
+    """Import uploaded files (takes or archives of takes) into a shoot; analyses start.
+
+    Raises
+    ------
+    TooLargeError
+        When an archive passes a limit (earlier uploads of the same request are kept).
+    InputError
+        When an archive cannot be read at all.
+    """
+    report = ImportReport()
+
+    def ingest(source: BinaryIO, name: str, label: str | None = None) -> None:
+        try:
+            take_id, run_id = ingest_take(
+                source, name, repository, files, runner, limits.max_upload_bytes, None, shoot_id
+            )
+        except MocapQAError as e:
+            report.failed.append({"name": label or name, "error": str(e)})
+        else:
+            report.created.append({"name": name, "take_id": take_id, "run_id": run_id})
+
+    for source, name in uploads:
+        if archive_kind(name) is None:
+            ingest(source, name)
+            continue
+        scratch = Path(tempfile.mkdtemp(prefix="archive-", dir=files.root / "incoming"))
+        try:
+            received = scratch / "archive"
+            _receive(source, received, name, limits.max_upload_bytes)
+            members = scratch / "members"
+            members.mkdir()
+            for member in unpack(
+                received, name, members, limits.max_members, limits.max_unpacked_bytes
+            ):
+                label = f"{name}:{member.name}"
+                if member.path is None:
+                    report.failed.append({"name": label, "error": str(member.problem)})
+                elif not _is_motion_name(member.name):
+                    report.skipped.append({"name": label, "reason": "not a motion file"})
+                else:
+                    with member.path.open("rb") as handle:
+                        base = PurePosixPath(member.name.replace("\\", "/")).name
+                        ingest(handle, base, label)
+                    member.path.unlink(missing_ok=True)
+        finally:
+            shutil.rmtree(scratch, ignore_errors=True)
+    return report

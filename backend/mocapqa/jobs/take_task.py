@@ -1,0 +1,125 @@
+"""One take analysed from its path, as a Dask task (or in-process for comparison).
+
+The task reads the take itself (the client never holds the corpus), analyses it, writes the
+run's files and a copy of the take into the data folder (shared by the workers), and returns
+only the small things the client stores: the take's row values and the run summary.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import shutil
+import time
+from pathlib import Path
+from typing import Any
+
+from mocapqa.core.motion import Motion
+from mocapqa.errors import MocapQAError, ParseError
+from mocapqa.jobs.runner import run_summary, write_outputs
+from mocapqa.pipeline.analyze import analyze
+from mocapqa.pipeline.loading import detect_take_format, read_take_file
+from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.store.files import FileStore
+
+__all__ = ["analyse_path", "content_sha256", "stored_name"]
+
+
+def content_sha256(path: Path) -> str:
+    """SHA-256 of a take: the file's bytes, or of a frame folder its files' names and bytes."""
+    digest = hashlib.sha256()
+    members = sorted(p for p in path.iterdir() if p.is_file()) if path.is_dir() else [path]
+    for member in members:
+        if path.is_dir():
+            digest.update(member.name.encode() + b"\0")
+        with member.open("rb") as handle:
+            while chunk := handle.read(1 << 20):
+                digest.update(chunk)
+    return digest.hexdigest()
+
+
+def stored_name(path: Path) -> str:
+    """The name a take is stored under (its file or folder name, made safe)."""
+    from mocapqa.jobs.intake import safe_file_name
+
+    return safe_file_name(path.name)
+
+
+def analyse_path(
+    path: str,
+    options: dict[str, Any],
+    take_id: str,
+    run_id: str,
+    data_dir: str | None,
+) -> dict[str, Any]:
+    """Read, analyse and (with ``data_dir``) store one take.
+
+    Parameters
+    ----------
+    path : str
+        A take file or an OpenPose frame folder, readable by the worker.
+    options : dict
+        Run options as JSON.
+    take_id, run_id : str
+        Ids chosen by the client (outputs go to ``runs/<run_id>``, the copy to
+        ``takes/<take_id>``).
+    data_dir : str, optional
+        The data folder; None analyses without writing anything.
+
+    Returns
+    -------
+    dict
+        ``{"status": "done", "take": row values, "summary": run summary, "time_s"}`` or
+        ``{"status": "failed", "error": message}`` for a file the readers reject.
+    """
+    started = time.perf_counter()
+    source = Path(path)
+    try:
+        format_name = detect_take_format(source)
+        try:
+            take = read_take_file(source, format_name, str(source))
+        except MocapQAError:
+            raise
+        except (ValueError, LookupError, TypeError, OverflowError, EOFError, OSError) as e:
+            raise ParseError(
+                f"Expected a readable {format_name} file, got {type(e).__name__}: {e}", source
+            ) from e
+        if take.n_frames == 0:
+            raise ParseError("Expected at least one frame, got 0", source)
+        result = analyze(take, AnalysisOptions.from_json(options))
+    except MocapQAError as e:
+        return {"status": "failed", "error": str(e)}
+    if isinstance(take, Motion):
+        kind, n_points, fps = "motion", take.skeleton.n_joints, take.fps
+    else:
+        kind, n_points, fps = "keypoints", take.n_keypoints, take.fps
+    name = stored_name(source)
+    if data_dir is not None:
+        files = FileStore(Path(data_dir))
+        folder = files.take_dir(take_id)
+        folder.mkdir(parents=True, exist_ok=True)
+        if source.is_dir():
+            shutil.copytree(source, folder / name, dirs_exist_ok=True)
+        else:
+            shutil.copyfile(source, folder / name)
+        write_outputs(files, run_id, result)
+    size = (
+        sum(p.stat().st_size for p in source.iterdir() if p.is_file())
+        if source.is_dir()
+        else source.stat().st_size
+    )
+    return {
+        "status": "done",
+        "take": {
+            "id": take_id,
+            "name": source.name[:255],
+            "format": format_name,
+            "kind": kind,
+            "size_bytes": size,
+            "n_frames": take.n_frames,
+            "fps": fps,
+            "n_joints": n_points,
+            "file_name": name,
+        },
+        "summary": run_summary(result),
+        "time_s": time.perf_counter() - started,
+    }

@@ -1,0 +1,171 @@
+"""The QA summary of one analysed take and its QA score (defined in ``docs/qa-summary.md``).
+
+One flat, JSON-ready dict per take, the same for the batch table, the API and the UI:
+
+* ``n_frames``, ``duration_s``, ``rig`` (limits rig family for BVH, ``"keypoints"`` otherwise)
+* ``twist_intervals`` and ``corrected_joint_frames`` (sum of the intervals' lengths)
+* ``violation_share`` — share of frames where at least one joint is outside its limits, and
+  ``worst_joint`` — the joint outside its limits in the most frames (None when none is)
+* ``joint_violations`` — per joint, share of frames outside the limits (joints with any)
+* ``filter_residual_mm`` — RMS distance between raw and filtered keypoints, mm (keypoint takes
+  in a metric unit; None otherwise)
+* ``missing_share`` — share of missing keypoint samples (0 for BVH takes)
+* ``score`` — 0–100, see :func:`qa_score`
+
+Checks that did not run leave their fields None; they then cost the score nothing.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from mocapqa.limits.rig import rig_family
+from mocapqa.pipeline.analyze import AnalysisResult
+
+__all__ = ["MM_PER_UNIT", "SCORE_TERMS", "SUMMARY_FIELDS", "qa_score", "qa_summary"]
+
+MM_PER_UNIT = {"m": 1000.0, "cm": 10.0, "mm": 1.0}
+"""Millimetres per length unit, for the units a residual can be given in mm."""
+
+SCORE_TERMS: dict[str, tuple[float, float]] = {
+    "twist_intervals": (0.30, 2.0),
+    "corrected_share": (0.20, 0.01),
+    "violation_share": (0.40, 0.05),
+    "missing_share": (0.40, 0.05),
+    "filter_residual_mm": (0.20, 20.0),
+}
+"""Per defect ``x``: weight ``w`` and half-effect value ``s`` of the factor ``1 − w·x/(x+s)``."""
+
+SUMMARY_FIELDS = (
+    "n_frames",
+    "duration_s",
+    "rig",
+    "twist_intervals",
+    "corrected_joint_frames",
+    "violation_share",
+    "worst_joint",
+    "filter_residual_mm",
+    "missing_share",
+    "score",
+)
+"""The summary's scalar columns, in table order (``joint_violations`` is the per-joint map)."""
+
+
+def qa_score(defects: dict[str, float | None]) -> float:
+    """The QA score, 0–100 (100: no defect found), rounded to 0.1.
+
+    ``score = 100 · Π_k (1 − w_k · x_k / (x_k + s_k))`` over the defects of
+    :data:`SCORE_TERMS`; a missing (None) or zero defect contributes a factor 1. Every factor
+    lies in ``(1 − w_k, 1]`` and decreases strictly as its defect grows, so the score is
+    monotone (non-increasing) in each defect and never below ``100 · Π (1 − w_k)``.
+
+    Parameters
+    ----------
+    defects : dict
+        Keys of :data:`SCORE_TERMS`; values ≥ 0 or None. ``corrected_share`` is corrected
+        joint-frames over ``frames × joints``.
+    """
+    score = 100.0
+    for name, (weight, half) in SCORE_TERMS.items():
+        value = defects.get(name)
+        if value is None or not math.isfinite(value) or value <= 0:
+            continue
+        score *= 1.0 - weight * value / (value + half)
+    return round(score, 1)
+
+
+def _union_frames(findings: list[dict[str, Any]], n_frames: int) -> int:
+    flagged = np.zeros(n_frames + 1, dtype=np.int32)
+    for finding in findings:
+        start = max(0, int(finding["start_frame"]))
+        stop = min(n_frames, int(finding["end_frame"]) + 1)
+        if stop > start:
+            flagged[start] += 1
+            flagged[stop] -= 1
+    return int(np.count_nonzero(np.cumsum(flagged)[:n_frames]))
+
+
+def _residual_mm(result: AnalysisResult, unit: str) -> float | None:
+    scale = MM_PER_UNIT.get(unit)
+    if scale is None:
+        return None
+    raw = np.asarray(result.raw_points, dtype=np.float64)
+    filtered = np.asarray(result.corrected_points, dtype=np.float64)
+    both = np.isfinite(raw).all(axis=-1) & np.isfinite(filtered).all(axis=-1)
+    if not both.any():
+        return None
+    distance = np.linalg.norm(raw[both] - filtered[both], axis=-1)
+    return round(float(np.sqrt(np.mean(distance**2))) * scale, 4)
+
+
+def qa_summary(result: AnalysisResult) -> dict[str, Any]:
+    """The QA summary of an analysis (fields in the module docstring).
+
+    Parameters
+    ----------
+    result : AnalysisResult
+        As returned by :func:`mocapqa.pipeline.analyze.analyze`.
+
+    Returns
+    -------
+    dict
+        JSON-ready; shares in [0, 1], residual in mm, score in [0, 100].
+    """
+    report = result.report
+    info = report["summary"]
+    steps = report["steps"]
+    findings = report["findings"]
+    n_frames = int(info["n_frames"])
+    motion = report["kind"] == "motion"
+    twist_ran = motion and steps["twist"]["state"] == "done"
+    limits_ran = motion and steps["limits"]["state"] == "done"
+    filter_ran = not motion and steps["filter"]["state"] == "done"
+
+    twist = [f for f in findings if f["kind"] == "twist"]
+    corrected = sum(int(f["end_frame"]) - int(f["start_frame"]) + 1 for f in twist)
+    n_joints = int(info.get("n_joints") or info.get("n_keypoints") or 1)
+
+    rig = "keypoints"
+    joint_violations: dict[str, float] = {}
+    violation_share: float | None = None
+    worst_joint: str | None = None
+    if result.corrected_motion is not None:
+        rig = rig_family(result.corrected_motion.skeleton)
+    if limits_ran:
+        limit_findings = [f for f in findings if f["kind"] == "limits"]
+        violation_share = round(_union_frames(limit_findings, n_frames) / max(n_frames, 1), 6)
+        per_joint: dict[str, int] = {}
+        for finding in limit_findings:
+            length = int(finding["end_frame"]) - int(finding["start_frame"]) + 1
+            per_joint[finding["joint"]] = per_joint.get(finding["joint"], 0) + length
+        joint_violations = {j: round(n / max(n_frames, 1), 6) for j, n in per_joint.items()}
+        if per_joint:
+            worst_joint = max(per_joint, key=lambda j: (per_joint[j], j))
+
+    residual = _residual_mm(result, str(info.get("length_unit"))) if filter_ran else None
+    missing = 0.0 if motion else round(float(info.get("missing_fraction") or 0.0), 6)
+    summary: dict[str, Any] = {
+        "n_frames": n_frames,
+        "duration_s": round(float(info["duration_s"]), 4),
+        "rig": rig,
+        "twist_intervals": len(twist) if twist_ran else None,
+        "corrected_joint_frames": corrected if twist_ran else None,
+        "violation_share": violation_share,
+        "worst_joint": worst_joint,
+        "filter_residual_mm": residual,
+        "missing_share": missing,
+        "joint_violations": joint_violations,
+    }
+    summary["score"] = qa_score(
+        {
+            "twist_intervals": float(len(twist)) if twist_ran else None,
+            "corrected_share": corrected / max(n_frames * n_joints, 1) if twist_ran else None,
+            "violation_share": violation_share,
+            "missing_share": missing,
+            "filter_residual_mm": residual,
+        }
+    )
+    return summary

@@ -1,0 +1,438 @@
+"""Shoots: named collections of takes, their take table, heat map, review queue and progress.
+
+Reads go to the ``take_qa`` rows (one per take, kept in step by the repository), so a shoot's
+table sorts and filters on indexed columns without walking every run.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from datetime import UTC, datetime
+from typing import Any
+
+from sqlalchemy import Engine, and_, delete, func, insert, or_, select, update
+from sqlalchemy.exc import IntegrityError
+from sqlalchemy.sql.elements import ColumnElement
+
+from mocapqa import __version__
+from mocapqa.errors import ConflictError, InputError, NotFoundError
+from mocapqa.store.qa import sync_take
+from mocapqa.store.repository import RUN_STATUSES, new_id, utc_now
+from mocapqa.store.tables import reviews, runs, shoots, take_qa, takes
+
+__all__ = ["SORT_COLUMNS", "ShootStore", "TakeFilter"]
+
+SORT_COLUMNS = (
+    "name",
+    "created_at",
+    "status",
+    "score",
+    "n_frames",
+    "duration_s",
+    "rig",
+    "twist_intervals",
+    "corrected_joint_frames",
+    "violation_share",
+    "worst_joint",
+    "filter_residual_mm",
+    "missing_share",
+    "n_findings",
+    "review_status",
+    "reviewer",
+)
+"""Columns a shoot's take table can be sorted by."""
+
+
+class TakeFilter:
+    """Filters of a shoot's take table (all optional, combined with AND).
+
+    Parameters
+    ----------
+    status : str, optional
+        Latest run status.
+    review_status : str, optional
+    rig : str, optional
+    min_score, max_score : float, optional
+        Inclusive QA score range.
+    has_findings : bool, optional
+        Only takes with (True) or without (False) findings.
+    search : str, optional
+        Case-insensitive substring of the take name.
+    """
+
+    def __init__(
+        self,
+        status: str | None = None,
+        review_status: str | None = None,
+        rig: str | None = None,
+        min_score: float | None = None,
+        max_score: float | None = None,
+        has_findings: bool | None = None,
+        search: str | None = None,
+    ) -> None:
+        if status is not None and status not in RUN_STATUSES:
+            raise InputError(f"Expected status in {list(RUN_STATUSES)}, got {status!r}")
+        self.status = status
+        self.review_status = review_status
+        self.rig = rig
+        self.min_score = min_score
+        self.max_score = max_score
+        self.has_findings = has_findings
+        self.search = search
+
+    def clauses(self) -> list[ColumnElement[bool]]:
+        """The SQL conditions."""
+        found: list[ColumnElement[bool]] = []
+        if self.status is not None:
+            found.append(take_qa.c.status == self.status)
+        if self.review_status is not None:
+            found.append(take_qa.c.review_status == self.review_status)
+        if self.rig is not None:
+            found.append(take_qa.c.rig == self.rig)
+        if self.min_score is not None:
+            found.append(take_qa.c.score >= self.min_score)
+        if self.max_score is not None:
+            found.append(take_qa.c.score <= self.max_score)
+        if self.has_findings is True:
+            found.append(take_qa.c.n_findings > 0)
+        elif self.has_findings is False:
+            found.append(take_qa.c.n_findings == 0)
+        if self.search:
+            pattern = "%" + self.search.lower().replace("%", r"\%").replace("_", r"\_") + "%"
+            found.append(func.lower(take_qa.c.name).like(pattern, escape="\\"))
+        return found
+
+
+def _plain(mapping: Any) -> dict[str, Any]:
+    # SQLite hands back naive datetimes; every stored time is UTC.
+    row = dict(mapping)
+    value = row.get("created_at")
+    if isinstance(value, datetime) and value.tzinfo is None:
+        row["created_at"] = value.replace(tzinfo=UTC)
+    return row
+
+
+class ShootStore:
+    """Database access for shoots and their take tables.
+
+    Parameters
+    ----------
+    engine : Engine
+        The repository's engine (its schema already created).
+    """
+
+    def __init__(self, engine: Engine) -> None:
+        self.engine = engine
+
+    # shoots ----------------------------------------------------------------------------
+    def create(self, name: str) -> dict[str, Any]:
+        """A new empty shoot; :class:`ConflictError` when the name is taken."""
+        clean = _checked_name(name)
+        row = {"id": new_id(), "name": clean, "created_at": utc_now()}
+        try:
+            with self.engine.begin() as conn:
+                conn.execute(insert(shoots).values(**row))
+        except IntegrityError as e:
+            raise ConflictError(f"Expected a new shoot name, got {clean!r} (taken)") from e
+        return self.get(str(row["id"]))
+
+    def ensure(self, name: str) -> dict[str, Any]:
+        """The shoot of that name, created when missing."""
+        with self.engine.connect() as conn:
+            found = conn.execute(select(shoots.c.id).where(shoots.c.name == name)).scalar()
+        if found is not None:
+            return self.get(str(found))
+        try:
+            return self.create(name)
+        except ConflictError:  # created meanwhile by another process
+            return self.ensure(name)
+
+    def rename(self, shoot_id: str, name: str) -> dict[str, Any]:
+        """Give a shoot a new (unused) name."""
+        clean = _checked_name(name)
+        self.get(shoot_id)
+        try:
+            with self.engine.begin() as conn:
+                conn.execute(update(shoots).where(shoots.c.id == shoot_id).values(name=clean))
+        except IntegrityError as e:
+            raise ConflictError(f"Expected a new shoot name, got {clean!r} (taken)") from e
+        return self.get(shoot_id)
+
+    def get(self, shoot_id: str) -> dict[str, Any]:
+        """One shoot with its counts; :class:`NotFoundError` when missing."""
+        found = self._with_counts(shoot_id)
+        if not found:
+            raise NotFoundError(f"Expected shoot {shoot_id!r} to exist, got none")
+        return found[0]
+
+    def list_all(self) -> list[dict[str, Any]]:
+        """Every shoot, by name, with counts per run status and per review status."""
+        return self._with_counts(None)
+
+    def _with_counts(self, shoot_id: str | None) -> list[dict[str, Any]]:
+        query = select(shoots).order_by(shoots.c.name)
+        counts = select(
+            take_qa.c.shoot_id,
+            take_qa.c.status,
+            take_qa.c.review_status,
+            func.count().label("n"),
+            func.coalesce(func.sum(take_qa.c.n_frames), 0).label("frames"),
+        ).group_by(take_qa.c.shoot_id, take_qa.c.status, take_qa.c.review_status)
+        if shoot_id is not None:
+            query = query.where(shoots.c.id == shoot_id)
+            counts = counts.where(take_qa.c.shoot_id == shoot_id)
+        else:
+            counts = counts.where(take_qa.c.shoot_id.is_not(None))
+        with self.engine.connect() as conn:
+            rows = [_plain(r) for r in conn.execute(query).mappings()]
+            tallies = list(conn.execute(counts).mappings())
+        by_id = {row["id"]: row for row in rows}
+        for row in rows:
+            row["n_takes"] = 0
+            row["n_frames"] = 0
+            row["status_counts"] = {s: 0 for s in RUN_STATUSES}
+            row["review_counts"] = {}
+        for tally in tallies:
+            shoot = by_id.get(tally["shoot_id"])
+            if shoot is None:
+                continue
+            n = int(tally["n"])
+            shoot["n_takes"] += n
+            shoot["n_frames"] += int(tally["frames"])
+            status = tally["status"] or "queued"
+            shoot["status_counts"][status] = shoot["status_counts"].get(status, 0) + n
+            review = tally["review_status"]
+            shoot["review_counts"][review] = shoot["review_counts"].get(review, 0) + n
+        return rows
+
+    def delete(self, shoot_id: str) -> tuple[list[str], list[str]]:
+        """Delete a shoot with its takes, runs and reviews; returns (take ids, run ids)."""
+        self.get(shoot_id)
+        with self.engine.begin() as conn:
+            take_ids = [
+                str(t)
+                for t in conn.execute(select(takes.c.id).where(takes.c.shoot_id == shoot_id))
+                .scalars()
+                .all()
+            ]
+            in_shoot = select(takes.c.id).where(takes.c.shoot_id == shoot_id)
+            run_ids = [
+                str(r)
+                for r in conn.execute(select(runs.c.id).where(runs.c.take_id.in_(in_shoot)))
+                .scalars()
+                .all()
+            ]
+            conn.execute(delete(take_qa).where(take_qa.c.take_id.in_(in_shoot)))
+            conn.execute(delete(reviews).where(reviews.c.take_id.in_(in_shoot)))
+            conn.execute(delete(runs).where(runs.c.take_id.in_(in_shoot)))
+            conn.execute(delete(takes).where(takes.c.shoot_id == shoot_id))
+            conn.execute(delete(shoots).where(shoots.c.id == shoot_id))
+        return take_ids, run_ids
+
+    # the take table --------------------------------------------------------------------
+    def page(
+        self,
+        shoot_id: str,
+        limit: int = 50,
+        offset: int = 0,
+        sort: str = "score",
+        descending: bool = False,
+        filters: TakeFilter | None = None,
+    ) -> tuple[list[dict[str, Any]], int]:
+        """A page of a shoot's takes (summary columns) and the total after filtering.
+
+        Rows without a value in the sort column come last in either direction.
+        """
+        if sort not in SORT_COLUMNS:
+            raise InputError(f"Expected sort in {list(SORT_COLUMNS)}, got {sort!r}")
+        self.get(shoot_id)
+        where = and_(take_qa.c.shoot_id == shoot_id, *(filters or TakeFilter()).clauses())
+        column = take_qa.c[sort]
+        order = column.desc().nulls_last() if descending else column.asc().nulls_last()
+        query = (
+            select(take_qa, takes.c.format, takes.c.fps, takes.c.n_joints)
+            .join(takes, takes.c.id == take_qa.c.take_id)
+            .where(where)
+            .order_by(order, take_qa.c.name, take_qa.c.take_id)
+            .limit(limit)
+            .offset(offset)
+        )
+        with self.engine.connect() as conn:
+            total = int(conn.execute(select(func.count()).where(where)).scalar_one())
+            rows = [_plain(r) for r in conn.execute(query).mappings()]
+        return rows, total
+
+    def rows(self, shoot_id: str, batch: int = 1000) -> Iterator[dict[str, Any]]:
+        """Every take row of a shoot, by name, read ``batch`` at a time (for exports)."""
+        offset = 0
+        while True:
+            page, _ = self.page(shoot_id, batch, offset, sort="name")
+            yield from page
+            if len(page) < batch:
+                return
+            offset += batch
+
+    def heatmap(
+        self, shoot_id: str, limit: int = 200, offset: int = 0, sort: str = "score"
+    ) -> dict[str, Any]:
+        """Joint × take share of frames outside the limits, for a page of the shoot's takes.
+
+        Returns
+        -------
+        dict
+            ``joints`` (those with any violation on the page, most violated first), ``takes``
+            (``{"take_id", "name", "score"}`` in table order) and ``values`` (``joints × takes``
+            shares in [0, 1]; 0 where none, None where the limits check did not run).
+        """
+        page, total = self.page(shoot_id, limit, offset, sort=sort)
+        totals: dict[str, float] = {}
+        for row in page:
+            for joint, share in (row["joint_violations"] or {}).items():
+                totals[joint] = totals.get(joint, 0.0) + float(share)
+        joints = sorted(totals, key=lambda j: (-totals[j], j))
+        values = [
+            [
+                (row["joint_violations"] or {}).get(joint, 0.0)
+                if row["violation_share"] is not None
+                else None
+                for row in page
+            ]
+            for joint in joints
+        ]
+        return {
+            "joints": joints,
+            "takes": [
+                {"take_id": r["take_id"], "name": r["name"], "score": r["score"]} for r in page
+            ],
+            "values": values,
+            "total": total,
+        }
+
+    def next_for_review(
+        self, shoot_id: str, after: str | None = None
+    ) -> tuple[dict[str, Any] | None, int]:
+        """The unreviewed analysed take with the lowest score (ties by name), and how many
+        unreviewed analysed takes remain.
+
+        ``after`` (a take id) skips that take, so a client can move on without deciding.
+        """
+        self.get(shoot_id)
+        where = and_(
+            take_qa.c.shoot_id == shoot_id,
+            take_qa.c.status == "done",
+            take_qa.c.review_status == "unreviewed",
+        )
+        query = (
+            select(take_qa, takes.c.format, takes.c.fps, takes.c.n_joints)
+            .join(takes, takes.c.id == take_qa.c.take_id)
+            .where(where)
+            .order_by(take_qa.c.score.asc().nulls_last(), take_qa.c.name, take_qa.c.take_id)
+            .limit(2)
+        )
+        with self.engine.connect() as conn:
+            found = [_plain(r) for r in conn.execute(query).mappings()]
+            remaining = int(conn.execute(select(func.count()).where(where)).scalar_one())
+        found = [r for r in found if r["take_id"] != after]
+        return (found[0] if found else None), remaining
+
+    # batches ---------------------------------------------------------------------------
+    def finished(self, sha256s: list[str], options: dict[str, Any]) -> dict[str, str]:
+        """Of these contents, those with a done run of these options and this version.
+
+        Returns
+        -------
+        dict
+            sha256 → take id of the finished run.
+        """
+        found: dict[str, str] = {}
+        with self.engine.connect() as conn:
+            for start in range(0, len(sha256s), 500):
+                chunk = sha256s[start : start + 500]
+                query = select(runs.c.input_sha256, runs.c.take_id, runs.c.options).where(
+                    runs.c.input_sha256.in_(chunk),
+                    runs.c.status == "done",
+                    runs.c.version == __version__,
+                )
+                for row in conn.execute(query).mappings():
+                    if row["options"] == options:
+                        found[str(row["input_sha256"])] = str(row["take_id"])
+        return found
+
+    def record_done(
+        self,
+        take: dict[str, Any],
+        run_id: str,
+        options: dict[str, Any],
+        summary: dict[str, Any],
+        server_time_s: float,
+    ) -> None:
+        """Store a take analysed elsewhere and its done run, in one transaction."""
+        now = utc_now()
+        with self.engine.begin() as conn:
+            conn.execute(insert(takes).values(**take, created_at=now))
+            conn.execute(
+                insert(runs).values(
+                    id=run_id,
+                    take_id=take["id"],
+                    status="done",
+                    progress=100,
+                    step="done",
+                    options=options,
+                    input_sha256=take["sha256"],
+                    version=__version__,
+                    summary=summary,
+                    server_time_s=server_time_s,
+                    created_at=now,
+                    started_at=now,
+                    finished_at=now,
+                )
+            )
+            sync_take(conn, str(take["id"]))
+
+    def qa_rows(self, take_ids: list[str]) -> dict[str, dict[str, Any]]:
+        """The summary rows of these takes, by take id."""
+        found: dict[str, dict[str, Any]] = {}
+        with self.engine.connect() as conn:
+            for start in range(0, len(take_ids), 500):
+                chunk = take_ids[start : start + 500]
+                query = select(take_qa).where(take_qa.c.take_id.in_(chunk))
+                for row in conn.execute(query).mappings():
+                    found[str(row["take_id"])] = _plain(row)
+        return found
+
+    def assign(self, take_id: str, shoot_id: str | None) -> None:
+        """Move a take into a shoot (or out of any, with None)."""
+        with self.engine.begin() as conn:
+            conn.execute(update(takes).where(takes.c.id == take_id).values(shoot_id=shoot_id))
+            sync_take(conn, take_id)
+
+    def progress(self, shoot_id: str) -> dict[str, Any]:
+        """Counts per status and frames analysed, for a running import or batch."""
+        shoot = self.get(shoot_id)
+        with self.engine.connect() as conn:
+            frames_done = conn.execute(
+                select(func.coalesce(func.sum(take_qa.c.n_frames), 0)).where(
+                    take_qa.c.shoot_id == shoot_id, take_qa.c.status == "done"
+                )
+            ).scalar_one()
+            pending = conn.execute(
+                select(func.count()).where(
+                    take_qa.c.shoot_id == shoot_id,
+                    or_(take_qa.c.status.in_(("queued", "running")), take_qa.c.status.is_(None)),
+                )
+            ).scalar_one()
+        counts = shoot["status_counts"]
+        return {
+            "shoot_id": shoot_id,
+            "n_takes": shoot["n_takes"],
+            "status_counts": counts,
+            "frames_done": int(frames_done),
+            "finished": int(pending) == 0,
+        }
+
+
+def _checked_name(name: str) -> str:
+    clean = " ".join(str(name).split())
+    if not clean or len(clean) > 255:
+        raise InputError(f"Expected a shoot name of 1–255 characters, got {name!r}")
+    return clean

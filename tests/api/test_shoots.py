@@ -1,0 +1,290 @@
+"""Shoots through the API: lifecycle, imports (files and archives), table, heat map, queue,
+export; real takes from the corpus."""
+
+from __future__ import annotations
+
+import csv
+import io
+import tarfile
+import time
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from mocapqa.api.app import create_app
+from mocapqa.config import Settings
+from mocapqa.render.service import RenderService
+
+API = "/api/v1"
+WALK = "bvh/cmu/cmu_12_01_walk.bvh"
+BANDAI = ("bvh/bandai/dataset-1_bow_not-confident_001.bvh", "bvh/bandai/dataset-1_bow_sad_001.bvh")
+TRC = "keypoints/pose2sim/S00_P00_T00_StaticTrial/pose-3d/S00_P00_T00_StaticTrial_0-12.trc"
+
+
+def _shoot(client: TestClient, name: str) -> dict[str, Any]:
+    response = client.post(f"{API}/shoots", json={"name": name})
+    assert response.status_code == 201, response.text
+    body: dict[str, Any] = response.json()
+    return body
+
+
+def _wait_finished(client: TestClient, shoot_id: str, timeout_s: float = 120.0) -> dict[str, Any]:
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        progress: dict[str, Any] = client.get(f"{API}/shoots/{shoot_id}/progress").json()
+        if progress["finished"]:
+            return progress
+        time.sleep(0.1)
+    raise TimeoutError("the shoot's analyses did not finish")
+
+
+def _zip(members: list[tuple[str, bytes]], symlink: str | None = None) -> bytes:
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, data in members:
+            archive.writestr(name, data)
+        if symlink is not None:
+            info = zipfile.ZipInfo(symlink)
+            info.external_attr = (0o120777 << 16) | 0
+            archive.writestr(info, "/etc/passwd")
+    return buffer.getvalue()
+
+
+def test_shoot_lifecycle(client: TestClient) -> None:
+    shoot = _shoot(client, "Day 1")
+    assert shoot["n_takes"] == 0
+    assert shoot["status_counts"] == {"queued": 0, "running": 0, "done": 0, "failed": 0}
+    assert client.post(f"{API}/shoots", json={"name": "Day 1"}).status_code == 409
+    assert client.post(f"{API}/shoots", json={"name": ""}).status_code == 422
+    renamed = client.patch(f"{API}/shoots/{shoot['id']}", json={"name": "Day one"})
+    assert renamed.status_code == 200
+    assert renamed.json()["name"] == "Day one"
+    other = _shoot(client, "Day 2")
+    taken = client.patch(f"{API}/shoots/{other['id']}", json={"name": "Day one"})
+    assert taken.status_code == 409
+    names = [s["name"] for s in client.get(f"{API}/shoots").json()]
+    assert names == ["Day 2", "Day one"]
+    assert client.get(f"{API}/shoots/{'0' * 32}").status_code == 404
+
+
+def test_import_files_table_queue_export_and_delete(client: TestClient, corpus_dir: Path) -> None:
+    shoot = _shoot(client, "walks")
+    sid = shoot["id"]
+    paths = [corpus_dir / WALK, *(corpus_dir / p for p in BANDAI), corpus_dir / TRC]
+    handles = [p.open("rb") for p in paths]
+    try:
+        response = client.post(
+            f"{API}/shoots/{sid}/takes",
+            files=[("files", (p.name, h)) for p, h in zip(paths, handles, strict=True)],
+        )
+    finally:
+        for handle in handles:
+            handle.close()
+    assert response.status_code == 201, response.text
+    report = response.json()
+    assert len(report["created"]) == 4
+    assert report["failed"] == report["skipped"] == []
+    progress = _wait_finished(client, sid)
+    assert progress["status_counts"]["done"] == 4
+    assert progress["frames_done"] == 524 + 145 + 221 + 12
+
+    listed = client.get(f"{API}/shoots")
+    assert listed.json()[0]["n_takes"] == 4
+    page = client.get(f"{API}/shoots/{sid}/takes", params={"sort": "score"}).json()
+    assert page["total"] == 4
+    scores = [row["score"] for row in page["items"]]
+    assert scores == sorted(scores)
+    assert all(0 <= s <= 100 for s in scores)
+    by_name = {row["name"]: row for row in page["items"]}
+    assert by_name[Path(TRC).name]["rig"] == "keypoints"
+    assert by_name[Path(TRC).name]["filter_residual_mm"] is not None
+    assert by_name["cmu_12_01_walk.bvh"]["rig"] == "cmu"
+    # The untouched walk's first frame is a synthetic T-pose: limits flag it.
+    assert by_name["cmu_12_01_walk.bvh"]["violation_share"] > 0
+
+    desc = client.get(f"{API}/shoots/{sid}/takes", params={"sort": "n_frames", "order": "desc"})
+    assert [r["n_frames"] for r in desc.json()["items"]] == [524, 221, 145, 12]
+    found = client.get(f"{API}/shoots/{sid}/takes", params={"search": "BOW", "rig": "bandai"})
+    assert found.json()["total"] == 2
+    ranged = client.get(f"{API}/shoots/{sid}/takes", params={"min_score": 101})
+    assert ranged.status_code == 422
+    assert client.get(f"{API}/shoots/{sid}/takes", params={"sort": "nope"}).status_code == 422
+    second = client.get(f"{API}/shoots/{sid}/takes", params={"limit": 2, "offset": 2}).json()
+    assert [r["take_id"] for r in second["items"]] == [r["take_id"] for r in page["items"][2:]]
+
+    heat = client.get(f"{API}/shoots/{sid}/heatmap").json()
+    assert len(heat["takes"]) == 4
+    assert len(heat["values"]) == len(heat["joints"])
+    walk_column = [t["name"] for t in heat["takes"]].index("cmu_12_01_walk.bvh")
+    assert any(row[walk_column] for row in heat["values"])
+
+    first = client.get(f"{API}/shoots/{sid}/next").json()
+    assert first["remaining"] == 4
+    assert first["take"]["take_id"] == page["items"][0]["take_id"]
+    skipped = client.get(f"{API}/shoots/{sid}/next", params={"after": first["take"]["take_id"]})
+    assert skipped.json()["take"]["take_id"] == page["items"][1]["take_id"]
+    review = {"status": "approved", "reviewer": "lead"}
+    posted = client.post(f"{API}/takes/{first['take']['take_id']}/reviews", json=review)
+    assert posted.status_code == 201, posted.text
+    after = client.get(f"{API}/shoots/{sid}/next").json()
+    assert after["remaining"] == 3
+    assert after["take"]["take_id"] == page["items"][1]["take_id"]
+
+    exported = client.get(f"{API}/shoots/{sid}/summary.csv")
+    assert exported.status_code == 200
+    assert exported.headers["content-type"].startswith("text/csv")
+    rows = list(csv.DictReader(io.StringIO(exported.text)))
+    assert sorted(r["name"] for r in rows) == sorted(p.name for p in paths)
+    approved = [r for r in rows if r["review_status"] == "approved"]
+    assert len(approved) == 1
+    assert approved[0]["reviewer"] == "lead"
+    as_json = client.get(f"{API}/shoots/{sid}/summary.json").json()
+    assert as_json["shoot"] == "walks"
+    assert {t["name"]: t["score"] for t in as_json["takes"]} == {
+        r["name"]: float(r["score"]) for r in rows
+    }
+
+    refused = client.delete(f"{API}/shoots/{sid}")
+    assert refused.status_code == 422
+    assert client.get(f"{API}/shoots/{sid}").status_code == 200
+    gone = client.delete(f"{API}/shoots/{sid}", params={"confirm": "walks"})
+    assert gone.status_code == 204
+    assert client.get(f"{API}/shoots/{sid}").status_code == 404
+    assert client.get(f"{API}/takes").json()["total"] == 0
+
+
+def test_zip_import_keeps_good_members(client: TestClient, corpus_dir: Path) -> None:
+    sid = _shoot(client, "archive")["id"]
+    walk = (corpus_dir / WALK).read_bytes()
+    bandai = (corpus_dir / BANDAI[0]).read_bytes()
+    corrupted = walk[: len(walk) // 3].replace(b"Frames: 524", b"Frames: 9999")
+    archive = _zip(
+        [
+            ("day/walk.bvh", walk),
+            ("day/sub/bow.bvh", bandai),
+            ("day/broken.bvh", corrupted),
+            ("day/notes.txt", b"call sheet"),
+            ("../../escape.bvh", bandai),
+            ("/abs/escape.bvh", bandai),
+        ],
+        symlink="day/link.bvh",
+    )
+    response = client.post(f"{API}/shoots/{sid}/takes", files=[("files", ("day.zip", archive))])
+    assert response.status_code == 201, response.text
+    report = response.json()
+    assert sorted(c["name"] for c in report["created"]) == ["bow.bvh", "walk.bvh"]
+    assert [s["name"] for s in report["skipped"]] == ["day.zip:day/notes.txt"]
+    failed = {f["name"]: f["error"] for f in report["failed"]}
+    assert set(failed) == {
+        "day.zip:day/broken.bvh",
+        "day.zip:../../escape.bvh",
+        "day.zip:/abs/escape.bvh",
+        "day.zip:day/link.bvh",
+    }
+    assert "line" in failed["day.zip:day/broken.bvh"]
+    assert "symbolic link" in failed["day.zip:day/link.bvh"]
+    assert "'..'" in failed["day.zip:../../escape.bvh"]
+    data_dir = client.app.state.services.settings.data_dir  # type: ignore[attr-defined]
+    assert not (data_dir.parent / "escape.bvh").exists()
+    assert not list(data_dir.rglob("escape.bvh"))
+    assert _wait_finished(client, sid)["status_counts"]["done"] == 2
+
+
+def test_tar_import_reports_links(client: TestClient, corpus_dir: Path) -> None:
+    sid = _shoot(client, "tarred")["id"]
+    buffer = io.BytesIO()
+    bandai = (corpus_dir / BANDAI[1]).read_bytes()
+    with tarfile.open(fileobj=buffer, mode="w:gz") as archive:
+        info = tarfile.TarInfo("takes/sad.bvh")
+        info.size = len(bandai)
+        archive.addfile(info, io.BytesIO(bandai))
+        for kind, name in (
+            (tarfile.SYMTYPE, "takes/soft.bvh"),
+            (tarfile.LNKTYPE, "takes/hard.bvh"),
+        ):
+            link = tarfile.TarInfo(name)
+            link.type = kind
+            link.linkname = "/etc/passwd"
+            archive.addfile(link)
+    response = client.post(
+        f"{API}/shoots/{sid}/takes", files=[("files", ("takes.tar.gz", buffer.getvalue()))]
+    )
+    assert response.status_code == 201, response.text
+    report = response.json()
+    assert [c["name"] for c in report["created"]] == ["sad.bvh"]
+    failed = {f["name"]: f["error"] for f in report["failed"]}
+    assert failed == {
+        "takes.tar.gz:takes/soft.bvh": "symbolic link",
+        "takes.tar.gz:takes/hard.bvh": "hard link",
+    }
+    garbage = client.post(
+        f"{API}/shoots/{sid}/takes", files=[("files", ("bad.tar.gz", b"not a tar at all"))]
+    )
+    assert garbage.status_code == 422
+
+
+def test_archive_bombs_are_refused_before_extracting(
+    tmp_path: Path, renderer: RenderService, corpus_dir: Path
+) -> None:
+    settings = Settings(
+        data_dir=tmp_path / "data", archive_max_unpacked_mb=1.0, archive_max_members=3
+    )
+    with TestClient(create_app(settings, renderer=renderer)) as client:
+        sid = _shoot(client, "bombs")["id"]
+        bomb = _zip([("zeros.bvh", bytes(20_000_000))])
+        assert len(bomb) < 100_000
+        response = client.post(f"{API}/shoots/{sid}/takes", files=[("files", ("b.zip", bomb))])
+        assert response.status_code == 413
+        assert "20000000 declared" in response.json()["detail"]
+        bandai = (corpus_dir / BANDAI[0]).read_bytes()
+        many = _zip([(f"t{i}.bvh", bandai) for i in range(4)])
+        response = client.post(f"{API}/shoots/{sid}/takes", files=[("files", ("m.zip", many))])
+        assert response.status_code == 413
+        assert "at most 3 members" in response.json()["detail"]
+        assert client.get(f"{API}/shoots/{sid}").json()["n_takes"] == 0
+        assert not list((settings.data_dir / "incoming").iterdir())
+
+
+def test_openapi_declares_shoot_statuses(client: TestClient) -> None:
+    paths = client.get("/openapi.json").json()["paths"]
+    delete = paths[f"{API}/shoots/{{shoot_id}}"]["delete"]["responses"]
+    assert {"204", "404", "422"} <= set(delete)
+    imports = paths[f"{API}/shoots/{{shoot_id}}/takes"]["post"]["responses"]
+    assert {"201", "404", "413", "422"} <= set(imports)
+
+
+@pytest.mark.parametrize("kind", ["sqlite"])
+def test_database_from_before_shoots_opens(kind: str, tmp_path: Path) -> None:
+    import sqlite3
+
+    from mocapqa.store.repository import Repository
+    from mocapqa.store.shoots import ShootStore
+
+    path = tmp_path / "old.sqlite3"
+    with sqlite3.connect(path) as conn:
+        conn.executescript(
+            """
+            CREATE TABLE takes (id VARCHAR(32) PRIMARY KEY, name VARCHAR(255) NOT NULL,
+              format VARCHAR(32) NOT NULL, kind VARCHAR(16) NOT NULL, size_bytes BIGINT NOT NULL,
+              sha256 VARCHAR(64) NOT NULL, n_frames INTEGER NOT NULL, fps FLOAT NOT NULL,
+              n_joints INTEGER NOT NULL, file_name VARCHAR(255) NOT NULL,
+              created_at DATETIME NOT NULL);
+            INSERT INTO takes VALUES ('0123456789abcdef0123456789abcdef', 'old.bvh', 'bvh',
+              'motion', 10, 'ff', 100, 30.0, 20, 'old.bvh', '2026-01-01 00:00:00');
+            """
+        )
+    repository = Repository(f"sqlite:///{path}")
+    try:
+        take = repository.get_take("0123456789abcdef0123456789abcdef")
+        assert take["shoot_id"] is None
+        store = ShootStore(repository.engine)
+        shoot = store.create("old")
+        store.assign(str(take["id"]), str(shoot["id"]))
+        rows, total = store.page(str(shoot["id"]))
+        assert total == 1
+        assert rows[0]["n_frames"] == 100
+    finally:
+        repository.close()
