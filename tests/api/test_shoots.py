@@ -190,7 +190,8 @@ def test_zip_import_keeps_good_members(client: TestClient, corpus_dir: Path) -> 
     data_dir = client.app.state.services.settings.data_dir  # type: ignore[attr-defined]
     assert not (data_dir.parent / "escape.bvh").exists()
     assert not list(data_dir.rglob("escape.bvh"))
-    assert _wait_finished(client, sid)["status_counts"]["done"] == 2
+    progress = _wait_finished(client, sid)
+    assert progress["status_counts"]["done"] == 2, (progress, client.get(f"{API}/takes").json())
 
 
 def test_tar_import_reports_links(client: TestClient, corpus_dir: Path) -> None:

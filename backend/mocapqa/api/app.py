@@ -28,6 +28,7 @@ from mocapqa.api.http_guards import install_http_guards
 from mocapqa.api.routes import filters, health, reviews, runs, shoots, stream, takes
 from mocapqa.config import Settings
 from mocapqa.jobs.demo import load_demo
+from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
@@ -87,6 +88,8 @@ def create_app(
     files = FileStore(settings.data_dir)
     owns_renderer = renderer is None
     render_service = RenderService() if renderer is None else renderer
+    # Runs go to a Dask cluster only when one is named; one take is faster on a thread here.
+    engine = Engine(settings.dask_scheduler) if settings.dask_scheduler else None
     runner = JobRunner(
         repository,
         files,
@@ -94,6 +97,7 @@ def create_app(
         render_service,
         max_attempts=settings.max_run_attempts,
         read_limits=settings.read_limits,
+        engine=engine,
     )
     services = Services(settings, repository, files, runner, render_service)
 
@@ -111,6 +115,8 @@ def create_app(
             yield
         finally:
             runner.shutdown()
+            if engine is not None:
+                engine.close()
             if owns_renderer:
                 render_service.close()
             repository.close()

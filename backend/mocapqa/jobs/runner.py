@@ -27,6 +27,7 @@ from mocapqa.io.bvh_write import format_bvh
 from mocapqa.io.guards import ReadLimits
 from mocapqa.io.keypoint_csv import csv_sidecar_path
 from mocapqa.jobs.fair_queue import FairQueue
+from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.rendered import render_thumbnail
 from mocapqa.pipeline.analyze import AnalysisResult, analyze
 from mocapqa.pipeline.loading import (
@@ -43,7 +44,7 @@ from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
 
-__all__ = ["JobRunner", "run_summary", "write_outputs"]
+__all__ = ["JobRunner", "read_options", "run_summary", "write_outputs"]
 
 log = logging.getLogger(__name__)
 
@@ -94,7 +95,7 @@ def write_outputs(files: FileStore, run_id: str, result: AnalysisResult) -> list
     return kinds
 
 
-def _reading(folder: Path) -> ReadOptions:
+def read_options(folder: Path) -> ReadOptions:
     """The read options chosen at upload (recorded beside the take), else the defaults."""
     try:
         data = json.loads((folder / READING_FILE).read_text(encoding="utf-8"))
@@ -134,6 +135,11 @@ class JobRunner:
         Starts of a run interrupted by a server stop before :meth:`start` fails it.
     read_limits : ReadLimits, optional
         Limits for re-reading a stored take (the upload was checked against the same).
+    engine : Engine, optional
+        A Dask engine: the analysis then runs on the cluster (which must share the data
+        folder) while the thread here waits, records progress and renders the thumbnail.
+        Without one, the analysis runs on this thread (faster for one take, see
+        ``docs/batch.md``).
     """
 
     def __init__(
@@ -144,7 +150,9 @@ class JobRunner:
         renderer: RenderService | None = None,
         max_attempts: int = 2,
         read_limits: ReadLimits | None = None,
+        engine: Engine | None = None,
     ) -> None:
+        self.engine = engine
         self.repository = repository
         self.files = files
         self.renderer = renderer
@@ -243,7 +251,10 @@ class JobRunner:
             options = AnalysisOptions.from_json(run["options"])
             with self._lock:
                 preloaded = self._preloaded.pop(run_id, None)
-            reading = _reading(path.parent)
+            reading = read_options(path.parent)
+            if self.engine is not None:
+                self._execute_on_dask(run_id, run, take, path, started)
+                return
             motion_or_keypoints = preloaded or read_take_file(
                 path, str(take["format"]), str(take["name"]), reading, self.read_limits
             )
@@ -275,6 +286,34 @@ class JobRunner:
         except Exception as e:  # a bug must not leave the run "running" forever
             log.exception("run %s failed", run_id)
             self._fail(run_id, f"internal error: {type(e).__name__}: {e}", started)
+
+    def _execute_on_dask(
+        self, run_id: str, run: dict[str, Any], take: dict[str, Any], path: Any, started: float
+    ) -> None:
+        from mocapqa.jobs.take_task import analyse_stored
+
+        assert self.engine is not None
+        self.repository.set_progress(run_id, 10, "analysing on the Dask cluster")
+        future = self.engine.client().submit(
+            analyse_stored,
+            str(path),
+            str(take["format"]),
+            str(take["name"]),
+            run["options"],
+            run_id,
+            str(self.files.root),
+            key=f"run-{run_id}",
+            pure=False,
+        )
+        summary = future.result()
+        if self.renderer is not None:
+            self.repository.set_progress(run_id, 97, "rendering the thumbnail")
+            folder = self.files.run_dir(run_id)
+            report = json.loads((folder / "report.json").read_bytes())
+            with np.load(folder / "points.npz") as points:
+                raw = points["raw"].astype(np.float64)
+            render_thumbnail(self.files, run_id, report, raw, self.renderer)
+        self.repository.finish_run(run_id, summary, None, time.perf_counter() - started)
 
     def _fail(self, run_id: str, message: str, started: float) -> None:
         try:

@@ -15,13 +15,13 @@ from typing import Any
 
 from mocapqa.core.motion import Motion
 from mocapqa.errors import MocapQAError, ParseError
-from mocapqa.jobs.runner import run_summary, write_outputs
+from mocapqa.jobs.runner import read_options, run_summary, write_outputs
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.loading import detect_take_format, read_take_file
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.files import FileStore
 
-__all__ = ["analyse_path", "content_sha256", "stored_name"]
+__all__ = ["analyse_path", "analyse_stored", "content_sha256", "stored_name"]
 
 
 def content_sha256(path: Path) -> str:
@@ -123,3 +123,21 @@ def analyse_path(
         "summary": run_summary(result),
         "time_s": time.perf_counter() - started,
     }
+
+
+def analyse_stored(
+    path: str, format_name: str, name: str, options: dict[str, Any], run_id: str, data_dir: str
+) -> dict[str, Any]:
+    """A server run on a Dask worker: read a stored take, analyse it, write the run's files.
+
+    Returns
+    -------
+    dict
+        The run summary (as :func:`mocapqa.jobs.runner.run_summary`). Errors the readers or
+        the analysis raise on purpose travel back as themselves.
+    """
+    stored = Path(path)
+    take = read_take_file(stored, format_name, name, read_options(stored.parent))
+    result = analyze(take, AnalysisOptions.from_json(options))
+    write_outputs(FileStore(Path(data_dir)), run_id, result)
+    return run_summary(result)

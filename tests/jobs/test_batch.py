@@ -1,0 +1,287 @@
+"""Batch analysis on a real ``distributed.LocalCluster`` (2 worker processes) and on separate
+``dask scheduler`` / ``dask worker`` processes, over real corpus takes."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import sqlite3
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import cloudpickle
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from mocapqa.api.app import create_app
+from mocapqa.config import Settings
+from mocapqa.jobs.batch import run_batch
+from mocapqa.jobs.engine import Engine
+from mocapqa.jobs.take_task import analyse_path
+from mocapqa.pipeline.analyze import analyze
+from mocapqa.pipeline.loading import read_take_file
+from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.pipeline.summary import qa_summary
+from mocapqa.store.repository import Repository
+from mocapqa.store.shoots import ShootStore
+
+TAKES = (
+    "bvh/bandai/dataset-1_bow_not-confident_001.bvh",
+    "bvh/bandai/dataset-1_bow_sad_001.bvh",
+    "bvh/cmu/cmu_12_01_walk.bvh",
+    "keypoints/pose2sim/S00_P00_T00_StaticTrial/pose-3d/S00_P00_T00_StaticTrial_0-12.trc",
+)
+ROOT = Path(__file__).resolve().parents[2]
+cloudpickle.register_pickle_by_value(sys.modules[__name__])
+
+
+@pytest.fixture(scope="module")
+def engine() -> Iterator[Engine]:
+    """One local cluster of 2 worker processes for the module."""
+    with Engine(workers=2) as local:
+        local.client()
+        yield local
+
+
+@pytest.fixture
+def corpus_copy(corpus_dir: Path, tmp_path: Path) -> Path:
+    """A folder of links to a few real takes, a corrupted take and a non-motion file."""
+    folder = tmp_path / "shoot"
+    folder.mkdir()
+    for relative in TAKES:
+        (folder / Path(relative).name).symlink_to(corpus_dir / relative)
+    walk = (corpus_dir / TAKES[2]).read_bytes()
+    (folder / "broken.bvh").write_bytes(
+        walk[: len(walk) // 2].replace(b"Frames: 524", b"Frames: 600")
+    )
+    (folder / "notes.txt").write_text("not a take")
+    return folder
+
+
+def _store(tmp_path: Path) -> tuple[Repository, ShootStore]:
+    repository = Repository(f"sqlite:///{tmp_path / 'db.sqlite3'}")
+    return repository, ShootStore(repository.engine)
+
+
+def _collect(rows: list[dict[str, Any]]) -> Any:
+    return rows.append
+
+
+def _report_without_timings(path: Path) -> dict[str, Any]:
+    report: dict[str, Any] = json.loads(path.read_text())
+    report.pop("timings_s", None)
+    return report
+
+
+def test_batch_equals_single_take_analysis(
+    engine: Engine, corpus_copy: Path, tmp_path: Path
+) -> None:
+    repository, shoots = _store(tmp_path)
+    data = tmp_path / "data"
+    shoot = shoots.create("day")
+    rows: list[dict[str, Any]] = []
+    counts = run_batch(
+        [corpus_copy], shoots, AnalysisOptions(), rows.append, engine, data, str(shoot["id"])
+    )
+    by_name = {Path(r["source"]).name: r for r in rows}
+    assert set(by_name) == {Path(t).name for t in TAKES} | {"broken.bvh"}
+    assert (counts.done, counts.failed, counts.skipped) == (4, 1, 0)
+    assert "line" in by_name["broken.bvh"]["error"]
+
+    for relative in TAKES:
+        row = by_name[Path(relative).name]
+        take = read_take_file(corpus_copy / Path(relative).name, "")
+        alone = analyze(take, AnalysisOptions())
+        expected = qa_summary(alone)
+        assert {k: row[k] for k in expected if k != "joint_violations"} == {
+            k: v for k, v in expected.items() if k != "joint_violations"
+        }
+        stored = repository.get_take(row["take_id"])
+        run = repository.get_run(str(stored["latest_run_id"]))
+        assert run["summary"]["qa"] == expected
+        folder = data / "runs" / str(run["id"])
+        report = _report_without_timings(folder / "report.json")
+        alone_report = json.loads(json.dumps({**alone.report, "downloads": report["downloads"]}))
+        alone_report.pop("timings_s", None)
+        assert report == alone_report
+        with np.load(folder / "points.npz") as points:
+            assert np.array_equal(
+                points["raw"], alone.raw_points.astype(np.float32), equal_nan=True
+            )
+            assert np.array_equal(
+                points["corrected"], alone.corrected_points.astype(np.float32), equal_nan=True
+            )
+        assert (data / "takes" / row["take_id"] / Path(relative).name).is_file()
+    page, total = shoots.page(str(shoot["id"]))
+    assert total == 4
+
+    again: list[dict[str, Any]] = []
+    counts = run_batch(
+        [corpus_copy], shoots, AnalysisOptions(), again.append, engine, data, str(shoot["id"])
+    )
+    assert (counts.done, counts.failed, counts.skipped) == (0, 1, 4)
+    assert {r["take_id"] for r in again if r["status"] == "skipped"} == {r["take_id"] for r in page}
+    assert all(r["score"] is not None for r in again if r["status"] == "skipped")
+    assert repository.list_takes()[1] == 4
+    other = AnalysisOptions(checks=("twist",))
+    counts = run_batch([corpus_copy], shoots, other, again.append, engine, data)
+    assert counts.done == 4
+    repository.close()
+
+
+def test_worker_killed_mid_batch(engine: Engine, corpus_copy: Path, tmp_path: Path) -> None:
+    repository, shoots = _store(tmp_path)
+    client = engine.client()
+    pids = client.run(os.getpid)
+    rows: list[dict[str, Any]] = []
+    killed = threading.Event()
+
+    def on_row(row: dict[str, Any]) -> None:
+        rows.append(row)
+        if not killed.is_set():
+            killed.set()
+            os.kill(next(iter(pids.values())), signal.SIGKILL)
+
+    counts = run_batch([corpus_copy], shoots, AnalysisOptions(), on_row, engine, tmp_path / "d")
+    assert killed.is_set()
+    assert (counts.done, counts.failed) == (4, 1)
+    assert repository.list_takes()[1] == 4
+    client.wait_for_workers(2, timeout=120)
+    repository.close()
+
+
+def _dies_on_walk(
+    path: str, options: dict[str, Any], take_id: str, run_id: str, data: str | None
+) -> dict[str, Any]:
+    if path.endswith("cmu_12_01_walk.bvh"):
+        os._exit(1)  # a take that takes its worker down
+    return analyse_path(path, options, take_id, run_id, data)
+
+
+def test_take_crashing_two_workers_fails_alone(
+    engine: Engine, corpus_copy: Path, tmp_path: Path
+) -> None:
+    repository, shoots = _store(tmp_path)
+    rows: list[dict[str, Any]] = []
+    counts = run_batch(
+        [corpus_copy], shoots, AnalysisOptions(), rows.append, engine, None, task=_dies_on_walk
+    )
+    failed = {Path(r["source"]).name: r["error"] for r in rows if r["status"] == "failed"}
+    assert set(failed) == {"cmu_12_01_walk.bvh", "broken.bvh"}
+    assert "KilledWorker" in failed["cmu_12_01_walk.bvh"]
+    assert counts.done == 3
+    engine.client().wait_for_workers(2, timeout=120)
+    repository.close()
+
+
+def _environment(tmp_path: Path) -> dict[str, str]:
+    return {
+        **os.environ,
+        "PYTHONPATH": str(ROOT / "backend"),
+        "MOCAPQA_DATA_DIR": str(tmp_path / "data"),
+    }
+
+
+def _takes_in(database: Path) -> int:
+    if not database.exists():
+        return 0
+    with sqlite3.connect(database, timeout=30) as conn:
+        try:
+            return int(conn.execute("SELECT count(*) FROM takes").fetchone()[0])
+        except sqlite3.OperationalError:
+            return 0
+
+
+def test_resume_after_the_client_is_killed(corpus_copy: Path, tmp_path: Path) -> None:
+    command = [
+        sys.executable, "-m", "mocapqa.cli.main", "batch", str(corpus_copy),
+        "--workers", "2", "--output", str(tmp_path / "out.jsonl"),
+    ]  # fmt: skip
+    env = _environment(tmp_path)
+    database = tmp_path / "data" / "mocapqa.sqlite3"
+    first = subprocess.Popen(command, env=env, start_new_session=True, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 300
+    while _takes_in(database) < 1 and first.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.2)
+    os.killpg(first.pid, signal.SIGKILL)
+    first.wait()
+    stored_before = _takes_in(database)
+    assert stored_before >= 1
+    second = subprocess.run(command, env=env, capture_output=True, text=True, timeout=600)
+    assert second.returncode == 2, second.stderr  # broken.bvh fails
+    rows = [json.loads(line) for line in (tmp_path / "out.jsonl").read_text().splitlines()]
+    statuses = [r["status"] for r in rows]
+    total = len(rows)
+    assert statuses.count("failed") == 1
+    assert statuses.count("skipped") >= stored_before
+    assert _takes_in(database) == total - 1
+    with sqlite3.connect(database) as conn:
+        duplicates = conn.execute(
+            "SELECT count(*) FROM (SELECT sha256 FROM takes GROUP BY sha256 HAVING count(*) > 1)"
+        ).fetchone()[0]
+        runs = conn.execute("SELECT count(*) FROM runs WHERE status = 'done'").fetchone()[0]
+    assert duplicates == 0
+    assert runs == total - 1
+
+
+def _free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+def test_batch_on_separate_scheduler_and_worker(corpus_copy: Path, tmp_path: Path) -> None:
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    env = _environment(tmp_path)
+    dask = str(Path(sys.executable).with_name("dask"))
+    scheduler = subprocess.Popen(
+        [dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
+        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+    worker = subprocess.Popen(
+        [dask, "worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard"],
+        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+    try:
+        repository, shoots = _store(tmp_path)
+        rows: list[dict[str, Any]] = []
+        with Engine(scheduler=address) as remote:
+            remote.client().wait_for_workers(1, timeout=120)
+            counts = run_batch(
+                [corpus_copy], shoots, AnalysisOptions(), rows.append, remote, tmp_path / "d"
+            )
+        assert (counts.done, counts.failed) == (4, 1)
+        assert repository.list_takes()[1] == 4
+        repository.close()
+        # The server sends its runs to the same cluster when MOCAPQA_DASK_SCHEDULER is set.
+        settings = Settings(data_dir=tmp_path / "server", dask_scheduler=address)
+        with TestClient(create_app(settings)) as client:
+            with (corpus_copy / Path(TAKES[0]).name).open("rb") as handle:
+                created = client.post("/api/v1/takes", files={"file": ("bow.bvh", handle)})
+            assert created.status_code == 201, created.text
+            run_id = created.json()["run_id"]
+            deadline = time.monotonic() + 300
+            run: dict[str, Any] = {"status": "queued"}
+            while run["status"] not in ("done", "failed") and time.monotonic() < deadline:
+                time.sleep(0.2)
+                run = client.get(f"/api/v1/runs/{run_id}").json()
+            assert run["status"] == "done", run
+            assert run["summary"]["qa"]["score"] is not None
+            assert client.get(f"/api/v1/runs/{run_id}/result").status_code == 200
+    finally:
+        for process in (worker, scheduler):
+            process.terminate()
+        for process in (worker, scheduler):
+            try:
+                process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                process.kill()
