@@ -208,7 +208,8 @@ def run_batch(
                 path, sha, take_id, run_id, task(str(path), options_json, take_id, run_id, folder)
             )
         return counts
-    _run_on_dask(engine, pending, options_json, folder, task, finish, emit)
+    if pending:  # a finished batch never starts (or connects to) a cluster
+        _run_on_dask(engine, pending, options_json, folder, task, finish, emit)
     return counts
 
 

@@ -1,0 +1,333 @@
+"""``mocapqa bench batch``: batch throughput on Dask against a plain loop, memory, resume time,
+and the shoot table's API latency at 10,000 takes."""
+
+from __future__ import annotations
+
+import resource
+import shutil
+import statistics
+import tempfile
+import threading
+import time
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from mocapqa.cli.app import bench_app
+
+__all__ = ["bench_batch"]
+
+
+def _peak_rss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+class _Sampler:
+    """Peak resident memory of this process while a block runs (sampled every 50 ms)."""
+
+    def __init__(self) -> None:
+        import psutil  # type: ignore[import-untyped]
+
+        self._process = psutil.Process()
+        self.peak = 0.0
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            self.peak = max(self.peak, self._process.memory_info().rss / 2**20)
+            self._stop.wait(0.05)
+
+    def __enter__(self) -> _Sampler:
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._stop.set()
+        self._thread.join()
+
+
+def _worker_peak_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def _warm_up(paths: list[str], options: dict[str, Any]) -> None:
+    from mocapqa.jobs.take_task import analyse_path
+
+    for path in paths:
+        analyse_path(path, options, "0" * 32, "0" * 32, None)
+
+
+def _sources(corpus: Path) -> list[Path]:
+    # The take with the only real twist errors is for evaluation, never for tuning: left out.
+    found = sorted((corpus / "bvh" / "bandai").glob("*.bvh"))
+    found += [corpus / "bvh" / "cmu" / "cmu_12_01_walk.bvh"]
+    found += [
+        p
+        for p in sorted((corpus / "bvh" / "cmu" / "iclone").glob("*.bvh"))
+        if p.name != "005_05.bvh"
+    ]
+    return [p for p in found if p.is_file()]
+
+
+def _latency(client: Any, url: str, params: dict[str, Any], repeats: int) -> tuple[float, float]:
+    times = []
+    for _ in range(repeats):
+        clock = time.perf_counter()
+        response = client.get(url, params=params)
+        times.append((time.perf_counter() - clock) * 1000)
+        if response.status_code != 200:
+            raise RuntimeError(f"{url} answered {response.status_code}: {response.text[:200]}")
+    times.sort()
+    return statistics.median(times), times[min(len(times) - 1, int(0.95 * len(times)))]
+
+
+def _stored_rows(repository: Any) -> list[dict[str, Any]]:
+    """Take values and run summaries of every stored take (to replicate for the API)."""
+    from sqlalchemy import select
+
+    from mocapqa.store.tables import runs, takes
+
+    columns = [
+        takes.c[name]
+        for name in ("format", "kind", "size_bytes", "n_frames", "fps", "n_joints", "file_name")
+    ]
+    with repository.engine.connect() as conn:
+        found = conn.execute(
+            select(*columns, runs.c.summary).join(runs, runs.c.take_id == takes.c.id)
+        ).mappings()
+        return [
+            {"take": {k: r[k] for k in r if k != "summary"}, "summary": r["summary"]} for r in found
+        ]
+
+
+def _fill(database_url: str, rows: list[dict[str, Any]], n_takes: int) -> str:
+    """A shoot of ``n_takes`` takes whose summaries repeat the batch's real ones."""
+    from sqlalchemy import insert
+
+    from mocapqa.store.repository import Repository, new_id, utc_now
+    from mocapqa.store.shoots import ShootStore
+    from mocapqa.store.tables import metadata, runs, take_qa, takes
+
+    repository = Repository(database_url)
+    metadata.drop_all(repository.engine)
+    repository.close()
+    repository = Repository(database_url)
+    shoot = ShootStore(repository.engine).create("bench")
+    now = utc_now()
+    take_rows, run_rows, qa_rows = [], [], []
+    for index in range(n_takes):
+        source = rows[index % len(rows)]
+        take_id, run_id = new_id(), new_id()
+        take_rows.append(
+            {
+                **source["take"],
+                "id": take_id,
+                "name": f"take_{index:05d}.bvh",
+                "sha256": f"{index:064x}",
+                "shoot_id": shoot["id"],
+                "created_at": now,
+            }
+        )
+        run_rows.append(
+            {
+                "id": run_id,
+                "take_id": take_id,
+                "status": "done",
+                "progress": 100,
+                "step": "done",
+                "options": {},
+                "input_sha256": f"{index:064x}",
+                "version": "bench",
+                "summary": source["summary"],
+                "created_at": now,
+            }
+        )
+        qa = source["summary"]["qa"]
+        qa_rows.append(
+            {
+                "take_id": take_id,
+                "shoot_id": shoot["id"],
+                "name": f"take_{index:05d}.bvh",
+                "kind": "motion",
+                "created_at": now,
+                "run_id": run_id,
+                "status": "done",
+                "review_status": "unreviewed",
+                "reviewer": None,
+                "n_findings": source["summary"]["n_findings"],
+                **{
+                    k: qa.get(k)
+                    for k in (
+                        "score",
+                        "n_frames",
+                        "duration_s",
+                        "rig",
+                        "twist_intervals",
+                        "corrected_joint_frames",
+                        "violation_share",
+                        "worst_joint",
+                        "filter_residual_mm",
+                        "missing_share",
+                        "joint_violations",
+                    )
+                },
+            }
+        )
+    with repository.engine.begin() as conn:
+        for table, values in ((takes, take_rows), (runs, run_rows), (take_qa, qa_rows)):
+            for start in range(0, len(values), 1000):
+                conn.execute(insert(table), values[start : start + 1000])
+    repository.close()
+    return str(shoot["id"])
+
+
+@bench_app.command("batch")
+def bench_batch(
+    takes: Annotated[int, typer.Option(help="Tiled takes in the corpus.")] = 2000,
+    mean_frames: Annotated[int, typer.Option(help="Mean frames per tiled take.")] = 520,
+    seed: Annotated[int, typer.Option(help="Seed of the tiling.")] = 0,
+    api_takes: Annotated[
+        int, typer.Option(help="Takes of the shoot for the API figures.")
+    ] = 10_000,
+    postgres_url: Annotated[
+        str | None, typer.Option(help="Also time the API on this PostgreSQL (emptied first).")
+    ] = None,
+    data: Annotated[Path | None, typer.Option(help="Corpus folder (default: found).")] = None,
+    scratch: Annotated[
+        Path | None, typer.Option(help="Scratch folder (default: temporary).")
+    ] = None,
+) -> None:
+    """Takes/s and frames/s on 1 and 2 Dask workers and in a plain loop; memory; resume time;
+    shoot-table API latency (list, sort by score, heat map) at ``--api-takes`` takes."""
+    import os
+
+    from fastapi.testclient import TestClient
+    from rich.console import Console
+    from rich.table import Table
+
+    from mocapqa.api.app import create_app
+    from mocapqa.bench.corpus import require_corpus
+    from mocapqa.bench.tiles import tile_corpus
+    from mocapqa.config import Settings
+    from mocapqa.jobs.batch import run_batch
+    from mocapqa.jobs.engine import Engine
+    from mocapqa.pipeline.options import AnalysisOptions
+    from mocapqa.store.repository import Repository
+    from mocapqa.store.shoots import ShootStore
+
+    console = Console()
+    root = Path(scratch) if scratch else Path(tempfile.mkdtemp(prefix="mocapqa-bench-batch-"))
+    corpus = require_corpus(data)
+    clock = time.perf_counter()
+    tiles = tile_corpus(_sources(corpus), root / "tiles", takes, mean_frames, seed)
+    console.print(
+        f"corpus: {tiles.n_takes} takes, {tiles.n_frames:,} frames, "
+        f"{tiles.n_bytes / 1e6:,.0f} MB in {time.perf_counter() - clock:.1f} s ({root})"
+    )
+    options = AnalysisOptions()
+    table = Table("run", "time s", "takes/s", "frames/s", "client peak MB", "worker peak MB")
+    figures: dict[str, float] = {}
+    # Warm-up, on every worker and in the loop's process alike: one tile of each source take,
+    # so numba's compiled kernels and each rig's limits model are loaded before timing.
+    by_source: dict[str, str] = {}
+    for tile in sorted(tiles.folder.iterdir()):
+        by_source.setdefault(tile.stem.split("_", 2)[2], str(tile))
+    warm = sorted(by_source.values())
+
+    def fresh(name: str) -> tuple[Repository, ShootStore, Path]:
+        folder = root / name
+        shutil.rmtree(folder, ignore_errors=True)
+        folder.mkdir(parents=True)
+        repository = Repository(f"sqlite:///{folder / 'db.sqlite3'}")
+        return repository, ShootStore(repository.engine), folder / "data"
+
+    rows: list[dict[str, Any]] = []
+    for workers in (1, 2):
+        repository, shoots, out = fresh(f"dask{workers}")
+        with Engine(workers=workers) as engine:
+            client = engine.client()
+            client.run(_warm_up, warm, options.to_json())
+            with _Sampler() as sampler:
+                clock = time.perf_counter()
+                counts = run_batch([tiles.folder], shoots, options, lambda r: None, engine, out)
+                elapsed = time.perf_counter() - clock
+            workers_peak = max(client.run(_worker_peak_mb).values())
+            if workers == 2:
+                clock = time.perf_counter()
+                again = run_batch([tiles.folder], shoots, options, lambda r: None, engine, out)
+                figures["resume_s"] = time.perf_counter() - clock
+                if again.skipped != takes:
+                    raise RuntimeError(f"resume re-ran takes: {again}")
+                rows = _stored_rows(repository)
+        repository.close()
+        if counts.done != takes:
+            raise RuntimeError(f"expected {takes} done, got {counts}")
+        figures[f"dask{workers}_s"] = elapsed
+        table.add_row(
+            f"Dask, {workers} worker process(es)",
+            f"{elapsed:.1f}",
+            f"{takes / elapsed:.1f}",
+            f"{counts.frames / elapsed:,.0f}",
+            f"{sampler.peak:.0f}",
+            f"{workers_peak:.0f}",
+        )
+
+    repository, shoots, out = fresh("loop")
+    _warm_up(warm, options.to_json())
+    with _Sampler() as sampler:
+        clock = time.perf_counter()
+        counts = run_batch([tiles.folder], shoots, options, lambda r: None, None, out)
+        elapsed = time.perf_counter() - clock
+    repository.close()
+    figures["loop_s"] = elapsed
+    table.add_row(
+        "plain loop, this process",
+        f"{elapsed:.1f}",
+        f"{takes / elapsed:.1f}",
+        f"{counts.frames / elapsed:,.0f}",
+        f"{sampler.peak:.0f}",
+        "–",
+    )
+    console.print(table)
+    overhead = figures["dask1_s"] / figures["loop_s"] - 1
+    console.print(
+        f"Dask overhead, 1 worker vs the loop: {overhead:+.1%} (target ≤ 15 %); "
+        f"2 workers / 1 worker speed-up: {figures['dask1_s'] / figures['dask2_s']:.2f}×; "
+        f"resume of the finished batch: {figures['resume_s']:.2f} s (target ≤ 5 s)"
+    )
+
+    latency = Table("database", "request", "p50 ms", "p95 ms")
+    targets = [("SQLite", f"sqlite:///{root / 'api.sqlite3'}")]
+    if postgres_url or os.environ.get("MOCAPQA_TEST_POSTGRES_URL"):
+        targets.append(("PostgreSQL", str(postgres_url or os.environ["MOCAPQA_TEST_POSTGRES_URL"])))
+    for label, url in targets:
+        shoot_id = _fill(url, rows, api_takes)
+        settings = Settings(data_dir=root / "api-data", database_url=url)
+        with TestClient(create_app(settings)) as client:
+            base = f"/api/v1/shoots/{shoot_id}"
+            requests: tuple[tuple[str, str, dict[str, Any]], ...] = (
+                ("list page (50, by created_at)", f"{base}/takes", {"sort": "created_at"}),
+                ("sort by score", f"{base}/takes", {"sort": "score", "offset": 5000}),
+                (
+                    "filter + search",
+                    f"{base}/takes",
+                    {
+                        "sort": "violation_share",
+                        "order": "desc",
+                        "min_score": 50,
+                        "search": "take_01",
+                    },
+                ),
+                ("heat map (200 takes)", f"{base}/heatmap", {}),
+                ("next for review", f"{base}/next", {}),
+                ("shoot list", "/api/v1/shoots", {}),
+            )
+            for name, path, params in requests:
+                _latency(client, path, params, 3)
+                p50, p95 = _latency(client, path, params, 40)
+                latency.add_row(label, name, f"{p50:.1f}", f"{p95:.1f}")
+    console.print(latency)
+    if scratch is None:
+        shutil.rmtree(root, ignore_errors=True)
