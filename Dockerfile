@@ -1,21 +1,56 @@
-# The mocapqa dashboard: Python 3.11 on Debian, the package with its PostgreSQL driver.
+# syntax=docker/dockerfile:1
+# The mocapqa image: the dashboard (`mocapqa serve`), the batch CLI and the Dask scheduler and
+# workers of the compose file's "dask" profile all run from it, so every process has the same
+# Python, numpy, dask and distributed versions.
+
 # three.js (the dashboard's 3D views) comes from the npm registry, pinned by package-lock.json.
-FROM node:20-bookworm-slim AS three
+FROM node:20.18.0-bookworm-slim AS three
 WORKDIR /js
 COPY package.json package-lock.json ./
 RUN npm ci --omit=dev --no-audit --no-fund && mkdir -p vendor/three \
  && cp node_modules/three/build/three.module.min.js node_modules/three/build/three.core.min.js \
        node_modules/three/LICENSE vendor/three/
 
-FROM python:3.11-slim-bookworm
-ENV PYTHONDONTWRITEBYTECODE=1 PYTHONUNBUFFERED=1 PIP_NO_CACHE_DIR=1 MOCAPQA_DATA_DIR=/data
+FROM python:3.11.9-slim-bookworm
+
+# Mesa's EGL/GL libraries let pyvista render off-screen (PNG thumbnails, contact sheets);
+# without them the app falls back to SVG drawings. curl is not needed: the healthcheck is Python.
+RUN apt-get update \
+    && apt-get install -y --no-install-recommends \
+       libegl1=1.6.0-1 libegl-mesa0=22.3.6-1+deb12u2 libgl1=1.6.0-1 \
+       libgl1-mesa-dri=22.3.6-1+deb12u2 libxrender1=1:0.9.10-1.1 \
+    && rm -rf /var/lib/apt/lists/*
+
+ENV PYTHONDONTWRITEBYTECODE=1 \
+    PYTHONUNBUFFERED=1 \
+    PIP_NO_CACHE_DIR=1 \
+    PIP_DISABLE_PIP_VERSION_CHECK=1 \
+    MOCAPQA_DATA_DIR=/data \
+    NUMBA_CACHE_DIR=/tmp/numba-cache \
+    PYVISTA_OFF_SCREEN=true
+
+RUN groupadd --system --gid 10001 mocapqa \
+    && useradd --system --uid 10001 --gid mocapqa --home-dir /app --shell /usr/sbin/nologin mocapqa
+
 WORKDIR /app
 COPY pyproject.toml README.md ./
 COPY backend ./backend
 COPY frontend ./frontend
 COPY --from=three /js/vendor/three ./frontend/vendor/three
-# Extra PyPI packages, e.g. "dask[distributed]" for the compose file's Dask worker.
-ARG EXTRA_PACKAGES=""
-RUN pip install ".[postgres]" $EXTRA_PACKAGES && mkdir -p /data
-EXPOSE 8000
+# The package with its PostgreSQL driver; dask[distributed] is a dependency of the package.
+# Versions of the package's own dependencies are bounded in pyproject.toml; the ones the image
+# serves with are pinned here so that app, scheduler and workers match.
+# "." is this project's own package (DL3013 asks for a version it cannot have).
+# hadolint ignore=DL3013
+RUN pip install "pip==24.2" \
+    && pip install ".[postgres]" "dask[distributed]==2026.8.0" \
+    && mkdir -p /data \
+    && chown 10001:10001 /data
+
+USER 10001:10001
+VOLUME ["/data"]
+EXPOSE 8000 8786 8787
+# Healthy when the API answers and its database query succeeds (/api/v1/health runs one).
+HEALTHCHECK --interval=15s --timeout=5s --start-period=60s --retries=4 \
+    CMD ["python", "-c", "import json,sys,urllib.request as u; r=json.load(u.urlopen('http://127.0.0.1:8000/api/v1/health', timeout=4)); sys.exit(r.get('status') != 'ok')"]
 CMD ["mocapqa", "serve", "--host", "0.0.0.0", "--port", "8000", "--demo"]

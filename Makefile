@@ -56,6 +56,7 @@ lint: install-dev js-deps
 	$(BIN)/ruff format --check backend tests
 	$(BIN)/lint-imports
 	$(BIN)/check-jsonschema --builtin-schema vendor.compose-spec docker-compose.yml
+	$(BIN)/hadolint Dockerfile
 
 typecheck: install-dev
 	$(BIN)/mypy

@@ -97,6 +97,11 @@ class Repository:
                 with self.engine.begin() as conn:
                     conn.execute(text(f"ALTER TABLE {table} ADD COLUMN {column} {sql_type}"))
 
+    def ping(self) -> None:
+        """Run a trivial query (for health checks); raises when the database is unreachable."""
+        with self.engine.connect() as conn:
+            conn.execute(select(1))
+
     def close(self) -> None:
         """Release the connection pool."""
         self.engine.dispose()

@@ -17,5 +17,6 @@ router = APIRouter(tags=["health"])
 
 @router.get("/health", responses=responses())
 def health(services: ServicesDep) -> HealthOut:
-    """The server is up; which version and database dialect it uses."""
+    """The server is up and its database answers; which version and dialect it uses."""
+    services.repository.ping()
     return HealthOut(version=__version__, database=services.repository.engine.dialect.name)
