@@ -289,3 +289,15 @@ def test_database_from_before_shoots_opens(kind: str, tmp_path: Path) -> None:
         assert rows[0]["n_frames"] == 100
     finally:
         repository.close()
+
+
+def test_demo_shoot_beside_the_single_takes(tmp_path: Path, renderer: RenderService) -> None:
+    from mocapqa.jobs.demo import DEMO_FILES, DEMO_SHOOT, DEMO_SHOOT_CORPUS_FILES
+
+    settings = Settings(data_dir=tmp_path / "data")
+    with TestClient(create_app(settings, demo=True, renderer=renderer)) as client:
+        shoots = client.get(f"{API}/shoots").json()
+        assert [s["name"] for s in shoots] == [DEMO_SHOOT]
+        n_shoot = len(DEMO_FILES) + len(DEMO_SHOOT_CORPUS_FILES)
+        assert shoots[0]["status_counts"]["done"] == shoots[0]["n_takes"] == n_shoot
+        assert client.get(f"{API}/takes").json()["total"] == len(DEMO_FILES) + n_shoot
