@@ -63,7 +63,7 @@ def load_demo(
     for path, shoot in [(p, None) for p in demo_paths()] + [(p, shoot_id) for p in _shoot_paths()]:
         with path.open("rb") as handle:
             take_id, run_id = ingest_take(
-                handle, path.name, repository, files, runner, 1 << 30, None, shoot
+                handle, path.name, repository, files, runner, 1 << 30, shoot_id=shoot
             )
         runner.wait(run_id, timeout_s)
         take_ids.append(take_id)

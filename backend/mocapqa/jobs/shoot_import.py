@@ -91,7 +91,7 @@ def import_uploads(
     def ingest(source: BinaryIO, name: str, label: str | None = None) -> None:
         try:
             take_id, run_id = ingest_take(
-                source, name, repository, files, runner, limits.max_upload_bytes, None, shoot_id
+                source, name, repository, files, runner, limits.max_upload_bytes, shoot_id=shoot_id
             )
         except MocapQAError as e:
             report.failed.append({"name": label or name, "error": str(e)})

@@ -8,6 +8,7 @@ only the small things the client stores: the take's row values and the run summa
 from __future__ import annotations
 
 import hashlib
+import json
 import shutil
 import time
 from pathlib import Path
@@ -17,7 +18,13 @@ from mocapqa.core.motion import Motion
 from mocapqa.errors import MocapQAError, ParseError
 from mocapqa.jobs.runner import read_options, run_summary, write_outputs
 from mocapqa.pipeline.analyze import analyze
-from mocapqa.pipeline.loading import detect_take_format, read_take_file
+from mocapqa.pipeline.loading import (
+    READING_FILE,
+    ReadOptions,
+    detect_take_format,
+    read_take_file,
+    reading_facts,
+)
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.files import FileStore
 
@@ -101,6 +108,8 @@ def analyse_path(
             shutil.copytree(source, folder / name, dirs_exist_ok=True)
         else:
             shutil.copyfile(source, folder / name)
+        facts = reading_facts(take, ReadOptions())
+        files.write_bytes(folder / READING_FILE, json.dumps(facts).encode())
         write_outputs(files, run_id, result)
     size = (
         sum(p.stat().st_size for p in source.iterdir() if p.is_file())

@@ -10,7 +10,7 @@ from collections.abc import Iterator
 from datetime import UTC, datetime
 from typing import Any
 
-from sqlalchemy import Engine, and_, delete, func, insert, or_, select, update
+from sqlalchemy import Engine, and_, delete, func, insert, select, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.sql.elements import ColumnElement
 
@@ -415,19 +415,14 @@ class ShootStore:
                     take_qa.c.shoot_id == shoot_id, take_qa.c.status == "done"
                 )
             ).scalar_one()
-            pending = conn.execute(
-                select(func.count()).where(
-                    take_qa.c.shoot_id == shoot_id,
-                    or_(take_qa.c.status.in_(("queued", "running")), take_qa.c.status.is_(None)),
-                )
-            ).scalar_one()
         counts = shoot["status_counts"]
         return {
             "shoot_id": shoot_id,
             "n_takes": shoot["n_takes"],
             "status_counts": counts,
             "frames_done": int(frames_done),
-            "finished": int(pending) == 0,
+            # From the same counts (one query), so "finished" never contradicts them.
+            "finished": counts["queued"] + counts["running"] == 0,
         }
 
 
