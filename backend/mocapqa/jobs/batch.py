@@ -1,9 +1,10 @@
 """Batch analysis of every motion file under some paths, on Dask or in this process.
 
-:func:`run_batch` finds the takes (:func:`discover`), hashes each (reading it in chunks), skips
-those whose content, options and mocapqa version already have a done run, sends the rest to
-the workers (:func:`mocapqa.jobs.take_task.analyse_path`, a bounded number in flight) and, as
-each finishes, stores its take and done run in one transaction and writes its result row.
+:func:`run_batch` finds the takes (:func:`discover`), hashes each (reading it in chunks, or
+taking the hash recorded for the same path, size and modification time), skips those whose
+content, options and mocapqa version already have a done run, sends the rest to the workers
+(:func:`mocapqa.jobs.take_task.analyse_path`, a bounded number in flight) and, as each
+finishes, stores its take and done run in one transaction and writes its result row.
 Nothing is stored for a take until its run is complete, so an interrupted batch (Ctrl-C, a
 lost scheduler) leaves no half-made rows, and running it again finishes the rest without
 duplicates (an interrupted task may leave an orphan output folder behind, never a row).
@@ -93,6 +94,24 @@ def discover(paths: Iterable[Path]) -> Iterator[tuple[Path, str | None]]:
                     yield here / name, None
 
 
+def _content_hash(
+    path: Path, known: dict[str, tuple[int, int, str]], learned: list[dict[str, Any]]
+) -> str:
+    """The take's SHA-256, from the cache when its size and modification time are unchanged."""
+    key = str(path.resolve())
+    if path.is_file():
+        stat = path.stat()
+        cached = known.get(key)
+        if cached is not None and cached[:2] == (stat.st_size, stat.st_mtime_ns):
+            return cached[2]
+        sha = content_sha256(path)
+        learned.append(
+            {"path": key, "size_bytes": stat.st_size, "mtime_ns": stat.st_mtime_ns, "sha256": sha}
+        )
+        return sha
+    return content_sha256(path)  # frame folders: hashed each time (they are few)
+
+
 def _summary_row(qa: dict[str, Any]) -> Row:
     return {key: value for key, value in qa.items() if key != "joint_violations"}
 
@@ -150,11 +169,14 @@ def run_batch(
 
     todo: list[tuple[Path, str]] = []
     seen: dict[str, Path] = {}
+    takes = [path for path, reason in items if reason is None]
+    known = shoots.known_hashes([str(p.resolve()) for p in takes])
+    learned: list[dict[str, Any]] = []
     for path, reason in items:
         if reason is not None:
             emit({"source": str(path), "status": "skipped", "error": reason})
             continue
-        sha = content_sha256(path)
+        sha = _content_hash(path, known, learned)
         if sha in seen:
             emit(
                 {"source": str(path), "status": "skipped", "error": f"same content as {seen[sha]}"}
@@ -162,6 +184,7 @@ def run_batch(
             continue
         seen[sha] = path
         todo.append((path, sha))
+    shoots.remember_hashes(learned)
 
     finished = shoots.finished([sha for _, sha in todo], options_json)
     stored = shoots.qa_rows(list(finished.values()))

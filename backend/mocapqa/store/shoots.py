@@ -18,7 +18,7 @@ from mocapqa import __version__
 from mocapqa.errors import ConflictError, InputError, NotFoundError
 from mocapqa.store.qa import sync_take
 from mocapqa.store.repository import RUN_STATUSES, new_id, utc_now
-from mocapqa.store.tables import reviews, runs, shoots, take_qa, takes
+from mocapqa.store.tables import reviews, runs, shoots, source_hashes, take_qa, takes
 
 __all__ = ["SORT_COLUMNS", "ShootStore", "TakeFilter"]
 
@@ -388,6 +388,36 @@ class ShootStore:
                 )
             )
             sync_take(conn, str(take["id"]))
+
+    def known_hashes(self, paths: list[str]) -> dict[str, tuple[int, int, str]]:
+        """Cached ``(size, mtime_ns, sha256)`` of these source paths."""
+        found: dict[str, tuple[int, int, str]] = {}
+        with self.engine.connect() as conn:
+            for start in range(0, len(paths), 500):
+                query = select(source_hashes).where(
+                    source_hashes.c.path.in_(paths[start : start + 500])
+                )
+                for row in conn.execute(query).mappings():
+                    found[str(row["path"])] = (
+                        int(row["size_bytes"]),
+                        int(row["mtime_ns"]),
+                        str(row["sha256"]),
+                    )
+        return found
+
+    def remember_hashes(self, rows: list[dict[str, Any]]) -> None:
+        """Store ``{"path", "size_bytes", "mtime_ns", "sha256"}`` rows, replacing older ones."""
+        if not rows:
+            return
+        with self.engine.begin() as conn:
+            for start in range(0, len(rows), 500):
+                chunk = rows[start : start + 500]
+                conn.execute(
+                    delete(source_hashes).where(
+                        source_hashes.c.path.in_([r["path"] for r in chunk])
+                    )
+                )
+                conn.execute(insert(source_hashes), chunk)
 
     def qa_rows(self, take_ids: list[str]) -> dict[str, dict[str, Any]]:
         """The summary rows of these takes, by take id."""

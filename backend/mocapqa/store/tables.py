@@ -21,7 +21,16 @@ from sqlalchemy import (
     Text,
 )
 
-__all__ = ["ADDED_COLUMNS", "metadata", "reviews", "runs", "shoots", "take_qa", "takes"]
+__all__ = [
+    "ADDED_COLUMNS",
+    "metadata",
+    "reviews",
+    "runs",
+    "shoots",
+    "source_hashes",
+    "take_qa",
+    "takes",
+]
 
 metadata = MetaData()
 """The schema; ``metadata.create_all(engine)`` creates it."""
@@ -128,3 +137,14 @@ take_qa = Table(
 )
 """One row per take: its latest run's status and QA summary and its latest review, kept in step
 by the repository so that a shoot's take table sorts and filters on indexed columns."""
+
+source_hashes = Table(
+    "source_hashes",
+    metadata,
+    Column("path", String(1024), primary_key=True),
+    Column("size_bytes", BigInteger, nullable=False),
+    Column("mtime_ns", BigInteger, nullable=False),
+    Column("sha256", String(64), nullable=False),
+)
+"""Content hashes of batch source files by path, size and modification time, so resuming a
+batch stats its files instead of reading them again."""
