@@ -158,6 +158,13 @@ class ShootStore:
             raise ConflictError(f"Expected a new shoot name, got {clean!r} (taken)") from e
         return self.get(shoot_id)
 
+    def require(self, shoot_id: str) -> None:
+        """:class:`NotFoundError` unless the shoot exists (one indexed lookup, no counts)."""
+        with self.engine.connect() as conn:
+            found = conn.execute(select(shoots.c.id).where(shoots.c.id == shoot_id)).first()
+        if found is None:
+            raise NotFoundError(f"Expected shoot {shoot_id!r} to exist, got none")
+
     def get(self, shoot_id: str) -> dict[str, Any]:
         """One shoot with its counts; :class:`NotFoundError` when missing."""
         found = self._with_counts(shoot_id)
@@ -245,7 +252,7 @@ class ShootStore:
         """
         if sort not in SORT_COLUMNS:
             raise InputError(f"Expected sort in {list(SORT_COLUMNS)}, got {sort!r}")
-        self.get(shoot_id)
+        self.require(shoot_id)
         where = and_(take_qa.c.shoot_id == shoot_id, *(filters or TakeFilter()).clauses())
         column = take_qa.c[sort]
         order = column.desc().nulls_last() if descending else column.asc().nulls_last()
@@ -316,7 +323,7 @@ class ShootStore:
 
         ``after`` (a take id) skips that take, so a client can move on without deciding.
         """
-        self.get(shoot_id)
+        self.require(shoot_id)
         where = and_(
             take_qa.c.shoot_id == shoot_id,
             take_qa.c.status == "done",

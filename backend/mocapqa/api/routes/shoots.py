@@ -113,7 +113,7 @@ def import_takes(
     Non-motion archive members are listed as skipped, unreadable or unsafe ones (links,
     names leaving the archive) as failed with their error; the rest are kept.
     """
-    _store(services).get(shoot_id)
+    _store(services).require(shoot_id)
     settings = services.settings
     limits = ImportLimits(
         max_upload_bytes=int(settings.max_upload_mb * 1_000_000),
