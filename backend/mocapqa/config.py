@@ -115,6 +115,7 @@ class Settings(BaseSettings):
             max_line_bytes=self.max_line_bytes,
             max_json_depth=self.max_json_depth,
         )
+
     dask_scheduler: str | None = None
     archive_max_members: int = 10_000
     archive_max_unpacked_mb: float = 2_000.0

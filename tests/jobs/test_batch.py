@@ -263,7 +263,9 @@ def test_batch_on_separate_scheduler_and_worker(corpus_copy: Path, tmp_path: Pat
         assert repository.list_takes()[1] == 4
         repository.close()
         # The server sends its runs to the same cluster when MOCAPQA_DASK_SCHEDULER is set.
-        settings = Settings(data_dir=tmp_path / "server", dask_scheduler=address)
+        settings = Settings(
+            allowed_hosts=["testserver"], data_dir=tmp_path / "server", dask_scheduler=address
+        )
         with TestClient(create_app(settings)) as client:
             with (corpus_copy / Path(TAKES[0]).name).open("rb") as handle:
                 created = client.post("/api/v1/takes", files={"file": ("bow.bvh", handle)})

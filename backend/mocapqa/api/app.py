@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import gzip
 import logging
+import re
 from collections.abc import AsyncIterator, Sequence
 from contextlib import asynccontextmanager
 from pathlib import Path
@@ -129,7 +130,13 @@ def create_app(
     )
     app.state.services = services
     app.add_middleware(GZipMiddleware, minimum_size=2048, compresslevel=5)
-    install_http_guards(app, settings, f"{API_PREFIX}/takes", runner.pending)
+    install_http_guards(
+        app,
+        settings,
+        f"{API_PREFIX}/takes",
+        runner.pending,
+        re.compile(rf"{API_PREFIX}/shoots/[^/]+/takes"),
+    )
     install_error_handlers(app)
     for router, dependencies in ROUTERS:
         app.include_router(router, prefix=API_PREFIX, dependencies=list(dependencies))

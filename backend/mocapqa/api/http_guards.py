@@ -8,7 +8,8 @@ One ASGI middleware (:class:`RequestGuard`), so each check answers before the bo
   delete through a visitor's browser. Clients that are not browsers send neither header.
 * **Body size**: counted while it streams (Content-Length or chunked), with Starlette's
   :class:`~starlette.middleware.body_limit.RequestBodyLimitMiddleware`: the upload route allows
-  ``max_upload_mb`` (plus the multipart envelope), every other route ``max_request_kb``.
+  ``max_upload_mb`` (plus the multipart envelope), a shoot import (many files or archives in
+  one request) ``archive_max_unpacked_mb``, every other route ``max_request_kb``.
   Over the limit the request gets 413 and no more of the body is read.
 * **Upload rate and queued runs per client**: an upload beyond
   ``uploads_per_minute_per_client``, or from a client with ``max_queued_runs_per_client`` runs
@@ -24,6 +25,7 @@ The ``Host`` header is checked by Starlette's ``TrustedHostMiddleware`` and CORS
 from __future__ import annotations
 
 import json
+import re
 import threading
 import time
 from collections import deque
@@ -147,10 +149,13 @@ class RequestGuard:
         settings: Settings,
         upload_path: str,
         pending_runs: Callable[[str], int],
+        import_paths: re.Pattern[str] | None = None,
     ) -> None:
         self.app = app
         self.settings = settings
         self.upload_path = upload_path
+        self.import_paths = import_paths
+        self.import_bytes = int(settings.archive_max_unpacked_mb * 1_000_000)
         self.pending_runs = pending_runs
         self.uploads = RateWindow(settings.uploads_per_minute_per_client)
         self.upload_bytes = int(settings.max_upload_mb * 1_000_000) + MULTIPART_SLACK_BYTES
@@ -162,7 +167,12 @@ class RequestGuard:
             return
         headers = Headers(scope=scope)
         method = scope["method"]
-        is_upload = method == "POST" and scope["path"] == self.upload_path
+        is_import = (
+            method == "POST"
+            and self.import_paths is not None
+            and self.import_paths.fullmatch(scope["path"]) is not None
+        )
+        is_upload = (method == "POST" and scope["path"] == self.upload_path) or is_import
         secured = self._with_headers(send, scope["path"].startswith(_DOCS_PATHS), is_upload)
         if method in _STATE_CHANGING and not origin_allowed(headers, self.settings.cors_origins):
             detail = (
@@ -177,6 +187,8 @@ class RequestGuard:
                 await _send_json(secured, 429, refused[0], refused[1])
                 return
         limit = self.upload_bytes if is_upload else self.request_bytes
+        if is_import:
+            limit = self.import_bytes
         await RequestBodyLimitMiddleware(self.app, limit)(scope, receive, secured)
 
     def _upload_refusal(self, client: str) -> tuple[dict[str, object], int] | None:
@@ -232,18 +244,27 @@ class RequestGuard:
 
 
 def install_http_guards(
-    app: FastAPI, settings: Settings, upload_path: str, pending_runs: Callable[[str], int]
+    app: FastAPI,
+    settings: Settings,
+    upload_path: str,
+    pending_runs: Callable[[str], int],
+    import_paths: re.Pattern[str] | None = None,
 ) -> None:
     """Add the request guard, CORS (when ``cors_origins`` is set) and the Host check, in the
-    order that makes the Host check run first."""
+    order that makes the Host check run first. ``import_paths`` matches the routes that take
+    many files in one request (uploads with the import body limit)."""
     app.add_middleware(
-        RequestGuard, settings=settings, upload_path=upload_path, pending_runs=pending_runs
+        RequestGuard,
+        settings=settings,
+        upload_path=upload_path,
+        pending_runs=pending_runs,
+        import_paths=import_paths,
     )
     if settings.cors_origins:
         app.add_middleware(
             CORSMiddleware,
             allow_origins=settings.cors_origins,
-            allow_methods=["GET", "POST", "DELETE"],
+            allow_methods=["GET", "POST", "PATCH", "DELETE"],
             allow_headers=["Content-Type", "Authorization"],
             max_age=600,
         )

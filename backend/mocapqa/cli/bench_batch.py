@@ -332,7 +332,9 @@ def bench_batch(
         targets.append(("PostgreSQL", str(postgres_url or os.environ["MOCAPQA_TEST_POSTGRES_URL"])))
     for label, url in targets:
         shoot_id = _fill(url, rows, api_takes)
-        settings = Settings(data_dir=root / "api-data", database_url=url)
+        settings = Settings(
+            data_dir=root / "api-data", database_url=url, allowed_hosts=["testserver"]
+        )
         with TestClient(create_app(settings)) as client:
             base = f"/api/v1/shoots/{shoot_id}"
             requests: tuple[tuple[str, str, dict[str, Any]], ...] = (

@@ -26,8 +26,8 @@ from mocapqa.errors import InputError, MocapQAError
 from mocapqa.io.bvh_write import format_bvh
 from mocapqa.io.guards import ReadLimits
 from mocapqa.io.keypoint_csv import csv_sidecar_path
-from mocapqa.jobs.fair_queue import FairQueue
 from mocapqa.jobs.engine import Engine
+from mocapqa.jobs.fair_queue import FairQueue
 from mocapqa.jobs.rendered import render_thumbnail
 from mocapqa.pipeline.analyze import AnalysisResult, analyze
 from mocapqa.pipeline.loading import (

@@ -374,9 +374,7 @@ class Repository:
                     )
                 )
             for take_id in set(
-                conn.execute(
-                    select(runs.c.take_id).where(runs.c.id.in_(ids + exhausted))
-                ).scalars()
+                conn.execute(select(runs.c.take_id).where(runs.c.id.in_(ids + exhausted))).scalars()
             ):
                 sync_take(conn, str(take_id))
         return ids

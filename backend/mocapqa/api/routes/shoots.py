@@ -13,6 +13,7 @@ from fastapi import APIRouter, File, Query, Response, UploadFile
 from fastapi.responses import StreamingResponse
 
 from mocapqa.api.deps import ServicesDep
+from mocapqa.api.errors import responses
 from mocapqa.api.shoot_schemas import (
     HeatmapOut,
     ImportOut,
@@ -33,18 +34,6 @@ __all__ = ["EXPORT_COLUMNS", "router"]
 router = APIRouter(prefix="/shoots", tags=["shoots"])
 """Routes of this resource, included under ``/api/v1``."""
 
-_ERRORS: dict[int, str] = {
-    404: "No shoot with this id",
-    409: "The name is taken by another shoot",
-    413: "An upload or archive passes a size or member limit",
-    415: "Not a recognised format",
-    422: "Invalid parameters or body",
-}
-
-
-def _errors(*codes: int) -> dict[int | str, dict[str, Any]]:
-    return {code: {"description": _ERRORS[code]} for code in codes}
-
 
 def _store(services: ServicesDep) -> ShootStore:
     return ShootStore(services.repository.engine)
@@ -53,31 +42,31 @@ def _store(services: ServicesDep) -> ShootStore:
 ShootSort = Literal[SORT_COLUMNS]  # type: ignore[valid-type]
 
 
-@router.post("", status_code=201, responses=_errors(409, 422))
+@router.post("", status_code=201, responses=responses(403, 409))
 def create_shoot(body: ShootIn, services: ServicesDep) -> ShootOut:
     """Create an empty shoot."""
     return ShootOut(**_store(services).create(body.name))
 
 
-@router.get("", responses=_errors(422))
+@router.get("", responses=responses())
 def list_shoots(services: ServicesDep) -> list[ShootOut]:
     """Every shoot, by name, with its take counts per run status and per review status."""
     return [ShootOut(**row) for row in _store(services).list_all()]
 
 
-@router.get("/{shoot_id}", responses=_errors(404, 422))
+@router.get("/{shoot_id}", responses=responses(404))
 def get_shoot(shoot_id: str, services: ServicesDep) -> ShootOut:
     """One shoot with its counts."""
     return ShootOut(**_store(services).get(shoot_id))
 
 
-@router.patch("/{shoot_id}", responses=_errors(404, 409, 422))
+@router.patch("/{shoot_id}", responses=responses(403, 404, 409))
 def rename_shoot(shoot_id: str, body: ShootIn, services: ServicesDep) -> ShootOut:
     """Rename a shoot."""
     return ShootOut(**_store(services).rename(shoot_id, body.name))
 
 
-@router.delete("/{shoot_id}", status_code=204, responses=_errors(404, 422))
+@router.delete("/{shoot_id}", status_code=204, responses=responses(403, 404))
 def delete_shoot(
     shoot_id: str,
     services: ServicesDep,
@@ -101,7 +90,7 @@ def delete_shoot(
     return Response(status_code=204)
 
 
-@router.post("/{shoot_id}/takes", status_code=201, responses=_errors(404, 413, 422))
+@router.post("/{shoot_id}/takes", status_code=201, responses=responses(403, 404, 413, 415, 429))
 def import_takes(
     shoot_id: str,
     services: ServicesDep,
@@ -131,7 +120,7 @@ def import_takes(
     return ImportOut(created=report.created, skipped=report.skipped, failed=report.failed)
 
 
-@router.get("/{shoot_id}/takes", responses=_errors(404, 422))
+@router.get("/{shoot_id}/takes", responses=responses(404))
 def list_shoot_takes(
     shoot_id: str,
     services: ServicesDep,
@@ -155,13 +144,13 @@ def list_shoot_takes(
     )
 
 
-@router.get("/{shoot_id}/progress", responses=_errors(404, 422))
+@router.get("/{shoot_id}/progress", responses=responses(404))
 def shoot_progress(shoot_id: str, services: ServicesDep) -> ProgressOut:
     """Takes per status and frames analysed; ``finished`` once nothing is queued or running."""
     return ProgressOut(**_store(services).progress(shoot_id))
 
 
-@router.get("/{shoot_id}/heatmap", responses=_errors(404, 422))
+@router.get("/{shoot_id}/heatmap", responses=responses(404))
 def shoot_heatmap(
     shoot_id: str,
     services: ServicesDep,
@@ -173,7 +162,7 @@ def shoot_heatmap(
     return HeatmapOut(**_store(services).heatmap(shoot_id, limit, offset, sort))
 
 
-@router.get("/{shoot_id}/next", responses=_errors(404, 422))
+@router.get("/{shoot_id}/next", responses=responses(404))
 def next_take(
     shoot_id: str,
     services: ServicesDep,
@@ -201,7 +190,7 @@ def _export_rows(store: ShootStore, shoot_id: str) -> Iterator[dict[str, Any]]:
 @router.get(
     "/{shoot_id}/summary.{kind}",
     responses={
-        **_errors(404, 422),
+        **responses(404),
         200: {"content": {"text/csv": {}, "application/json": {}}},
     },
     response_class=Response,
