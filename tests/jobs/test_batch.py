@@ -25,11 +25,13 @@ from mocapqa.api.app import create_app
 from mocapqa.config import Settings
 from mocapqa.jobs.batch import run_batch
 from mocapqa.jobs.engine import Engine
+from mocapqa.jobs.runner import write_outputs
 from mocapqa.jobs.take_task import analyse_path
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.loading import read_take_file
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.pipeline.summary import qa_summary
+from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
 from mocapqa.store.shoots import ShootStore
 
@@ -108,10 +110,12 @@ def test_batch_equals_single_take_analysis(
         run = repository.get_run(str(stored["latest_run_id"]))
         assert run["summary"]["qa"] == expected
         folder = data / "runs" / str(run["id"])
+        # The same files as the single-take path writes for this result (the server's).
+        alone_store = FileStore(tmp_path / "alone")
+        write_outputs(alone_store, str(run["id"]), alone)
+        alone_folder = alone_store.run_dir(str(run["id"]))
         report = _report_without_timings(folder / "report.json")
-        alone_report = json.loads(json.dumps({**alone.report, "downloads": report["downloads"]}))
-        alone_report.pop("timings_s", None)
-        assert report == alone_report
+        assert report == _report_without_timings(alone_folder / "report.json")
         with np.load(folder / "points.npz") as points:
             assert np.array_equal(
                 points["raw"], alone.raw_points.astype(np.float32), equal_nan=True
