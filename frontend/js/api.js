@@ -74,3 +74,23 @@ export async function waitForRun(runId, onProgress, intervalMs = 300) {
     await new Promise((r) => setTimeout(r, intervalMs));
   }
 }
+
+// Shoots: many takes imported at once, a server-side take table, progress, review queue, export.
+export const listShoots = () => request("GET", "/shoots");
+export const getShoot = (id) => request("GET", `/shoots/${id}`);
+export const createShoot = (name) => request("POST", "/shoots", { name });
+export const shootTakes = (id, query) => request("GET", `/shoots/${id}/takes?${query}`);
+export const shootProgress = (id) => request("GET", `/shoots/${id}/progress`);
+export const shootHeatmap = (id, query) => request("GET", `/shoots/${id}/heatmap?${query}`);
+export const nextForReview = (id, after) => request("GET", `/shoots/${id}/next${after ? `?after=${after}` : ""}`);
+export const summaryUrl = (id, kind) => `${BASE}/shoots/${id}/summary.${kind}`;
+export const shootLink = (id, query = "") => `#/shoot/${id}${query ? `?${query}` : ""}`;
+
+/** Import files and archives into a shoot (one multipart request, field `files` repeated). */
+export async function importIntoShoot(id, files) {
+  const form = new FormData();
+  for (const file of files) form.append("files", file, file.name);
+  const response = await fetch(`${BASE}/shoots/${id}/takes`, { method: "POST", body: form });
+  if (!response.ok) throw await apiError(response.status, await response.text());
+  return response.json();
+}

@@ -1,7 +1,8 @@
-// The router: #/ (takes), #/upload, #/take/ID?run=RID&frame=F, #/compare. One module per view.
+// The router: #/ (takes), #/upload, #/shoots, #/shoot/ID[/review], #/take/ID?run=RID&frame=F, #/compare. One module per view.
 import { h } from "./dom.js";
 import { compareView } from "./compare.js";
 import { listView } from "./list.js";
+import { reviewQueueView, shootsView, shootView } from "./shoot.js";
 import { takeView } from "./take.js";
 import { uploadView } from "./upload.js";
 
@@ -18,6 +19,9 @@ function route() {
   const view = parts[0] === "take" ? takeView(main, parts[1], params, (t) => teardowns.push(t))
     : parts[0] === "upload" ? uploadView(main)
     : parts[0] === "compare" ? compareView(main, params)
+    : parts[0] === "shoots" ? shootsView(main)
+    : parts[0] === "shoot" && parts[2] === "review" ? reviewQueueView(main, parts[1], (t) => teardowns.push(t))
+    : parts[0] === "shoot" ? shootView(main, parts[1], params, (t) => teardowns.push(t))
     : listView(main, params, route).then(() => { main.dataset.ready = "1"; });
   view.catch((e) => main.replaceChildren(h("p", { class: "error" }, e.message)));
 }

@@ -1,0 +1,123 @@
+// Pure functions of the shoot view: the take table's query string, column formatting, score
+// colours, progress, import results and the review keys. No DOM: unit-tested with node --test.
+import { fmt } from "./format.js";
+
+/** Filters and paging the take table understands, with their defaults (the server's). */
+export const TABLE_DEFAULTS = {
+  sort: "score", order: "asc", limit: 25, offset: 0,
+  status: "", review_status: "", rig: "", min_score: "", max_score: "", has_findings: "", search: "",
+};
+
+/** The table's state from the view's URL parameters (unknown keys ignored, numbers parsed). */
+export function tableState(params) {
+  const out = { ...TABLE_DEFAULTS };
+  for (const key of Object.keys(TABLE_DEFAULTS)) {
+    const value = params.get(key);
+    if (value != null) out[key] = value;
+  }
+  out.limit = Math.max(1, Math.min(500, Number.parseInt(out.limit, 10) || TABLE_DEFAULTS.limit));
+  out.offset = Math.max(0, Number.parseInt(out.offset, 10) || 0);
+  if (out.order !== "asc" && out.order !== "desc") out.order = "asc";
+  return out;
+}
+
+/** The query string of GET /shoots/{id}/takes (empty filters left out, keys in a fixed order). */
+export function takesQuery(state) {
+  const query = new URLSearchParams();
+  for (const key of Object.keys(TABLE_DEFAULTS)) {
+    const value = state[key];
+    if (value === "" || value == null) continue;
+    query.set(key, String(value).trim());
+  }
+  return query.toString();
+}
+
+/** The view's own URL parameters: only what differs from the defaults, so links stay short. */
+export function viewQuery(state) {
+  const query = new URLSearchParams();
+  for (const [key, fallback] of Object.entries(TABLE_DEFAULTS)) {
+    if (state[key] !== "" && state[key] != null && String(state[key]) !== String(fallback)) query.set(key, String(state[key]));
+  }
+  return query.toString();
+}
+
+/** Clicking a column header: the same column flips the order, a new one sorts ascending. Any
+ * sort goes back to the first page. */
+export function nextSort(state, column) {
+  const order = state.sort === column && state.order === "asc" ? "desc" : "asc";
+  return { ...state, sort: column, order, offset: 0 };
+}
+
+/** Paging: "1–25 of 60" and the offsets of the previous/next pages (null at either end). */
+export function pageInfo(offset, limit, total) {
+  const first = total === 0 ? 0 : offset + 1;
+  const last = Math.min(total, offset + limit);
+  return {
+    text: `${first}–${last} of ${total}`,
+    previous: offset > 0 ? Math.max(0, offset - limit) : null,
+    next: offset + limit < total ? offset + limit : null,
+  };
+}
+
+const percent = (v) => (v == null ? "–" : `${fmt(100 * v, 1)} %`);
+const count = (v) => (v == null ? "–" : String(v));
+
+/** The take table's summary columns: the server's sort key, a header, a formatter, and
+ * whether a narrow window hides it. */
+export const TAKE_COLUMNS = [
+  { key: "name", label: "name", format: (v) => v },
+  { key: "status", label: "run", format: (v) => v || "none" },
+  { key: "score", label: "score", format: (v) => fmt(v, 1) },
+  { key: "n_frames", label: "frames", format: count },
+  { key: "duration_s", label: "duration", format: (v) => (v == null ? "–" : `${fmt(v, 1)} s`), narrow: true },
+  { key: "rig", label: "rig", format: (v) => v || "–", narrow: true },
+  { key: "twist_intervals", label: "twist", format: count },
+  { key: "violation_share", label: "outside limits", format: percent },
+  { key: "worst_joint", label: "worst joint", format: (v) => v || "–", narrow: true },
+  { key: "filter_residual_mm", label: "filter mm", format: (v) => fmt(v, 2), narrow: true },
+  { key: "missing_share", label: "missing", format: percent, narrow: true },
+  { key: "n_findings", label: "findings", format: count },
+  { key: "review_status", label: "review", format: (v) => (v || "unreviewed").replace("_", " ") },
+  { key: "reviewer", label: "reviewer", format: (v) => v || "–", narrow: true },
+];
+
+/** One cell's text. */
+export function formatCell(key, row) {
+  const column = TAKE_COLUMNS.find((c) => c.key === key);
+  return column ? column.format(row[key]) : String(row[key] ?? "–");
+}
+
+/** A QA score's colour: red at 0, amber at 50, green at 100 (HSL hue 0→120); grey when the
+ * take has no score yet. */
+export function scoreColor(score) {
+  if (score == null || Number.isNaN(Number(score))) return "#9aa3ad";
+  const clamped = Math.max(0, Math.min(100, Number(score)));
+  return `hsl(${Math.round(1.2 * clamped)}, 65%, 40%)`;
+}
+
+/** Progress of a shoot's analysis: share of takes finished (done or failed) and a line of text. */
+export function progressSummary(progress) {
+  const counts = progress.status_counts || {};
+  const finished = (counts.done || 0) + (counts.failed || 0);
+  const total = progress.n_takes || 0;
+  const parts = ["queued", "running", "done", "failed"].filter((s) => counts[s]).map((s) => `${counts[s]} ${s}`);
+  return {
+    finished, total, share: total ? finished / total : 1,
+    text: `${finished} of ${total} takes analysed${parts.length ? ` (${parts.join(", ")})` : ""} · ${progress.frames_done} frames`,
+  };
+}
+
+/** An import's answer in three lists of lines: kept, skipped (with reason), failed (with error). */
+export function importLines(result) {
+  return {
+    kept: (result.created || []).map((c) => c.name),
+    skipped: (result.skipped || []).map((s) => `${s.name}: ${s.reason}`),
+    failed: (result.failed || []).map((f) => `${f.name}: ${f.error}`),
+  };
+}
+
+/** Review queue keys: the decision a key records (case-insensitive), or null. */
+export const REVIEW_KEYS = { a: "approved", f: "needs_fix", r: "rejected" };
+export function decisionForKey(key) {
+  return REVIEW_KEYS[String(key).toLowerCase()] || null;
+}

@@ -1,0 +1,276 @@
+// Shoots: the list (#/shoots), one shoot's take table with import, live progress, export and
+// the violations heat map (#/shoot/ID), and its review queue (#/shoot/ID/review).
+// The table is sorted, filtered and paged on the server; its state lives in the URL.
+import * as api from "./api.js";
+import { activatable, badge, h, REVIEW } from "./dom.js";
+import { loadPlotly, untabbableModebar } from "./plotly.js";
+import { fmt } from "./format.js";
+import {
+  decisionForKey, formatCell, importLines, nextSort, pageInfo, progressSummary, scoreColor,
+  TAKE_COLUMNS, tableState, takesQuery, viewQuery,
+} from "./shoot-format.js";
+
+const POLL_MS = 1000;
+
+export async function shootsView(main) {
+  const shoots = await api.listShoots();
+  const name = h("input", { id: "shoot-name", placeholder: "new shoot name", "aria-label": "new shoot name", required: true });
+  const message = h("span", { id: "shoot-message", class: "error" });
+  const form = h("form", { class: "controls", id: "shoot-create" }, name, h("button", { class: "primary", type: "submit" }, "create shoot"), message);
+  form.addEventListener("submit", async (e) => {
+    e.preventDefault();
+    try {
+      const shoot = await api.createShoot(name.value.trim());
+      location.hash = api.shootLink(shoot.id);
+    } catch (error) { message.textContent = error.message; }
+  });
+  const counts = (c) => ["queued", "running", "done", "failed"].map((s) => h("td", {}, c[s] || 0));
+  const rows = shoots.map((s) => activatable(h("tr", { class: "clickable", "data-shoot": s.id, "aria-label": `open ${s.name}` },
+    h("td", { class: "name" }, s.name), h("td", {}, s.n_takes), h("td", { class: "narrow-hide" }, s.n_frames), counts(s.status_counts),
+    h("td", { class: "narrow-hide" }, s.review_counts.unreviewed || 0)), () => { location.hash = api.shootLink(s.id); }));
+  main.replaceChildren(h("h1", {}, `Shoots (${shoots.length})`), form,
+    h("table", { id: "shoot-list" }, h("thead", {}, h("tr", {}, ["name", "takes", "frames", "queued", "running", "done", "failed", "unreviewed"].map((c, k) =>
+      h("th", { class: k === 2 || k === 7 ? "narrow-hide" : null }, c)))), h("tbody", {}, rows)),
+    shoots.length ? null : h("p", { class: "muted" }, "No shoot yet: create one, then import its takes."));
+  main.dataset.ready = "1";
+}
+
+/** Every file of a drop, folders walked recursively (DataTransfer items → file system entries). */
+async function droppedFiles(dataTransfer) {
+  const entries = [...dataTransfer.items].map((item) => item.webkitGetAsEntry && item.webkitGetAsEntry()).filter(Boolean);
+  if (!entries.length) return [...dataTransfer.files];
+  const files = [];
+  const walk = async (entry) => {
+    if (entry.isFile) files.push(await new Promise((resolve, reject) => entry.file(resolve, reject)));
+    else if (entry.isDirectory) {
+      const reader = entry.createReader();
+      for (;;) {
+        const batch = await new Promise((resolve, reject) => reader.readEntries(resolve, reject));
+        if (!batch.length) break;
+        for (const child of batch) await walk(child);
+      }
+    }
+  };
+  for (const entry of entries) await walk(entry);
+  return files;
+}
+
+function importPanel(shootId, onImported) {
+  const result = h("div", { id: "import-result" });
+  const filesInput = h("input", { type: "file", id: "import-files", multiple: true, hidden: true });
+  const folderInput = h("input", { type: "file", id: "import-folder", webkitdirectory: true, multiple: true, hidden: true });
+  const send = async (files) => {
+    if (!files.length) return;
+    result.replaceChildren(h("p", { class: "muted", id: "import-busy" }, `importing ${files.length} file(s)…`));
+    try {
+      const lines = importLines(await api.importIntoShoot(shootId, files));
+      const list = (id, title, items, cls) => h("div", { id, class: cls }, h("strong", {}, `${title} (${items.length})`),
+        items.length ? h("ul", {}, items.map((t) => h("li", {}, t))) : null);
+      result.replaceChildren(list("import-kept", "kept", lines.kept, ""), list("import-skipped", "skipped", lines.skipped, "muted"),
+        list("import-failed", "failed", lines.failed, lines.failed.length ? "error" : "muted"));
+    } catch (e) {
+      result.replaceChildren(h("p", { class: "error", id: "import-error" }, `Import refused: ${e.message}`));
+    }
+    onImported();
+  };
+  filesInput.addEventListener("change", () => send([...filesInput.files]));
+  folderInput.addEventListener("change", () => send([...folderInput.files]));
+  const zone = h("div", { class: "dropzone", id: "import-zone" },
+    h("p", {}, "Drop takes, folders or .zip / .tar.gz archives here, or ",
+      h("button", { type: "button", onclick: () => filesInput.click() }, "choose files"), " ",
+      h("button", { type: "button", onclick: () => folderInput.click() }, "choose a folder")),
+    filesInput, folderInput);
+  zone.addEventListener("dragover", (e) => { e.preventDefault(); zone.classList.add("over"); });
+  zone.addEventListener("dragleave", () => zone.classList.remove("over"));
+  zone.addEventListener("drop", (e) => {
+    e.preventDefault(); zone.classList.remove("over");
+    droppedFiles(e.dataTransfer).then(send);
+  });
+  return h("div", {}, zone, result);
+}
+
+function filterBar(state, apply) {
+  const select = (key, label, options) => h("label", {}, `${label} `, h("select", { id: `shoot-${key}`, onchange: (e) => apply({ [key]: e.target.value }) },
+    options.map(([v, text]) => h("option", { value: v, selected: String(state[key]) === v }, text))));
+  const input = (key, label, attrs) => {
+    const el = h("input", { id: `shoot-${key}`, value: state[key], "aria-label": label, placeholder: label, ...attrs });
+    let timer = null;
+    el.addEventListener("input", () => { clearTimeout(timer); timer = setTimeout(() => apply({ [key]: el.value }), 350); });
+    return el;
+  };
+  return h("div", { class: "controls shoot-filters" },
+    input("search", "search name", { type: "search" }),
+    select("status", "run", [["", "any"], ["queued", "queued"], ["running", "running"], ["done", "done"], ["failed", "failed"]]),
+    select("review_status", "review", [["", "any"], ...Object.entries(REVIEW)]),
+    select("has_findings", "findings", [["", "any"], ["true", "some"], ["false", "none"]]),
+    input("rig", "rig", { class: "short" }),
+    input("min_score", "min score", { type: "number", min: 0, max: 100, class: "short" }),
+    input("max_score", "max score", { type: "number", min: 0, max: 100, class: "short" }));
+}
+
+function takeTable(page, state, apply) {
+  const header = TAKE_COLUMNS.map((c) => {
+    const sorted = state.sort === c.key;
+    const th = h("th", { class: `sortable${c.narrow ? " narrow-hide" : ""}`, "data-sort": c.key, "aria-sort": sorted ? (state.order === "asc" ? "ascending" : "descending") : "none" },
+      c.label, sorted ? (state.order === "asc" ? " ▲" : " ▼") : "");
+    return activatable(th, () => apply(nextSort(state, c.key)));
+  });
+  const rows = page.items.map((t) => activatable(h("tr", { class: "clickable", "data-take": t.take_id, "aria-label": `open ${t.name}` },
+    h("td", { class: "thumb-cell" }, t.status === "done" ? h("img", { class: "thumb", src: api.thumbnailUrl(t.take_id, t.run_id), alt: "" }) : null),
+    TAKE_COLUMNS.map((c) => {
+      const text = formatCell(c.key, t);
+      const cell = c.key === "status" ? badge(text) : c.key === "review_status" ? badge(text, t.review_status)
+        : c.key === "score" ? h("span", { class: "score", style: null, "data-score": t.score ?? "" }, text) : text;
+      const td = h("td", { class: `${c.key === "name" ? "name" : ""}${c.narrow ? " narrow-hide" : ""}` || null }, cell);
+      if (c.key === "score") td.firstChild.style.color = scoreColor(t.score);
+      return td;
+    })), () => { location.hash = api.takeLink(t.take_id, t.run_id); }));
+  return h("div", { class: "table-scroll" }, h("table", { id: "shoot-takes" },
+    h("thead", {}, h("tr", {}, h("th", {}, ""), header)), h("tbody", {}, rows)));
+}
+
+export async function shootView(main, shootId, params, onTeardown) {
+  let state = tableState(params);
+  const shoot = await api.getShoot(shootId);
+  const progressBar = h("progress", { id: "shoot-progress", max: 1, value: 0 });
+  const progressText = h("span", { id: "shoot-progress-text" });
+  const tableArea = h("div", { id: "shoot-table-area" });
+  const heatmap = h("div", { id: "shoot-heatmap", class: "panel" });
+  let timer = null;
+  let alive = true;
+  onTeardown(() => { alive = false; clearTimeout(timer); });
+
+  const drawTable = async () => {
+    const page = await api.shootTakes(shootId, takesQuery(state));
+    if (!alive) return;
+    const info = pageInfo(state.offset, state.limit, page.total);
+    const move = (offset) => h("button", { disabled: offset == null, onclick: () => apply({ offset }) });
+    const previous = move(info.previous); previous.append("‹ previous"); previous.id = "page-previous";
+    const next = move(info.next); next.append("next ›"); next.id = "page-next";
+    tableArea.replaceChildren(filterBar(state, apply), takeTable(page, state, apply),
+      h("div", { class: "controls" }, previous, h("span", { id: "page-info" }, info.text), next));
+    tableArea.dataset.query = takesQuery(state);
+  };
+  function apply(patch) {
+    const resetsPage = !("offset" in patch);
+    state = { ...state, ...patch, ...(resetsPage ? { offset: 0 } : {}) };
+    history.replaceState(null, "", api.shootLink(shootId, viewQuery(state)));
+    drawTable().catch(showError);
+  }
+  const showError = (e) => tableArea.prepend(h("p", { class: "error" }, e.message));
+
+  const drawHeatmap = async () => {
+    const [Plotly, data] = await Promise.all([loadPlotly(), api.shootHeatmap(shootId, "limit=200&sort=score")]);
+    if (!alive) return;
+    if (!data.joints.length || !data.takes.length) {
+      heatmap.replaceChildren(h("h2", {}, "Joint limits"), h("p", { class: "muted" }, "No joint-limit results yet."));
+      return;
+    }
+    const chart = h("div", { id: "heatmap-chart" });
+    heatmap.replaceChildren(h("h2", {}, "Share of frames outside the joint limits (joint × take)"), chart);
+    const z = data.values.map((row) => row.map((v) => (v == null ? null : 100 * v)));
+    await Plotly.newPlot(chart, [{
+      type: "heatmap", x: data.joints, y: data.takes.map((t) => t.name), z, colorscale: "YlOrRd", zmin: 0,
+      colorbar: { title: { text: "%" } }, hovertemplate: "%{y}<br>%{x}: %{z:.1f} %<extra></extra>",
+    }], {
+      height: Math.max(260, 120 + 22 * data.takes.length), margin: { l: 180, r: 20, t: 10, b: 110 },
+      yaxis: { autorange: "reversed", automargin: true }, xaxis: { tickangle: -45, automargin: true },
+    }, { responsive: true, displaylogo: false });
+    untabbableModebar(chart);
+  };
+
+  // Poll while anything is queued or running; when it all finishes, redraw table and heat map.
+  let wasRunning = false;
+  const poll = async () => {
+    const progress = await api.shootProgress(shootId);
+    if (!alive) return;
+    const summary = progressSummary(progress);
+    progressBar.value = summary.share;
+    progressText.textContent = summary.text;
+    progressPanel.dataset.finished = progress.finished ? "1" : "0";
+    if (!progress.finished) {
+      wasRunning = true;
+      await drawTable();
+      timer = setTimeout(() => poll().catch(showError), POLL_MS);
+    } else if (wasRunning) {
+      wasRunning = false;
+      await Promise.all([drawTable(), drawHeatmap()]);
+    }
+  };
+  const progressPanel = h("div", { class: "panel", id: "progress-panel" }, "analysis ", progressBar, " ", progressText);
+
+  main.replaceChildren(
+    h("h1", {}, h("a", { href: "#/shoots" }, "Shoots"), ` / ${shoot.name}`),
+    h("div", { class: "controls" },
+      h("a", { class: "button primary", id: "review-queue", href: `#/shoot/${shootId}/review` }, "review queue"),
+      h("a", { class: "download", id: "export-csv", href: api.summaryUrl(shootId, "csv"), download: "" }, "summary CSV"),
+      h("a", { class: "download", id: "export-json", href: api.summaryUrl(shootId, "json"), download: "" }, "summary JSON")),
+    importPanel(shootId, () => { clearTimeout(timer); wasRunning = true; poll().catch(showError); }),
+    progressPanel,
+    tableArea, heatmap);
+  await drawTable();
+  await poll();
+  main.dataset.ready = "1";
+  drawHeatmap().catch((e) => heatmap.replaceChildren(h("p", { class: "error" }, e.message)));
+}
+
+export async function reviewQueueView(main, shootId, onTeardown) {
+  const shoot = await api.getShoot(shootId);
+  const reviewer = h("input", { id: "queue-reviewer", value: localStorage.getItem("mocapqa-reviewer") || "", placeholder: "your name", "aria-label": "reviewer" });
+  const card = h("div", { class: "panel", id: "queue-card" });
+  const message = h("p", { id: "queue-message", class: "muted" });
+  const help = h("p", { class: "muted", id: "keys-help" },
+    "Keys: A approve · F needs fix · R reject (each saves and moves to the next take) · S skip · O open the take · ? shows or hides this line");
+  let current = null;
+  let busy = false;
+
+  const show = async (after) => {
+    const next = await api.nextForReview(shootId, after);
+    current = next.take;
+    if (!current) {
+      card.replaceChildren(h("p", { id: "queue-done" }, "Nothing left to review in this shoot."));
+      card.dataset.take = "";
+      return;
+    }
+    const t = current;
+    const score = h("span", { class: "score big", id: "queue-score" }, fmt(t.score, 1));
+    score.style.color = scoreColor(t.score);
+    const decide = (decision, label, key) => h("button", { "data-decision": decision, onclick: () => record(decision) }, `${label} (${key})`);
+    card.dataset.take = t.take_id;
+    card.replaceChildren(
+      h("div", { class: "row" },
+        h("img", { class: "thumb big", src: api.thumbnailUrl(t.take_id, t.run_id), alt: "" }),
+        h("div", { class: "col" },
+          h("h2", { id: "queue-name" }, t.name), h("p", {}, "QA score ", score, ` · ${next.remaining} left to review`),
+          h("table", { class: "compact" }, h("tbody", {}, TAKE_COLUMNS.filter((c) => !["name", "score", "review_status", "reviewer"].includes(c.key))
+            .map((c) => h("tr", {}, h("th", {}, c.label), h("td", {}, formatCell(c.key, t)))))),
+          h("p", {}, h("a", { href: api.takeLink(t.take_id, t.run_id), id: "queue-open" }, "open in the take view")))),
+      h("div", { class: "controls" }, decide("approved", "approve", "A"), decide("needs_fix", "needs fix", "F"), decide("rejected", "reject", "R"),
+        h("button", { onclick: () => skip() }, "skip (S)")));
+  };
+  const record = async (decision) => {
+    if (!current || busy) return;
+    busy = true;
+    try {
+      localStorage.setItem("mocapqa-reviewer", reviewer.value);
+      await api.addReview(current.take_id, { status: decision, notes: "", reviewer: reviewer.value || "anonymous" });
+      message.textContent = `${current.name}: ${REVIEW[decision]}`;
+      await show();
+    } catch (e) { message.textContent = e.message; message.className = "error"; } finally { busy = false; }
+  };
+  const skip = async () => { if (current && !busy) await show(current.take_id); };
+  const onKey = (e) => {
+    if (e.target instanceof HTMLInputElement || e.target instanceof HTMLTextAreaElement || e.ctrlKey || e.metaKey || e.altKey) return;
+    const decision = decisionForKey(e.key);
+    if (decision) { e.preventDefault(); record(decision); }
+    else if (e.key === "s" || e.key === "S") { e.preventDefault(); skip(); }
+    else if ((e.key === "o" || e.key === "O") && current) location.hash = api.takeLink(current.take_id, current.run_id);
+    else if (e.key === "?") help.hidden = !help.hidden;
+  };
+  document.addEventListener("keydown", onKey);
+  onTeardown(() => document.removeEventListener("keydown", onKey));
+  main.replaceChildren(h("h1", {}, h("a", { href: "#/shoots" }, "Shoots"), " / ", h("a", { href: api.shootLink(shootId) }, shoot.name), " / review queue"),
+    h("div", { class: "controls" }, "Reviewer ", reviewer), help, card, message);
+  await show();
+  main.dataset.ready = "1";
+}

@@ -1,0 +1,97 @@
+import { test } from "node:test";
+import assert from "node:assert/strict";
+import {
+  decisionForKey, formatCell, importLines, nextSort, pageInfo, progressSummary, scoreColor,
+  tableState, takesQuery, viewQuery, TABLE_DEFAULTS,
+} from "../../frontend/js/shoot-format.js";
+
+test("tableState parses numbers, clamps the page size and rejects unknown orders", () => {
+  const s = tableState(new URLSearchParams("limit=9000&offset=-4&order=sideways&sort=rig&status=done&junk=1"));
+  assert.equal(s.limit, 500);
+  assert.equal(s.offset, 0);
+  assert.equal(s.order, "asc");
+  assert.equal(s.sort, "rig");
+  assert.equal(s.status, "done");
+  assert.equal("junk" in s, false);
+  assert.equal(tableState(new URLSearchParams("")).limit, TABLE_DEFAULTS.limit);
+});
+
+test("takesQuery leaves out empty filters, keeps zero and trims search", () => {
+  const q = new URLSearchParams(takesQuery({ ...TABLE_DEFAULTS, min_score: 0, search: "  walk ", has_findings: "true" }));
+  assert.equal(q.get("min_score"), "0");
+  assert.equal(q.get("search"), "walk");
+  assert.equal(q.get("has_findings"), "true");
+  assert.equal(q.get("sort"), "score");
+  assert.equal(q.get("limit"), "25");
+  assert.equal(q.has("status"), false);
+  assert.equal(q.has("rig"), false);
+});
+
+test("viewQuery keeps only what differs from the defaults", () => {
+  assert.equal(viewQuery({ ...TABLE_DEFAULTS }), "");
+  assert.equal(viewQuery({ ...TABLE_DEFAULTS, order: "desc", offset: 25 }), "order=desc&offset=25");
+  // A round trip through the URL gives the same state.
+  const state = { ...TABLE_DEFAULTS, sort: "n_findings", status: "failed", max_score: "40" };
+  const back = tableState(new URLSearchParams(viewQuery(state)));
+  assert.equal(takesQuery(back), takesQuery(state));
+});
+
+test("nextSort flips the same column and starts a new one ascending, on the first page", () => {
+  const s = { ...TABLE_DEFAULTS, offset: 50 };
+  assert.deepEqual([nextSort(s, "score").order, nextSort(s, "score").offset], ["desc", 0]);
+  assert.equal(nextSort({ ...s, order: "desc" }, "score").order, "asc");
+  const other = nextSort({ ...s, order: "desc" }, "name");
+  assert.deepEqual([other.sort, other.order], ["name", "asc"]);
+});
+
+test("pageInfo names the rows shown and the neighbouring pages", () => {
+  assert.deepEqual(pageInfo(0, 25, 60), { text: "1–25 of 60", previous: null, next: 25 });
+  assert.deepEqual(pageInfo(50, 25, 60), { text: "51–60 of 60", previous: 25, next: null });
+  assert.deepEqual(pageInfo(10, 25, 60).previous, 0);
+  assert.deepEqual(pageInfo(0, 25, 0), { text: "0–0 of 0", previous: null, next: null });
+});
+
+test("formatCell formats shares as percent, missing values as a dash", () => {
+  const row = { violation_share: 0.1234, missing_share: null, duration_s: 2.5, score: 87.25, status: null, review_status: "needs_fix", n_findings: 0 };
+  assert.equal(formatCell("violation_share", row), "12.3 %");
+  assert.equal(formatCell("missing_share", row), "–");
+  assert.equal(formatCell("duration_s", row), "2.5 s");
+  assert.equal(formatCell("score", row), "87.3");
+  assert.equal(formatCell("status", row), "none");
+  assert.equal(formatCell("review_status", row), "needs fix");
+  assert.equal(formatCell("n_findings", row), "0");
+});
+
+test("scoreColor runs from red through amber to green, grey without a score", () => {
+  assert.equal(scoreColor(0), "hsl(0, 65%, 40%)");
+  assert.equal(scoreColor(50), "hsl(60, 65%, 40%)");
+  assert.equal(scoreColor(100), "hsl(120, 65%, 40%)");
+  assert.equal(scoreColor(140), "hsl(120, 65%, 40%)");
+  assert.equal(scoreColor(null), "#9aa3ad");
+  assert.equal(scoreColor(undefined), "#9aa3ad");
+});
+
+test("progressSummary counts done and failed takes as finished", () => {
+  const p = progressSummary({ n_takes: 4, status_counts: { done: 2, failed: 1, running: 1 }, frames_done: 900 });
+  assert.equal(p.finished, 3);
+  assert.equal(p.share, 0.75);
+  assert.equal(p.text, "3 of 4 takes analysed (1 running, 2 done, 1 failed) · 900 frames");
+  assert.equal(progressSummary({ n_takes: 0, status_counts: {}, frames_done: 0 }).share, 1);
+});
+
+test("importLines lists kept names, skip reasons and errors", () => {
+  const lines = importLines({
+    created: [{ name: "a.bvh", take_id: "1", run_id: "2" }],
+    skipped: [{ name: "x.zip:notes.txt", reason: "not a motion file" }],
+    failed: [{ name: "b.bvh", error: "line 3: bad" }],
+  });
+  assert.deepEqual(lines, { kept: ["a.bvh"], skipped: ["x.zip:notes.txt: not a motion file"], failed: ["b.bvh: line 3: bad"] });
+});
+
+test("decisionForKey maps A/F/R in either case and nothing else", () => {
+  assert.equal(decisionForKey("a"), "approved");
+  assert.equal(decisionForKey("F"), "needs_fix");
+  assert.equal(decisionForKey("r"), "rejected");
+  assert.equal(decisionForKey("x"), null);
+  assert.equal(decisionForKey(" "), null);
+});
