@@ -121,3 +121,13 @@ export const REVIEW_KEYS = { a: "approved", f: "needs_fix", r: "rejected" };
 export function decisionForKey(key) {
   return REVIEW_KEYS[String(key).toLowerCase()] || null;
 }
+
+/** The heat map's rows: the server sends `values` as joints × takes (shares in [0, 1]); the
+ * chart draws one row per take, so this turns it into takes × joints, in percent (null kept
+ * where the limits check did not run). */
+export function heatmapRows(data) {
+  return data.takes.map((_, t) => data.joints.map((_, j) => {
+    const share = data.values[j][t];
+    return share == null ? null : 100 * share;
+  }));
+}

@@ -6,7 +6,7 @@ import { activatable, badge, h, REVIEW } from "./dom.js";
 import { loadPlotly, untabbableModebar } from "./plotly.js";
 import { fmt } from "./format.js";
 import {
-  decisionForKey, formatCell, importLines, nextSort, pageInfo, progressSummary, scoreColor,
+  decisionForKey, formatCell, heatmapRows, importLines, nextSort, pageInfo, progressSummary, scoreColor,
   TAKE_COLUMNS, tableState, takesQuery, viewQuery,
 } from "./shoot-format.js";
 
@@ -163,14 +163,15 @@ export async function shootView(main, shootId, params, onTeardown) {
     const [Plotly, data] = await Promise.all([loadPlotly(), api.shootHeatmap(shootId, "limit=200&sort=score")]);
     if (!alive) return;
     if (!data.joints.length || !data.takes.length) {
-      heatmap.replaceChildren(h("h2", {}, "Joint limits"), h("p", { class: "muted" }, "No joint-limit results yet."));
+      const why = data.takes.length ? "No joint outside its limits in these takes." : "No joint-limit results yet.";
+      heatmap.replaceChildren(h("h2", {}, "Joint limits"), h("p", { class: "muted", id: "heatmap-empty" }, why));
       return;
     }
     const chart = h("div", { id: "heatmap-chart" });
     heatmap.replaceChildren(h("h2", {}, "Share of frames outside the joint limits (joint × take)"), chart);
-    const z = data.values.map((row) => row.map((v) => (v == null ? null : 100 * v)));
     await Plotly.newPlot(chart, [{
-      type: "heatmap", x: data.joints, y: data.takes.map((t) => t.name), z, colorscale: "YlOrRd", zmin: 0,
+      type: "heatmap", x: data.joints, y: data.takes.map((t) => t.name), z: heatmapRows(data),
+      colorscale: "YlOrRd", reversescale: true, zmin: 0, hoverongaps: false,
       colorbar: { title: { text: "%" } }, hovertemplate: "%{y}<br>%{x}: %{z:.1f} %<extra></extra>",
     }], {
       height: Math.max(260, 120 + 22 * data.takes.length), margin: { l: 180, r: 20, t: 10, b: 110 },

@@ -1,7 +1,7 @@
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import {
-  decisionForKey, formatCell, importLines, nextSort, pageInfo, progressSummary, scoreColor,
+  decisionForKey, formatCell, heatmapRows, importLines, nextSort, pageInfo, progressSummary, scoreColor,
   tableState, takesQuery, viewQuery, TABLE_DEFAULTS,
 } from "../../frontend/js/shoot-format.js";
 
@@ -94,4 +94,10 @@ test("decisionForKey maps A/F/R in either case and nothing else", () => {
   assert.equal(decisionForKey("r"), "rejected");
   assert.equal(decisionForKey("x"), null);
   assert.equal(decisionForKey(" "), null);
+});
+
+test("heatmapRows turns joints × takes shares into takes × joints percent", () => {
+  const data = { joints: ["knee", "elbow"], takes: [{ name: "a" }, { name: "b" }, { name: "c" }], values: [[0.5, 0, null], [0.25, 0.1, null]] };
+  assert.deepEqual(heatmapRows(data), [[50, 25], [0, 10], [null, null]]);
+  assert.deepEqual(heatmapRows({ joints: [], takes: [{ name: "a" }], values: [] }), [[]]);
 });

@@ -1,0 +1,204 @@
+"""The shoot view in headless Chromium, on real takes of the corpus: import a folder into a new
+shoot, watch the analysis finish, sort, walk the review queue with the keyboard, export CSV.
+
+Screenshots go to ``tests/artifacts/shoot-*.png`` (gitignored). Time bounds are generous.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import httpx
+import pytest
+
+from mocapqa.api.routes.shoots import EXPORT_COLUMNS
+from mocapqa.jobs.demo import demo_paths
+
+pytestmark = pytest.mark.browser
+
+ARTIFACTS = Path(__file__).resolve().parents[1] / "artifacts"
+TAKES = (
+    "bvh/bandai/dataset-1_dash_normal_001.bvh",
+    "bvh/cmu/cmu_12_01_walk.bvh",
+    "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d/S00_P00_T01_BalancingTrial_0-100.trc",
+)
+"""Real corpus takes; the bundled demo walk with injected twist errors joins them, so the
+scores differ."""
+ANALYSIS_MS = 300_000
+
+
+class Page:
+    """A Playwright page that records console errors and failed requests."""
+
+    def __init__(self, chromium: Any, width: int = 1400, height: int = 1000) -> None:
+        self.page = chromium.new_page(
+            viewport={"width": width, "height": height}, accept_downloads=True
+        )
+        self.errors: list[str] = []
+        self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
+        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
+
+    def open(self, url: str) -> None:
+        self.page.goto(url)
+        self.page.wait_for_selector("main[data-ready='1']", timeout=60_000)
+
+    def no_sideways_scroll(self) -> bool:
+        return bool(
+            self.page.evaluate(
+                "() => document.scrollingElement.scrollWidth"
+                " <= document.scrollingElement.clientWidth"
+            )
+        )
+
+
+@pytest.fixture
+def page(chromium: Any) -> Iterator[Page]:
+    opened = Page(chromium)
+    yield opened
+    assert opened.errors == []
+    opened.page.close()
+
+
+@pytest.fixture
+def take_folder(corpus_dir: Path, tmp_path: Path) -> Path:
+    """A folder of four takes, one in a sub-folder, and a file that is no take."""
+    folder = tmp_path / "day1"
+    (folder / "more").mkdir(parents=True)
+    for k, relative in enumerate(TAKES):
+        target = folder / ("more" if k == 2 else "") / Path(relative).name
+        shutil.copyfile(corpus_dir / relative, target)
+    twist_demo = demo_paths()[0]
+    assert twist_demo.name.endswith("_twist_errors.bvh")
+    shutil.copyfile(twist_demo, folder / twist_demo.name)
+    (folder / "notes.txt").write_text("slate notes, not a take\n")
+    return folder
+
+
+def scores(page: Page) -> list[float]:
+    texts = page.page.locator("#shoot-takes tbody .score").all_inner_texts()
+    return [float(t) for t in texts]
+
+
+def test_import_progress_sort_review_export(
+    live_server: str, chromium: Any, page: Page, take_folder: Path
+) -> None:
+    ARTIFACTS.mkdir(exist_ok=True)
+    p = page.page
+    page.open(f"{live_server}/#/shoots")
+    p.fill("#shoot-name", "Day 1")
+    p.click("#shoot-create button[type=submit]")
+    p.wait_for_url("**/#/shoot/*")
+    p.wait_for_selector("main[data-ready='1'] #import-zone", timeout=60_000)
+    shoot_id = p.url.split("#/shoot/")[1].split("?")[0]
+
+    # Import the whole folder through the folder picker (webkitdirectory).
+    p.set_input_files("#import-folder", take_folder)
+    p.wait_for_selector("#import-kept", timeout=120_000)
+    assert "kept (4)" in p.inner_text("#import-kept")
+    rejected = p.inner_text("#import-skipped") + p.inner_text("#import-failed")
+    assert "notes.txt" in rejected
+
+    # Live progress: the bar reaches "done" without a reload.
+    p.wait_for_selector("#progress-panel[data-finished='1']", timeout=ANALYSIS_MS)
+    p.wait_for_function(
+        "() => document.getElementById('shoot-progress-text').textContent"
+        ".startsWith('4 of 4 takes analysed')",
+        timeout=30_000,
+    )
+    p.wait_for_function(
+        "() => document.querySelectorAll('#shoot-takes tbody tr').length === 4", timeout=30_000
+    )
+    assert p.locator("#shoot-takes tbody .badge.done").count() == 4
+    p.screenshot(path=str(ARTIFACTS / "shoot-table.png"), full_page=True)
+
+    # Sort by score: the default is ascending; a click on the header turns it around.
+    ascending = scores(page)
+    assert ascending == sorted(ascending)
+    assert len(set(ascending)) > 1  # the twist errors cost the demo walk points
+    p.click("#shoot-takes th[data-sort='score']")
+    p.wait_for_selector("#shoot-takes th[data-sort='score'][aria-sort='descending']")
+    assert scores(page) == sorted(ascending, reverse=True)
+    assert "order=desc" in p.url
+    # Sort by name from the keyboard (headers are focusable).
+    p.focus("#shoot-takes th[data-sort='name']")
+    p.keyboard.press("Enter")
+    p.wait_for_selector("#shoot-takes th[data-sort='name'][aria-sort='ascending']")
+    names = p.locator("#shoot-takes tbody td.name").all_inner_texts()
+    assert names == sorted(names)
+    # Search filters on the server.
+    p.fill("#shoot-search", "dash")
+    p.wait_for_function(
+        "() => document.querySelectorAll('#shoot-takes tbody tr').length === 1", timeout=30_000
+    )
+    assert p.inner_text("#page-info") == "1–1 of 1"
+
+    # The review queue, lowest score first, walked with A, F, R.
+    p.click("#review-queue")
+    p.wait_for_selector("main[data-ready='1'] #queue-card[data-take]", timeout=30_000)
+    p.fill("#queue-reviewer", "ana")
+    p.click("h1")  # leave the input so the keys reach the queue
+    seen = []
+    queue_scores = []
+    for step, key in enumerate(("a", "f", "r", "a")):
+        take = p.get_attribute("#queue-card", "data-take")
+        seen.append(take)
+        queue_scores.append(float(p.inner_text("#queue-score")))
+        if step == 0:
+            p.screenshot(path=str(ARTIFACTS / "shoot-review-queue.png"), full_page=True)
+        p.keyboard.press(key)
+        p.wait_for_function(
+            "(t) => document.getElementById('queue-card').dataset.take !== t", arg=take
+        )
+    p.wait_for_selector("#queue-done")
+    assert len(set(seen)) == 4
+    assert queue_scores == sorted(queue_scores)
+    rows = httpx.get(f"{live_server}/api/v1/shoots/{shoot_id}/takes", timeout=30).json()["items"]
+    decided = {r["take_id"]: (r["review_status"], r["reviewer"]) for r in rows}
+    assert [decided[t] for t in seen] == [
+        ("approved", "ana"),
+        ("needs_fix", "ana"),
+        ("rejected", "ana"),
+        ("approved", "ana"),
+    ]
+
+    # Export the summary as CSV from the shoot view.
+    page.open(f"{live_server}/#/shoot/{shoot_id}")
+    with p.expect_download() as download_info:
+        p.click("#export-csv")
+    download = download_info.value
+    text = Path(download.path()).read_text()
+    table = list(csv.reader(io.StringIO(text)))
+    assert table[0] == list(EXPORT_COLUMNS)
+    assert len(table) == 1 + 4
+    assert p.get_attribute("#export-json", "href").endswith("/summary.json")
+
+    # The heat map (Plotly, loaded by this view only): one row per take, lowest score first;
+    # the keypoint take, which has no joint limits, is an empty row.
+    p.wait_for_selector("#heatmap-chart .main-svg", timeout=60_000)
+    rows = p.evaluate(
+        "() => { const d = document.getElementById('heatmap-chart').data[0];"
+        " return d.y.map((name, k) => [name, d.z[k]]); }"
+    )
+    assert rows[0][0] == "cmu_12_01_walk_twist_errors.bvh"
+    by_name = dict(rows)
+    assert max(by_name["cmu_12_01_walk_twist_errors.bvh"]) > 0
+    assert all(v is None for v in by_name[Path(TAKES[2]).name])
+    assert all(v == 0 for v in by_name["cmu_12_01_walk.bvh"])
+    p.screenshot(path=str(ARTIFACTS / "shoot-heatmap.png"), full_page=True)
+
+    # A 900 px window scrolls only down.
+    narrow = Page(chromium, width=900, height=900)
+    narrow.open(f"{live_server}/#/shoot/{shoot_id}")
+    narrow.page.wait_for_selector("#shoot-takes tbody tr")
+    narrow.page.wait_for_selector("#shoot-heatmap h2", timeout=60_000)
+    assert narrow.no_sideways_scroll()
+    narrow.page.screenshot(path=str(ARTIFACTS / "shoot-900px.png"), full_page=True)
+    narrow.open(f"{live_server}/#/shoots")
+    assert narrow.no_sideways_scroll()
+    assert narrow.errors == []
+    narrow.page.close()
