@@ -9,6 +9,7 @@ from __future__ import annotations
 import csv
 import io
 import shutil
+import zipfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -142,6 +143,11 @@ def test_import_progress_sort_review_export(
     p.wait_for_selector("main[data-ready='1'] #queue-card[data-take]", timeout=30_000)
     p.fill("#queue-reviewer", "ana")
     p.click("h1")  # leave the input so the keys reach the queue
+    assert "A approve" in p.inner_text("#keys-help")
+    p.keyboard.press("?")
+    assert p.locator("#keys-help").is_hidden()
+    p.keyboard.press("?")
+    assert p.locator("#keys-help").is_visible()
     seen = []
     queue_scores = []
     for step, key in enumerate(("a", "f", "r", "a")):
@@ -202,3 +208,27 @@ def test_import_progress_sort_review_export(
     assert narrow.no_sideways_scroll()
     assert narrow.errors == []
     narrow.page.close()
+
+
+def test_archive_and_broken_file_show_kept_skipped_and_failed(
+    live_server: str, page: Page, corpus_dir: Path, tmp_path: Path
+) -> None:
+    shoot = httpx.post(f"{live_server}/api/v1/shoots", json={"name": "Archive day"}, timeout=30)
+    shoot.raise_for_status()
+    archive = tmp_path / "day2.zip"
+    with zipfile.ZipFile(archive, "w") as bundle:
+        bundle.write(corpus_dir / TAKES[0], f"takes/{Path(TAKES[0]).name}")
+        bundle.writestr("takes/slate.txt", "not a take")
+    broken = tmp_path / "broken.bvh"
+    broken.write_text("HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0\n")
+    page.open(f"{live_server}/#/shoot/{shoot.json()['id']}")
+    page.page.set_input_files("#import-files", [archive, broken])
+    page.page.wait_for_selector("#import-kept", timeout=120_000)
+    assert "kept (1)" in page.page.inner_text("#import-kept")
+    assert "day2.zip:takes/slate.txt: not a motion file" in page.page.inner_text("#import-skipped")
+    failed = page.page.inner_text("#import-failed")
+    assert "failed (1)" in failed
+    assert "broken.bvh" in failed
+    page.page.wait_for_selector("#progress-panel[data-finished='1']", timeout=ANALYSIS_MS)
+    page.page.wait_for_selector("#shoot-takes tbody tr .badge.done", timeout=30_000)
+    page.page.screenshot(path=str(ARTIFACTS / "shoot-import-result.png"), full_page=True)
