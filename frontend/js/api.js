@@ -86,11 +86,17 @@ export const nextForReview = (id, after) => request("GET", `/shoots/${id}/next${
 export const summaryUrl = (id, kind) => `${BASE}/shoots/${id}/summary.${kind}`;
 export const shootLink = (id, query = "") => `#/shoot/${id}${query ? `?${query}` : ""}`;
 
-/** Import files and archives into a shoot (one multipart request, field `files` repeated). */
-export async function importIntoShoot(id, files) {
-  const form = new FormData();
-  for (const file of files) form.append("files", file, file.name);
-  const response = await fetch(`${BASE}/shoots/${id}/takes`, { method: "POST", body: form });
-  if (!response.ok) throw await apiError(response.status, await response.text());
-  return response.json();
+/** Import files and archives into a shoot (one multipart request, field `files` repeated);
+ * `onProgress(sent, total)` reports the request's bytes sent. */
+export function importIntoShoot(id, files, onProgress = () => {}) {
+  return new Promise((resolve, reject) => {
+    const xhr = new XMLHttpRequest();
+    xhr.open("POST", `${BASE}/shoots/${id}/takes`);
+    xhr.upload.onprogress = (e) => { if (e.lengthComputable) onProgress(e.loaded, e.total); };
+    xhr.onload = () => (xhr.status === 201 ? resolve(JSON.parse(xhr.responseText)) : reject(apiError(xhr.status, xhr.responseText)));
+    xhr.onerror = () => reject(new Error("network error during the import"));
+    const form = new FormData();
+    for (const file of files) form.append("files", file, file.name);
+    xhr.send(form);
+  });
 }

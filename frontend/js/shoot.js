@@ -61,9 +61,16 @@ function importPanel(shootId, onImported) {
   const folderInput = h("input", { type: "file", id: "import-folder", webkitdirectory: true, multiple: true, hidden: true });
   const send = async (files) => {
     if (!files.length) return;
-    result.replaceChildren(h("p", { class: "muted", id: "import-busy" }, `importing ${files.length} file(s)…`));
+    const bar = h("progress", { id: "import-progress", max: 1, value: 0 });
+    const text = h("span", {}, `sending ${files.length} file(s)…`);
+    result.replaceChildren(h("p", { class: "muted", id: "import-busy" }, bar, " ", text));
+    const sent = (loaded, total) => {
+      bar.value = loaded / total;
+      text.textContent = loaded < total ? `sending ${files.length} file(s): ${fmt(loaded / 1e6, 1)} of ${fmt(total / 1e6, 1)} MB`
+        : `${files.length} file(s) sent; the server is unpacking and registering them…`;
+    };
     try {
-      const lines = importLines(await api.importIntoShoot(shootId, files));
+      const lines = importLines(await api.importIntoShoot(shootId, files, sent));
       const list = (id, title, items, cls) => h("div", { id, class: cls }, h("strong", {}, `${title} (${items.length})`),
         items.length ? h("ul", {}, items.map((t) => h("li", {}, t))) : null);
       result.replaceChildren(list("import-kept", "kept", lines.kept, ""), list("import-skipped", "skipped", lines.skipped, "muted"),
@@ -218,10 +225,11 @@ export async function shootView(main, shootId, params, onTeardown) {
 export async function reviewQueueView(main, shootId, onTeardown) {
   const shoot = await api.getShoot(shootId);
   const reviewer = h("input", { id: "queue-reviewer", value: localStorage.getItem("mocapqa-reviewer") || "", placeholder: "your name", "aria-label": "reviewer" });
+  const notes = h("textarea", { id: "queue-notes", placeholder: "notes (optional, saved with the next decision)", "aria-label": "notes" });
   const card = h("div", { class: "panel", id: "queue-card" });
   const message = h("p", { id: "queue-message", class: "muted" });
   const help = h("p", { class: "muted", id: "keys-help" },
-    "Keys: A approve · F needs fix · R reject (each saves and moves to the next take) · S skip · O open the take · ? shows or hides this line");
+    "Keys: A approve · F needs fix · R reject (each saves, with the notes, and moves to the next take) · S skip · O open the take · ? shows or hides this line · keys typed in the fields are text");
   let current = null;
   let busy = false;
 
@@ -254,8 +262,9 @@ export async function reviewQueueView(main, shootId, onTeardown) {
     busy = true;
     try {
       localStorage.setItem("mocapqa-reviewer", reviewer.value);
-      await api.addReview(current.take_id, { status: decision, notes: "", reviewer: reviewer.value || "anonymous" });
-      message.textContent = `${current.name}: ${REVIEW[decision]}`;
+      await api.addReview(current.take_id, { status: decision, notes: notes.value, reviewer: reviewer.value || "anonymous" });
+      notes.value = "";
+      message.textContent = `${current.name}: ${REVIEW[decision]}`; message.className = "muted";
       await show();
     } catch (e) { message.textContent = e.message; message.className = "error"; } finally { busy = false; }
   };
@@ -271,7 +280,7 @@ export async function reviewQueueView(main, shootId, onTeardown) {
   document.addEventListener("keydown", onKey);
   onTeardown(() => document.removeEventListener("keydown", onKey));
   main.replaceChildren(h("h1", {}, h("a", { href: "#/shoots" }, "Shoots"), " / ", h("a", { href: api.shootLink(shootId) }, shoot.name), " / review queue"),
-    h("div", { class: "controls" }, "Reviewer ", reviewer), help, card, message);
+    h("div", { class: "controls" }, "Reviewer ", reviewer), help, card, notes, message);
   await show();
   main.dataset.ready = "1";
 }

@@ -156,6 +156,9 @@ def test_import_progress_sort_review_export(
         queue_scores.append(float(p.inner_text("#queue-score")))
         if step == 0:
             p.screenshot(path=str(ARTIFACTS / "shoot-review-queue.png"), full_page=True)
+        if step == 1:
+            p.fill("#queue-notes", "left wrist pops at the turn")
+            p.click("h1")
         p.keyboard.press(key)
         p.wait_for_function(
             "(t) => document.getElementById('queue-card').dataset.take !== t", arg=take
@@ -165,6 +168,8 @@ def test_import_progress_sort_review_export(
     assert queue_scores == sorted(queue_scores)
     rows = httpx.get(f"{live_server}/api/v1/shoots/{shoot_id}/takes", timeout=30).json()["items"]
     decided = {r["take_id"]: (r["review_status"], r["reviewer"]) for r in rows}
+    reviews = httpx.get(f"{live_server}/api/v1/takes/{seen[1]}", timeout=30).json()["reviews"]
+    assert reviews[0]["notes"] == "left wrist pops at the turn"
     assert [decided[t] for t in seen] == [
         ("approved", "ana"),
         ("needs_fix", "ana"),
