@@ -141,6 +141,7 @@ export async function shootView(main, shootId, params, onTeardown) {
   const shoot = await api.getShoot(shootId);
   const progressBar = h("progress", { id: "shoot-progress", max: 1, value: 0 });
   const progressText = h("span", { id: "shoot-progress-text" });
+  const tableBox = h("div", {});
   const tableArea = h("div", { id: "shoot-table-area" });
   const heatmap = h("div", { id: "shoot-heatmap", class: "panel" });
   let timer = null;
@@ -154,8 +155,12 @@ export async function shootView(main, shootId, params, onTeardown) {
     const move = (offset) => h("button", { disabled: offset == null, onclick: () => apply({ offset }) });
     const previous = move(info.previous); previous.append("‹ previous"); previous.id = "page-previous";
     const next = move(info.next); next.append("next ›"); next.id = "page-next";
-    tableArea.replaceChildren(filterBar(state, apply), takeTable(page, state, apply),
+    // The filter bar stays (a poll must not take the focus from the search field); the table
+    // and pager are redrawn, and a focused header keeps the focus.
+    const focused = document.activeElement && document.activeElement.dataset ? document.activeElement.dataset.sort : null;
+    tableBox.replaceChildren(takeTable(page, state, apply),
       h("div", { class: "controls" }, previous, h("span", { id: "page-info" }, info.text), next));
+    if (focused) tableBox.querySelector(`th[data-sort="${focused}"]`)?.focus();
     tableArea.dataset.query = takesQuery(state);
   };
   function apply(patch) {
@@ -216,6 +221,7 @@ export async function shootView(main, shootId, params, onTeardown) {
     importPanel(shootId, () => { clearTimeout(timer); wasRunning = true; poll().catch(showError); }),
     progressPanel,
     tableArea, heatmap);
+  tableArea.replaceChildren(filterBar(state, apply), tableBox);
   await drawTable();
   await poll();
   main.dataset.ready = "1";

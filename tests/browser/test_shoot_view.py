@@ -129,6 +129,7 @@ def test_import_progress_sort_review_export(
     p.focus("#shoot-takes th[data-sort='name']")
     p.keyboard.press("Enter")
     p.wait_for_selector("#shoot-takes th[data-sort='name'][aria-sort='ascending']")
+    assert p.evaluate("() => document.activeElement.dataset.sort") == "name"
     names = p.locator("#shoot-takes tbody td.name").all_inner_texts()
     assert names == sorted(names)
     # Search filters on the server.
