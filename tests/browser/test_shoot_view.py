@@ -203,6 +203,13 @@ def test_import_progress_sort_review_export(
     assert all(v == 0 for v in by_name["cmu_12_01_walk.bvh"])
     p.screenshot(path=str(ARTIFACTS / "shoot-heatmap.png"), full_page=True)
 
+    # The shoots list counts the takes per run status.
+    page.open(f"{live_server}/#/shoots")
+    row = p.locator(f"#shoot-list tr[data-shoot='{shoot_id}'] td").all_inner_texts()
+    assert row[:2] == ["Day 1", "4"]
+    assert row[3:7] == ["0", "0", "4", "0"]  # queued, running, done, failed
+    p.screenshot(path=str(ARTIFACTS / "shoot-list.png"), full_page=True)
+
     # A 900 px window scrolls only down.
     narrow = Page(chromium, width=900, height=900)
     narrow.open(f"{live_server}/#/shoot/{shoot_id}")
