@@ -245,3 +245,19 @@ def test_archive_and_broken_file_show_kept_skipped_and_failed(
     page.page.wait_for_selector("#progress-panel[data-finished='1']", timeout=ANALYSIS_MS)
     page.page.wait_for_selector("#shoot-takes tbody tr .badge.done", timeout=30_000)
     page.page.screenshot(path=str(ARTIFACTS / "shoot-import-result.png"), full_page=True)
+
+
+def test_dropped_files_are_imported(live_server: str, page: Page, corpus_dir: Path) -> None:
+    shoot = httpx.post(f"{live_server}/api/v1/shoots", json={"name": "Drop day"}, timeout=30)
+    shoot.raise_for_status()
+    page.open(f"{live_server}/#/shoot/{shoot.json()['id']}")
+    take = corpus_dir / TAKES[0]
+    dropped = page.page.evaluate_handle(
+        "([name, text]) => { const d = new DataTransfer();"
+        " d.items.add(new File([text], name)); return d; }",
+        [take.name, take.read_text()],
+    )
+    page.page.dispatch_event("#import-zone", "drop", {"dataTransfer": dropped})
+    page.page.wait_for_selector("#import-kept", timeout=120_000)
+    assert f"kept (1)\n{take.name}" in page.page.inner_text("#import-kept")
+    page.page.wait_for_selector("#progress-panel[data-finished='1']", timeout=ANALYSIS_MS)
