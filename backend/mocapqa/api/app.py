@@ -26,7 +26,7 @@ from mocapqa import __version__
 from mocapqa.api.deps import Services
 from mocapqa.api.errors import install_error_handlers
 from mocapqa.api.http_guards import install_http_guards
-from mocapqa.api.routes import filters, health, reviews, runs, shoots, stream, takes
+from mocapqa.api.routes import decisions, filters, health, reviews, runs, shoots, stream, takes
 from mocapqa.config import Settings
 from mocapqa.jobs.demo import load_demo
 from mocapqa.jobs.engine import Engine
@@ -45,6 +45,7 @@ ROUTERS: tuple[tuple[APIRouter, Sequence[Any]], ...] = (
     (takes.router, ()),
     (runs.router, ()),
     (reviews.router, ()),
+    (decisions.router, ()),
     (filters.router, ()),
     (stream.router, ()),
     (shoots.router, ()),

@@ -62,7 +62,7 @@ STATUS_MEANING: dict[int, str] = {
     400: "Bad request (the Host header is not allowed, or another client error)",
     403: "Refused: a state-changing request from another site",
     404: "Not found: the take or run does not exist",
-    409: "Conflict: the run is not finished",
+    409: "Conflict: the run is not finished, or has no twist intervals (a keypoint take)",
     413: "Too large: the body or the take exceeds a limit (named in the detail)",
     415: "Unsupported media: the file's format is not recognised",
     422: "Invalid: a parameter, an option or the file's content (field or line named)",

@@ -23,6 +23,7 @@ from sqlalchemy import (
 
 __all__ = [
     "ADDED_COLUMNS",
+    "interval_decisions",
     "metadata",
     "reviews",
     "runs",
@@ -148,3 +149,18 @@ source_hashes = Table(
 )
 """Content hashes of batch source files by path, size and modification time, so resuming a
 batch stats its files instead of reading them again."""
+
+interval_decisions = Table(
+    "interval_decisions",
+    metadata,
+    Column("id", Integer, primary_key=True, autoincrement=True),
+    Column("run_id", String(32), ForeignKey("runs.id", ondelete="CASCADE"), index=True),
+    Column("interval_id", Integer, nullable=False),
+    Column("decision", String(16), nullable=False),
+    Column("note", Text, nullable=False, default=""),
+    Column("reviewer", String(255), nullable=False),
+    Column("client", String(255), nullable=False),
+    Column("created_at", DateTime(timezone=True), nullable=False),
+)
+"""A reviewer's accept / reject of one twist interval of a run, kept as history (the newest row
+per interval is the decision; ``client`` is where it came from)."""

@@ -1,0 +1,95 @@
+"""Reviewers' accept / reject decisions on a run's twist intervals, kept as history.
+
+Every decision is a row (when, from where, who, an optional note); the newest row of an
+interval is its decision. Rows go with their run (``ON DELETE CASCADE``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from sqlalchemy import Engine, func, insert, select
+
+from mocapqa.errors import InputError
+from mocapqa.store.repository import utc_now
+from mocapqa.store.tables import interval_decisions
+
+__all__ = ["INTERVAL_DECISIONS", "IntervalDecisions"]
+
+INTERVAL_DECISIONS = ("accept", "reject")
+"""What a reviewer can decide about one twist interval."""
+
+
+def _row(mapping: Any) -> dict[str, Any]:
+    row = dict(mapping)
+    created = row["created_at"]
+    if created.tzinfo is None:  # SQLite hands back naive datetimes; every stored time is UTC
+        row["created_at"] = created.replace(tzinfo=utc_now().tzinfo)
+    return row
+
+
+class IntervalDecisions:
+    """Reads and writes of :data:`~mocapqa.store.tables.interval_decisions`.
+
+    Parameters
+    ----------
+    engine : Engine
+        The repository's engine (the table is part of its schema).
+    """
+
+    def __init__(self, engine: Engine) -> None:
+        self.engine = engine
+
+    def add(
+        self, run_id: str, interval_id: int, decision: str, note: str, reviewer: str, client: str
+    ) -> dict[str, Any]:
+        """Append a decision to a run's history and return its row.
+
+        Raises
+        ------
+        InputError
+            For a decision not in :data:`INTERVAL_DECISIONS`.
+        """
+        if decision not in INTERVAL_DECISIONS:
+            raise InputError(f"Expected decision in {list(INTERVAL_DECISIONS)}, got {decision!r}")
+        with self.engine.begin() as conn:
+            result = conn.execute(
+                insert(interval_decisions)
+                .values(
+                    run_id=run_id,
+                    interval_id=interval_id,
+                    decision=decision,
+                    note=note,
+                    reviewer=reviewer or "anonymous",
+                    client=client[:255],
+                    created_at=utc_now(),
+                )
+                .returning(interval_decisions)
+            )
+            return _row(result.mappings().one())
+
+    def history(self, run_id: str) -> list[dict[str, Any]]:
+        """Every decision on a run's intervals, newest first."""
+        table = interval_decisions
+        with self.engine.connect() as conn:
+            rows = conn.execute(
+                select(table).where(table.c.run_id == run_id).order_by(table.c.id.desc())
+            ).mappings()
+            return [_row(r) for r in rows]
+
+    def latest(self, run_id: str) -> dict[int, str]:
+        """Interval id → its newest decision, for the intervals that have one."""
+        table = interval_decisions
+        newest = (
+            select(func.max(table.c.id).label("id"))
+            .where(table.c.run_id == run_id)
+            .group_by(table.c.interval_id)
+            .subquery()
+        )
+        with self.engine.connect() as conn:
+            rows = conn.execute(
+                select(table.c.interval_id, table.c.decision).join(
+                    newest, table.c.id == newest.c.id
+                )
+            ).all()
+        return {int(r.interval_id): str(r.decision) for r in rows}
