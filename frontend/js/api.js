@@ -43,6 +43,9 @@ export const getFrames = (id, { start = 0, stop = null, step = 1, maxFrames = 80
 };
 export const startRun = (takeId, options) => request("POST", `/takes/${takeId}/runs`, options);
 export const addReview = (takeId, review) => request("POST", `/takes/${takeId}/reviews`, review);
+export const getDecisions = (runId) => request("GET", `/runs/${runId}/decisions`);
+export const addDecision = (runId, intervalId, body) => request("POST", `/runs/${runId}/intervals/${intervalId}/decisions`, body);
+export const decidedUrl = (runId) => `${BASE}/runs/${runId}/decisions/bvh`;
 export const listFilters = () => request("GET", "/filters");
 export const downloadUrl = (runId, kind) => `${BASE}/runs/${runId}/download/${kind}`;
 export const thumbnailUrl = (takeId, runId) => `${BASE}/takes/${takeId}/thumbnail?run=${runId || ""}`;

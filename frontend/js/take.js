@@ -9,6 +9,7 @@ import * as store from "./state.js";
 import { createTimeline } from "./timeline.js";
 import { reviewPanel } from "./review.js";
 import { rerunPanel } from "./rerun.js";
+import { intervalDecisions } from "./decisions.js";
 
 const OVERVIEW_FRAMES = 800; // frames of a take drawn before any window is loaded
 const FIRST_FRAMES = 100; // a first, light overview: the skeletons do not wait for the full one
@@ -75,10 +76,11 @@ export async function takeView(main, takeId, params, onTeardown) {
     h("div", { class: "controls panel player", id: "player" }, playButton, "speed ", speed, scrubber, frameLabel, jointLabel),
   );
   const help = h("p", { class: "muted", id: "keys-help" },
-    "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · A/F/R approve, needs fix, reject (saves) · Enter on a row opens it · ? shows or hides this line");
+    "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · A/F/R approve, needs fix, reject the take (saves) · Y/X accept, reject the focused or last opened twist interval (saves) · Enter on a row opens it · ? shows or hides this line");
   const timelines = h("div", {});
   const review = reviewPanel(take);
-  main.append(help, findingsTable(result.findings, (f) => { store.set({ joint: f.joint }); focusCharts(); jump(f.start_frame); viewsRow.scrollIntoView({ block: "start" }); }),
+  const decided = intervalDecisions(run, result);
+  main.append(help, findingsTable(result.findings, decided, (f) => { decided.opened(f); store.set({ joint: f.joint }); focusCharts(); jump(f.start_frame); viewsRow.scrollIntoView({ block: "start" }); }),
     timelines, review, stepsPanel(result), downloadsPanel(run, result), rerunPanel(take, run, filters));
 
   // Frames: the overview (whole take, decimated) or, when paused, a full-rate window around.
@@ -177,6 +179,8 @@ export async function takeView(main, takeId, params, onTeardown) {
     } else if (e.key === "n" || e.key === "N" || e.key === "p" || e.key === "P") {
       const stop = nextStop(stops, store.state.frame, e.key.toLowerCase() === "n" ? 1 : -1);
       if (stop != null) { if (player.playing) togglePlay(); jump(stop); }
+    } else if (decided.onKey(e)) {
+      e.preventDefault();
     } else if (DECISIONS[e.key.toLowerCase()]) {
       review.decide(DECISIONS[e.key.toLowerCase()]);
     } else if (e.key === "?") {
@@ -237,24 +241,25 @@ function runPicker(take, run) {
     h("a", { href: `#/compare?a=${run.id}` }, "compare…"));
 }
 
-function findingsTable(findings, onOpen) {
+function findingsTable(findings, decided, onOpen) {
   const columns = [["kind", "kind"], ["joint", "joint"], ["start_frame", "frames"], ["duration", "frames long"], ["value", "offset / outside"], ["confidence", "confidence"]];
   let key = "start_frame", dir = 1;
   const body = h("tbody");
   const render = () => {
-    body.replaceChildren(...sortFindings(findings, key, dir).map((f) => activatable(h("tr", { class: "clickable finding", "data-start": f.start_frame },
+    body.replaceChildren(...sortFindings(findings, key, dir).map((f) => activatable(h("tr", { class: "clickable finding", "data-start": f.start_frame, "data-interval": f.kind === "twist" ? f.id : null },
       h("td", {}, f.kind), h("td", {}, f.joint), h("td", {}, `${f.start_frame}–${f.end_frame}`), h("td", {}, f.end_frame - f.start_frame + 1),
-      h("td", {}, f.value == null ? "–" : `${fmt(f.value, 1)} ${f.unit === "deg" ? "°" : f.unit}`), h("td", {}, fmt(f.confidence, 2))), () => onOpen(f))));
+      h("td", {}, f.value == null ? "–" : `${fmt(f.value, 1)} ${f.unit === "deg" ? "°" : f.unit}`), h("td", {}, f.kind === "twist" ? `${fmt(100 * f.confidence, 0)} %` : fmt(f.confidence, 2)),
+      decided.enabled ? decided.cell(f) : null), () => onOpen(f))));
   };
   const head = h("tr", {}, columns.map(([k, label]) => activatable(h("th", { class: "sortable", "data-key": k, "aria-sort": "none" }, label), (e) => {
     dir = key === k ? -dir : 1; key = k;
     for (const th of e.currentTarget.parentNode.children) th.setAttribute("aria-sort", "none");
     e.currentTarget.setAttribute("aria-sort", dir > 0 ? "ascending" : "descending");
     render();
-  })));
+  })), decided.enabled ? h("th", {}, "applied · decision") : null);
   render();
   return h("div", { class: "panel" }, h("h2", {}, `Findings (${findings.length})`),
-    findings.length ? h("table", { id: "findings" }, h("thead", {}, head), body) : h("p", { class: "muted" }, "No findings."));
+    findings.length ? h("table", { id: "findings" }, h("thead", {}, head), body) : h("p", { class: "muted" }, "No findings."), decided.footer());
 }
 
 function downloadsPanel(run, result) {

@@ -1,0 +1,103 @@
+// Accept / reject per twist interval in the findings table. A decision shows at once and is
+// saved as a row of the run's decision history (the newest per interval counts); the download
+// link serves the raw take with exactly the accepted corrections (an undecided interval keeps
+// the run's own choice, shown as "applied" / "not applied").
+import * as api from "./api.js";
+import { badge, h } from "./dom.js";
+
+export const DECISION_KEYS = { y: "accept", x: "reject" }; // on the focused or last opened twist row
+const LABELS = { accept: "accepted", reject: "rejected" };
+const BADGE = { accept: "approved", reject: "rejected" };
+
+/** Decision cells for the findings rows of `run` and the panel parts below the table. */
+export function intervalDecisions(run, result) {
+  const twist = result.kind === "motion" && result.series && result.series.twist;
+  const latest = new Map(); // interval id -> "accept" | "reject"
+  const cells = new Map(); // interval id -> the row's decision cell
+  let current = null; // the last opened twist interval
+  const message = h("span", { id: "decision-message", class: "muted" });
+  const note = h("input", { id: "decision-note", placeholder: "note for the next decision", "aria-label": "decision note" });
+  const history = h("ul", { id: "decision-history" });
+  const byId = new Map((twist ? twist.intervals : []).map((i) => [i.id, i]));
+
+  const showHistory = (rows) => history.replaceChildren(...rows.map((r) => {
+    const i = byId.get(r.interval_id);
+    const where = i ? `${i.joint} ${i.start_frame}–${i.end_frame}` : "";
+    return h("li", {}, `${new Date(r.created_at).toLocaleString()} · ${r.reviewer}: `, badge(LABELS[r.decision], BADGE[r.decision]),
+      ` interval ${r.interval_id} ${where}`, r.note ? ` — ${r.note}` : "");
+  }));
+
+  const fill = (id) => {
+    const cell = cells.get(id);
+    const f = byId.get(id);
+    if (!cell || !f) return;
+    const decision = latest.get(id);
+    const buttons = ["accept", "reject"].map((d) => {
+      const button = h("button", { class: `small decide-${d}`, "data-decision": d, "aria-pressed": String(decision === d),
+        onclick: (e) => { e.stopPropagation(); decide(id, d); } }, d === "accept" ? "Accept" : "Reject");
+      // Enter or space on a button acts on the button, not on its row.
+      button.addEventListener("keydown", (e) => { if (e.key === "Enter" || e.key === " ") e.stopPropagation(); });
+      return button;
+    });
+    cell.replaceChildren(
+      h("span", { class: "applied muted" }, f.applied ? "applied" : "not applied"), " ",
+      decision ? badge(LABELS[decision], BADGE[decision]) : h("span", { class: "muted" }, "undecided"), " ",
+      ...buttons);
+  };
+
+  async function decide(id, decision) {
+    const before = latest.get(id);
+    latest.set(id, decision); // shows at once; undone if the server refuses
+    fill(id);
+    current = id;
+    try {
+      const reviewer = localStorage.getItem("mocapqa-reviewer") || "anonymous";
+      await api.addDecision(run.id, id, { decision, note: note.value, reviewer });
+      note.value = "";
+      message.textContent = `interval ${id} ${LABELS[decision]}`; message.className = "muted";
+      showHistory((await api.getDecisions(run.id)).history);
+    } catch (e) {
+      if (before) latest.set(id, before); else latest.delete(id);
+      fill(id);
+      message.textContent = e.message; message.className = "error";
+    }
+  }
+
+  const loaded = twist ? api.getDecisions(run.id).then((body) => {
+    for (const i of body.intervals) if (i.decision) latest.set(i.id, i.decision);
+    for (const id of cells.keys()) fill(id);
+    showHistory(body.history);
+  }).catch((e) => { message.textContent = e.message; message.className = "error"; }) : Promise.resolve();
+
+  return {
+    enabled: Boolean(twist),
+    loaded,
+    /** The decision cell of a findings row (empty for a limits finding). */
+    cell(f) {
+      const cell = h("td", { class: "decision" });
+      if (twist && f.kind === "twist" && byId.has(f.id)) { cells.set(f.id, cell); fill(f.id); }
+      return cell;
+    },
+    opened(f) { if (f.kind === "twist") current = f.id; },
+    /** Y / X on the focused (else the last opened) twist row; true when the key was used. */
+    onKey(e) {
+      const decision = DECISION_KEYS[e.key.toLowerCase()];
+      if (!twist || !decision) return false;
+      const row = document.activeElement && document.activeElement.closest && document.activeElement.closest("tr[data-interval]");
+      const id = row ? Number(row.dataset.interval) : current;
+      if (id == null || !byId.has(id)) { message.textContent = "open or focus a twist finding first"; message.className = "muted"; return true; }
+      decide(id, decision);
+      return true;
+    },
+    /** Below the table: the download, a note for the next decision and the history. */
+    footer() {
+      if (!twist) return null;
+      return h("div", { id: "decisions" },
+        h("div", { class: "controls" },
+          h("a", { href: api.decidedUrl(run.id), download: "", id: "download-decided", class: "download" }, "Download with accepted corrections"),
+          note, message),
+        h("p", { class: "muted" }, "An undecided interval keeps the run's choice (applied or not); the download is the raw take with exactly the corrected intervals' levels removed (no motion filter)."),
+        history);
+    },
+  };
+}

@@ -1,0 +1,83 @@
+"""Accepting and rejecting twist intervals in the take view, on 005_05's real knee errors."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import httpx
+import pytest
+from tests.browser.test_workstation import ARTIFACTS, KNEES_TAKE, Page, upload
+
+pytestmark = pytest.mark.browser
+
+
+@pytest.fixture(scope="module")
+def knees(live_server: str, corpus_dir: Path) -> dict[str, Any]:
+    return upload(live_server, corpus_dir / KNEES_TAKE)
+
+
+@pytest.fixture
+def page(chromium: Any) -> Iterator[Page]:
+    opened = Page(chromium)
+    yield opened
+    opened.close()
+
+
+def decision_of(page: Page, interval: int) -> str:
+    return page.page.inner_text(f"#findings tr[data-interval='{interval}'] td.decision")
+
+
+def test_accept_and_reject_intervals_persist_and_the_download_has_them(
+    live_server: str, knees: dict[str, Any], page: Page
+) -> None:
+    p = page.page
+    page.open_take(live_server, knees)
+    rows = p.locator("#findings tbody tr[data-interval]")
+    p.wait_for_selector("#findings td.decision button.decide-accept")
+    assert rows.count() >= 2
+    twist = {f["id"]: f for f in knees["result"]["findings"] if f["kind"] == "twist"}
+    # Accept one the run left alone and reject one it applied: both change the corrected take.
+    first = next((i for i, f in twist.items() if not f["applied"]), min(twist))
+    second = next(i for i, f in twist.items() if f["applied"] and i != first)
+    # Each twist row shows its confidence in %, whether the run applied it, and no decision yet.
+    cells = p.locator(f"#findings tr[data-interval='{first}'] td")
+    assert cells.nth(5).inner_text() == f"{round(100 * twist[first]['confidence'])} %"
+    applied = "not applied" if not twist[first]["applied"] else "applied"
+    assert decision_of(page, first).startswith(applied)
+    assert "undecided" in decision_of(page, first)
+
+    # The mouse accepts the first; the decision shows before the server has answered.
+    p.click(f"#findings tr[data-interval='{first}'] button.decide-accept")
+    assert "accepted" in decision_of(page, first)
+    # The keyboard rejects the second: focus its row, press X.
+    p.locator(f"#findings tr[data-interval='{second}']").focus()
+    p.keyboard.press("x")
+    assert "rejected" in decision_of(page, second)
+    p.wait_for_function("() => document.querySelectorAll('#decision-history li').length === 2")
+    history = p.inner_text("#decision-history")
+    assert f"interval {second}" in history.splitlines()[0]
+    assert "rejected" in history.splitlines()[0]
+    p.locator("#findings").scroll_into_view_if_needed()
+    ARTIFACTS.mkdir(exist_ok=True)
+    p.locator("#findings").locator("xpath=..").screenshot(
+        path=str(ARTIFACTS / "decisions-accept-reject.png")
+    )
+
+    # After a reload the decisions are still there (they come from the server).
+    page.open_take(live_server, knees)
+    p.wait_for_selector("#decision-history li")
+    assert "accepted" in decision_of(page, first)
+    assert "rejected" in decision_of(page, second)
+    assert p.locator("#decision-history li").count() == 2
+
+    # The link serves the BVH with exactly these decisions (the API's decided take).
+    with p.expect_download() as download:
+        p.click("#download-decided")
+    served = Path(download.value.path()).read_bytes()
+    assert served.startswith(b"HIERARCHY")
+    expected = httpx.get(f"{live_server}/api/v1/runs/{knees['run']}/decisions/bvh", timeout=60)
+    assert served == expected.content
+    corrected = httpx.get(f"{live_server}/api/v1/runs/{knees['run']}/download/bvh", timeout=60)
+    assert served != corrected.content  # the decisions changed the run's own choice
