@@ -6,6 +6,7 @@ interval is its decision. Rows go with their run (``ON DELETE CASCADE``).
 
 from __future__ import annotations
 
+from datetime import UTC
 from typing import Any
 
 from sqlalchemy import Engine, func, insert, select
@@ -24,7 +25,7 @@ def _row(mapping: Any) -> dict[str, Any]:
     row = dict(mapping)
     created = row["created_at"]
     if created.tzinfo is None:  # SQLite hands back naive datetimes; every stored time is UTC
-        row["created_at"] = created.replace(tzinfo=utc_now().tzinfo)
+        row["created_at"] = created.replace(tzinfo=UTC)
     return row
 
 
