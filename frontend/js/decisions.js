@@ -40,7 +40,7 @@ export function intervalDecisions(run, result) {
       return button;
     });
     cell.replaceChildren(
-      h("span", { class: "applied muted" }, f.applied ? "applied" : "not applied"), " ",
+      h("span", { class: "applied muted" }, f.applied ? "applied" : "not applied"), " · ",
       decision ? badge(LABELS[decision], BADGE[decision]) : h("span", { class: "muted" }, "undecided"), " ",
       ...buttons);
   };
