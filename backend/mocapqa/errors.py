@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 __all__ = [
+    "AuthenticationError",
     "ConflictError",
     "ForbiddenError",
     "FormatError",
@@ -118,7 +119,13 @@ class ConflictError(MocapQAError):
 
 
 class ForbiddenError(MocapQAError):
-    """The request is not allowed from where it came (for example a cross-site upload)."""
+    """The request is not allowed: from where it came (a cross-site upload, a missing CSRF
+    token) or for who sent it (a role that may not do this, a take owned by another user)."""
+
+
+class AuthenticationError(MocapQAError):
+    """The request names no valid user: no credentials while the server has users, an unknown,
+    expired or revoked token, a wrong password, or a disabled user."""
 
 
 class RateLimitError(MocapQAError):

@@ -17,41 +17,61 @@ from pathlib import Path
 from typing import Any
 
 import plotly
-from fastapi import APIRouter, FastAPI, Request, Response
+from fastapi import APIRouter, Depends, FastAPI, Request, Response
 from fastapi.middleware.gzip import GZipMiddleware
 from fastapi.responses import FileResponse, HTMLResponse, RedirectResponse
 from fastapi.staticfiles import StaticFiles
 
 from mocapqa import __version__
+from mocapqa.api.auth import require
 from mocapqa.api.deps import Services
 from mocapqa.api.errors import install_error_handlers
 from mocapqa.api.http_guards import install_http_guards
-from mocapqa.api.routes import decisions, filters, health, reviews, runs, shoots, stream, takes
+from mocapqa.api.routes import (
+    decisions,
+    filters,
+    health,
+    reviews,
+    runs,
+    session,
+    shoots,
+    stream,
+    takes,
+    users,
+)
 from mocapqa.config import Settings
 from mocapqa.jobs.demo import load_demo
 from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.render.service import RenderService
+from mocapqa.store.accounts import Accounts
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
+from mocapqa.store.roles import Action
 
 __all__ = ["API_PREFIX", "create_app", "frontend_dir", "plotly_js_path"]
 
 API_PREFIX = "/api/v1"
 """Path prefix of every API route."""
 
+_READ = Depends(require(Action.READ))
 ROUTERS: tuple[tuple[APIRouter, Sequence[Any]], ...] = (
     (health.router, ()),
-    (takes.router, ()),
-    (runs.router, ()),
-    (reviews.router, ()),
-    (decisions.router, ()),
-    (filters.router, ()),
-    (stream.router, ()),
-    (shoots.router, ()),
+    (session.router, ()),
+    (users.router, ()),
+    (takes.router, (_READ,)),
+    (runs.router, (_READ,)),
+    (reviews.router, (_READ,)),
+    (decisions.router, (_READ,)),
+    (filters.router, (_READ,)),
+    (stream.router, (_READ,)),
+    (shoots.router, (_READ,)),
 )
 """Every router with the dependencies that guard all its routes (``Depends(...)`` items):
-the one place where a router gets, for example, a sign-in requirement."""
+the one place where a router gets, for example, a sign-in requirement. Reading needs a
+signed-in viewer (or a server without users); routes that change something name their own
+action (``api/auth.py``'s ``require``), the account routes each theirs. A new router (shoots)
+goes here with ``(_READ,)`` and its delete route calls ``require_owner``."""
 log = logging.getLogger(__name__)
 
 
@@ -102,6 +122,7 @@ def create_app(
         engine=engine,
     )
     services = Services(settings, repository, files, runner, render_service)
+    accounts = Accounts(repository.engine)
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
@@ -130,6 +151,7 @@ def create_app(
         lifespan=lifespan,
     )
     app.state.services = services
+    app.state.accounts = accounts
     app.add_middleware(GZipMiddleware, minimum_size=2048, compresslevel=5)
     install_http_guards(
         app,

@@ -7,6 +7,7 @@ from typing import Annotated, Any
 
 from fastapi import Depends, Request
 
+from mocapqa.api.auth import PrincipalDep
 from mocapqa.config import Settings
 from mocapqa.errors import RateLimitError
 from mocapqa.jobs.runner import JobRunner
@@ -58,8 +59,11 @@ TakeDep = Annotated[dict[str, Any], Depends(get_take)]
 """Route parameter type that receives the take row named by ``take_id`` (404 when missing)."""
 
 
-def get_client(request: Request) -> str:
-    """Who is asking, for quotas: the client's address (the user, once there are accounts)."""
+def get_client(request: Request, principal: PrincipalDep) -> str:
+    """Who is asking, for quotas and fair scheduling: the signed-in user, else (a server
+    without users) the client's address."""
+    if principal.user is not None:
+        return f"user:{principal.user.id}"
     return request.client.host if request.client else "unknown"
 
 

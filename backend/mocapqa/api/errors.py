@@ -20,6 +20,7 @@ from starlette.routing import compile_path
 
 from mocapqa.api.schemas import ErrorOut
 from mocapqa.errors import (
+    AuthenticationError,
     ConflictError,
     ForbiddenError,
     FormatError,
@@ -54,13 +55,16 @@ STATUS_CODES: tuple[tuple[type[MocapQAError], int], ...] = (
     (NotFoundError, 404),
     (ConflictError, 409),
     (ForbiddenError, 403),
+    (AuthenticationError, 401),
     (RateLimitError, 429),
     (MocapQAError, 400),
 )
 
 STATUS_MEANING: dict[int, str] = {
     400: "Bad request (the Host header is not allowed, or another client error)",
-    403: "Refused: a state-changing request from another site",
+    401: "Not signed in: no valid session cookie or Bearer token while the server has users",
+    403: "Refused: a state-changing request from another site or without the session's CSRF "
+    "token, or a role (or owner) that may not do this",
     404: "Not found: the take or run does not exist",
     409: "Conflict: the run is not finished, or has no twist intervals (a keypoint take)",
     413: "Too large: the body or the take exceeds a limit (named in the detail)",
@@ -83,7 +87,14 @@ def responses(*statuses: int) -> dict[int | str, dict[str, Any]]:
     """The OpenAPI ``responses=`` of a route answering these error statuses (and 400/422,
     which every route may answer: a refused Host header, a malformed parameter)."""
     wanted = sorted({400, 422, *statuses})
-    return {s: {"model": ErrorOut, "description": STATUS_MEANING[s]} for s in wanted}
+    answers: dict[int | str, dict[str, Any]] = {
+        s: {"model": ErrorOut, "description": STATUS_MEANING[s]} for s in wanted
+    }
+    if 401 in answers:
+        answers[401]["headers"] = {
+            "WWW-Authenticate": {"schema": {"type": "string"}, "description": "Bearer"}
+        }
+    return answers
 
 
 def error_body(error: str, detail: str, **extra: Any) -> dict[str, Any]:
@@ -103,6 +114,8 @@ async def _handle(request: Request, error: Exception) -> JSONResponse:
     headers = None
     if isinstance(error, RateLimitError):
         headers = {"Retry-After": str(error.retry_after_s)}
+    if isinstance(error, AuthenticationError):
+        headers = {"WWW-Authenticate": "Bearer"}
     body = error_body(type(error).__name__, str(error), **extra)
     return JSONResponse(body, status_code=status_for(error), headers=headers)
 

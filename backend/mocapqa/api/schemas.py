@@ -127,6 +127,9 @@ class TakeOut(BaseModel):
     status: RunStatus | None
     review_status: ReviewStatus
     n_findings: int | None
+    owner_id: int | None = Field(
+        None, description="The user who uploaded it (none before accounts or without users)."
+    )
 
 
 class TakeCreatedOut(TakeOut):
@@ -165,7 +168,6 @@ class ReviewIn(BaseModel):
 
     status: ReviewStatus
     notes: str = Field("", max_length=10_000)
-    reviewer: str = Field("anonymous", min_length=1, max_length=255)
 
 
 class ReviewOut(BaseModel):

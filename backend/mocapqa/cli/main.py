@@ -23,6 +23,8 @@ COMMAND_MODULES: dict[str, tuple[str, ...]] = {
     "report": ("report",),
     "serve": ("serve",),
     "batch": ("batch",),
+    "users": ("accounts",),
+    "tokens": ("accounts",),
     "limits": ("limits",),
     "bench batch": ("bench_batch",),
     "bench io": ("bench_io",),

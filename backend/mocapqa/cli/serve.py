@@ -2,11 +2,61 @@
 
 from __future__ import annotations
 
+import ipaddress
+
 import typer
 
 from mocapqa.cli.app import app
 
-__all__ = ["serve"]
+__all__ = ["FIRST_ADMIN", "is_loopback", "serve"]
+
+FIRST_ADMIN = "admin"
+"""Name of the admin ``serve`` creates on first start with an empty user table."""
+
+
+def is_loopback(host: str) -> bool:
+    """Whether ``host`` is reachable only from this machine."""
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host.strip("[]")).is_loopback
+    except ValueError:
+        return False
+
+
+def _sign_in(host: str, port: int) -> str | None:
+    """On a loopback address, a one-time sign-in link for an admin (the first start creates
+    one); elsewhere, a refusal unless users exist. Returns the link."""
+    from mocapqa.api.routes.session import sign_in_link
+    from mocapqa.config import get_settings
+    from mocapqa.errors import MocapQAError
+    from mocapqa.store.accounts import Accounts
+    from mocapqa.store.repository import Repository
+    from mocapqa.store.roles import Role
+
+    settings = get_settings()
+    settings.data_dir.mkdir(parents=True, exist_ok=True)
+    repository = Repository(settings.resolved_database_url)
+    try:
+        accounts = Accounts(repository.engine)
+        if not is_loopback(host):
+            if not accounts.has_users():
+                raise MocapQAError(
+                    f"Expected a configured user before serving on {host} (reachable from "
+                    "other machines), got none: create one with `mocapqa users add NAME --role "
+                    "admin --password`, or serve on 127.0.0.1"
+                )
+            return None
+        admins = [u for u in accounts.list_users() if u.role is Role.ADMIN and not u.disabled]
+        if not accounts.has_users():
+            admins = [accounts.add_user(FIRST_ADMIN, Role.ADMIN)]
+            accounts.record("user_add", None, "serve", FIRST_ADMIN, "role=admin (first start)")
+        if not admins:
+            return None
+        shown = f"[{host}]" if ":" in host else host
+        return sign_in_link(accounts, admins[0], f"http://{shown}:{port}")
+    finally:
+        repository.close()
 
 
 @app.command()
@@ -22,6 +72,10 @@ def serve(
     ``MOCAPQA_DATABASE_URL`` names another. Requests must name this server in their
     ``Host`` header: loopback names, the ``--host`` address, and ``MOCAPQA_ALLOWED_HOSTS``
     (a JSON list) for anything else, such as the machine's name when serving on 0.0.0.0.
+
+    On a loopback address it prints a one-time sign-in link (valid 15 minutes) for an admin;
+    the first start on an empty store creates that admin (``admin``, token and link only).
+    Serving on any other address needs a user made first (``mocapqa users add``).
     """
     import uvicorn
 
@@ -34,7 +88,10 @@ def serve(
     if host not in ("0.0.0.0", "::", "") and host not in settings.allowed_hosts:
         # The address served on is a name clients use; others go in MOCAPQA_ALLOWED_HOSTS.
         settings = settings.model_copy(update={"allowed_hosts": [*settings.allowed_hosts, host]})
+    link = _sign_in(host, port)
     typer.echo(f"mocapqa: data in {settings.data_dir}, dashboard at http://{host}:{port}/")
+    if link:
+        typer.echo(f"mocapqa: sign in (once, within 15 minutes) at {link}")
     uvicorn.run(
         create_app(settings, demo=demo),
         host=host,

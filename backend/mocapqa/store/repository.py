@@ -212,6 +212,11 @@ class Repository:
             rows = [_row(r) for r in conn.execute(page).mappings()]
         return rows, total
 
+    def set_owner(self, take_id: str, owner_id: int | None) -> None:
+        """Record who uploaded a take (none while the server has no users)."""
+        with self.engine.begin() as conn:
+            conn.execute(update(takes).where(takes.c.id == take_id).values(owner_id=owner_id))
+
     def delete_take(self, take_id: str) -> list[str]:
         """Delete a take with its runs and reviews; returns the deleted run ids."""
         with self.engine.begin() as conn:
@@ -380,8 +385,10 @@ class Repository:
         return ids
 
     # reviews ---------------------------------------------------------------------------
-    def add_review(self, take_id: str, status: str, notes: str, reviewer: str) -> dict[str, Any]:
-        """Append a review entry to a take's history."""
+    def add_review(
+        self, take_id: str, status: str, notes: str, reviewer: str, user_id: int | None = None
+    ) -> dict[str, Any]:
+        """Append a review entry to a take's history, by the user ``reviewer`` (``user_id``)."""
         if status not in REVIEW_STATUSES:
             raise InputError(f"Expected review status in {list(REVIEW_STATUSES)}, got {status!r}")
         self.get_take(take_id)
@@ -393,6 +400,7 @@ class Repository:
                     status=status,
                     notes=notes,
                     reviewer=reviewer or "anonymous",
+                    user_id=user_id,
                     created_at=utc_now(),
                 )
                 .returning(reviews)

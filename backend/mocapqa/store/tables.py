@@ -9,6 +9,7 @@ from __future__ import annotations
 from sqlalchemy import (
     JSON,
     BigInteger,
+    Boolean,
     Column,
     DateTime,
     Float,
@@ -23,6 +24,7 @@ from sqlalchemy import (
 
 __all__ = [
     "ADDED_COLUMNS",
+    "audit",
     "interval_decisions",
     "metadata",
     "reviews",
@@ -31,6 +33,8 @@ __all__ = [
     "source_hashes",
     "take_qa",
     "takes",
+    "tokens",
+    "users",
 ]
 
 metadata = MetaData()
@@ -62,8 +66,10 @@ takes = Table(
     # Added after the first release: :func:`mocapqa.store.upgrade.upgrade_schema` adds it to
     # databases made before it.
     Column("shoot_id", String(32), ForeignKey("shoots.id"), nullable=True, index=True),
+    Column("owner_id", Integer, nullable=True, index=True),
 )
-"""One row per uploaded take."""
+"""One row per uploaded take; ``owner_id`` is the user who uploaded it (none for takes
+uploaded before accounts, or while the server had no users)."""
 
 runs = Table(
     "runs",
@@ -89,6 +95,8 @@ interrupted by a server stop is started again, up to a limit)."""
 
 ADDED_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("runs", "attempts", "INTEGER NOT NULL DEFAULT 0"),
+    ("takes", "owner_id", "INTEGER"),
+    ("reviews", "user_id", "INTEGER"),
 )
 """Columns added since the first schema: (table, column, SQL type and default). A database
 made before them gets them with ``ALTER TABLE ... ADD COLUMN`` when opened, until schema
@@ -103,8 +111,10 @@ reviews = Table(
     Column("notes", Text, nullable=False, default=""),
     Column("reviewer", String(255), nullable=False),
     Column("created_at", DateTime(timezone=True), nullable=False),
+    Column("user_id", Integer, nullable=True),
 )
-"""Review decisions per take, kept as history."""
+"""Review decisions per take, kept as history. ``reviewer`` is the signed-in user's name
+(``user_id`` their id); reviews made before accounts keep the free-text name they were given."""
 
 take_qa = Table(
     "take_qa",
@@ -164,3 +174,47 @@ interval_decisions = Table(
 )
 """A reviewer's accept / reject of one twist interval of a run, kept as history (the newest row
 per interval is the decision; ``client`` is where it came from)."""
+
+users = Table(
+    "users",
+    metadata,
+    Column("id", Integer, primary_key=True, autoincrement=True),
+    Column("name", String(64), nullable=False, unique=True),
+    Column("role", String(16), nullable=False),
+    Column("password_hash", Text, nullable=True),
+    Column("disabled", Boolean, nullable=False, default=False),
+    Column("created_at", DateTime(timezone=True), nullable=False),
+)
+"""Accounts. ``password_hash`` is an argon2 hash (none for a token-only user)."""
+
+tokens = Table(
+    "tokens",
+    metadata,
+    Column("id", String(32), primary_key=True),
+    Column("user_id", Integer, ForeignKey("users.id", ondelete="CASCADE"), index=True),
+    Column("kind", String(16), nullable=False),
+    Column("name", String(255), nullable=False, default=""),
+    Column("secret_sha256", String(64), nullable=False),
+    Column("csrf", String(64), nullable=True),
+    Column("created_at", DateTime(timezone=True), nullable=False),
+    Column("expires_at", DateTime(timezone=True), nullable=False),
+    Column("last_used_at", DateTime(timezone=True), nullable=True),
+    Column("revoked_at", DateTime(timezone=True), nullable=True),
+)
+"""Credentials of three kinds: ``api`` (personal tokens), ``session`` (a browser's sign-in,
+with its CSRF token) and ``link`` (a one-time sign-in link). Only the SHA-256 of the secret is
+stored: the secrets are 256 random bits, so a fast hash is enough (passwords get argon2)."""
+
+audit = Table(
+    "audit",
+    metadata,
+    Column("id", Integer, primary_key=True, autoincrement=True),
+    Column("at", DateTime(timezone=True), nullable=False, index=True),
+    Column("user_id", Integer, nullable=True),
+    Column("user_name", String(64), nullable=True),
+    Column("action", String(32), nullable=False),
+    Column("target", String(255), nullable=False, default=""),
+    Column("detail", Text, nullable=False, default=""),
+    Column("client", String(64), nullable=False, default=""),
+)
+"""Append-only record of who did what, when and from where (no API route edits it)."""

@@ -14,7 +14,7 @@ router = APIRouter(tags=["filters"])
 """Routes of this resource, included under ``/api/v1``."""
 
 
-@router.get("/filters", responses=responses())
+@router.get("/filters", responses=responses(401))
 def list_filters() -> list[FilterInfo]:
     """Every registered filter (empty while the filters package is not installed)."""
     return [FilterInfo(**item) for item in filter_catalog()]

@@ -6,9 +6,10 @@ import json
 from typing import Annotated, Literal
 
 import numpy as np
-from fastapi import APIRouter, Query
+from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import FileResponse, Response
 
+from mocapqa.api.auth import Principal, audit, require
 from mocapqa.api.deps import ClientDep, ServicesDep, TakeDep, require_run_slot
 from mocapqa.api.errors import responses
 from mocapqa.api.schemas import AnalysisOptionsIn, RunOut
@@ -16,6 +17,7 @@ from mocapqa.api.views import run_out
 from mocapqa.errors import InputError, NotFoundError
 from mocapqa.jobs.rendered import html_report
 from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.store.roles import Action
 
 __all__ = ["router"]
 
@@ -33,8 +35,10 @@ MAX_FRAME = 2**31 - 1
 """Largest frame index or step a query may name (the schema refuses more with 422)."""
 
 
-@router.post("/takes/{take_id}/runs", status_code=201, responses=responses(403, 404, 413, 429))
+@router.post("/takes/{take_id}/runs", status_code=201, responses=responses(401, 403, 404, 413, 429))
 def start_run(
+    request: Request,
+    principal: Annotated[Principal, Depends(require(Action.RUN))],
     take: TakeDep,
     services: ServicesDep,
     client: ClientDep,
@@ -50,10 +54,11 @@ def start_run(
     require_run_slot(services, client)
     run_id = services.repository.add_run(str(take["id"]), parsed.to_json())
     services.runner.submit(run_id, client=client)
+    audit(request, principal, "run", str(take["id"]), f"run {run_id}")
     return run_out(services.repository.get_run(run_id))
 
 
-@router.get("/runs/{run_id}", responses=responses(404))
+@router.get("/runs/{run_id}", responses=responses(401, 404))
 def get_run(run_id: str, services: ServicesDep) -> RunOut:
     """A run's status (queued | running | done | failed), progress (0–100 %) and step."""
     return run_out(services.repository.get_run(run_id))
@@ -61,7 +66,7 @@ def get_run(run_id: str, services: ServicesDep) -> RunOut:
 
 @router.get(
     "/runs/{run_id}/result",
-    responses={200: {"content": {"application/json": {}}}, **responses(404, 409)},
+    responses={200: {"content": {"application/json": {}}}, **responses(401, 404, 409)},
 )
 def get_result(run_id: str, services: ServicesDep) -> Response:
     """The report: summary, steps, findings and the plotted series (409 until done)."""
@@ -72,7 +77,7 @@ def get_result(run_id: str, services: ServicesDep) -> Response:
 
 @router.get(
     "/runs/{run_id}/frames",
-    responses={200: {"content": {"application/json": {}}}, **responses(404, 409)},
+    responses={200: {"content": {"application/json": {}}}, **responses(401, 404, 409)},
 )
 def get_frames(
     run_id: str,
@@ -128,7 +133,7 @@ def get_frames(
 @router.get(
     "/runs/{run_id}/download/report.html",
     response_class=Response,
-    responses={200: {"content": {"text/html": {}}}, **responses(404, 409)},
+    responses={200: {"content": {"text/html": {}}}, **responses(401, 404, 409)},
 )
 def download_html_report(run_id: str, services: ServicesDep) -> Response:
     """The self-contained HTML QA report of a finished run (built on first request)."""
@@ -148,7 +153,7 @@ def download_html_report(run_id: str, services: ServicesDep) -> Response:
     response_class=FileResponse,
     responses={
         200: {"content": {"text/plain": {}, "text/csv": {}, "application/json": {}}},
-        **responses(404, 409),
+        **responses(401, 404, 409),
     },
 )
 def download(

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from fastapi import APIRouter, File, Form, Query, Response, UploadFile
+from fastapi import APIRouter, Depends, File, Form, Query, Request, Response, UploadFile
 
+from mocapqa.api.auth import Principal, audit, require, require_owner
 from mocapqa.api.deps import ClientDep, ServicesDep, TakeDep, require_run_slot
 from mocapqa.api.errors import responses
 from mocapqa.api.schemas import (
@@ -21,6 +22,7 @@ from mocapqa.jobs.intake import ingest_take, reading_of
 from mocapqa.jobs.rendered import THUMBNAIL_PNG
 from mocapqa.jobs.thumbnails import thumbnail_svg
 from mocapqa.pipeline.loading import ReadOptions
+from mocapqa.store.roles import Action
 
 __all__ = ["router"]
 
@@ -30,8 +32,10 @@ MAX_OFFSET = 2**31 - 1
 """Largest page offset (the schema refuses more with 422)."""
 
 
-@router.post("", status_code=201, responses=responses(403, 413, 415, 429))
+@router.post("", status_code=201, responses=responses(401, 403, 413, 415, 429))
 def upload_take(
+    request: Request,
+    principal: Annotated[Principal, Depends(require(Action.UPLOAD))],
     services: ServicesDep,
     client: ClientDep,
     file: Annotated[UploadFile, File()],
@@ -74,12 +78,14 @@ def upload_take(
         limits=services.settings.read_limits,
         client=client,
     )
+    services.repository.set_owner(take_id, principal.user_id)
+    audit(request, principal, "upload", take_id, f"{file.filename or 'take'} run {run_id}")
     row = services.repository.get_take(take_id)
     reading = reading_of(services.files, take_id)
     return TakeCreatedOut(**take_fields(row), run_id=run_id, reading=reading)
 
 
-@router.get("", responses=responses())
+@router.get("", responses=responses(401))
 def list_takes(
     services: ServicesDep,
     limit: Annotated[int, Query(ge=1, le=500)] = 50,
@@ -93,7 +99,7 @@ def list_takes(
     return TakePageOut(items=items, total=total, limit=limit, offset=offset)
 
 
-@router.get("/{take_id}", responses=responses(404))
+@router.get("/{take_id}", responses=responses(401, 404))
 def get_take(take: TakeDep, services: ServicesDep) -> TakeDetailOut:
     """One take with its runs (oldest first) and its review history (newest first)."""
     take_id = str(take["id"])
@@ -105,13 +111,21 @@ def get_take(take: TakeDep, services: ServicesDep) -> TakeDetailOut:
     )
 
 
-@router.delete("/{take_id}", status_code=204, responses=responses(403, 404))
-def delete_take(take: TakeDep, services: ServicesDep) -> Response:
-    """Delete a take, its runs (a queued or running one is stopped), reviews and files."""
+@router.delete("/{take_id}", status_code=204, responses=responses(401, 403, 404))
+def delete_take(
+    request: Request,
+    principal: Annotated[Principal, Depends(require(Action.DELETE_OWN))],
+    take: TakeDep,
+    services: ServicesDep,
+) -> Response:
+    """Delete a take, its runs (a queued or running one is stopped), reviews and files: its
+    owner or an admin."""
     take_id = str(take["id"])
+    require_owner(principal, take.get("owner_id"), f"take {take_id}")
     run_ids = services.repository.delete_take(take_id)
     services.runner.cancel(run_ids)
     services.files.remove_take(take_id, run_ids)
+    audit(request, principal, "delete", take_id, str(take["name"]))
     return Response(status_code=204)
 
 
@@ -120,7 +134,7 @@ def delete_take(take: TakeDep, services: ServicesDep) -> Response:
     response_class=Response,
     responses={
         200: {"content": {"image/png": {}, "image/svg+xml": {}}, "description": "A picture"},
-        **responses(404),
+        **responses(401, 404),
     },
 )
 def thumbnail(take: TakeDep, services: ServicesDep) -> Response:

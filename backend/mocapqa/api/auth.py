@@ -1,0 +1,166 @@
+"""Who is asking, and whether they may: the principal of a request and the role checks.
+
+A request names its user with ``Authorization: Bearer TOKEN`` (a personal token) or with the
+browser's session cookie. A state-changing request (POST, PUT, PATCH, DELETE) made with the
+cookie must also carry the session's CSRF token in the ``X-CSRF-Token`` header (the double
+submit: the token is also in a cookie the page's script can read, which another site cannot);
+Bearer requests are exempt, as a browser never adds that header by itself.
+
+While the server has no user at all, every request is served as an anonymous admin (the open
+embedded default); once a user exists, a request without valid credentials gets 401.
+
+Each route names the :class:`~mocapqa.store.roles.Action` it performs with :func:`require`;
+:data:`~mocapqa.api.app.ROUTERS` gives every router its read requirement. Deleting a take (and
+a shoot) also needs :func:`require_owner`: its owner, or a role allowed ``delete_any``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Annotated
+
+from fastapi import Depends, Request
+from starlette.requests import HTTPConnection
+
+from mocapqa.errors import AuthenticationError, ForbiddenError
+from mocapqa.store.accounts import Accounts, User
+from mocapqa.store.roles import Action, Role, allows
+
+__all__ = [
+    "CSRF_COOKIE",
+    "CSRF_HEADER",
+    "SESSION_COOKIE",
+    "AccountsDep",
+    "Principal",
+    "PrincipalDep",
+    "audit",
+    "client_address",
+    "get_accounts",
+    "get_principal",
+    "require",
+    "require_owner",
+]
+
+SESSION_COOKIE = "mocapqa_session"
+"""The browser's session cookie (HttpOnly)."""
+CSRF_COOKIE = "mocapqa_csrf"
+"""The session's CSRF token, readable by the page's script."""
+CSRF_HEADER = "X-CSRF-Token"
+"""The header a cookie-authenticated state-changing request repeats the CSRF token in."""
+_STATE_CHANGING = frozenset({"POST", "PUT", "PATCH", "DELETE"})
+
+
+@dataclass(frozen=True, slots=True)
+class Principal:
+    """Who a request acts as: a user (``user``), or the anonymous admin of a server with no
+    users (``user`` None); ``via`` is ``token``, ``session`` or ``open``."""
+
+    user: User | None
+    role: Role
+    via: str
+
+    @property
+    def name(self) -> str:
+        """The user's name (``anonymous`` on an open server)."""
+        return self.user.name if self.user else "anonymous"
+
+    @property
+    def user_id(self) -> int | None:
+        """The user's id (None on an open server)."""
+        return self.user.id if self.user else None
+
+
+def get_accounts(connection: HTTPConnection) -> Accounts:
+    """The app's account store."""
+    accounts = connection.app.state.accounts
+    if not isinstance(accounts, Accounts):  # pragma: no cover - set by create_app
+        raise RuntimeError("app.state.accounts is not set")
+    return accounts
+
+
+AccountsDep = Annotated[Accounts, Depends(get_accounts)]
+"""Route parameter type that receives the app's :class:`Accounts`."""
+
+
+def client_address(connection: HTTPConnection) -> str:
+    """The client's address (for the audit log)."""
+    return connection.client.host if connection.client else "unknown"
+
+
+def get_principal(connection: HTTPConnection, accounts: AccountsDep) -> Principal:
+    """Who the request acts as (see the module notes).
+
+    Raises
+    ------
+    AuthenticationError
+        Bad credentials, or none while users exist (401).
+    ForbiddenError
+        A cookie-authenticated state-changing request without the session's CSRF token (403).
+    """
+    header = connection.headers.get("authorization", "")
+    if header:
+        scheme, _, token = header.partition(" ")
+        if scheme.lower() != "bearer" or not token.strip():
+            raise AuthenticationError("Expected 'Authorization: Bearer TOKEN', got another form")
+        user, _ = accounts.verify(token.strip(), "api")
+        return Principal(user, user.role, "token")
+    cookie = connection.cookies.get(SESSION_COOKIE)
+    if cookie:
+        user, csrf = accounts.verify(cookie, "session")
+        method = connection.scope.get("method", "GET")
+        if method in _STATE_CHANGING:
+            sent = connection.headers.get(CSRF_HEADER, "")
+            if not csrf or not sent or sent != csrf:
+                raise ForbiddenError(
+                    f"Expected the session's CSRF token in the {CSRF_HEADER} header of a "
+                    f"{method} request signed in with the cookie, got "
+                    + ("a wrong one" if sent else "none")
+                )
+        return Principal(user, user.role, "session")
+    if accounts.has_users():
+        raise AuthenticationError(
+            "Expected a signed-in user (session cookie or 'Authorization: Bearer TOKEN'), "
+            "got neither"
+        )
+    return Principal(None, Role.ADMIN, "open")
+
+
+PrincipalDep = Annotated[Principal, Depends(get_principal)]
+"""Route parameter type that receives the request's :class:`Principal`."""
+
+
+def require(action: Action) -> Callable[[Principal], Principal]:
+    """A dependency refusing (403) a principal whose role may not perform ``action``."""
+
+    def check(principal: PrincipalDep) -> Principal:
+        if not allows(principal.role, action):
+            raise ForbiddenError(
+                f"Expected a role allowed to {action.value.replace('_', ' ')}, got "
+                f"{principal.name!r} as {principal.role.value}"
+            )
+        return principal
+
+    check.__name__ = f"require_{action.value}"
+    return check
+
+
+def require_owner(principal: Principal, owner_id: int | None, what: str) -> None:
+    """Refuse (403) deleting ``what`` unless the principal owns it or may delete anything.
+
+    The hook every owned resource's delete route calls (takes now; shoots too).
+    """
+    if allows(principal.role, Action.DELETE_ANY):
+        return
+    if owner_id is None or owner_id != principal.user_id:
+        raise ForbiddenError(
+            f"Expected the owner of {what} or an admin, got {principal.name!r} "
+            f"as {principal.role.value}"
+        )
+
+
+def audit(
+    request: Request, principal: Principal, action: str, target: str, detail: str = ""
+) -> None:
+    """Record what a principal did, from the request's address."""
+    get_accounts(request).record(action, principal.user, client_address(request), target, detail)
