@@ -1,0 +1,220 @@
+"""Accounts and roles through the API: the role × endpoint matrix (SQLite and PostgreSQL),
+CSRF on cookie requests, the one-time sign-in link, and the audit log of every action."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+from tests.api.conftest import make_settings
+
+from mocapqa.api.app import create_app
+from mocapqa.api.auth import CSRF_COOKIE, CSRF_HEADER
+from mocapqa.api.routes.session import sign_in_link
+from mocapqa.config import Settings
+from mocapqa.render.service import RenderService
+from mocapqa.store.accounts import Accounts
+from mocapqa.store.roles import Role
+
+ROLES = {"admin": Role.ADMIN, "viewer": Role.VIEWER, "rev1": Role.REVIEWER, "rev2": Role.REVIEWER}
+PASSWORD = "correct horse battery"
+
+
+@pytest.fixture
+def team(
+    settings: Settings, renderer: RenderService
+) -> Iterator[tuple[TestClient, dict[str, dict[str, str]]]]:
+    """An app with an admin, a viewer and two reviewers, and each one's Bearer header."""
+    settings = settings.model_copy(update={"job_workers": 1})
+    with TestClient(create_app(settings, renderer=renderer)) as client:
+        accounts: Accounts = client.app.state.accounts  # type: ignore[attr-defined]
+        headers = {}
+        for name, role in ROLES.items():
+            user = accounts.add_user(name, role, PASSWORD)
+            token = accounts.issue(user.id, "api", __import__("datetime").timedelta(days=1))
+            headers[name] = {"Authorization": f"Bearer {token.token}"}
+        headers["anonymous"] = {}
+        yield client, headers
+
+
+def _upload(client: TestClient, path: Path, headers: dict[str, str]) -> Any:
+    with path.open("rb") as handle:
+        return client.post("/api/v1/takes", files={"file": (path.name, handle)}, headers=headers)
+
+
+def test_role_endpoint_matrix(
+    team: tuple[TestClient, dict[str, dict[str, str]]], cmu_walk: Path
+) -> None:
+    client, headers = team
+    mine = _upload(client, cmu_walk, headers["rev1"])
+    assert mine.status_code == 201, mine.text
+    take = mine.json()["id"]
+    assert mine.json()["owner_id"] is not None
+    run = mine.json()["run_id"]
+    who = ["anonymous", "viewer", "rev1", "rev2", "admin"]
+    # (method, path, body) -> expected status for each of `who`
+    matrix: list[tuple[str, str, Any, list[int | None]]] = [
+        ("GET", "/health", None, [200, 200, 200, 200, 200]),
+        ("GET", "/me", None, [401, 200, 200, 200, 200]),
+        ("GET", "/takes", None, [401, 200, 200, 200, 200]),
+        ("GET", f"/takes/{take}", None, [401, 200, 200, 200, 200]),
+        ("GET", f"/takes/{take}/reviews", None, [401, 200, 200, 200, 200]),
+        ("GET", f"/runs/{run}", None, [401, 200, 200, 200, 200]),
+        ("GET", "/filters", None, [401, 200, 200, 200, 200]),
+        ("POST", f"/takes/{take}/reviews", {"status": "approved"}, [401, 403, 201, 201, 201]),
+        ("POST", f"/takes/{take}/runs", {}, [401, 403, 201, 201, 201]),
+        ("GET", "/users", None, [401, 403, 403, 403, 200]),
+        ("POST", "/users", {"name": "x", "role": "viewer"}, [401, 403, 403, 403, 201]),
+        ("PATCH", "/users/viewer", {"role": "viewer"}, [401, 403, 403, 403, 200]),
+        ("GET", "/audit", None, [401, 403, 403, 403, 200]),
+        ("GET", "/tokens", None, [401, 200, 200, 200, 200]),
+        ("POST", "/tokens", {"expires_days": 1}, [401, 201, 201, 201, 201]),
+        # rev2 is a reviewer, but not the take's owner (rev1 and admin: checked below)
+        ("DELETE", f"/takes/{take}", None, [401, 403, None, 403, None]),
+    ]
+    failures = []
+    for method, path, body, expected in matrix:
+        for name, status in zip(who, expected, strict=True):
+            if status is None:
+                continue
+            answer = client.request(method, f"/api/v1{path}", json=body, headers=headers[name])
+            if answer.status_code != status:
+                failures.append(f"{method} {path} as {name}: {answer.status_code} != {status}")
+    assert not failures, "\n".join(failures)
+    assert client.get("/api/v1/takes", headers=headers["anonymous"]).headers[
+        "www-authenticate"
+    ] == "Bearer"
+    # the reviewer of a review is who is signed in, whatever the body says
+    review = client.post(
+        f"/api/v1/takes/{take}/reviews",
+        json={"status": "rejected", "reviewer": "somebody else"},
+        headers=headers["rev2"],
+    )
+    assert review.json()["reviewer"] == "rev2"
+    # the owner deletes their own take; an admin deletes anyone's
+    assert client.delete(f"/api/v1/takes/{take}", headers=headers["rev1"]).status_code == 204
+    other = _upload(client, cmu_walk, headers["rev2"]).json()["id"]
+    assert client.delete(f"/api/v1/takes/{other}", headers=headers["rev1"]).status_code == 403
+    assert client.delete(f"/api/v1/takes/{other}", headers=headers["admin"]).status_code == 204
+    assert _upload(client, cmu_walk, headers["viewer"]).status_code == 403
+    assert _upload(client, cmu_walk, headers["anonymous"]).status_code == 401
+
+
+def test_tokens_are_revocable_and_expire(
+    team: tuple[TestClient, dict[str, dict[str, str]]],
+) -> None:
+    client, headers = team
+    made = client.post("/api/v1/tokens", json={"name": "ci"}, headers=headers["viewer"]).json()
+    mine = {"Authorization": f"Bearer {made['token']}"}
+    assert client.get("/api/v1/me", headers=mine).json()["name"] == "viewer"
+    listed = client.get("/api/v1/tokens", headers=mine).json()
+    assert "token" not in listed[0] and listed[0]["id"] == made["id"]
+    # another non-admin cannot revoke it; its owner can
+    assert client.delete(f"/api/v1/tokens/{made['id']}", headers=headers["rev1"]).status_code == 403
+    assert client.delete(f"/api/v1/tokens/{made['id']}", headers=mine).status_code == 204
+    assert client.get("/api/v1/me", headers=mine).status_code == 401
+    accounts: Accounts = client.app.state.accounts  # type: ignore[attr-defined]
+    user = accounts.get_user("viewer")
+    expired = accounts.issue(user.id, "api", __import__("datetime").timedelta(seconds=-1))
+    answer = client.get("/api/v1/me", headers={"Authorization": f"Bearer {expired.token}"})
+    assert answer.status_code == 401
+    forged = made["token"][:-4] + "AAAA"
+    assert client.get("/api/v1/me", headers={"Authorization": f"Bearer {forged}"}).status_code == 401
+    # disabling a user stops their tokens
+    client.patch("/api/v1/users/rev2", json={"disabled": True}, headers=headers["admin"])
+    assert client.get("/api/v1/me", headers=headers["rev2"]).status_code == 401
+    # the last admin stays
+    answer = client.patch("/api/v1/users/admin", json={"role": "viewer"}, headers=headers["admin"])
+    assert answer.status_code == 409
+
+
+def test_cookie_requests_need_the_csrf_token(
+    team: tuple[TestClient, dict[str, dict[str, str]]], cmu_walk: Path
+) -> None:
+    client, headers = team
+    take = _upload(client, cmu_walk, headers["rev1"]).json()["id"]
+    bad = client.post("/api/v1/auth/sign-in", json={"name": "rev2", "password": "nope"})
+    assert bad.status_code == 401
+    assert SESSION_COOKIE_NAME not in client.cookies
+    signed = client.post("/api/v1/auth/sign-in", json={"name": "rev2", "password": PASSWORD})
+    assert signed.status_code == 200, signed.text
+    cookie = signed.headers.get_list("set-cookie")
+    session = next(c for c in cookie if c.startswith(SESSION_COOKIE_NAME))
+    assert "HttpOnly" in session and "SameSite=strict" in session
+    assert client.get("/api/v1/me").json()["name"] == "rev2"
+    review = {"status": "approved"}
+    assert client.post(f"/api/v1/takes/{take}/reviews", json=review).status_code == 403
+    wrong = {CSRF_HEADER: "x" * 43}
+    assert client.post(f"/api/v1/takes/{take}/reviews", json=review, headers=wrong).status_code == 403
+    right = {CSRF_HEADER: client.cookies[CSRF_COOKIE]}
+    answer = client.post(f"/api/v1/takes/{take}/reviews", json=review, headers=right)
+    assert answer.status_code == 201 and answer.json()["reviewer"] == "rev2"
+    assert client.post("/api/v1/auth/sign-out", headers=right).status_code == 204
+    client.cookies.clear()
+    client.cookies.set(SESSION_COOKIE_NAME, session.split(";")[0].split("=", 1)[1])
+    assert client.get("/api/v1/me").status_code == 401  # the old session was ended
+
+
+SESSION_COOKIE_NAME = "mocapqa_session"
+
+
+def test_sign_in_link_works_once(team: tuple[TestClient, dict[str, dict[str, str]]]) -> None:
+    client, _ = team
+    accounts: Accounts = client.app.state.accounts  # type: ignore[attr-defined]
+    link = sign_in_link(accounts, accounts.get_user("admin"), "http://testserver")
+    first = client.get(link, follow_redirects=False)
+    assert first.status_code == 303 and first.headers["location"] == "/"
+    assert client.get("/api/v1/me").json()["name"] == "admin"
+    client.cookies.clear()
+    again = client.get(link, follow_redirects=False)
+    assert again.status_code == 303 and "refused" in again.headers["location"]
+    assert client.get("/api/v1/me").status_code == 401
+
+
+def test_every_action_is_audited(
+    team: tuple[TestClient, dict[str, dict[str, str]]], cmu_walk: Path
+) -> None:
+    client, headers = team
+    take = _upload(client, cmu_walk, headers["rev1"]).json()["id"]
+    client.post(f"/api/v1/takes/{take}/runs", json={}, headers=headers["rev1"])
+    client.post(f"/api/v1/takes/{take}/reviews", json={"status": "approved"}, headers=headers["rev1"])
+    client.delete(f"/api/v1/takes/{take}", headers=headers["admin"])
+    client.post("/api/v1/auth/sign-in", json={"name": "rev1", "password": "wrong"})
+    client.post("/api/v1/auth/sign-in", json={"name": "rev1", "password": PASSWORD})
+    client.cookies.clear()
+    client.patch("/api/v1/users/viewer", json={"role": "reviewer"}, headers=headers["admin"])
+    made = client.post("/api/v1/tokens", json={}, headers=headers["viewer"]).json()
+    client.delete(f"/api/v1/tokens/{made['id']}", headers=headers["admin"])
+    page = client.get("/api/v1/audit?limit=100", headers=headers["admin"]).json()
+    entries = {(e["action"], e["user_name"], e["target"]) for e in page["items"]}
+    expected = {
+        ("upload", "rev1", take),
+        ("run", "rev1", take),
+        ("review", "rev1", take),
+        ("delete", "admin", take),
+        ("sign_in_failed", None, "rev1"),
+        ("sign_in", "rev1", "rev1"),
+        ("user_change", "admin", "viewer"),
+        ("token_create", "viewer", made["id"]),
+        ("token_revoke", "admin", made["id"]),
+    }
+    assert expected <= entries, expected - entries
+    assert all(e["client"] == "testclient" for e in page["items"])
+    assert page["total"] == len(page["items"])
+    # read only: no route writes or deletes entries
+    for method in ("POST", "PUT", "PATCH", "DELETE"):
+        assert client.request(method, "/api/v1/audit", headers=headers["admin"]).status_code == 405
+
+
+def test_open_without_users(tmp_path: Path, renderer: RenderService, cmu_walk: Path) -> None:
+    settings = make_settings("sqlite", tmp_path)
+    with TestClient(create_app(settings, renderer=renderer)) as client:
+        me = client.get("/api/v1/me").json()
+        assert me["via"] == "open" and me["role"] == "admin"
+        assert _upload(client, cmu_walk, {}).status_code == 201
+        accounts: Accounts = client.app.state.accounts  # type: ignore[attr-defined]
+        accounts.add_user("first", Role.ADMIN)
+        assert client.get("/api/v1/takes").status_code == 401
