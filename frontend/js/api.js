@@ -2,14 +2,22 @@
 // an Error whose message is the API's own "detail" (with the file's line for parse errors).
 
 const BASE = "/api/v1";
+const SIGN_IN_PAGE = "/static/signin.html";
 
-async function request(method, path, body) {
-  const init = { method, headers: {} };
+// The session's CSRF token (a cookie the page may read), repeated on every state-changing request.
+export function csrfHeaders() {
+  const match = document.cookie.match(/(?:^|; )mocapqa_csrf=([^;]*)/);
+  return match ? { "X-CSRF-Token": decodeURIComponent(match[1]) } : {};
+}
+
+export async function request(method, path, body) {
+  const init = { method, headers: method === "GET" ? {} : csrfHeaders() };
   if (body !== undefined) {
     init.headers["Content-Type"] = "application/json";
     init.body = JSON.stringify(body);
   }
   const response = await fetch(BASE + path, init);
+  if (response.status === 401 && !location.pathname.startsWith(SIGN_IN_PAGE)) location.assign(SIGN_IN_PAGE);
   if (!response.ok) throw await apiError(response.status, await response.text());
   if (response.status === 204) return null;
   return response.json();
@@ -56,6 +64,7 @@ export function uploadTake(file, onProgress) {
   return new Promise((resolve, reject) => {
     const xhr = new XMLHttpRequest();
     xhr.open("POST", `${BASE}/takes`);
+    for (const [name, value] of Object.entries(csrfHeaders())) xhr.setRequestHeader(name, value);
     // Bytes of this file sent so far (the request's own overhead is left out).
     xhr.upload.onprogress = (e) => { if (e.lengthComputable) onProgress(Math.min(file.size, e.loaded * (file.size / e.total))); };
     xhr.onload = () => {

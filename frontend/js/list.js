@@ -20,7 +20,7 @@ export async function listView(main, params, refresh) {
       e.stopPropagation();
       if (confirm(`Delete ${t.name}?`)) { await api.deleteTake(t.id); refresh(); }
     });
-    return activatable(h("tr", { class: "clickable", "data-take": t.id, "aria-label": `open ${t.name}` },
+    return activatable(h("tr", { class: "clickable", "data-take": t.id, "data-owner": t.owner_id ?? "", "aria-label": `open ${t.name}` },
       h("td", { class: "thumb-cell" }, h("img", { class: "thumb", src: api.thumbnailUrl(t.id, t.latest_run_id), alt: "" })),
       h("td", { class: "name" }, t.name), h("td", { class: "narrow-hide" }, t.format), h("td", {}, `${t.n_frames} @ ${fmt(t.fps, 0)} fps`),
       h("td", { class: "narrow-hide" }, t.n_joints), h("td", {}, badge(t.status || "none")), h("td", {}, badge(REVIEW[t.review_status], t.review_status)),

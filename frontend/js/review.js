@@ -8,14 +8,13 @@ export function reviewPanel(take) {
   const current = take.reviews[0];
   const status = h("select", { id: "review-status", "aria-label": "review decision" }, Object.entries(REVIEW).map(([v, l]) => h("option", { value: v, selected: v === (current ? current.status : "unreviewed") }, l)));
   const notes = h("textarea", { id: "review-notes", placeholder: "notes", "aria-label": "notes" });
-  const reviewer = h("input", { id: "reviewer", value: localStorage.getItem("mocapqa-reviewer") || "", placeholder: "your name", "aria-label": "reviewer" });
   const message = h("span", { id: "review-message", class: "muted" });
   const history = h("ul", { id: "review-history" });
   const showHistory = (reviews) => history.replaceChildren(...reviews.map((r) => h("li", {}, `${new Date(r.created_at).toLocaleString()} · ${r.reviewer}: `, badge(REVIEW[r.status], r.status), r.notes ? ` — ${r.notes}` : "")));
   const save = h("button", { id: "review-save", class: "primary", onclick: async () => {
     try {
-      localStorage.setItem("mocapqa-reviewer", reviewer.value);
-      await api.addReview(take.id, { status: status.value, notes: notes.value, reviewer: reviewer.value || "anonymous" });
+      // The reviewer is whoever is signed in.
+      await api.addReview(take.id, { status: status.value, notes: notes.value });
       const fresh = await api.getTake(take.id);
       showHistory(fresh.reviews);
       message.textContent = "saved"; message.className = "muted";
@@ -24,6 +23,6 @@ export function reviewPanel(take) {
   showHistory(take.reviews);
   /** Record a decision from the keyboard (A/F/R): set it and save. */
   panel.decide = (decision) => { status.value = decision; save.click(); };
-  panel.append(h("h2", {}, "Review"), h("div", { class: "controls" }, status, reviewer, save, message), notes, history);
+  panel.append(h("h2", {}, "Review"), h("div", { class: "controls" }, status, save, message), notes, history);
   return panel;
 }

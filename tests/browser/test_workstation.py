@@ -309,7 +309,6 @@ def test_keyboard_only_review_from_the_take_list(
     start = page.frame()
     page.settle()
     # A decision from the keyboard (F: needs fix) is saved; the frame stays where it was.
-    p.fill("#reviewer", "keyboard")
     p.evaluate("() => document.activeElement.blur()")
     p.keyboard.press("f")
     p.wait_for_selector("#review-history li")
