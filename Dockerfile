@@ -53,4 +53,6 @@ EXPOSE 8000 8786 8787
 # Healthy when the API answers and its database query succeeds (/api/v1/health runs one).
 HEALTHCHECK --interval=15s --timeout=5s --start-period=60s --retries=4 \
     CMD ["python", "-c", "import json,sys,urllib.request as u; r=json.load(u.urlopen('http://127.0.0.1:8000/api/v1/health', timeout=4)); sys.exit(r.get('status') != 'ok')"]
-CMD ["mocapqa", "serve", "--host", "0.0.0.0", "--port", "8000", "--demo"]
+# Serving on 0.0.0.0 (the container's address) needs a user: an admin is made on the first
+# start; its one-time sign-in link is in the container's log (`docker logs`).
+CMD ["sh", "-c", "mocapqa users list | grep -q . || mocapqa users add admin --role admin; exec mocapqa serve --host 0.0.0.0 --port 8000 --demo"]

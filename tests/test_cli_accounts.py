@@ -34,7 +34,9 @@ def mocapqa(data_dir: Path, *args: str, stdin: str = "") -> subprocess.Completed
 def test_users_and_tokens_contract(tmp_path: Path) -> None:
     data = tmp_path / "store"
     assert mocapqa(data, "users", "add", "ci", "--role", "reviewer").returncode == 0
-    added = mocapqa(data, "users", "add", "boss", "--role", "admin", "--password-stdin", stdin="pw\n")
+    added = mocapqa(
+        data, "users", "add", "boss", "--role", "admin", "--password-stdin", stdin="pw\n"
+    )
     assert added.returncode == 0, added.stderr
     assert mocapqa(data, "users", "add", "ci", "--role", "viewer").returncode != 0  # taken
     assert mocapqa(data, "users", "add", "x", "--role", "owner").returncode != 0  # no such role
@@ -60,7 +62,8 @@ def test_users_and_tokens_contract(tmp_path: Path) -> None:
         answer = client.get("/api/v1/me", headers={"Authorization": f"Bearer {second}"})
         assert answer.status_code == 401
         actions = [e["action"] for e in client.app.state.accounts.list_audit(100, 0)[0]]  # type: ignore[attr-defined]
-    assert actions.count("user_add") == 2 and "token_revoke" in actions
+    assert actions.count("user_add") == 2
+    assert "token_revoke" in actions
 
 
 def test_serve_refuses_a_public_address_without_users(tmp_path: Path) -> None:
@@ -77,7 +80,8 @@ def test_first_loopback_start_makes_an_admin_and_a_link(tmp_path: Path) -> None:
         link = _sign_in("127.0.0.1", 8123)
     finally:
         del os.environ["MOCAPQA_DATA_DIR"]
-    assert link is not None and link.startswith("http://127.0.0.1:8123/api/v1/auth/link/mqa_")
+    assert link is not None
+    assert link.startswith("http://127.0.0.1:8123/api/v1/auth/link/mqa_")
     users = mocapqa(tmp_path / "store", "users", "list").stdout.splitlines()
     assert users == ["admin\tadmin\tenabled\ttokens only"]
     settings = Settings(data_dir=tmp_path / "store", allowed_hosts=["testserver"])

@@ -84,9 +84,10 @@ def test_role_endpoint_matrix(
             if answer.status_code != status:
                 failures.append(f"{method} {path} as {name}: {answer.status_code} != {status}")
     assert not failures, "\n".join(failures)
-    assert client.get("/api/v1/takes", headers=headers["anonymous"]).headers[
-        "www-authenticate"
-    ] == "Bearer"
+    assert (
+        client.get("/api/v1/takes", headers=headers["anonymous"]).headers["www-authenticate"]
+        == "Bearer"
+    )
     # the reviewer of a review is who is signed in, whatever the body says
     review = client.post(
         f"/api/v1/takes/{take}/reviews",
@@ -111,7 +112,8 @@ def test_tokens_are_revocable_and_expire(
     mine = {"Authorization": f"Bearer {made['token']}"}
     assert client.get("/api/v1/me", headers=mine).json()["name"] == "viewer"
     listed = client.get("/api/v1/tokens", headers=mine).json()
-    assert "token" not in listed[0] and listed[0]["id"] == made["id"]
+    assert "token" not in listed[0]
+    assert listed[0]["id"] == made["id"]
     # another non-admin cannot revoke it; its owner can
     assert client.delete(f"/api/v1/tokens/{made['id']}", headers=headers["rev1"]).status_code == 403
     assert client.delete(f"/api/v1/tokens/{made['id']}", headers=mine).status_code == 204
@@ -122,7 +124,9 @@ def test_tokens_are_revocable_and_expire(
     answer = client.get("/api/v1/me", headers={"Authorization": f"Bearer {expired.token}"})
     assert answer.status_code == 401
     forged = made["token"][:-4] + "AAAA"
-    assert client.get("/api/v1/me", headers={"Authorization": f"Bearer {forged}"}).status_code == 401
+    assert (
+        client.get("/api/v1/me", headers={"Authorization": f"Bearer {forged}"}).status_code == 401
+    )
     # disabling a user stops their tokens
     client.patch("/api/v1/users/rev2", json={"disabled": True}, headers=headers["admin"])
     assert client.get("/api/v1/me", headers=headers["rev2"]).status_code == 401
@@ -143,15 +147,19 @@ def test_cookie_requests_need_the_csrf_token(
     assert signed.status_code == 200, signed.text
     cookie = signed.headers.get_list("set-cookie")
     session = next(c for c in cookie if c.startswith(SESSION_COOKIE_NAME))
-    assert "HttpOnly" in session and "SameSite=strict" in session
+    assert "HttpOnly" in session
+    assert "SameSite=strict" in session
     assert client.get("/api/v1/me").json()["name"] == "rev2"
     review = {"status": "approved"}
     assert client.post(f"/api/v1/takes/{take}/reviews", json=review).status_code == 403
     wrong = {CSRF_HEADER: "x" * 43}
-    assert client.post(f"/api/v1/takes/{take}/reviews", json=review, headers=wrong).status_code == 403
+    assert (
+        client.post(f"/api/v1/takes/{take}/reviews", json=review, headers=wrong).status_code == 403
+    )
     right = {CSRF_HEADER: client.cookies[CSRF_COOKIE]}
     answer = client.post(f"/api/v1/takes/{take}/reviews", json=review, headers=right)
-    assert answer.status_code == 201 and answer.json()["reviewer"] == "rev2"
+    assert answer.status_code == 201
+    assert answer.json()["reviewer"] == "rev2"
     assert client.post("/api/v1/auth/sign-out", headers=right).status_code == 204
     client.cookies.clear()
     client.cookies.set(SESSION_COOKIE_NAME, session.split(";")[0].split("=", 1)[1])
@@ -166,11 +174,13 @@ def test_sign_in_link_works_once(team: tuple[TestClient, dict[str, dict[str, str
     accounts: Accounts = client.app.state.accounts  # type: ignore[attr-defined]
     link = sign_in_link(accounts, accounts.get_user("admin"), "http://testserver")
     first = client.get(link, follow_redirects=False)
-    assert first.status_code == 303 and first.headers["location"] == "/"
+    assert first.status_code == 303
+    assert first.headers["location"] == "/"
     assert client.get("/api/v1/me").json()["name"] == "admin"
     client.cookies.clear()
     again = client.get(link, follow_redirects=False)
-    assert again.status_code == 303 and "refused" in again.headers["location"]
+    assert again.status_code == 303
+    assert "refused" in again.headers["location"]
     assert client.get("/api/v1/me").status_code == 401
 
 
@@ -180,7 +190,9 @@ def test_every_action_is_audited(
     client, headers = team
     take = _upload(client, cmu_walk, headers["rev1"]).json()["id"]
     client.post(f"/api/v1/takes/{take}/runs", json={}, headers=headers["rev1"])
-    client.post(f"/api/v1/takes/{take}/reviews", json={"status": "approved"}, headers=headers["rev1"])
+    client.post(
+        f"/api/v1/takes/{take}/reviews", json={"status": "approved"}, headers=headers["rev1"]
+    )
     client.delete(f"/api/v1/takes/{take}", headers=headers["admin"])
     client.post("/api/v1/auth/sign-in", json={"name": "rev1", "password": "wrong"})
     client.post("/api/v1/auth/sign-in", json={"name": "rev1", "password": PASSWORD})
@@ -213,8 +225,24 @@ def test_open_without_users(tmp_path: Path, renderer: RenderService, cmu_walk: P
     settings = make_settings("sqlite", tmp_path)
     with TestClient(create_app(settings, renderer=renderer)) as client:
         me = client.get("/api/v1/me").json()
-        assert me["via"] == "open" and me["role"] == "admin"
+        assert me["via"] == "open"
+        assert me["role"] == "admin"
         assert _upload(client, cmu_walk, {}).status_code == 201
         accounts: Accounts = client.app.state.accounts  # type: ignore[attr-defined]
         accounts.add_user("first", Role.ADMIN)
         assert client.get("/api/v1/takes").status_code == 401
+
+
+def test_stream_needs_a_user(team: tuple[TestClient, dict[str, dict[str, str]]]) -> None:
+    from starlette.testclient import WebSocketDenialResponse
+
+    client, headers = team
+    with (
+        pytest.raises(WebSocketDenialResponse) as refused,
+        client.websocket_connect("/api/v1/stream/filter"),
+    ):
+        pass
+    assert refused.value.status_code == 401
+    with client.websocket_connect("/api/v1/stream/filter", headers=headers["viewer"]) as ws:
+        ws.send_json({"fps": 30, "n_keypoints": 3})
+        assert ws.receive_json()["ready"] is True

@@ -14,6 +14,7 @@ import os
 import subprocess
 import sys
 import time
+from datetime import timedelta
 from pathlib import Path
 
 import httpx
@@ -22,13 +23,16 @@ from tests.api.conftest import make_settings
 from tests.api.live_server import live_server
 
 from mocapqa.render.service import RenderService
+from mocapqa.store.accounts import Accounts
+from mocapqa.store.repository import Repository
+from mocapqa.store.roles import Role
 
 pytestmark = pytest.mark.schemathesis
 
 CONFIG = Path(__file__).with_name("schemathesis.toml")
 ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts"
 MAX_EXAMPLES = 40
-"""Examples per operation and phase (15 operations)."""
+"""Examples per operation and phase (24 operations)."""
 RUN_BOUND_S = 900.0
 """Generous bound on the whole run (about 2 minutes on an idle machine)."""
 
@@ -39,15 +43,25 @@ def test_schemathesis_finds_nothing(
     settings = make_settings(
         "sqlite", tmp_path, allowed_hosts=["127.0.0.1"], uploads_per_minute_per_client=120
     )
+    # Signed in as an admin through a personal token (the server has users, so an anonymous
+    # request would get 401).
+    settings.data_dir.mkdir(parents=True)
+    repository = Repository(settings.resolved_database_url)
+    accounts = Accounts(repository.engine)
+    admin = accounts.add_user("schemathesis-admin", Role.ADMIN)
+    token = accounts.issue(admin.id, "api", timedelta(days=1)).token
+    repository.close()
+    bearer = {"Authorization": f"Bearer {token}"}
     with live_server(settings, renderer) as url:
         # 005_05 has twist intervals, so the decision routes are exercised past their 404.
         data = (corpus_dir / "bvh" / "cmu" / "iclone" / "005_05.bvh").read_bytes()
         take, spare = (
-            httpx.post(f"{url}/api/v1/takes", files={"file": (name, data)}).json()
+            httpx.post(f"{url}/api/v1/takes", files={"file": (name, data)}, headers=bearer).json()
             for name in ("knees.bvh", "spare.bvh")
         )
         deadline = time.monotonic() + RUN_BOUND_S
-        while httpx.get(f"{url}/api/v1/runs/{take['run_id']}").json()["status"] != "done":
+        run_url = f"{url}/api/v1/runs/{take['run_id']}"
+        while httpx.get(run_url, headers=bearer).json()["status"] != "done":
             assert time.monotonic() < deadline, "the take's analysis did not finish"
             time.sleep(0.2)
         env = {
@@ -61,6 +75,7 @@ def test_schemathesis_finds_nothing(
             str(Path(sys.executable).with_name("schemathesis")),
             "--config-file", str(CONFIG),
             "run", f"{url}/openapi.json",
+            "--header", f"Authorization: Bearer {token}",
             "--checks", "all",
             "--max-examples", str(MAX_EXAMPLES),
             "--workers", "1",

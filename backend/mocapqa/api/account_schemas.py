@@ -9,6 +9,7 @@ from pydantic import BaseModel, Field
 from mocapqa.store.roles import Action, Role
 
 __all__ = [
+    "USER_NAME",
     "AuditOut",
     "AuditPageOut",
     "MeOut",
@@ -50,10 +51,14 @@ class UserOut(BaseModel):
     created_at: datetime
 
 
+USER_NAME = r"^[A-Za-z0-9][A-Za-z0-9._@-]{0,63}$"
+"""What a user name may hold (the store checks the same)."""
+
+
 class UserIn(BaseModel):
     """A new user; without a password it signs in only with tokens."""
 
-    name: str = Field(min_length=1, max_length=64)
+    name: str = Field(pattern=USER_NAME)
     role: Role
     password: str | None = Field(None, min_length=8, max_length=1024)
 

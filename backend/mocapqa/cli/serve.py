@@ -25,8 +25,9 @@ def is_loopback(host: str) -> bool:
 
 
 def _sign_in(host: str, port: int) -> str | None:
-    """On a loopback address, a one-time sign-in link for an admin (the first start creates
-    one); elsewhere, a refusal unless users exist. Returns the link."""
+    """A one-time sign-in link for the first enabled admin, printed to the server's own
+    output (as Jupyter does). On a loopback address the first start on an empty store creates
+    that admin; on any other address a store without users is refused."""
     from mocapqa.api.routes.session import sign_in_link
     from mocapqa.config import get_settings
     from mocapqa.errors import MocapQAError
@@ -39,21 +40,20 @@ def _sign_in(host: str, port: int) -> str | None:
     repository = Repository(settings.resolved_database_url)
     try:
         accounts = Accounts(repository.engine)
-        if not is_loopback(host):
-            if not accounts.has_users():
-                raise MocapQAError(
-                    f"Expected a configured user before serving on {host} (reachable from "
-                    "other machines), got none: create one with `mocapqa users add NAME --role "
-                    "admin --password`, or serve on 127.0.0.1"
-                )
-            return None
+        if not is_loopback(host) and not accounts.has_users():
+            raise MocapQAError(
+                f"Expected a configured user before serving on {host} (reachable from "
+                "other machines), got none: create one with `mocapqa users add NAME --role "
+                "admin --password`, or serve on 127.0.0.1"
+            )
         admins = [u for u in accounts.list_users() if u.role is Role.ADMIN and not u.disabled]
         if not accounts.has_users():
             admins = [accounts.add_user(FIRST_ADMIN, Role.ADMIN)]
             accounts.record("user_add", None, "serve", FIRST_ADMIN, "role=admin (first start)")
         if not admins:
             return None
-        shown = f"[{host}]" if ":" in host else host
+        shown = "127.0.0.1" if host in ("0.0.0.0", "::", "") else host
+        shown = f"[{shown}]" if ":" in shown else shown
         return sign_in_link(accounts, admins[0], f"http://{shown}:{port}")
     finally:
         repository.close()
@@ -73,9 +73,9 @@ def serve(
     ``Host`` header: loopback names, the ``--host`` address, and ``MOCAPQA_ALLOWED_HOSTS``
     (a JSON list) for anything else, such as the machine's name when serving on 0.0.0.0.
 
-    On a loopback address it prints a one-time sign-in link (valid 15 minutes) for an admin;
-    the first start on an empty store creates that admin (``admin``, token and link only).
-    Serving on any other address needs a user made first (``mocapqa users add``).
+    It prints a one-time sign-in link (valid 15 minutes) for an admin. On a loopback address
+    the first start on an empty store creates that admin (``admin``, link and tokens only);
+    serving on any other address needs a user made first (``mocapqa users add``).
     """
     import uvicorn
 
