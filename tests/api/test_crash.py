@@ -14,12 +14,17 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
+from datetime import timedelta
 from pathlib import Path
 from typing import Any
 
 import httpx
 import pytest
 from tests.api.live_server import free_port
+
+from mocapqa.cli.serve import FIRST_ADMIN
+from mocapqa.store.accounts import Accounts
+from mocapqa.store.repository import Repository
 
 BOUND_S = 900.0
 """Generous bound on any one wait."""
@@ -53,6 +58,17 @@ def poll(what: str, check: Callable[[], Any]) -> Any:
     raise TimeoutError(f"{what}: not within {BOUND_S} s")
 
 
+def admin_bearer(data_dir: Path) -> dict[str, str]:
+    """An ``Authorization`` header for the admin ``serve`` made in ``data_dir``."""
+    repository = Repository(f"sqlite:///{data_dir / 'mocapqa.sqlite3'}")
+    try:
+        accounts = Accounts(repository.engine)
+        token = accounts.issue(accounts.get_user(FIRST_ADMIN).id, "api", timedelta(days=1))
+    finally:
+        repository.close()
+    return {"Authorization": f"Bearer {token.token}"}
+
+
 class Server:
     """``mocapqa serve`` as a child process on a data folder."""
 
@@ -72,10 +88,12 @@ class Server:
             command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
         )
         poll("server start", lambda: httpx.get(f"{self.url}/api/v1/health").is_success)
+        # `serve` made an admin on its first start: the test acts as it, through a token.
+        self.client = httpx.Client(headers=admin_bearer(data_dir), timeout=300)
 
     def run(self, run_id: str) -> dict[str, Any]:
         """The run's current state."""
-        answer: dict[str, Any] = httpx.get(f"{self.url}/api/v1/runs/{run_id}").json()
+        answer: dict[str, Any] = self.client.get(f"{self.url}/api/v1/runs/{run_id}").json()
         return answer
 
     def kill(self) -> None:
@@ -111,7 +129,7 @@ def test_a_run_interrupted_by_a_crash_finishes_after_restart(
     server = Server(data_dir)
     try:
         with take.open("rb") as handle:
-            created = httpx.post(
+            created = server.client.post(
                 f"{server.url}/api/v1/takes", files={"file": (take.name, handle)}, timeout=300
             ).json()
         run_id = created["run_id"]
@@ -123,8 +141,8 @@ def test_a_run_interrupted_by_a_crash_finishes_after_restart(
         run = server.run(run_id)
         assert run["status"] == "done", run["error"]
         assert run["attempts"] == 2
-        assert httpx.get(f"{server.url}/api/v1/runs/{run_id}/result").is_success
-        listed = httpx.get(f"{server.url}/api/v1/takes").json()
+        assert server.client.get(f"{server.url}/api/v1/runs/{run_id}/result").is_success
+        listed = server.client.get(f"{server.url}/api/v1/takes").json()
         assert [t["id"] for t in listed["items"]] == [created["id"]]
     finally:
         server.stop()
@@ -138,7 +156,7 @@ def test_a_run_interrupted_twice_is_failed_with_the_reason(tmp_path: Path, cmu_w
     server = Server(data_dir)
     try:
         with take.open("rb") as handle:
-            created = httpx.post(
+            created = server.client.post(
                 f"{server.url}/api/v1/takes", files={"file": (take.name, handle)}, timeout=300
             ).json()
         run_id = created["run_id"]
@@ -152,7 +170,7 @@ def test_a_run_interrupted_twice_is_failed_with_the_reason(tmp_path: Path, cmu_w
         assert run["attempts"] == 2
         assert "stopped during it 2 times" in run["error"]
         # the server is still useful: another run of the same take can be asked for
-        again = httpx.post(f"{server.url}/api/v1/takes/{created['id']}/runs", json={})
+        again = server.client.post(f"{server.url}/api/v1/takes/{created['id']}/runs", json={})
         assert again.status_code == 201
     finally:
         server.stop()

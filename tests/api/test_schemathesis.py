@@ -50,6 +50,8 @@ def test_schemathesis_finds_nothing(
     accounts = Accounts(repository.engine)
     admin = accounts.add_user("schemathesis-admin", Role.ADMIN)
     token = accounts.issue(admin.id, "api", timedelta(days=1)).token
+    spare_user = accounts.add_user("spare", Role.VIEWER)
+    spare_token = accounts.issue(spare_user.id, "api", timedelta(days=1)).id
     repository.close()
     bearer = {"Authorization": f"Bearer {token}"}
     with live_server(settings, renderer) as url:
@@ -69,6 +71,8 @@ def test_schemathesis_finds_nothing(
             "MOCAPQA_ST_TAKE_ID": take["id"],
             "MOCAPQA_ST_RUN_ID": take["run_id"],
             "MOCAPQA_ST_SPARE_TAKE_ID": spare["id"],
+            "MOCAPQA_ST_SPARE_USER": spare_user.name,
+            "MOCAPQA_ST_SPARE_TOKEN_ID": spare_token,
             "NO_COLOR": "1",
         }
         command = [

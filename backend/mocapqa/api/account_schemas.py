@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from datetime import datetime
 
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, Field, StrictBool
 
 from mocapqa.store.roles import Action, Role
 
@@ -67,7 +67,7 @@ class UserPatchIn(BaseModel):
     """Changes to a user."""
 
     role: Role | None = None
-    disabled: bool | None = None
+    disabled: StrictBool | None = None
     password: str | None = Field(None, min_length=8, max_length=1024)
 
 

@@ -10,6 +10,7 @@ from mocapqa.api.auth import (
     CSRF_COOKIE,
     SESSION_COOKIE,
     AccountsDep,
+    Principal,
     PrincipalDep,
     client_address,
 )
@@ -50,7 +51,7 @@ def _start_session(accounts: Accounts, user: User, request: Request, response: R
     )
 
 
-def _me(principal: PrincipalDep) -> MeOut:
+def _me(principal: Principal) -> MeOut:
     return MeOut(
         name=principal.name,
         user_id=principal.user_id,
@@ -73,8 +74,6 @@ def sign_in(body: SignInIn, request: Request, response: Response, accounts: Acco
         raise
     _start_session(accounts, user, request, response)
     accounts.record("sign_in", user, address, user.name, "password")
-    from mocapqa.api.auth import Principal
-
     return _me(Principal(user, user.role, "session"))
 
 
