@@ -22,7 +22,7 @@ from mocapqa.store.roles import Role
 
 pytestmark = pytest.mark.browser
 
-ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts"
+ARTIFACTS = Path(__file__).resolve().parents[1] / "artifacts"
 PASSWORD = "correct horse battery"
 RUN_BOUND_S = 900.0
 
