@@ -70,7 +70,8 @@ _STATE_CHANGING = frozenset({"POST", "PUT", "PATCH", "DELETE"})
 
 
 def client_key(scope: Scope) -> str:
-    """Who is asking: the client's address (the user, once there are accounts)."""
+    """Who is asking, before the body is read: the client's address (the routes count queued
+    runs per signed-in user, ``deps.get_client``)."""
     client = scope.get("client")
     return str(client[0]) if client else "unknown"
 
