@@ -246,3 +246,15 @@ def test_stream_needs_a_user(team: tuple[TestClient, dict[str, dict[str, str]]])
     with client.websocket_connect("/api/v1/stream/filter", headers=headers["viewer"]) as ws:
         ws.send_json({"fps": 30, "n_keypoints": 3})
         assert ws.receive_json()["ready"] is True
+
+
+def test_password_guessing_is_slowed(team: tuple[TestClient, dict[str, dict[str, str]]]) -> None:
+    client, headers = team
+    wrong = {"name": "rev1", "password": "guess"}
+    answers = [client.post("/api/v1/auth/sign-in", json=wrong).status_code for _ in range(11)]
+    assert answers == [401] * 10 + [429]
+    right = client.post("/api/v1/auth/sign-in", json={"name": "rev1", "password": PASSWORD})
+    assert right.status_code == 429
+    assert int(right.headers["retry-after"]) >= 1
+    page = client.get("/api/v1/audit", headers=headers["admin"]).json()
+    assert sum(e["action"] == "sign_in_failed" for e in page["items"]) == 12

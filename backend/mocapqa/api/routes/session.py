@@ -15,7 +15,8 @@ from mocapqa.api.auth import (
     client_address,
 )
 from mocapqa.api.errors import responses
-from mocapqa.errors import AuthenticationError
+from mocapqa.api.http_guards import RateWindow
+from mocapqa.errors import AuthenticationError, RateLimitError
 from mocapqa.store.accounts import LINK_TTL, SESSION_TTL, Accounts, User
 from mocapqa.store.roles import allowed_actions
 
@@ -25,6 +26,18 @@ router = APIRouter(tags=["session"])
 """Routes of this resource, included under ``/api/v1``."""
 LINK_PATH = "/api/v1/auth/link/"
 """Path of a one-time sign-in link; the token follows."""
+SIGN_INS_PER_MINUTE = 10
+"""Password sign-in attempts one address may make per minute (more get 429): enough for a
+person's typos, too few to guess passwords."""
+
+
+def _attempts(request: Request) -> RateWindow:
+    """The app's window of sign-in attempts per address (made on first use)."""
+    window = getattr(request.app.state, "sign_in_attempts", None)
+    if not isinstance(window, RateWindow):
+        window = RateWindow(SIGN_INS_PER_MINUTE)
+        request.app.state.sign_in_attempts = window
+    return window
 
 
 def sign_in_link(accounts: Accounts, user: User, base_url: str) -> str:
@@ -61,12 +74,21 @@ def _me(principal: Principal) -> MeOut:
     )
 
 
-@router.post("/auth/sign-in", responses=responses(401, 403, 413))
+@router.post("/auth/sign-in", responses=responses(401, 403, 413, 429))
 def sign_in(body: SignInIn, request: Request, response: Response, accounts: AccountsDep) -> MeOut:
     """Sign in with a name and password: sets the session cookie (HttpOnly, SameSite=Strict,
     Secure over https) and the CSRF cookie whose value state-changing requests repeat in
-    ``X-CSRF-Token``. A failed attempt is recorded in the audit log."""
+    ``X-CSRF-Token``. A failed attempt is recorded in the audit log; more than
+    :data:`SIGN_INS_PER_MINUTE` attempts a minute from one address get 429."""
     address = client_address(request)
+    wait = _attempts(request).admit(address)
+    if wait > 0:
+        accounts.record("sign_in_failed", None, address, body.name, "too many attempts")
+        raise RateLimitError(
+            f"Expected at most {SIGN_INS_PER_MINUTE} sign-in attempts a minute from one "
+            "address, got more",
+            retry_after_s=int(wait) + 1,
+        )
     try:
         user = accounts.check_password(body.name, body.password)
     except AuthenticationError:
