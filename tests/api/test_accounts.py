@@ -102,6 +102,16 @@ def test_role_endpoint_matrix(
     assert client.delete(f"/api/v1/takes/{other}", headers=headers["admin"]).status_code == 204
     assert _upload(client, cmu_walk, headers["viewer"]).status_code == 403
     assert _upload(client, cmu_walk, headers["anonymous"]).status_code == 401
+    # shoots: read by everyone signed in, made by reviewers, deleted (with their takes) by admins
+    day = {"name": "day1"}
+    assert client.get("/api/v1/shoots", headers=headers["anonymous"]).status_code == 401
+    assert client.get("/api/v1/shoots", headers=headers["viewer"]).status_code == 200
+    assert client.post("/api/v1/shoots", json=day, headers=headers["viewer"]).status_code == 403
+    shoot = client.post("/api/v1/shoots", json=day, headers=headers["rev1"])
+    assert shoot.status_code == 201
+    gone = f"/api/v1/shoots/{shoot.json()['id']}?confirm=day1"
+    assert client.delete(gone, headers=headers["rev1"]).status_code == 403
+    assert client.delete(gone, headers=headers["admin"]).status_code == 204
 
 
 def test_tokens_are_revocable_and_expire(

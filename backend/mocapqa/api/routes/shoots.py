@@ -9,9 +9,10 @@ import json
 from collections.abc import Iterator
 from typing import Annotated, Any, Literal
 
-from fastapi import APIRouter, File, Query, Response, UploadFile
+from fastapi import APIRouter, Depends, File, Query, Response, UploadFile
 from fastapi.responses import StreamingResponse
 
+from mocapqa.api.auth import require
 from mocapqa.api.deps import ServicesDep
 from mocapqa.api.errors import responses
 from mocapqa.api.shoot_schemas import (
@@ -27,10 +28,15 @@ from mocapqa.api.shoot_schemas import (
 from mocapqa.errors import InputError
 from mocapqa.jobs.batch_output import COLUMNS
 from mocapqa.jobs.shoot_import import ImportLimits, import_uploads
+from mocapqa.store.roles import Action
 from mocapqa.store.shoots import SORT_COLUMNS, ShootStore, TakeFilter
 
 __all__ = ["EXPORT_COLUMNS", "router"]
 
+_UPLOAD = Depends(require(Action.UPLOAD))
+# Shoots have no owner yet: deleting one (with all its takes) is for admins; an owner column
+# and ``require_owner`` (api/auth.py) would let a reviewer delete the shoots they made.
+_DELETE_SHOOT = Depends(require(Action.DELETE_ANY))
 router = APIRouter(prefix="/shoots", tags=["shoots"])
 """Routes of this resource, included under ``/api/v1``."""
 
@@ -42,31 +48,36 @@ def _store(services: ServicesDep) -> ShootStore:
 ShootSort = Literal[SORT_COLUMNS]  # type: ignore[valid-type]
 
 
-@router.post("", status_code=201, responses=responses(403, 409))
+@router.post("", status_code=201, responses=responses(401, 403, 409), dependencies=[_UPLOAD])
 def create_shoot(body: ShootIn, services: ServicesDep) -> ShootOut:
     """Create an empty shoot."""
     return ShootOut(**_store(services).create(body.name))
 
 
-@router.get("", responses=responses())
+@router.get("", responses=responses(401))
 def list_shoots(services: ServicesDep) -> list[ShootOut]:
     """Every shoot, by name, with its take counts per run status and per review status."""
     return [ShootOut(**row) for row in _store(services).list_all()]
 
 
-@router.get("/{shoot_id}", responses=responses(404))
+@router.get("/{shoot_id}", responses=responses(401, 404))
 def get_shoot(shoot_id: str, services: ServicesDep) -> ShootOut:
     """One shoot with its counts."""
     return ShootOut(**_store(services).get(shoot_id))
 
 
-@router.patch("/{shoot_id}", responses=responses(403, 404, 409))
+@router.patch("/{shoot_id}", responses=responses(401, 403, 404, 409), dependencies=[_UPLOAD])
 def rename_shoot(shoot_id: str, body: ShootIn, services: ServicesDep) -> ShootOut:
     """Rename a shoot."""
     return ShootOut(**_store(services).rename(shoot_id, body.name))
 
 
-@router.delete("/{shoot_id}", status_code=204, responses=responses(403, 404))
+@router.delete(
+    "/{shoot_id}",
+    status_code=204,
+    responses=responses(401, 403, 404),
+    dependencies=[_DELETE_SHOOT],
+)
 def delete_shoot(
     shoot_id: str,
     services: ServicesDep,
@@ -90,7 +101,12 @@ def delete_shoot(
     return Response(status_code=204)
 
 
-@router.post("/{shoot_id}/takes", status_code=201, responses=responses(403, 404, 413, 415, 429))
+@router.post(
+    "/{shoot_id}/takes",
+    status_code=201,
+    responses=responses(401, 403, 404, 413, 415, 429),
+    dependencies=[_UPLOAD],
+)
 def import_takes(
     shoot_id: str,
     services: ServicesDep,
@@ -120,7 +136,7 @@ def import_takes(
     return ImportOut(created=report.created, skipped=report.skipped, failed=report.failed)
 
 
-@router.get("/{shoot_id}/takes", responses=responses(404))
+@router.get("/{shoot_id}/takes", responses=responses(401, 404))
 def list_shoot_takes(
     shoot_id: str,
     services: ServicesDep,
@@ -144,13 +160,13 @@ def list_shoot_takes(
     )
 
 
-@router.get("/{shoot_id}/progress", responses=responses(404))
+@router.get("/{shoot_id}/progress", responses=responses(401, 404))
 def shoot_progress(shoot_id: str, services: ServicesDep) -> ProgressOut:
     """Takes per status and frames analysed; ``finished`` once nothing is queued or running."""
     return ProgressOut(**_store(services).progress(shoot_id))
 
 
-@router.get("/{shoot_id}/heatmap", responses=responses(404))
+@router.get("/{shoot_id}/heatmap", responses=responses(401, 404))
 def shoot_heatmap(
     shoot_id: str,
     services: ServicesDep,
@@ -162,7 +178,7 @@ def shoot_heatmap(
     return HeatmapOut(**_store(services).heatmap(shoot_id, limit, offset, sort))
 
 
-@router.get("/{shoot_id}/next", responses=responses(404))
+@router.get("/{shoot_id}/next", responses=responses(401, 404))
 def next_take(
     shoot_id: str,
     services: ServicesDep,
@@ -190,7 +206,7 @@ def _export_rows(store: ShootStore, shoot_id: str) -> Iterator[dict[str, Any]]:
 @router.get(
     "/{shoot_id}/summary.{kind}",
     responses={
-        **responses(404),
+        **responses(401, 404),
         200: {"content": {"text/csv": {}, "application/json": {}}},
     },
     response_class=Response,
