@@ -48,8 +48,15 @@ def qa_values(take: dict[str, Any], run: dict[str, Any] | None) -> dict[str, Any
 
 def sync_take(conn: Connection, take_id: str) -> None:
     """Rebuild the ``take_qa`` row of one take (removes it when the take is gone)."""
+    # The take's row is locked first (PostgreSQL; SQLite serialises writers anyway): two
+    # transactions rebuilding the same take at once (a run finishing while a review is saved)
+    # would otherwise both delete, then both insert, and the second fail on the primary key.
+    take = (
+        conn.execute(select(takes).where(takes.c.id == take_id).with_for_update())
+        .mappings()
+        .first()
+    )
     conn.execute(delete(take_qa).where(take_qa.c.take_id == take_id))
-    take = conn.execute(select(takes).where(takes.c.id == take_id)).mappings().first()
     if take is None:
         return
     run = (
