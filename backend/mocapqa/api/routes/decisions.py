@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Depends, Path
+from fastapi import APIRouter, Depends, Path, Request
 from fastapi.responses import Response
 
+from mocapqa.api.auth import Principal, audit, require
 from mocapqa.api.decision_schemas import DecisionIn, DecisionOut, DecisionsOut
 from mocapqa.api.deps import ClientDep, ServicesDep
 from mocapqa.api.errors import responses
@@ -15,6 +16,7 @@ from mocapqa.errors import NotFoundError
 from mocapqa.jobs.accepted import decided_bvh, decided_motion, run_intervals, with_decisions
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.decisions import IntervalDecisions
+from mocapqa.store.roles import Action
 
 __all__ = ["router"]
 
@@ -41,7 +43,7 @@ def _out(row: dict[str, Any]) -> DecisionOut:
     return DecisionOut.model_validate({**row, "reviewer": display_name(str(row["reviewer"]))})
 
 
-@router.get("/decisions", responses=responses(404, 409))
+@router.get("/decisions", responses=responses(401, 404, 409))
 def list_decisions(run: DoneRunDep, services: ServicesDep, decisions: DecisionsDep) -> DecisionsOut:
     """The run's twist intervals with their newest decision, and every decision (newest
     first). 409 for a keypoint take or a run without the twist check."""
@@ -58,9 +60,13 @@ def list_decisions(run: DoneRunDep, services: ServicesDep, decisions: DecisionsD
 
 
 @router.post(
-    "/intervals/{interval_id}/decisions", status_code=201, responses=responses(403, 404, 409, 413)
+    "/intervals/{interval_id}/decisions",
+    status_code=201,
+    responses=responses(401, 403, 404, 409, 413),
 )
 def add_decision(
+    request: Request,
+    principal: Annotated[Principal, Depends(require(Action.REVIEW))],
     run: DoneRunDep,
     interval_id: Annotated[int, Path(ge=0, le=2**31 - 1)],
     body: DecisionIn,
@@ -77,15 +83,16 @@ def add_decision(
             f"Expected a twist interval id of run {run_id} ({len(known)} interval(s)), "
             f"got {interval_id}"
         )
-    reviewer = display_name(body.reviewer) or "anonymous"
-    row = decisions.add(run_id, interval_id, body.decision, body.note, reviewer, client)
+    # The reviewer is who is signed in; a body's ``reviewer`` is ignored.
+    row = decisions.add(run_id, interval_id, body.decision, body.note, principal.name, client)
+    audit(request, principal, "decision", run_id, f"interval {interval_id}: {body.decision}")
     return _out(row)
 
 
 @router.get(
     "/decisions/bvh",
     response_class=Response,
-    responses={200: {"content": {"text/plain": {}}}, **responses(404, 409)},
+    responses={200: {"content": {"text/plain": {}}}, **responses(401, 404, 409)},
 )
 def download_decided(run: DoneRunDep, services: ServicesDep, decisions: DecisionsDep) -> Response:
     """The raw take with exactly the accepted corrections, as BVH: the levels of accepted
