@@ -13,7 +13,7 @@ from sqlalchemy.engine import Connection
 
 from mocapqa.store.tables import reviews, runs, take_qa, takes
 
-__all__ = ["QA_COLUMNS", "qa_values", "sync_take"]
+__all__ = ["QA_COLUMNS", "lock_take", "qa_values", "sync_take"]
 
 QA_COLUMNS = (
     "score",
@@ -46,16 +46,27 @@ def qa_values(take: dict[str, Any], run: dict[str, Any] | None) -> dict[str, Any
     return values
 
 
-def sync_take(conn: Connection, take_id: str) -> None:
-    """Rebuild the ``take_qa`` row of one take (removes it when the take is gone)."""
-    # The take's row is locked first (PostgreSQL; SQLite serialises writers anyway): two
-    # transactions rebuilding the same take at once (a run finishing while a review is saved)
-    # would otherwise both delete, then both insert, and the second fail on the primary key.
-    take = (
+def lock_take(conn: Connection, take_id: str) -> Any:
+    """Lock a take's row for the rest of the transaction; returns the row, or None if gone.
+
+    One lock order for every writer (PostgreSQL; SQLite serialises writers anyway): the take
+    first, then its runs, reviews and ``take_qa`` row. A writer that touched a run before the
+    take (a run finishing) while another held the take and waited for that run (a delete)
+    deadlocked; two writers rebuilding one take's QA row at once both inserted it.
+    """
+    return (
         conn.execute(select(takes).where(takes.c.id == take_id).with_for_update())
         .mappings()
         .first()
     )
+
+
+def sync_take(conn: Connection, take_id: str) -> None:
+    """Rebuild the ``take_qa`` row of one take (removes it when the take is gone).
+
+    Callers that also change the take's runs or reviews call :func:`lock_take` first.
+    """
+    take = lock_take(conn, take_id)
     conn.execute(delete(take_qa).where(take_qa.c.take_id == take_id))
     if take is None:
         return

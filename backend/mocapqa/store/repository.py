@@ -28,7 +28,7 @@ from sqlalchemy.engine import Connection
 
 from mocapqa import __version__
 from mocapqa.errors import ConflictError, InputError, NotFoundError
-from mocapqa.store.qa import sync_take
+from mocapqa.store.qa import lock_take, sync_take
 from mocapqa.store.tables import ADDED_COLUMNS, metadata, reviews, runs, take_qa, takes
 from mocapqa.store.upgrade import upgrade_schema
 
@@ -220,7 +220,7 @@ class Repository:
     def delete_take(self, take_id: str) -> list[str]:
         """Delete a take with its runs and reviews; returns the deleted run ids."""
         with self.engine.begin() as conn:
-            found = conn.execute(select(takes.c.id).where(takes.c.id == take_id)).first()
+            found = lock_take(conn, take_id)
             if found is None:
                 raise NotFoundError(f"Expected take {take_id!r} to exist, got none")
             run_ids = [
@@ -257,6 +257,7 @@ class Repository:
         """Queue a new run of a take with the given options; earlier runs are kept."""
         take = self.get_take(take_id)
         with self.engine.begin() as conn:
+            lock_take(conn, take_id)
             run_id = self._insert_run(conn, take_id, str(take["sha256"]), options)
             sync_take(conn, take_id)
             return run_id
@@ -292,6 +293,7 @@ class Repository:
     def mark_running(self, run_id: str) -> None:
         """Move a run from queued to running."""
         with self.engine.begin() as conn:
+            self._lock_run_take(conn, run_id)
             conn.execute(
                 update(runs)
                 .where(runs.c.id == run_id)
@@ -323,6 +325,7 @@ class Repository:
     ) -> None:
         """Mark a run done (``error`` None) or failed."""
         with self.engine.begin() as conn:
+            self._lock_run_take(conn, run_id)
             conn.execute(
                 update(runs)
                 .where(runs.c.id == run_id)
@@ -337,6 +340,11 @@ class Repository:
                 )
             )
             self._sync_run_take(conn, run_id)
+
+    def _lock_run_take(self, conn: Connection, run_id: str) -> None:
+        take_id = conn.execute(select(runs.c.take_id).where(runs.c.id == run_id)).scalar()
+        if take_id is not None:
+            lock_take(conn, str(take_id))
 
     def _sync_run_take(self, conn: Connection, run_id: str) -> None:
         take_id = conn.execute(select(runs.c.take_id).where(runs.c.id == run_id)).scalar()
@@ -393,6 +401,7 @@ class Repository:
             raise InputError(f"Expected review status in {list(REVIEW_STATUSES)}, got {status!r}")
         self.get_take(take_id)
         with self.engine.begin() as conn:
+            lock_take(conn, take_id)
             result = conn.execute(
                 insert(reviews)
                 .values(
