@@ -19,6 +19,7 @@ from typing import Any
 from pwdlib import PasswordHash
 from sqlalchemy import Engine, func, insert, select, update
 
+from mocapqa.core.text import display_name
 from mocapqa.errors import AuthenticationError, ConflictError, InputError, NotFoundError
 from mocapqa.store.repository import new_id, utc_now
 from mocapqa.store.roles import Role
@@ -356,7 +357,12 @@ class Accounts:
         target: str = "",
         detail: str = "",
     ) -> None:
-        """Append an audit entry (who, now, what, from where)."""
+        """Append an audit entry (who, now, what, from where).
+
+        Client-given text (a file name, a note) is stored as the API echoes it, without control
+        or format characters: PostgreSQL refuses NUL in text, and the log is read by people.
+        """
+        target, detail = display_name(target, 255), display_name(detail, 2000)
         with self.engine.begin() as conn:
             conn.execute(
                 insert(audit).values(
@@ -364,8 +370,8 @@ class Accounts:
                     user_id=user.id if user else None,
                     user_name=user.name if user else None,
                     action=action[:32],
-                    target=target[:255],
-                    detail=detail[:2000],
+                    target=target,
+                    detail=detail,
                     client=client[:64],
                 )
             )

@@ -27,6 +27,7 @@ from sqlalchemy import (
 from sqlalchemy.engine import Connection
 
 from mocapqa import __version__
+from mocapqa.core.text import display_name
 from mocapqa.errors import ConflictError, InputError, NotFoundError
 from mocapqa.store.qa import lock_take, sync_take
 from mocapqa.store.tables import ADDED_COLUMNS, metadata, reviews, runs, take_qa, takes
@@ -407,8 +408,8 @@ class Repository:
                 .values(
                     take_id=take_id,
                     status=status,
-                    notes=notes,
-                    reviewer=reviewer or "anonymous",
+                    notes=notes.replace("\x00", ""),
+                    reviewer=display_name(reviewer) or "anonymous",
                     user_id=user_id,
                     created_at=utc_now(),
                 )
