@@ -10,12 +10,11 @@ from typing import Any
 
 import pytest
 from fastapi.testclient import TestClient
+from tests.store.conftest import clean_database
 
 from mocapqa.api.app import create_app
 from mocapqa.config import Settings
 from mocapqa.render.service import RenderService
-from mocapqa.store.repository import Repository
-from mocapqa.store.tables import metadata
 
 
 def make_settings(kind: str, tmp_path: Path, **changes: Any) -> Settings:
@@ -25,9 +24,7 @@ def make_settings(kind: str, tmp_path: Path, **changes: Any) -> Settings:
         url = os.environ.get("MOCAPQA_TEST_POSTGRES_URL")
         if not url:
             pytest.skip("MOCAPQA_TEST_POSTGRES_URL is not set (scripts/with-postgres.sh sets it)")
-        cleaner = Repository(url)
-        metadata.drop_all(cleaner.engine)
-        cleaner.close()
+        clean_database(url)
     changes.setdefault("allowed_hosts", ["testserver", "localhost", "127.0.0.1"])
     return Settings(data_dir=tmp_path / "data", database_url=url, **changes)
 

@@ -7,9 +7,10 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from sqlalchemy import create_engine
 
 from mocapqa.store.repository import Repository
-from mocapqa.store.tables import metadata
+from mocapqa.store.upgrade import drop_database
 
 
 def database_params() -> list[object]:
@@ -24,10 +25,15 @@ def database_url(kind: str, tmp_path: Path) -> str:
     url = os.environ.get("MOCAPQA_TEST_POSTGRES_URL")
     if not url:
         pytest.skip("MOCAPQA_TEST_POSTGRES_URL is not set (scripts/with-postgres.sh sets it)")
-    cleaner = Repository(url)
-    metadata.drop_all(cleaner.engine)
-    cleaner.close()
+    clean_database(url)
     return url
+
+
+def clean_database(url: str) -> None:
+    """Drop the store's tables and its migration stamp, without migrating first."""
+    engine = create_engine(url)
+    drop_database(engine)
+    engine.dispose()
 
 
 @pytest.fixture(params=database_params())

@@ -129,10 +129,11 @@ def _fill(database_url: str, rows: list[dict[str, Any]], n_takes: int) -> str:
 
     from mocapqa.store.repository import Repository, new_id, utc_now
     from mocapqa.store.shoots import ShootStore
-    from mocapqa.store.tables import metadata, runs, take_qa, takes
+    from mocapqa.store.tables import runs, take_qa, takes
+    from mocapqa.store.upgrade import drop_database
 
     repository = Repository(database_url)
-    metadata.drop_all(repository.engine)
+    drop_database(repository.engine)
     repository.close()
     repository = Repository(database_url)
     shoot = ShootStore(repository.engine).create("bench")

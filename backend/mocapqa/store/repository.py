@@ -8,6 +8,7 @@ after they are complete, so nothing half-written is ever marked done).
 
 from __future__ import annotations
 
+import logging
 import uuid
 from datetime import UTC, datetime
 from typing import Any
@@ -19,9 +20,7 @@ from sqlalchemy import (
     event,
     func,
     insert,
-    inspect,
     select,
-    text,
     update,
 )
 from sqlalchemy.engine import Connection
@@ -30,10 +29,12 @@ from mocapqa import __version__
 from mocapqa.core.text import display_name
 from mocapqa.errors import ConflictError, InputError, NotFoundError
 from mocapqa.store.qa import lock_take, sync_take
-from mocapqa.store.tables import ADDED_COLUMNS, metadata, reviews, runs, take_qa, takes
-from mocapqa.store.upgrade import upgrade_schema
+from mocapqa.store.tables import reviews, runs, take_qa, takes
+from mocapqa.store.upgrade import upgrade_database
 
 __all__ = ["REVIEW_STATUSES", "RUN_STATUSES", "Repository", "new_id", "utc_now"]
+
+log = logging.getLogger(__name__)
 
 RUN_STATUSES = ("queued", "running", "done", "failed")
 """A run's states, in life order."""
@@ -85,18 +86,10 @@ class Repository:
         self.engine: Engine = create_engine(database_url, pool_pre_ping=True)
         if self.engine.dialect.name == "sqlite":
             event.listen(self.engine, "connect", _sqlite_pragmas)
-        metadata.create_all(self.engine)
-        self._add_missing_columns()
-        upgrade_schema(self.engine)
-
-    def _add_missing_columns(self) -> None:
-        """Bring a database made by an earlier version up to :data:`ADDED_COLUMNS`."""
-        inspector = inspect(self.engine)
-        for table, column, sql_type in ADDED_COLUMNS:
-            present = {c["name"] for c in inspector.get_columns(table)}
-            if column not in present:
-                with self.engine.begin() as conn:
-                    conn.execute(text(f"ALTER TABLE {table} ADD COLUMN {column} {sql_type}"))
+        self.upgrades = upgrade_database(self.engine)
+        """What opening the database did to its schema (empty when it was up to date)."""
+        for step in self.upgrades:
+            log.info("database: %s", step)
 
     def ping(self) -> None:
         """Run a trivial query (for health checks); raises when the database is unreachable."""

@@ -23,7 +23,6 @@ from sqlalchemy import (
 )
 
 __all__ = [
-    "ADDED_COLUMNS",
     "audit",
     "interval_decisions",
     "metadata",
@@ -38,7 +37,10 @@ __all__ = [
 ]
 
 metadata = MetaData()
-"""The schema; ``metadata.create_all(engine)`` creates it."""
+"""The schema. Databases are created and upgraded by the migrations in ``store/migrations``
+(:func:`mocapqa.store.upgrade.upgrade_database`): a change here needs a new revision there, and
+``tests/store/test_migrations.py`` fails until the migrated schema matches this one
+(docs/database.md)."""
 
 shoots = Table(
     "shoots",
@@ -46,8 +48,10 @@ shoots = Table(
     Column("id", String(32), primary_key=True),
     Column("name", String(255), nullable=False, unique=True),
     Column("created_at", DateTime(timezone=True), nullable=False),
+    Column("owner_id", Integer, nullable=True),
 )
-"""Named collections of takes; a take belongs to at most one."""
+"""Named collections of takes; a take belongs to at most one. ``owner_id`` is the user who made
+the shoot (none for shoots made before shoots had owners, or while the server had no users)."""
 
 takes = Table(
     "takes",
@@ -63,8 +67,6 @@ takes = Table(
     Column("n_joints", Integer, nullable=False),
     Column("file_name", String(255), nullable=False),
     Column("created_at", DateTime(timezone=True), nullable=False),
-    # Added after the first release: :func:`mocapqa.store.upgrade.upgrade_schema` adds it to
-    # databases made before it.
     Column("shoot_id", String(32), ForeignKey("shoots.id"), nullable=True, index=True),
     Column("owner_id", Integer, nullable=True, index=True),
 )
@@ -92,15 +94,6 @@ runs = Table(
 )
 """One row per analysis run; several per take. ``attempts`` counts its starts (a run
 interrupted by a server stop is started again, up to a limit)."""
-
-ADDED_COLUMNS: tuple[tuple[str, str, str], ...] = (
-    ("runs", "attempts", "INTEGER NOT NULL DEFAULT 0"),
-    ("takes", "owner_id", "INTEGER"),
-    ("reviews", "user_id", "INTEGER"),
-)
-"""Columns added since the first schema: (table, column, SQL type and default). A database
-made before them gets them with ``ALTER TABLE ... ADD COLUMN`` when opened, until schema
-migrations take this over."""
 
 reviews = Table(
     "reviews",

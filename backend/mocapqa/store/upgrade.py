@@ -1,40 +1,222 @@
-"""Bring a database made by an earlier version up to the current schema, in place.
+"""Create a database, or bring one made by an earlier version up to the current schema, in place.
 
-Until the project adopts migrations, changes are additive and applied here when the repository
-opens a database: ``metadata.create_all`` adds new tables (``shoots``, ``take_qa``); this module
-adds the nullable ``takes.shoot_id`` column (and its index) that ``create_all`` cannot add to an
-existing table, and fills ``take_qa`` for takes that have no row yet.
+The schema's history is the Alembic migrations in ``store/migrations/versions`` (one revision per
+change, ``0001`` being the first released schema). :func:`upgrade_database` runs
+``alembic upgrade head`` on the store's own connection, with a configuration built here (no
+``alembic.ini`` at run time), in one transaction that other processes opening the same database
+wait for (a PostgreSQL advisory lock; SQLite's ``BEGIN IMMEDIATE``).
+
+A database made before the project had migrations has no ``alembic_version`` table. Its
+revision is read from what it holds (:data:`LEGACY_MARKERS`: each released schema added a table
+or a column that the previous one lacked), it is stamped with that revision and migrated on from
+there; no row is touched. Afterwards, every take without a ``take_qa`` row gets one (the shoots
+revision makes that table empty).
+
+SQLite's foreign keys are off while migrating: a batch migration rebuilds a table by copying it,
+and dropping the old copy must not cascade into the rows that refer to it; the database's
+references are checked (``PRAGMA foreign_key_check``) before the transaction commits.
 """
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Any
+
+from alembic import command
+from alembic.autogenerate import compare_metadata
+from alembic.config import Config
+from alembic.runtime.migration import MigrationContext
+from alembic.script import ScriptDirectory
 from sqlalchemy import Engine, inspect, select, text
+from sqlalchemy.engine import Connection
 
+from mocapqa.errors import ConflictError
 from mocapqa.store.qa import sync_take
-from mocapqa.store.tables import take_qa, takes
+from mocapqa.store.tables import metadata, take_qa, takes
 
-__all__ = ["upgrade_schema"]
+__all__ = [
+    "LEGACY_MARKERS",
+    "MIGRATIONS",
+    "alembic_config",
+    "current_revision",
+    "downgrade_database",
+    "drop_database",
+    "head_revision",
+    "legacy_revision",
+    "schema_difference",
+    "upgrade_database",
+]
+
+MIGRATIONS = Path(__file__).with_name("migrations")
+"""The Alembic script folder (shipped inside the package)."""
+
+LEGACY_MARKERS: tuple[tuple[str, str, str | None], ...] = (
+    ("0001", "takes", None),
+    ("0002", "runs", "attempts"),
+    ("0003", "shoots", None),
+    ("0004", "source_hashes", None),
+    ("0005", "interval_decisions", None),
+    ("0006", "users", None),
+)
+"""(revision, table, column): a database made before migrations holds revision N's schema when
+it has the table (and column) of N and of every revision before it. The code of those versions
+created all its tables and added its columns whenever it opened a database, so a version's
+marker never comes without the rest of its schema."""
+
+_LOCK_KEY = 0x6D6F6361
+"""PostgreSQL advisory lock id held while migrating ("moca")."""
 
 
-def upgrade_schema(engine: Engine) -> list[str]:
-    """Apply the additive changes a database lacks; returns what was done (for the log)."""
+def alembic_config(connection: Connection | None = None) -> Config:
+    """Alembic's configuration for the store's migrations, built in code.
+
+    Parameters
+    ----------
+    connection : Connection, optional
+        The connection ``env.py`` migrates (``config.attributes["connection"]``).
+    """
+    config = Config()
+    config.set_main_option("script_location", str(MIGRATIONS))
+    config.attributes["connection"] = connection
+    return config
+
+
+def head_revision() -> str:
+    """The newest revision of the migration history."""
+    head = ScriptDirectory.from_config(alembic_config()).get_current_head()
+    if head is None:  # pragma: no cover - the package ships its revisions
+        raise RuntimeError(f"no migration found in {MIGRATIONS}")
+    return head
+
+
+def legacy_revision(connection: Connection) -> str | None:
+    """The revision a database made before migrations holds (None: not such a database).
+
+    A database with an ``alembic_version`` table, or without a ``takes`` table, is not one.
+    """
+    inspector = inspect(connection)
+    tables = set(inspector.get_table_names())
+    if "alembic_version" in tables or "takes" not in tables:
+        return None
+    found = None
+    for revision, table, column in LEGACY_MARKERS:
+        if table not in tables:
+            break
+        if column is not None and column not in {c["name"] for c in inspector.get_columns(table)}:
+            break
+        found = revision
+    return found
+
+
+def current_revision(engine: Engine) -> str | None:
+    """The database's revision: ``alembic_version``'s, else the legacy one read from its
+    tables (:func:`legacy_revision`), else None (an empty database)."""
+    with engine.connect() as conn:
+        stamped = MigrationContext.configure(conn).get_current_revision()
+        return stamped if stamped is not None else legacy_revision(conn)
+
+
+def schema_difference(engine: Engine) -> list[Any]:
+    """What Alembic's autogenerate finds between the database and the models
+    (:data:`~mocapqa.store.tables.metadata`): empty when the migrations made exactly the
+    schema the code declares (a model edited without a migration shows up here)."""
+    with engine.connect() as conn:
+        context = MigrationContext.configure(conn, opts={"compare_type": True})
+        return list(compare_metadata(context, metadata))
+
+
+def _repair_legacy(conn: Connection, revision: str) -> list[str]:
+    # Versions before migrations added ``takes.owner_id`` to an older database by ALTER TABLE
+    # without the index they gave it in a new one.
+    if revision != "0006":
+        return []
+    indexes = {ix["name"] for ix in inspect(conn).get_indexes("takes")}
+    if "ix_takes_owner_id" in indexes:
+        return []
+    conn.execute(text("CREATE INDEX ix_takes_owner_id ON takes (owner_id)"))
+    return ["created the index ix_takes_owner_id"]
+
+
+def _fill_take_qa(conn: Connection) -> list[str]:
+    missing = [
+        str(take_id)
+        for take_id in conn.execute(
+            select(takes.c.id).where(~takes.c.id.in_(select(take_qa.c.take_id)))
+        ).scalars()
+    ]
+    for take_id in missing:
+        sync_take(conn, take_id)
+    return [f"filled take_qa for {len(missing)} take(s)"] if missing else []
+
+
+def _check_references(conn: Connection) -> None:
+    broken = conn.exec_driver_sql("PRAGMA foreign_key_check").fetchall()
+    if broken:
+        raise ConflictError(
+            f"Expected every reference to hold after migrating, got {len(broken)} broken "
+            f"(first: table {broken[0][0]!r} row {broken[0][1]} → {broken[0][2]!r})"
+        )
+
+
+def _migrate(engine: Engine, target: str, downgrade: bool = False) -> list[str]:
+    sqlite = engine.dialect.name == "sqlite"
     done: list[str] = []
-    columns = {c["name"] for c in inspect(engine).get_columns("takes")}
-    with engine.begin() as conn:
-        if "shoot_id" not in columns:
-            conn.execute(
-                text("ALTER TABLE takes ADD COLUMN shoot_id VARCHAR(32) REFERENCES shoots (id)")
-            )
-            conn.execute(text("CREATE INDEX IF NOT EXISTS ix_takes_shoot_id ON takes (shoot_id)"))
-            done.append("added takes.shoot_id")
-        missing = [
-            str(take_id)
-            for take_id in conn.execute(
-                select(takes.c.id).where(~takes.c.id.in_(select(take_qa.c.take_id)))
-            ).scalars()
-        ]
-        for take_id in missing:
-            sync_take(conn, take_id)
-        if missing:
-            done.append(f"filled take_qa for {len(missing)} take(s)")
+    with engine.connect() as conn:
+        if sqlite:
+            conn.exec_driver_sql("PRAGMA foreign_keys=OFF")
+            conn.commit()
+        try:
+            if sqlite:
+                conn.exec_driver_sql("BEGIN IMMEDIATE")
+            else:
+                conn.execute(text("SELECT pg_advisory_xact_lock(:key)"), {"key": _LOCK_KEY})
+            config = alembic_config(conn)
+            legacy = legacy_revision(conn)
+            if legacy is not None:
+                done += _repair_legacy(conn, legacy)
+                command.stamp(config, legacy)
+                done.append(f"stamped a database made before migrations at {legacy}")
+            before = MigrationContext.configure(conn).get_current_revision()
+            if downgrade:
+                command.downgrade(config, target)
+            else:
+                command.upgrade(config, target)
+            after = MigrationContext.configure(conn).get_current_revision()
+            if after != before:
+                done.append(f"migrated {before or 'an empty database'} → {after or 'none'}")
+            if after is not None and not downgrade:
+                done += _fill_take_qa(conn)
+            if sqlite:
+                _check_references(conn)
+            conn.commit()
+        finally:
+            if sqlite:
+                conn.rollback()
+                conn.exec_driver_sql("PRAGMA foreign_keys=ON")
+                conn.commit()
     return done
+
+
+def upgrade_database(engine: Engine) -> list[str]:
+    """Create the schema, or migrate the database to the newest revision; returns what was
+    done (for the log; empty when it was up to date).
+
+    Raises
+    ------
+    ConflictError
+        Migrating would leave a broken reference (SQLite; nothing is changed).
+    """
+    return _migrate(engine, "head")
+
+
+def downgrade_database(engine: Engine, revision: str) -> list[str]:
+    """Migrate the database back to ``revision`` (``base``: no table left)."""
+    return _migrate(engine, revision, downgrade=True)
+
+
+def drop_database(engine: Engine) -> None:
+    """Drop every table of the store, the migration stamp included (tests and benchmarks start
+    over this way)."""
+    with engine.begin() as conn:
+        metadata.drop_all(conn)
+        conn.execute(text("DROP TABLE IF EXISTS alembic_version"))
