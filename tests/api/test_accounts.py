@@ -18,6 +18,7 @@ from mocapqa.config import Settings
 from mocapqa.render.service import RenderService
 from mocapqa.store.accounts import Accounts
 from mocapqa.store.roles import Role
+from mocapqa.store.shoots import ShootStore
 
 ROLES = {"admin": Role.ADMIN, "viewer": Role.VIEWER, "rev1": Role.REVIEWER, "rev2": Role.REVIEWER}
 PASSWORD = "correct horse battery"
@@ -102,16 +103,75 @@ def test_role_endpoint_matrix(
     assert client.delete(f"/api/v1/takes/{other}", headers=headers["admin"]).status_code == 204
     assert _upload(client, cmu_walk, headers["viewer"]).status_code == 403
     assert _upload(client, cmu_walk, headers["anonymous"]).status_code == 401
-    # shoots: read by everyone signed in, made by reviewers, deleted (with their takes) by admins
+    # shoots: read by everyone signed in, made by reviewers (test_shoot_owner_matrix: the rest)
     day = {"name": "day1"}
     assert client.get("/api/v1/shoots", headers=headers["anonymous"]).status_code == 401
     assert client.get("/api/v1/shoots", headers=headers["viewer"]).status_code == 200
     assert client.post("/api/v1/shoots", json=day, headers=headers["viewer"]).status_code == 403
-    shoot = client.post("/api/v1/shoots", json=day, headers=headers["rev1"])
-    assert shoot.status_code == 201
-    gone = f"/api/v1/shoots/{shoot.json()['id']}?confirm=day1"
-    assert client.delete(gone, headers=headers["rev1"]).status_code == 403
-    assert client.delete(gone, headers=headers["admin"]).status_code == 204
+    assert client.post("/api/v1/shoots", json=day, headers=headers["rev1"]).status_code == 201
+
+
+def test_shoot_owner_matrix(
+    team: tuple[TestClient, dict[str, dict[str, str]]], cmu_walk: Path
+) -> None:
+    """A shoot is renamed and deleted by its maker or an admin; a second reviewer may read it
+    and import into it (owning what it imports), but not rename or delete it."""
+    client, headers = team
+    made = client.post("/api/v1/shoots", json={"name": "day1"}, headers=headers["rev1"])
+    assert made.status_code == 201, made.text
+    shoot = made.json()["id"]
+    rev1 = client.get("/api/v1/me", headers=headers["rev1"]).json()["user_id"]
+    assert made.json()["owner_id"] == rev1
+    with cmu_walk.open("rb") as handle:
+        part = [("files", (cmu_walk.name, handle.read()))]
+    imported = client.post(f"/api/v1/shoots/{shoot}/takes", files=part, headers=headers["rev2"])
+    assert imported.status_code == 201, imported.text
+    take = imported.json()["created"][0]["take_id"]
+    who = ["anonymous", "viewer", "rev1", "rev2", "admin"]
+    base = f"/api/v1/shoots/{shoot}"
+    matrix: list[tuple[str, str, Any, list[int | None]]] = [
+        ("GET", base, None, [401, 200, 200, 200, 200]),
+        ("GET", f"{base}/takes", None, [401, 200, 200, 200, 200]),
+        ("PATCH", base, {"name": "day1"}, [401, 403, 200, 403, 200]),
+        ("DELETE", f"{base}?confirm=day1", None, [401, 403, None, 403, None]),
+        # the importer owns the take it imported; the shoot's owner does not
+        ("DELETE", f"/api/v1/takes/{take}", None, [401, 403, 403, None, None]),
+    ]
+    failures = []
+    for method, path, body, expected in matrix:
+        for name, status in zip(who, expected, strict=True):
+            if status is None:
+                continue
+            answer = client.request(method, path, json=body, headers=headers[name])
+            if answer.status_code != status:
+                failures.append(f"{method} {path} as {name}: {answer.status_code} != {status}")
+    assert not failures, "\n".join(failures)
+    assert (
+        client.get(f"/api/v1/takes/{take}", headers=headers["rev2"]).json()["owner_id"]
+        == (client.get("/api/v1/me", headers=headers["rev2"]).json()["user_id"])
+    )
+    # the owner deletes the shoot, with every take in it
+    assert client.delete(f"{base}?confirm=day1", headers=headers["rev1"]).status_code == 204
+    assert client.get(f"/api/v1/takes/{take}", headers=headers["admin"]).status_code == 404
+    # an admin deletes anyone's shoot; a shoot without an owner (made before owners) is theirs
+    other = client.post("/api/v1/shoots", json={"name": "day2"}, headers=headers["rev2"]).json()
+    assert (
+        client.delete(
+            f"/api/v1/shoots/{other['id']}?confirm=day2", headers=headers["admin"]
+        ).status_code
+        == 204
+    )
+    orphan = ShootStore(client.app.state.services.repository.engine).create("day3")  # type: ignore[attr-defined]
+    assert orphan["owner_id"] is None
+    for name in ("rev1", "rev2"):
+        path = f"/api/v1/shoots/{orphan['id']}"
+        assert client.patch(path, json={"name": "x"}, headers=headers[name]).status_code == 403
+        assert client.delete(f"{path}?confirm=day3", headers=headers[name]).status_code == 403
+    path = f"/api/v1/shoots/{orphan['id']}?confirm=day3"
+    assert client.delete(path, headers=headers["admin"]).status_code == 204
+    log = client.get("/api/v1/audit?limit=500", headers=headers["admin"]).json()["items"]
+    actions = [e["action"] for e in log]
+    assert {"shoot_create", "shoot_rename", "shoot_delete"} <= set(actions)
 
 
 def test_tokens_are_revocable_and_expire(

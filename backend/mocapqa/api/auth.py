@@ -10,8 +10,9 @@ While the server has no user at all, every request is served as an anonymous adm
 embedded default); once a user exists, a request without valid credentials gets 401.
 
 Each route names the :class:`~mocapqa.store.roles.Action` it performs with :func:`require`;
-:data:`~mocapqa.api.app.ROUTERS` gives every router its read requirement. Deleting a take (and
-a shoot) also needs :func:`require_owner`: its owner, or a role allowed ``delete_any``.
+:data:`~mocapqa.api.app.ROUTERS` gives every router its read requirement. Deleting a take, and
+renaming or deleting a shoot, also needs :func:`require_owner`: its owner, or a role allowed
+``delete_any``.
 """
 
 from __future__ import annotations
@@ -146,9 +147,10 @@ def require(action: Action) -> Callable[[Principal], Principal]:
 
 
 def require_owner(principal: Principal, owner_id: int | None, what: str) -> None:
-    """Refuse (403) deleting ``what`` unless the principal owns it or may delete anything.
-
-    The hook every owned resource's delete route calls (takes now; shoots too).
+    """Refuse (403) deleting or changing ``what`` unless the principal owns it or may delete
+    anything: the one owner rule, which every owned resource's delete (and rename) route calls
+    (takes, shoots). A resource without an owner (made before owners, or on a server without
+    users) is an admin's alone.
     """
     if allows(principal.role, Action.DELETE_ANY):
         return

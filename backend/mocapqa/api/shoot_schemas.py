@@ -37,6 +37,11 @@ class ShootOut(BaseModel):
     n_frames: int
     status_counts: dict[str, int] = Field(description="Takes per latest run status")
     review_counts: dict[str, int] = Field(description="Takes per review status")
+    owner_id: int | None = Field(
+        None,
+        description="The user who made it, who may rename and delete it besides admins (none "
+        "for shoots made before shoots had owners, or without users).",
+    )
 
 
 class ShootTakeOut(BaseModel):

@@ -125,10 +125,11 @@ class ShootStore:
         self.engine = engine
 
     # shoots ----------------------------------------------------------------------------
-    def create(self, name: str) -> dict[str, Any]:
-        """A new empty shoot; :class:`ConflictError` when the name is taken."""
+    def create(self, name: str, owner_id: int | None = None) -> dict[str, Any]:
+        """A new empty shoot owned by ``owner_id`` (None: no owner, only admins may rename
+        or delete it); :class:`ConflictError` when the name is taken."""
         clean = _checked_name(name)
-        row = {"id": new_id(), "name": clean, "created_at": utc_now()}
+        row = {"id": new_id(), "name": clean, "created_at": utc_now(), "owner_id": owner_id}
         try:
             with self.engine.begin() as conn:
                 conn.execute(insert(shoots).values(**row))

@@ -9,10 +9,10 @@ import json
 from collections.abc import Iterator
 from typing import Annotated, Any, Literal
 
-from fastapi import APIRouter, Depends, File, Query, Response, UploadFile
+from fastapi import APIRouter, Depends, File, Query, Request, Response, UploadFile
 from fastapi.responses import StreamingResponse
 
-from mocapqa.api.auth import require
+from mocapqa.api.auth import Principal, audit, require, require_owner
 from mocapqa.api.deps import ServicesDep
 from mocapqa.api.errors import responses
 from mocapqa.api.shoot_schemas import (
@@ -33,10 +33,10 @@ from mocapqa.store.shoots import SORT_COLUMNS, ShootStore, TakeFilter
 
 __all__ = ["EXPORT_COLUMNS", "router"]
 
-_UPLOAD = Depends(require(Action.UPLOAD))
-# Shoots have no owner yet: deleting one (with all its takes) is for admins; an owner column
-# and ``require_owner`` (api/auth.py) would let a reviewer delete the shoots they made.
-_DELETE_SHOOT = Depends(require(Action.DELETE_ANY))
+# A shoot's maker (its owner) renames and deletes it, as a take's uploader deletes the take;
+# admins may do both to any shoot, and are the only ones for shoots without an owner.
+Maker = Annotated[Principal, Depends(require(Action.UPLOAD))]
+Deleter = Annotated[Principal, Depends(require(Action.DELETE_OWN))]
 router = APIRouter(prefix="/shoots", tags=["shoots"])
 """Routes of this resource, included under ``/api/v1``."""
 
@@ -48,10 +48,14 @@ def _store(services: ServicesDep) -> ShootStore:
 ShootSort = Literal[SORT_COLUMNS]  # type: ignore[valid-type]
 
 
-@router.post("", status_code=201, responses=responses(401, 403, 409), dependencies=[_UPLOAD])
-def create_shoot(body: ShootIn, services: ServicesDep) -> ShootOut:
-    """Create an empty shoot."""
-    return ShootOut(**_store(services).create(body.name))
+@router.post("", status_code=201, responses=responses(401, 403, 409))
+def create_shoot(
+    request: Request, principal: Maker, body: ShootIn, services: ServicesDep
+) -> ShootOut:
+    """Create an empty shoot, owned by the signed-in user."""
+    shoot = _store(services).create(body.name, principal.user_id)
+    audit(request, principal, "shoot_create", str(shoot["id"]), str(shoot["name"]))
+    return ShootOut(**shoot)
 
 
 @router.get("", responses=responses(401))
@@ -66,29 +70,39 @@ def get_shoot(shoot_id: str, services: ServicesDep) -> ShootOut:
     return ShootOut(**_store(services).get(shoot_id))
 
 
-@router.patch("/{shoot_id}", responses=responses(401, 403, 404, 409), dependencies=[_UPLOAD])
-def rename_shoot(shoot_id: str, body: ShootIn, services: ServicesDep) -> ShootOut:
-    """Rename a shoot."""
-    return ShootOut(**_store(services).rename(shoot_id, body.name))
+@router.patch("/{shoot_id}", responses=responses(401, 403, 404, 409))
+def rename_shoot(
+    request: Request, principal: Maker, shoot_id: str, body: ShootIn, services: ServicesDep
+) -> ShootOut:
+    """Rename a shoot: its owner or an admin (403 otherwise)."""
+    store = _store(services)
+    before = store.get(shoot_id)
+    require_owner(principal, before["owner_id"], f"shoot {shoot_id}")
+    shoot = store.rename(shoot_id, body.name)
+    audit(request, principal, "shoot_rename", shoot_id, f"{before['name']} → {shoot['name']}")
+    return ShootOut(**shoot)
 
 
 @router.delete(
     "/{shoot_id}",
     status_code=204,
     responses=responses(401, 403, 404),
-    dependencies=[_DELETE_SHOOT],
 )
 def delete_shoot(
+    request: Request,
+    principal: Deleter,
     shoot_id: str,
     services: ServicesDep,
     confirm: Annotated[str, Query(description="The shoot's exact name, to confirm")] = "",
 ) -> Response:
-    """Delete a shoot **with all its takes**, their runs, reviews and files.
+    """Delete a shoot **with all its takes**, their runs, reviews and files: its owner or an
+    admin (403 otherwise), whoever uploaded the takes.
 
     ``confirm`` must repeat the shoot's name (422 otherwise, nothing deleted).
     """
     store = _store(services)
     shoot = store.get(shoot_id)
+    require_owner(principal, shoot["owner_id"], f"shoot {shoot_id}")
     if confirm != shoot["name"]:
         raise InputError(
             f"Expected confirm={shoot['name']!r} to delete the shoot and its "
@@ -98,6 +112,7 @@ def delete_shoot(
     for take_id in take_ids:
         services.files.remove_take(take_id, [])
     services.files.remove_runs(run_ids)
+    audit(request, principal, "shoot_delete", shoot_id, f"{shoot['name']}: {len(take_ids)} take(s)")
     return Response(status_code=204)
 
 
@@ -105,9 +120,10 @@ def delete_shoot(
     "/{shoot_id}/takes",
     status_code=201,
     responses=responses(401, 403, 404, 413, 415, 429),
-    dependencies=[_UPLOAD],
 )
 def import_takes(
+    request: Request,
+    principal: Maker,
     shoot_id: str,
     services: ServicesDep,
     files: Annotated[list[UploadFile], File(description="Takes, .zip or .tar.gz archives")],
@@ -116,7 +132,8 @@ def import_takes(
     archives unpacked member by member. Each take's analysis starts with default options.
 
     Non-motion archive members are listed as skipped, unreadable or unsafe ones (links,
-    names leaving the archive) as failed with their error; the rest are kept.
+    names leaving the archive) as failed with their error; the rest are kept, owned by the
+    signed-in user (who may delete them, as takes uploaded one by one).
     """
     _store(services).require(shoot_id)
     settings = services.settings
@@ -133,6 +150,9 @@ def import_takes(
         services.runner,
         limits,
     )
+    for take in report.created:
+        services.repository.set_owner(take["take_id"], principal.user_id)
+        audit(request, principal, "upload", take["take_id"], f"{take['name']} run {take['run_id']}")
     return ImportOut(created=report.created, skipped=report.skipped, failed=report.failed)
 
 
