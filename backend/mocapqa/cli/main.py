@@ -25,6 +25,7 @@ COMMAND_MODULES: dict[str, tuple[str, ...]] = {
     "batch": ("batch",),
     "users": ("accounts",),
     "tokens": ("accounts",),
+    "db": ("database",),
     "limits": ("limits",),
     "bench batch": ("bench_batch",),
     "bench io": ("bench_io",),

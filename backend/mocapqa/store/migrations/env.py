@@ -5,6 +5,10 @@ hands over an open connection as ``config.attributes["connection"]``, inside the
 holds. From the command line (``alembic -c backend/mocapqa/store/migrations/alembic.ini``, for
 writing a new revision; see docs/database.md) the database comes from ``-x url=...``, then from
 ``MOCAPQA_DATABASE_URL``.
+
+Alembic runs this file as a script (under its own module name); imported as
+``mocapqa.store.migrations.env`` (the documentation test imports every module) it only defines
+:func:`run_on`.
 """
 
 from __future__ import annotations
@@ -41,13 +45,20 @@ def _url() -> str:
     return url
 
 
-if context.is_offline_mode():
-    raise SystemExit("Expected an online migration (the store's migrations need a connection)")
-_given = context.config.attributes.get("connection")
-if isinstance(_given, Connection):
-    run_on(_given)
-else:
-    _engine = create_engine(_url())
-    with _engine.connect() as _connection:
-        run_on(_connection)
-    _engine.dispose()
+def main() -> None:
+    """Migrate the connection given in the configuration, or the database named on the command
+    line."""
+    if context.is_offline_mode():
+        raise SystemExit("Expected an online migration (the store's migrations need a connection)")
+    given = context.config.attributes.get("connection")
+    if isinstance(given, Connection):
+        run_on(given)
+        return
+    engine = create_engine(_url())
+    with engine.connect() as connection:
+        run_on(connection)
+    engine.dispose()
+
+
+if not __name__.startswith("mocapqa."):
+    main()

@@ -21,4 +21,4 @@ def upgrade() -> None:
 
 
 def downgrade() -> None:
-    raise NotImplementedError("The store migrates forward only (docs/database.md)")
+    ${downgrades if downgrades else "pass"}
