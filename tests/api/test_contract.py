@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 import sqlite3
 from pathlib import Path
 from typing import Any
@@ -148,28 +149,17 @@ def test_start_sweeps_incoming_and_fails_a_run_interrupted_twice(
 
 
 def test_a_database_without_the_attempts_column_still_opens(tmp_path: Path) -> None:
-    """A database made before ``runs.attempts`` existed gets the column when opened."""
+    """A database made before ``runs.attempts`` existed (the first release's, in
+    tests/data/legacy) gets the column when opened."""
     path = tmp_path / "old.sqlite3"
+    legacy = Path(__file__).resolve().parents[1] / "data" / "legacy"
+    shutil.copyfile(legacy / "228f57d.sqlite3", path)
     with sqlite3.connect(path) as conn:
-        conn.executescript(
-            "CREATE TABLE takes (id VARCHAR(32) PRIMARY KEY, name VARCHAR(255) NOT NULL,"
-            " format VARCHAR(32) NOT NULL, kind VARCHAR(16) NOT NULL, size_bytes BIGINT NOT NULL,"
-            " sha256 VARCHAR(64) NOT NULL, n_frames INTEGER NOT NULL, fps FLOAT NOT NULL,"
-            " n_joints INTEGER NOT NULL, file_name VARCHAR(255) NOT NULL,"
-            " created_at DATETIME NOT NULL);"
-            "CREATE TABLE runs (id VARCHAR(32) PRIMARY KEY, take_id VARCHAR(32)"
-            " REFERENCES takes(id) ON DELETE CASCADE, status VARCHAR(16) NOT NULL,"
-            " progress INTEGER NOT NULL, step VARCHAR(255) NOT NULL, options JSON NOT NULL,"
-            " input_sha256 VARCHAR(64) NOT NULL, version VARCHAR(32) NOT NULL, error TEXT,"
-            " summary JSON, server_time_s FLOAT, created_at DATETIME NOT NULL,"
-            " started_at DATETIME, finished_at DATETIME);"
-            "INSERT INTO takes VALUES ('" + "a" * 32 + "', 'old', 'bvh', 'motion', 1, 'x', 1, 30,"
-            " 1, 'old.bvh', '2026-01-01 00:00:00');"
-            "INSERT INTO runs VALUES ('" + "b" * 32 + "', '" + "a" * 32 + "', 'done', 100,"
-            " 'done', '{}', 'x', '0.1', NULL, NULL, 1.0, '2026-01-01 00:00:00', NULL, NULL);"
-        )
+        columns = [row[1] for row in conn.execute("PRAGMA table_info(runs)")]
+        (run_id,) = conn.execute("SELECT id FROM runs WHERE status = 'done' LIMIT 1").fetchone()
+    assert "attempts" not in columns
     repository = Repository(f"sqlite:///{path}")
-    run = repository.get_run("b" * 32)
+    run = repository.get_run(run_id)
     repository.close()
     assert run["attempts"] == 0
     assert run["status"] == "done"

@@ -18,6 +18,7 @@ from mocapqa.api.app import create_app
 from mocapqa.config import Settings
 from mocapqa.render.service import RenderService
 
+LEGACY = Path(__file__).resolve().parents[1] / "data" / "legacy"
 API = "/api/v1"
 WALK = "bvh/cmu/cmu_12_01_walk.bvh"
 BANDAI = ("bvh/bandai/dataset-1_bow_not-confident_001.bvh", "bvh/bandai/dataset-1_bow_sad_001.bvh")
@@ -264,34 +265,26 @@ def test_openapi_declares_shoot_statuses(client: TestClient) -> None:
 
 @pytest.mark.parametrize("kind", ["sqlite"])
 def test_database_from_before_shoots_opens(kind: str, tmp_path: Path) -> None:
-    import sqlite3
+    """A database made by the first release (tests/data/legacy) takes shoots once opened."""
+    import shutil
 
     from mocapqa.store.repository import Repository
     from mocapqa.store.shoots import ShootStore
 
     path = tmp_path / "old.sqlite3"
-    with sqlite3.connect(path) as conn:
-        conn.executescript(
-            """
-            CREATE TABLE takes (id VARCHAR(32) PRIMARY KEY, name VARCHAR(255) NOT NULL,
-              format VARCHAR(32) NOT NULL, kind VARCHAR(16) NOT NULL, size_bytes BIGINT NOT NULL,
-              sha256 VARCHAR(64) NOT NULL, n_frames INTEGER NOT NULL, fps FLOAT NOT NULL,
-              n_joints INTEGER NOT NULL, file_name VARCHAR(255) NOT NULL,
-              created_at DATETIME NOT NULL);
-            INSERT INTO takes VALUES ('0123456789abcdef0123456789abcdef', 'old.bvh', 'bvh',
-              'motion', 10, 'ff', 100, 30.0, 20, 'old.bvh', '2026-01-01 00:00:00');
-            """
-        )
+    shutil.copyfile(LEGACY / "228f57d.sqlite3", path)
     repository = Repository(f"sqlite:///{path}")
     try:
-        take = repository.get_take("0123456789abcdef0123456789abcdef")
+        items, total = repository.list_takes()
+        assert total == 2
+        take = min(items, key=lambda t: str(t["name"]))
         assert take["shoot_id"] is None
         store = ShootStore(repository.engine)
         shoot = store.create("old")
         store.assign(str(take["id"]), str(shoot["id"]))
         rows, total = store.page(str(shoot["id"]))
         assert total == 1
-        assert rows[0]["n_frames"] == 100
+        assert rows[0]["n_frames"] == take["n_frames"] == 24
     finally:
         repository.close()
 

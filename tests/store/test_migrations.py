@@ -9,6 +9,7 @@ the schema the models declare, with the app working on it.
 from __future__ import annotations
 
 import shutil
+import sqlite3
 from concurrent.futures import ThreadPoolExecutor
 from datetime import timedelta
 from pathlib import Path
@@ -24,6 +25,7 @@ from tests.store.conftest import database_params, database_url
 
 from mocapqa.api.app import create_app
 from mocapqa.config import Settings
+from mocapqa.errors import ConflictError
 from mocapqa.store.repository import Repository
 from mocapqa.store.tables import metadata
 from mocapqa.store.upgrade import (
@@ -211,3 +213,16 @@ def test_downgrade_to_an_older_revision_keeps_its_rows(kind: str, tmp_path: Path
     downgrade_database(repository.engine, "base")
     assert set(inspect(repository.engine).get_table_names()) <= {"alembic_version"}
     repository.close()
+
+
+def test_a_database_this_project_did_not_make_is_refused_untouched(tmp_path: Path) -> None:
+    path = tmp_path / "other.sqlite3"
+    with sqlite3.connect(path) as conn:
+        conn.execute("CREATE TABLE takes (id VARCHAR(32) PRIMARY KEY, title TEXT)")
+        conn.execute("INSERT INTO takes VALUES ('a', 'mine')")
+    with pytest.raises(ConflictError, match=r"revision 0001 has takes, runs, reviews\), got takes"):
+        Repository(f"sqlite:///{path}")
+    with sqlite3.connect(path) as conn:
+        tables = [r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type='table'")]
+        assert tables == ["takes"]
+        assert conn.execute("SELECT * FROM takes").fetchall() == [("a", "mine")]

@@ -50,18 +50,18 @@ __all__ = [
 MIGRATIONS = Path(__file__).with_name("migrations")
 """The Alembic script folder (shipped inside the package)."""
 
-LEGACY_MARKERS: tuple[tuple[str, str, str | None], ...] = (
-    ("0001", "takes", None),
-    ("0002", "runs", "attempts"),
-    ("0003", "shoots", None),
-    ("0004", "source_hashes", None),
-    ("0005", "interval_decisions", None),
-    ("0006", "users", None),
+LEGACY_MARKERS: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("0001", ("takes", "runs", "reviews")),
+    ("0002", ("runs.attempts",)),
+    ("0003", ("shoots", "take_qa", "takes.shoot_id")),
+    ("0004", ("source_hashes",)),
+    ("0005", ("interval_decisions",)),
+    ("0006", ("users", "tokens", "audit", "takes.owner_id", "reviews.user_id")),
 )
-"""(revision, table, column): a database made before migrations holds revision N's schema when
-it has the table (and column) of N and of every revision before it. The code of those versions
-created all its tables and added its columns whenever it opened a database, so a version's
-marker never comes without the rest of its schema."""
+"""(revision, the tables and ``table.column``s it added): a database made before migrations
+holds revision N's schema when it has everything N and the revisions before it added. The code
+of those versions created all its tables and added its columns whenever it opened a database,
+so a version's additions come all together or not at all."""
 
 _LOCK_KEY = 0x6D6F6361
 """PostgreSQL advisory lock id held while migrating ("moca")."""
@@ -93,16 +93,33 @@ def legacy_revision(connection: Connection) -> str | None:
     """The revision a database made before migrations holds (None: not such a database).
 
     A database with an ``alembic_version`` table, or without a ``takes`` table, is not one.
+
+    Raises
+    ------
+    ConflictError
+        Part of a revision's tables or columns only: not a database this project made.
     """
     inspector = inspect(connection)
     tables = set(inspector.get_table_names())
     if "alembic_version" in tables or "takes" not in tables:
         return None
-    found = None
-    for revision, table, column in LEGACY_MARKERS:
+
+    def has(marker: str) -> bool:
+        table, _, column = marker.partition(".")
         if table not in tables:
-            break
-        if column is not None and column not in {c["name"] for c in inspector.get_columns(table)}:
+            return False
+        return not column or column in {c["name"] for c in inspector.get_columns(table)}
+
+    found = None
+    for revision, markers in LEGACY_MARKERS:
+        present = [marker for marker in markers if has(marker)]
+        if len(present) < len(markers):
+            if present or found is None:
+                raise ConflictError(
+                    f"Expected a database made by mocapqa (revision {revision} has "
+                    f"{', '.join(markers)}), got {', '.join(present) or 'none of them'} "
+                    f"beside {', '.join(sorted(tables))}"
+                )
             break
         found = revision
     return found
