@@ -19,11 +19,12 @@ references are checked (``PRAGMA foreign_key_check``) before the transaction com
 
 from __future__ import annotations
 
+import logging
+from functools import cache
 from pathlib import Path
 from typing import Any
 
 from alembic import command
-from alembic.autogenerate import compare_metadata
 from alembic.config import Config
 from alembic.runtime.migration import MigrationContext
 from alembic.script import ScriptDirectory
@@ -63,6 +64,9 @@ holds revision N's schema when it has everything N and the revisions before it a
 of those versions created all its tables and added its columns whenever it opened a database,
 so a version's additions come all together or not at all."""
 
+# Alembic logs its set-up at INFO on every open; the store logs what it changed instead.
+logging.getLogger("alembic").setLevel(logging.WARNING)
+
 _LOCK_KEY = 0x6D6F6361
 """PostgreSQL advisory lock id held while migrating ("moca")."""
 
@@ -81,6 +85,7 @@ def alembic_config(connection: Connection | None = None) -> Config:
     return config
 
 
+@cache
 def head_revision() -> str:
     """The newest revision of the migration history."""
     head = ScriptDirectory.from_config(alembic_config()).get_current_head()
@@ -137,6 +142,8 @@ def schema_difference(engine: Engine) -> list[Any]:
     """What Alembic's autogenerate finds between the database and the models
     (:data:`~mocapqa.store.tables.metadata`): empty when the migrations made exactly the
     schema the code declares (a model edited without a migration shows up here)."""
+    from alembic.autogenerate import compare_metadata  # loads its plugins: only when asked
+
     with engine.connect() as conn:
         context = MigrationContext.configure(conn, opts={"compare_type": True})
         return list(compare_metadata(context, metadata))
@@ -178,6 +185,11 @@ def _check_references(conn: Connection) -> None:
 def _migrate(engine: Engine, target: str, downgrade: bool = False) -> list[str]:
     sqlite = engine.dialect.name == "sqlite"
     done: list[str] = []
+    if target == "head":
+        # the common case, without a lock or a write: already at the newest revision
+        with engine.connect() as conn:
+            if MigrationContext.configure(conn).get_current_revision() == head_revision():
+                return done
     with engine.connect() as conn:
         if sqlite:
             conn.exec_driver_sql("PRAGMA foreign_keys=OFF")
