@@ -85,9 +85,13 @@ def alembic_config(connection: Connection | None = None) -> Config:
     return config
 
 
-@cache
 def head_revision() -> str:
-    """The newest revision of the migration history."""
+    """The newest revision of the migration history (read once per process)."""
+    return _head()
+
+
+@cache
+def _head() -> str:
     head = ScriptDirectory.from_config(alembic_config()).get_current_head()
     if head is None:  # pragma: no cover - the package ships its revisions
         raise RuntimeError(f"no migration found in {MIGRATIONS}")
