@@ -226,3 +226,20 @@ def test_a_database_this_project_did_not_make_is_refused_untouched(tmp_path: Pat
         tables = [r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type='table'")]
         assert tables == ["takes"]
         assert conn.execute("SELECT * FROM takes").fetchall() == [("a", "mine")]
+
+
+def test_a_reference_broken_before_migrating_does_not_stop_it(tmp_path: Path) -> None:
+    """SQLite checks references after migrating; one the old database already broke (its
+    foreign keys were off) is kept as it was, not counted against the migration."""
+    url = legacy_database("sqlite", "228f57d", tmp_path)
+    with sqlite3.connect(url.removeprefix("sqlite:///")) as conn:
+        conn.execute(
+            "INSERT INTO reviews (take_id, status, notes, reviewer, created_at)"
+            " VALUES ('gone', 'approved', 'orphan', 'ann', '2026-01-01 00:00:00')"
+        )
+    repository = Repository(url)
+    with repository.engine.connect() as conn:
+        notes = conn.execute(text("SELECT notes FROM reviews WHERE take_id = 'gone'")).scalars()
+        assert notes.all() == ["orphan"]
+    assert current_revision(repository.engine) == head_revision()
+    repository.close()
