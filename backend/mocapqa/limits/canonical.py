@@ -73,6 +73,7 @@ __all__ = [
 
 # The long axis of every canonical frame.
 CANONICAL_AXIS = np.array([0.0, 1.0, 0.0])
+_FLEXION_AXIS = np.array([1.0, 0.0, 0.0])
 
 _PARENT_ROLE = {
     "upper_arm": "clavicle",
@@ -297,8 +298,15 @@ def canonical_frames(
             parent = rig.joint(side, parent_role)  # type: ignore[arg-type]
             partner = world_long(side, parent_role, parent) if parent is not None else left_w
             sign_w = left_w
-        normals = _local(quats[:, joint], np.cross(along, partner))
         sign_ref = np.mean(_local(quats[:, joint], sign_w), axis=0)
+        forearm = rig.joint(side, "forearm") if role == "hand" else None
+        if forearm is not None:
+            # The wrist hardly bends, so its bend plane is a weak, rig-dependent signal: the
+            # hand takes the forearm's flexion axis, as seen from its own frame.
+            forearm_x = rotate(frame_of(side, "forearm", forearm), _FLEXION_AXIS)
+            normals = _local(quats[:, joint], rotate(quats[:, forearm], forearm_x[None]))
+        else:
+            normals = _local(quats[:, joint], np.cross(along, partner))
         flexion, bend = _median_direction(normals, long_axes[joint], sign_ref)
         if bend < _MIN_BEND_SIN2:
             flexion = sign_ref
