@@ -14,10 +14,12 @@ from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.kinematics.quaternion import conjugate, geodesic_angle, multiply, rotate
 from mocapqa.limits.analysis import check_limits
 from mocapqa.limits.build import BuildParams, build_canonical_model
-from mocapqa.limits.canonical import CANONICAL_AXIS, canonical_quats, rig_frames, rig_key
+from mocapqa.limits.canonical import CANONICAL_AXIS, rig_frames, rig_key
+from mocapqa.limits.charting import canonical_quats
 from mocapqa.limits.expmap import expmap_from_quats
-from mocapqa.limits.model import LimitsModel, load_model, model_bytes
+from mocapqa.limits.model import LimitsModel
 from mocapqa.limits.occupancy import OccupancyParams
+from mocapqa.limits.storage import load_model, model_bytes
 
 MAP_ONLY = BuildParams(
     occupancy=OccupancyParams(bin_deg=15.0, dilation_bins=2, tau_margin_deg=40.0, interpolate=True),

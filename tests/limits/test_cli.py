@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from mocapqa.cli.main import main
-from mocapqa.limits.model import load_model
+from mocapqa.limits.storage import load_model
 
 
 def test_check_prints_json_with_the_flagged_fraction(
@@ -38,7 +38,7 @@ def test_build_then_show_writes_a_model_and_an_image(corpus_dir: Path, tmp_path:
 def test_check_with_a_model_of_another_rig_exits_with_the_limits_code(
     corpus_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from mocapqa.limits.model import default_model_paths
+    from mocapqa.limits.storage import default_model_paths
 
     bandai = next(p for p in default_model_paths() if p.name == "bandai.npz")
     code = main(["limits", "check", str(corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh"),

@@ -12,15 +12,15 @@ from mocapqa.io.bvh import read_bvh
 from mocapqa.limits.analysis import check_limits, joint_map_json
 from mocapqa.limits.build import BuildParams, build_model
 from mocapqa.limits.discriminator import DiscriminatorParams
-from mocapqa.limits.model import (
-    LimitsModel,
+from mocapqa.limits.model import LimitsModel
+from mocapqa.limits.occupancy import OccupancyParams
+from mocapqa.limits.storage import (
     default_model_paths,
     load_default_model,
     load_model,
     model_bytes,
     save_model,
 )
-from mocapqa.limits.occupancy import OccupancyParams
 
 BANDAI = ("dataset-1_walk_normal_001.bvh", "dataset-2_walk_normal_001.bvh")
 TINY = BuildParams(

@@ -12,8 +12,10 @@ from mocapqa.errors import InputError, ShapeError
 from mocapqa.limits.occupancy import (
     OccupancyParams,
     build_occupancy,
+    evaluate,
     is_valid,
     limit_distances,
+    signed_excess,
     swing_bins,
     twist_bounds,
 )
@@ -107,3 +109,78 @@ def test_interpolated_bounds_are_continuous_across_bin_edges() -> None:
     # Between the two bin centres (−7.5°, 7.5°) the half-width goes linearly from 10° to 50°.
     probe = np.array([[np.deg2rad(s1), 0.0, 0.0] for s1 in (-7.5, -3.75, 3.75, 7.5)])
     np.testing.assert_allclose(np.rad2deg(twist_bounds(occupancy, probe)[1]), [10, 20, 40, 50])
+
+
+def _brute_force_arc(tau: np.ndarray) -> tuple[float, float]:
+    """Centre and half-width of the shortest arc covering ``tau``, on a 0.01° grid of starts."""
+    best = (0.0, np.pi)
+    for start in np.deg2rad(np.arange(-180.0, 180.0, 0.01)):
+        width = float(np.max((tau - start) % (2 * np.pi)))
+        if width < 2 * best[1]:
+            best = (start + width / 2, width / 2)
+    return float((best[0] + np.pi) % (2 * np.pi) - np.pi), best[1]
+
+
+def test_every_bin_keeps_the_shortest_arc_of_its_twists() -> None:
+    rng = np.random.default_rng(4)
+    for centre_deg in (0.0, 170.0, -175.0):
+        tau = np.deg2rad(centre_deg + rng.uniform(-30.0, 30.0, 12))
+        tau = (tau + np.pi) % (2 * np.pi) - np.pi
+        occupancy = build_occupancy(
+            np.c_[np.full((12, 2), D(0.5)), tau], OccupancyParams(bin_deg=1.0, smooth=False)
+        )
+        low, high = occupancy.tau_min[180, 180], occupancy.tau_max[180, 180]
+        centre, half = _brute_force_arc(tau)
+        np.testing.assert_allclose(0.5 * (high - low), half, atol=D(0.01))
+        offset = (0.5 * (low + high) - centre + np.pi) % (2 * np.pi) - np.pi
+        assert abs(offset) < D(0.01)
+
+
+def test_a_dilated_bin_covers_the_arcs_of_its_neighbours_across_the_wrap() -> None:
+    # Two neighbouring bins with arcs on either side of ±180°: the ring bins between and around
+    # them take the union, a 40° arc across 180°, not the 320° arc the other way round.
+    samples = _samples([(0.5, 0.5, 160.0), (0.5, 0.5, 170.0), (2.5, 0.5, -170.0),
+                        (2.5, 0.5, -160.0)])  # fmt: skip
+    occupancy = build_occupancy(
+        samples, OccupancyParams(bin_deg=1.0, dilation_bins=1, smooth=False)
+    )
+    ring = occupancy.occupied.copy()
+    ring[180, 180] = ring[182, 180] = False
+    assert ring.sum() == 13  # the 3×5 block around the two bins, less the two
+    width = np.rad2deg(occupancy.tau_max[181, 180] - occupancy.tau_min[181, 180])
+    np.testing.assert_allclose(width, 40.0, atol=1e-9)
+    inside = _samples([(1.5, 0.5, 180.0), (1.5, 0.5, -165.0), (1.5, 0.5, 165.0)])
+    outside = _samples([(1.5, 0.5, 0.0), (1.5, 0.5, 150.0), (1.5, 0.5, -150.0)])
+    assert is_valid(occupancy, inside).all()
+    assert not is_valid(occupancy, outside).any()
+
+
+def test_smoothing_averages_twist_centres_the_short_way_round() -> None:
+    # Bins at 175° and −175°: their smoothed centres stay near 180°, not near 0°.
+    samples = _samples([(0.5, 0.5, 175.0), (1.5, 0.5, -175.0)])
+    occupancy = build_occupancy(samples, OccupancyParams(bin_deg=1.0, smooth=True))
+    for i1 in (180, 181):
+        centre = 0.5 * (occupancy.tau_min[i1, 180] + occupancy.tau_max[i1, 180])
+        assert abs(abs((np.rad2deg(centre) + 180) % 360 - 180) - 180) < 5
+
+
+def test_the_lookups_agree_with_evaluate_on_any_leading_shape() -> None:
+    rng = np.random.default_rng(2)
+    samples = np.c_[rng.normal(0, 0.6, (500, 2)), rng.uniform(-np.pi, np.pi, 500)]
+    occupancy = build_occupancy(
+        samples, OccupancyParams(bin_deg=15.0, dilation_bins=1, tau_margin_deg=10, interpolate=True)
+    )
+    queries = np.c_[rng.normal(0, 1.2, (600, 2)), rng.uniform(-np.pi, np.pi, 600)]
+    valid, swing, twist, excess = evaluate(occupancy, queries)
+    grid = queries.reshape(20, 30, 3)
+    np.testing.assert_array_equal(is_valid(occupancy, grid), valid.reshape(20, 30))
+    swing_grid, twist_grid = limit_distances(occupancy, grid)
+    np.testing.assert_array_equal(swing_grid, swing.reshape(20, 30))
+    np.testing.assert_array_equal(twist_grid, twist.reshape(20, 30))
+    np.testing.assert_array_equal(signed_excess(occupancy, grid), excess.reshape(20, 30, 3))
+    # Outside means a positive distance, inside none; the signed excess has those sizes.
+    assert (~valid).any()
+    assert valid.any()
+    np.testing.assert_array_equal(np.hypot(swing, twist) > 0, ~valid)
+    np.testing.assert_allclose(np.hypot(excess[:, 0], excess[:, 1]), swing, atol=1e-9)
+    np.testing.assert_allclose(np.abs(excess[:, 2]), twist, atol=1e-9)

@@ -30,7 +30,7 @@ COMMAND_MODULES: dict[str, tuple[str, ...]] = {
     "bench batch": ("bench_batch",),
     "bench io": ("bench_io",),
     "bench filters": ("filters",),
-    "bench limits": ("limits",),
+    "bench limits": ("bench_limits",),
     "bench render": ("render",),
     "bench twist": ("twist",),
 }

@@ -23,18 +23,14 @@ from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles
 from mocapqa.errors import InputError, LimitsFileError
 from mocapqa.kinematics.quaternion import multiply
-from mocapqa.limits.canonical import (
-    CANONICAL_AXIS,
-    CanonicalFrames,
-    canonical_rotations,
-    rig_key,
-    take_frames,
-)
+from mocapqa.limits.canonical import CANONICAL_AXIS, CanonicalFrames, rig_key, take_frames
+from mocapqa.limits.charting import canonical_params
 from mocapqa.limits.discriminator import network_valid
-from mocapqa.limits.expmap import expmap_from_quats, limit_params_from_quats
-from mocapqa.limits.model import LimitsModel, check_rig, load_default_model
-from mocapqa.limits.occupancy import evaluate, limit_distances, signed_excess
+from mocapqa.limits.expmap import limit_params_from_quats
+from mocapqa.limits.model import LimitsModel, check_rig
+from mocapqa.limits.occupancy import evaluate
 from mocapqa.limits.readout import violation_text
+from mocapqa.limits.storage import load_default_model
 
 __all__ = ["LimitsReport", "charted", "check_limits", "joint_map_json", "limit_params"]
 
@@ -208,7 +204,7 @@ def charted(
         frames=frames.frames[picked],
         parent_frames=multiply(frames.parent_frames[picked], references),
     )
-    params = expmap_from_quats(canonical_rotations(motion, charted_frames), CANONICAL_AXIS)
+    params = canonical_params(motion, charted_frames, CANONICAL_AXIS)
     used = {int(frames.joints[c]) for c in picked}
     unused = [n for i, n in enumerate(motion.skeleton.names) if i not in used]
     missing = [j.role for j in model.joints if j.role not in column]
@@ -286,16 +282,14 @@ def check_limits(
     valid = np.zeros((n_frames, n_joints), dtype=bool)
     joints = [model.joints[k] for k in columns]
     for j, joint in enumerate(joints):
-        if method == "map":
-            valid[:, j], swing[:, j], twist[:, j], excess[:, j] = evaluate(
-                joint.occupancy, params[:, j]
-            )
-            continue
-        swing[:, j], twist[:, j] = limit_distances(joint.occupancy, params[:, j])
-        excess[:, j] = signed_excess(joint.occupancy, params[:, j])
-        if joint.network is None:
-            raise LimitsFileError(f"Expected a discriminator for joint {joint.name!r}, got none")
-        else:
+        valid[:, j], swing[:, j], twist[:, j], excess[:, j] = evaluate(
+            joint.occupancy, params[:, j]
+        )
+        if method == "network":
+            if joint.network is None:
+                raise LimitsFileError(
+                    f"Expected a discriminator for joint {joint.name!r}, got none"
+                )
             valid[:, j] = network_valid(joint.network, params[:, j])
     score = np.where(valid & (method == "map"), 0.0, np.hypot(swing, twist))
     excess = np.where(valid[..., None], 0.0, excess)

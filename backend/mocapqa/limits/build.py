@@ -19,13 +19,8 @@ from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import SIDES, role_key
 from mocapqa.errors import InputError
-from mocapqa.limits.canonical import (
-    CANONICAL_AXIS,
-    CanonicalFrames,
-    canonical_quats,
-    rig_frames,
-    rig_key,
-)
+from mocapqa.limits.canonical import CANONICAL_AXIS, CanonicalFrames, rig_frames, rig_key
+from mocapqa.limits.charting import canonical_quats
 from mocapqa.limits.discriminator import DiscriminatorParams, train_discriminator
 from mocapqa.limits.expmap import limit_params_from_quats
 from mocapqa.limits.model import JointLimits, LimitsModel, StoredFrames

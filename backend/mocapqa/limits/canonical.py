@@ -12,13 +12,13 @@ world rotation) is the segment's anatomical frame:
   children's OFFSETs (the knuckles), or, when they are all zero (CMU, Bandai), along its
   parent's bone as seen from its own frame on average over the frames;
 * ``x`` — the flexion axis, the normal of the limb plane: ``y × u`` with ``u`` the neighbouring
-  segment (upper arm and upper leg: the forearm / lower leg; forearm, hand, lower leg and foot:
-  their parent segment; clavicle: the body's up axis). Its direction about the long axis in the
-  joint's frame is the weighted circular median over the take's frames (weights sin² of the
-  bend, so straight frames weigh nothing, and a burst of twist errors in less than half the
-  weight cannot move it), signed to point to the body's left (forward for the clavicle). When
-  the limb hardly bends in the take (mean sin² of the bend below sin² 10°), the body's left
-  axis is used;
+  segment (upper arm and upper leg: the forearm / lower leg; forearm, lower leg and foot: their
+  parent segment; clavicle: the body's up axis); a hand, whose wrist hardly bends, takes the
+  forearm frame's ``x`` instead. Its direction about ``y`` in the joint's frame is the weighted
+  circular median over the frames (weights sin² of the bend, so straight frames weigh nothing
+  and a burst of twist errors in under half the weight cannot move it), signed to the body's
+  left (forward for the clavicle); when the limb hardly bends (mean sin² under sin² 10°), the
+  body's left axis is used;
 * ``z = x × y``.
 
 The body's left axis is the right→left hip vector (shoulders for the arms), the up axis runs
@@ -29,18 +29,13 @@ The canonical local rotation of a role joint is ``Q_j = conj(A_parent) ⊗ A_j``
 parent the previous role joint of the limb, so helper joints between them (twist bones, CMU's
 ``LHipJoint``) do not matter.
 
-**Reference pose.** The frames come from the takes' own frames (world geometry of every frame),
-not from the OFFSET rest pose: the zero-rotation pose of Character Creator and Bandai points
-every limb the same way, so it holds no anatomy, and no take of those rigs starts in a T-pose
-except ``007_04`` / ``007_12``. For hinge-like joints (knee, elbow, ankle) the limb plane is
-the joint's hinge and is the same in every take of a rig; for the forearm and the hand it
-follows the take's mean pronation. Everything is computed from world positions and rotations,
-so re-expressing a rig with rotated joint frames (same world poses) gives identical ``Q_j``.
+**Reference pose.** The frames come from the takes' own frames (world geometry), not from
+the OFFSET rest pose, which holds no anatomy on Character Creator and Bandai (docs/limits.md).
+Re-expressing a rig with rotated joint frames (same world poses) gives identical ``Q_j``.
 
-A take's own frames follow it when most of its frames are damaged (a short clip with long
-bursts of twist errors), so a model stores the frames of every rig it was built from, estimated
-over all that rig's takes (:func:`rig_frames`, looked up by :func:`rig_key`); only a rig the
-model has not seen is framed from the take being checked.
+A take's own frames follow it when most of its frames are damaged, so a model stores the frames
+of every rig it was built from, estimated over all that rig's takes (:func:`rig_frames`, looked
+up by :func:`rig_key`); only a rig the model has not seen is framed from the take checked.
 """
 
 from __future__ import annotations
@@ -56,15 +51,13 @@ from mocapqa.core.motion import Motion, Skeleton
 from mocapqa.core.rig import SIDES, RigMap, find_roles, role_key
 from mocapqa.errors import InputError
 from mocapqa.kinematics.forward import forward_kinematics
-from mocapqa.kinematics.quaternion import conjugate, multiply, rotate
+from mocapqa.kinematics.quaternion import conjugate, rotate
 from mocapqa.limits.rig import MODELLED_ROLES, axis_label
 
 __all__ = [
     "CANONICAL_AXIS",
     "CanonicalFrames",
     "canonical_frames",
-    "canonical_quats",
-    "canonical_rotations",
     "rig_frames",
     "rig_key",
     "role_parent",
@@ -299,7 +292,7 @@ def canonical_frames(
             partner = world_long(side, parent_role, parent) if parent is not None else left_w
             sign_w = left_w
         sign_ref = np.mean(_local(quats[:, joint], sign_w), axis=0)
-        forearm = rig.joint(side, "forearm") if role == "hand" else None
+        forearm = rig.joint(side, "forearm") if role == "hand" else None  # type: ignore[arg-type]
         if forearm is not None:
             # The wrist hardly bends, so its bend plane is a weak, rig-dependent signal: the
             # hand takes the forearm's flexion axis, as seen from its own frame.
@@ -346,56 +339,6 @@ def canonical_frames(
     )
 
 
-def _world_rotations(motion: Motion, joints: np.ndarray) -> FloatArray:
-    """World rotations ``(F, len(joints), 4)`` of some joints: their ancestors only are walked."""
-    parents = motion.skeleton.parents
-    needed: set[int] = set()
-    for joint in joints.tolist():
-        while joint >= 0 and joint not in needed:
-            needed.add(joint)
-            joint = int(parents[joint])
-    world: dict[int, FloatArray] = {}
-    for joint in sorted(needed):
-        parent = int(parents[joint])
-        local = motion.quats[:, joint]
-        world[joint] = local if parent < 0 else multiply(world[parent], local)
-    return np.stack([world[j] for j in joints.tolist()], axis=1)
-
-
-def _right_matrices(quats: FloatArray) -> FloatArray:
-    """Matrices ``M (..., 4, 4)`` with ``p ⊗ q = M(q) p`` (scalar-last quaternions)."""
-    x, y, z, w = quats[..., 0], quats[..., 1], quats[..., 2], quats[..., 3]
-    rows = (
-        (w, z, -y, x),
-        (-z, w, x, y),
-        (y, -x, w, z),
-        (-x, -y, -z, w),
-    )
-    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
-
-
-def canonical_rotations(motion: Motion, frames: CanonicalFrames) -> FloatArray:
-    """Canonical local rotations ``Q_j = conj(R_parent C_parent) ⊗ R_j C_j``.
-
-    Parameters
-    ----------
-    motion : Motion
-    frames : CanonicalFrames
-        From :func:`canonical_frames` on the same skeleton.
-
-    Returns
-    -------
-    ndarray, shape (F, R, 4)
-        Unit quaternions, one column per role of ``frames``.
-    """
-    world = _world_rotations(motion, np.concatenate((frames.joints, frames.parents)))
-    n = len(frames.joints)
-    # Right products by constant frames as one matrix product each.
-    child = np.einsum("rij,frj->fri", _right_matrices(frames.frames), world[:, :n])
-    parent = np.einsum("rij,frj->fri", _right_matrices(frames.parent_frames), world[:, n:])
-    return multiply(conjugate(parent), child)
-
-
 def take_frames(
     motion: Motion, rig: RigMap | None = None, known: CanonicalFrames | None = None
 ) -> CanonicalFrames:
@@ -408,15 +351,6 @@ def take_frames(
         keep = np.linspace(0, motion.n_frames - 1, _MEDIAN_FRAMES).astype(np.intp)
         sample = Motion(motion.skeleton, motion.quats[keep], motion.translations[keep], motion.fps)
     return canonical_frames(sample, rig)
-
-
-def canonical_quats(
-    motion: Motion, rig: RigMap | None = None, known: CanonicalFrames | None = None
-) -> tuple[CanonicalFrames, FloatArray]:
-    """Canonical frames of a take (:func:`take_frames`) and its canonical rotations
-    ``(F, R, 4)``."""
-    frames = take_frames(motion, rig, known)
-    return frames, canonical_rotations(motion, frames)
 
 
 def rig_key(motion: Motion) -> str:

@@ -34,7 +34,13 @@ import numpy as np
 from mocapqa.core.arrays import FloatArray
 from mocapqa.kinematics.quaternion import conjugate, multiply
 
-__all__ = ["expmap_from_quats", "limit_params_from_quats", "quats_from_expmap", "twist_frames"]
+__all__ = [
+    "expmap_from_quats",
+    "limit_params_from_quats",
+    "quats_from_expmap",
+    "swing_twist_params",
+    "twist_frames",
+]
 
 _TINY = 1e-12
 
@@ -79,8 +85,24 @@ def expmap_from_quats(quats: FloatArray, axes: FloatArray) -> FloatArray:
     """
     frames = twist_frames(axes)
     vec = np.einsum("...ij,...j->...i", frames, quats[..., :3])
-    qx, qy, qz = vec[..., 0], vec[..., 1], vec[..., 2]
-    qs = quats[..., 3]
+    return swing_twist_params(vec[..., 0], vec[..., 1], vec[..., 2], quats[..., 3])
+
+
+def swing_twist_params(
+    qx: FloatArray, qy: FloatArray, qz: FloatArray, qs: FloatArray
+) -> FloatArray:
+    """``(s1, s2, τ)`` from quaternion components already read in the twist frame.
+
+    Parameters
+    ----------
+    qx, qy, qz, qs : ndarray, shape (...)
+        Vector components in the frame ``(e1, a, e2)`` of :func:`twist_frames`, and the scalar.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        ``(s1, s2, τ)`` in radians (see the module notes).
+    """
     c_zx = np.hypot(qs, qy)
     degenerate = c_zx < _TINY
     safe = np.where(degenerate, 1.0, c_zx)

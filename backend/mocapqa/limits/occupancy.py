@@ -35,6 +35,7 @@ from scipy import ndimage
 
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray, as_float_array
 from mocapqa.errors import InputError, ShapeError
+from mocapqa.limits.intervals import circular_intervals, dilate, smooth, wrap
 
 __all__ = [
     "OccupancyMap",
@@ -47,8 +48,6 @@ __all__ = [
     "swing_bins",
     "twist_bounds",
 ]
-
-_KERNEL = np.outer([1.0, 2.0, 1.0], [1.0, 2.0, 1.0]) / 16.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -136,7 +135,7 @@ class OccupancyMap:
         ):
             raise InputError("Expected 0 <= tau_max - tau_min <= 2π on occupied bins")
         # Centre and half-width of every bin, empty bins taking their nearest occupied bin's.
-        centre = _wrap(0.5 * (tau_min + tau_max))[nearest[0], nearest[1]]
+        centre = wrap(0.5 * (tau_min + tau_max))[nearest[0], nearest[1]]
         half = (0.5 * (tau_max - tau_min))[nearest[0], nearest[1]]
         object.__setattr__(self, "_centre", np.ascontiguousarray(centre))
         object.__setattr__(self, "_half", np.ascontiguousarray(half))
@@ -157,12 +156,11 @@ class OccupancyMap:
         return self._nearest
 
 
-def _wrap(angles: FloatArray) -> FloatArray:
-    """Angles wrapped to ``[−π, π)``."""
-    return np.asarray((angles + np.pi) % (2.0 * np.pi) - np.pi, dtype=np.float64)
-
-
-def twist_bounds(occupancy: OccupancyMap, params: FloatArray) -> tuple[FloatArray, FloatArray]:
+def twist_bounds(
+    occupancy: OccupancyMap,
+    params: FloatArray,
+    bins: tuple[IntArray, IntArray] | None = None,
+) -> tuple[FloatArray, FloatArray]:
     """Centre and half-width (radians) of the twist interval at each swing of ``params``.
 
     The bin's own values, or with ``occupancy.interpolate`` the bilinear interpolation between
@@ -173,13 +171,15 @@ def twist_bounds(occupancy: OccupancyMap, params: FloatArray) -> tuple[FloatArra
     occupancy : OccupancyMap
     params : ndarray, shape (..., 3)
         ``(s1, s2, τ)`` in radians.
+    bins : (ndarray, ndarray), optional
+        :func:`swing_bins` of ``params``, when already computed.
 
     Returns
     -------
     centre, half : ndarray, shape (...)
     """
     centre, half = occupancy._centre, occupancy._half
-    i1, i2 = swing_bins(params, occupancy.bin_deg)
+    i1, i2 = swing_bins(params, occupancy.bin_deg) if bins is None else bins
     own = centre[i1, i2]
     if not occupancy.interpolate:
         return own, half[i1, i2]
@@ -194,7 +194,7 @@ def twist_bounds(occupancy: OccupancyMap, params: FloatArray) -> tuple[FloatArra
     for d1, w1 in ((0, 1.0 - t1), (1, t1)):
         for d2, w2 in ((0, 1.0 - t2), (1, t2)):
             w = w1 * w2
-            out_c += w * _wrap(centre[a1 + d1, a2 + d2] - own)
+            out_c += w * wrap(centre[a1 + d1, a2 + d2] - own)
             out_h += w * half[a1 + d1, a2 + d2]
     return own + out_c, out_h
 
@@ -206,75 +206,6 @@ def swing_bins(params: FloatArray, bin_deg: float) -> tuple[IntArray, IntArray]:
     idx = np.floor((params[..., :2] + np.pi) / width).astype(np.intp)
     np.clip(idx, 0, n - 1, out=idx)
     return idx[..., 0], idx[..., 1]
-
-
-def _shifted(values: FloatArray, fill: float) -> list[tuple[float, FloatArray]]:
-    """The 3×3 neighbourhood of every bin: (kernel weight, neighbour values) pairs."""
-    n = values.shape[0]
-    padded = np.pad(values, 1, constant_values=fill)
-    return [
-        (float(_KERNEL[d1 + 1, d2 + 1]), padded[1 + d1 : 1 + d1 + n, 1 + d2 : 1 + d2 + n])
-        for d1 in (-1, 0, 1)
-        for d2 in (-1, 0, 1)
-    ]
-
-
-def _smooth(
-    centre: FloatArray, half: FloatArray, occupied: BoolArray
-) -> tuple[FloatArray, FloatArray]:
-    """3×3 Gaussian smoothing over occupied bins of the centres (the short way round from the
-    bin's own) and the half-widths."""
-    own = np.where(occupied, centre, 0.0)
-    total_c = np.zeros_like(own)
-    total_h = np.zeros_like(own)
-    norm = np.zeros_like(own)
-    pairs = zip(_shifted(own, 0.0), _shifted(np.where(occupied, half, 0.0), 0.0),
-                _shifted(occupied.astype(np.float64), 0.0), strict=True)  # fmt: skip
-    for (w, c), (_, h), (_, o) in pairs:
-        total_c += w * o * _wrap(c - own)
-        total_h += w * o * h
-        norm += w * o
-    norm = np.where(norm > 0, norm, 1.0)
-    return (
-        np.where(occupied, _wrap(own + total_c / norm), np.nan),
-        np.where(occupied, total_h / norm, np.nan),
-    )
-
-
-def _dilate(
-    occupied: BoolArray, centre: FloatArray, half: FloatArray
-) -> tuple[BoolArray, FloatArray, FloatArray]:
-    """Add one ring of bins, each with the union (widest arc) of its occupied neighbours."""
-    n = occupied.shape[0]
-    ring = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), bool)) & ~occupied
-    pad = 1
-    occ = np.pad(occupied, pad)
-    cen = np.pad(np.where(occupied, centre, 0.0), pad)
-    hal = np.pad(np.where(occupied, half, 0.0), pad)
-    sin_sum = np.zeros((n, n))
-    cos_sum = np.zeros((n, n))
-    shifts = [(d1, d2) for d1 in (-1, 0, 1) for d2 in (-1, 0, 1)]
-    for d1, d2 in shifts:
-        window = (slice(pad + d1, pad + d1 + n), slice(pad + d2, pad + d2 + n))
-        sin_sum += np.where(occ[window], np.sin(cen[window]), 0.0)
-        cos_sum += np.where(occ[window], np.cos(cen[window]), 0.0)
-    reference = np.arctan2(sin_sum, cos_sum)
-    low = np.full((n, n), np.inf)
-    high = np.full((n, n), -np.inf)
-    for d1, d2 in shifts:
-        window = (slice(pad + d1, pad + d1 + n), slice(pad + d2, pad + d2 + n))
-        mid = reference + _wrap(cen[window] - reference)
-        low = np.where(occ[window], np.minimum(low, mid - hal[window]), low)
-        high = np.where(occ[window], np.maximum(high, mid + hal[window]), high)
-    high = np.where(ring, high, 0.0)
-    low = np.where(ring, low, 0.0)
-    ring_half = np.minimum(0.5 * (high - low), np.pi)
-    ring_centre = _wrap(0.5 * (high + low))
-    return (
-        occupied | ring,
-        np.where(ring, ring_centre, centre),
-        np.where(ring, ring_half, half),
-    )
 
 
 def build_occupancy(params: FloatArray, settings: OccupancyParams) -> OccupancyMap:
@@ -301,11 +232,11 @@ def build_occupancy(params: FloatArray, settings: OccupancyParams) -> OccupancyM
     n = settings.n_bins
     i1, i2 = swing_bins(params, settings.bin_deg)
     flat = i1 * n + i2
-    centre, half, occupied = _circular_intervals(flat, params[:, 2], n)
+    centre, half, occupied = circular_intervals(flat, params[:, 2], n)
     if settings.smooth:
-        centre, half = _smooth(centre, half, occupied)
+        centre, half = smooth(centre, half, occupied)
     for _ in range(settings.dilation_bins):
-        occupied, centre, half = _dilate(occupied, centre, half)
+        occupied, centre, half = dilate(occupied, centre, half)
     margin = np.deg2rad(settings.tau_margin_deg)
     half = np.minimum(half + margin, np.pi)
     lows = np.where(occupied, centre - half, np.nan)
@@ -313,145 +244,78 @@ def build_occupancy(params: FloatArray, settings: OccupancyParams) -> OccupancyM
     return OccupancyMap(settings.bin_deg, occupied, lows, highs, settings.interpolate)
 
 
-def _circular_intervals(
-    flat: IntArray, tau: FloatArray, n: int
-) -> tuple[FloatArray, FloatArray, BoolArray]:
-    """Per bin, the shortest arc covering its twists: centre, half-width, occupied (N, N)."""
-    centre = np.full(n * n, np.nan)
-    half = np.full(n * n, np.nan)
-    order = np.lexsort((tau, flat))
-    flat_s, tau_s = flat[order], _wrap(tau[order])
-    starts = np.flatnonzero(np.r_[True, flat_s[1:] != flat_s[:-1]])
-    ends = np.r_[starts[1:], flat_s.size]
-    for a, b in zip(starts, ends, strict=True):
-        values = tau_s[a:b]
-        gaps = np.diff(np.r_[values, values[0] + 2.0 * np.pi])
-        k = int(np.argmax(gaps))
-        low = values[(k + 1) % values.size]
-        width = 2.0 * np.pi - gaps[k]
-        centre[flat_s[a]] = _wrap(np.asarray(low + 0.5 * width))
-        half[flat_s[a]] = 0.5 * width
-    occupied = np.isfinite(centre).reshape(n, n)
-    return centre.reshape(n, n), half.reshape(n, n), occupied
-
-
-def is_valid(occupancy: OccupancyMap, params: FloatArray) -> BoolArray:
-    """The paper's ``isValid(s1, s2, τ)``: swing bin occupied and τ within its bounds.
-
-    Parameters
-    ----------
-    occupancy : OccupancyMap
-    params : ndarray, shape (..., 3)
-        ``(s1, s2, τ)`` in radians.
-
-    Returns
-    -------
-    ndarray of bool, shape (...)
-    """
-    i1, i2 = swing_bins(params, occupancy.bin_deg)
-    centre, half = twist_bounds(occupancy, params)
-    inside = np.abs(_wrap(params[..., 2] - centre)) <= half
-    return np.asarray(occupancy.occupied[i1, i2] & inside)
-
-
-def limit_distances(occupancy: OccupancyMap, params: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """How far rotations lie outside the valid region, in degrees of swing and of twist.
-
-    The swing distance is from ``(s1, s2)`` to the nearest occupied bin (0 inside one); the twist
-    distance is from ``τ`` to the twist interval at that swing (:func:`twist_bounds`), the
-    shorter way round the circle. Both are 0 for a valid rotation.
-
-    Parameters
-    ----------
-    occupancy : OccupancyMap
-    params : ndarray, shape (..., 3)
-        ``(s1, s2, τ)`` in radians.
-
-    Returns
-    -------
-    swing_deg, twist_deg : ndarray, shape (...)
-    """
-    i1, i2 = swing_bins(params, occupancy.bin_deg)
-    n1 = occupancy.nearest[0][i1, i2]
-    n2 = occupancy.nearest[1][i1, i2]
-    width = np.deg2rad(occupancy.bin_deg)
-    gaps = []
-    for k, nb in ((0, n1), (1, n2)):
-        low = -np.pi + nb * width
-        value = params[..., k]
-        gaps.append(np.maximum(np.maximum(low - value, value - (low + width)), 0.0))
-    swing = np.hypot(gaps[0], gaps[1])
-    centre, half = twist_bounds(occupancy, params)
-    twist = np.maximum(np.abs(_wrap(params[..., 2] - centre)) - half, 0.0)
-    return np.rad2deg(swing), np.rad2deg(twist)
-
-
-def signed_excess(occupancy: OccupancyMap, params: FloatArray) -> FloatArray:
-    """How far, and which way, each parameter lies outside the valid region, degrees.
-
-    Parameters
-    ----------
-    occupancy : OccupancyMap
-    params : ndarray, shape (..., 3)
-        ``(s1, s2, τ)`` in radians.
-
-    Returns
-    -------
-    ndarray, shape (..., 3)
-        Signed distance of ``s1`` and ``s2`` beyond the nearest occupied bin and of ``τ``
-        beyond the twist interval (positive: past the upper side); 0 inside.
-    """
-    i1, i2 = swing_bins(params, occupancy.bin_deg)
-    width = np.deg2rad(occupancy.bin_deg)
-    out = np.zeros(params.shape)
-    for k in (0, 1):
-        low = -np.pi + occupancy.nearest[k][i1, i2] * width
-        value = params[..., k]
-        out[..., k] = value - np.clip(value, low, low + width)
-    centre, half = twist_bounds(occupancy, params)
-    offset = _wrap(params[..., 2] - centre)
-    out[..., 2] = np.sign(offset) * np.maximum(np.abs(offset) - half, 0.0)
-    return np.rad2deg(out)
-
-
 def evaluate(
     occupancy: OccupancyMap, params: FloatArray
 ) -> tuple[BoolArray, FloatArray, FloatArray, FloatArray]:
-    """Validity, distances and signed excess in one pass (the twist bounds looked up once).
+    """Validity, distances and signed excess in one pass (bins and twist bounds looked up once).
+
+    A rotation is valid (the paper's ``isValid(s1, s2, τ)``) when its swing bin is occupied and
+    ``τ`` lies inside the twist interval at its swing (:func:`twist_bounds`). Outside, the swing
+    distance runs from ``(s1, s2)`` to the nearest occupied bin (0 inside one) and the twist
+    distance from ``τ`` to the interval, the shorter way round the circle.
 
     Parameters
     ----------
     occupancy : OccupancyMap
-    params : ndarray, shape (N, 3)
+    params : ndarray, shape (..., 3)
         ``(s1, s2, τ)`` in radians.
 
     Returns
     -------
-    valid : ndarray of bool, shape (N,)
-        As :func:`is_valid`.
-    swing_deg, twist_deg : ndarray, shape (N,)
-        As :func:`limit_distances`.
-    excess_deg : ndarray, shape (N, 3)
-        As :func:`signed_excess`, computed on the invalid rows only (0 elsewhere).
+    valid : ndarray of bool, shape (...)
+    swing_deg, twist_deg : ndarray, shape (...)
+        Degrees outside the valid region in swing and in twist; 0 for a valid rotation.
+    excess_deg : ndarray, shape (..., 3)
+        Signed distance of ``s1`` and ``s2`` beyond the nearest occupied bin and of ``τ``
+        beyond the twist interval (positive: past the upper side); 0 inside.
     """
-    i1, i2 = swing_bins(params, occupancy.bin_deg)
-    centre, half = twist_bounds(occupancy, params)
-    offset = _wrap(params[:, 2] - centre)
+    shape = params.shape[:-1]
+    flat = np.reshape(params, (-1, 3))
+    i1, i2 = swing_bins(flat, occupancy.bin_deg)
+    centre, half = twist_bounds(occupancy, flat, (i1, i2))
+    offset = wrap(flat[:, 2] - centre)
     beyond = np.abs(offset) - half
-    occupied = occupancy.occupied[i1, i2]
-    valid = occupied & (beyond <= 0.0)
+    valid = occupancy.occupied[i1, i2] & (beyond <= 0.0)
     twist_deg = np.rad2deg(np.maximum(beyond, 0.0))
-    swing_deg = np.zeros(params.shape[0])
-    excess = np.zeros(params.shape)
+    swing_deg = np.zeros(flat.shape[0])
+    excess = np.zeros(flat.shape)
     bad = np.flatnonzero(~valid)
     if bad.size:
+        # Only invalid rotations can lie outside: a valid one is in an occupied bin (its own
+        # nearest) and inside its twist interval.
         width = np.deg2rad(occupancy.bin_deg)
         gaps = np.zeros((bad.size, 2))
         for k in (0, 1):
             low = -np.pi + occupancy.nearest[k][i1[bad], i2[bad]] * width
-            value = params[bad, k]
+            value = flat[bad, k]
             gaps[:, k] = value - np.clip(value, low, low + width)
         swing_deg[bad] = np.rad2deg(np.hypot(gaps[:, 0], gaps[:, 1]))
         excess[bad, :2] = np.rad2deg(gaps)
-        excess[bad, 2] = np.rad2deg(np.sign(offset[bad]) * np.maximum(beyond[bad], 0.0))
-    return valid, swing_deg, twist_deg, excess
+        excess[bad, 2] = np.sign(offset[bad]) * twist_deg[bad]
+    return (
+        valid.reshape(shape),
+        swing_deg.reshape(shape),
+        twist_deg.reshape(shape),
+        excess.reshape(params.shape),
+    )
+
+
+def is_valid(occupancy: OccupancyMap, params: FloatArray) -> BoolArray:
+    """The paper's ``isValid(s1, s2, τ)`` of ``params (..., 3)`` (radians), shape (...).
+
+    The ``valid`` of :func:`evaluate`.
+    """
+    return evaluate(occupancy, params)[0]
+
+
+def limit_distances(occupancy: OccupancyMap, params: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Degrees outside the valid region in swing and in twist of ``params (..., 3)`` (radians),
+    each shape (...): the ``swing_deg`` and ``twist_deg`` of :func:`evaluate`."""
+    _, swing_deg, twist_deg, _ = evaluate(occupancy, params)
+    return swing_deg, twist_deg
+
+
+def signed_excess(occupancy: OccupancyMap, params: FloatArray) -> FloatArray:
+    """How far, and which way, each parameter of ``params (..., 3)`` (radians) lies outside
+    the valid region, degrees, shape (..., 3): the ``excess_deg`` of :func:`evaluate`."""
+    return evaluate(occupancy, params)[3]

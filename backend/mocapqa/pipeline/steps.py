@@ -1,7 +1,7 @@
 """The pipeline's steps: each calls one algorithm entry point and normalises its output.
 
 * twist — :func:`mocapqa.twist.analysis.analyze_twist`
-* limits — :func:`mocapqa.limits.model.load_default_model` and
+* limits — :func:`mocapqa.limits.storage.load_default_model` and
   :func:`mocapqa.limits.analysis.check_limits`; a rig without a shipped model reports
   ``"no_model"`` ("no model for this rig") instead of failing the run
 * filters — :func:`mocapqa.filters.apply.filter_keypoints` and
@@ -28,7 +28,8 @@ from mocapqa.core.rig import find_roles
 from mocapqa.errors import LimitsFileError
 from mocapqa.filters.apply import filter_keypoints, filter_motion
 from mocapqa.limits.analysis import check_limits
-from mocapqa.limits.model import LimitsModel, load_default_model
+from mocapqa.limits.model import LimitsModel
+from mocapqa.limits.storage import load_default_model
 from mocapqa.pipeline.options import ParamValue
 from mocapqa.twist.analysis import analyze_twist
 

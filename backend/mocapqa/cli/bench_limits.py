@@ -1,0 +1,225 @@
+"""``mocapqa bench limits``: the canonical model per rig and left out, the per-rig models."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from mocapqa.cli.app import bench_app
+
+__all__ = ["bench_limits"]
+
+console = Console(highlight=False)
+
+
+def _pct(value: float) -> str:
+    return "—" if math.isnan(value) else f"{100 * value:.2f}"
+
+
+def _ci(value: float, interval: tuple[float, float]) -> str:
+    return f"{_pct(value)} [{_pct(interval[0])}–{_pct(interval[1])}]"
+
+
+@bench_app.command("limits")
+def bench_limits(
+    corpus_dir: Annotated[Path, typer.Argument(help="Corpus folder (shared/data).")],
+    rig: Annotated[str | None, typer.Option(help="Per-rig part: only this rig family.")] = None,
+    networks: Annotated[bool, typer.Option(help="Train and measure the discriminators.")] = True,
+    min_offset_deg: Annotated[float, typer.Option(help="Smallest injected offset.")] = 60.0,
+    seed: Annotated[int, typer.Option(help="Seed of the injected errors.")] = 0,
+    shipped: Annotated[
+        bool, typer.Option(help="Measure the shipped models (built on the same split).")
+    ] = True,
+    per_rig: Annotated[
+        bool,
+        typer.Option(help="Also the per-rig models' own benchmark (networks, speeds)."),
+    ] = False,
+) -> None:
+    """Canonical model per rig and leave-one-rig-out; optionally the per-rig models."""
+    _bench_canonical(corpus_dir, shipped, seed, min_offset_deg)
+    if per_rig:
+        _bench_per_rig(corpus_dir, rig, networks, min_offset_deg, seed, shipped)
+
+
+def _bench_canonical(corpus_dir: Path, shipped: bool, seed: int, min_offset_deg: float) -> None:
+    from dataclasses import replace
+
+    from mocapqa.bench.limits import canonical_takes, corpus_rigs, role_takes
+    from mocapqa.bench.limits_canonical import (
+        EVALUATION_ONLY,
+        bootstrap_interval,
+        canonical_speed,
+        count_takes,
+        leave_one_rig_out,
+    )
+    from mocapqa.core.motion import Motion
+    from mocapqa.limits.build import DEFAULT_BUILD, build_canonical_model, build_model
+    from mocapqa.limits.rig import rig_family
+    from mocapqa.limits.storage import default_model_paths, load_model
+
+    build_takes = canonical_takes(corpus_dir, exclude=EVALUATION_ONLY)
+    names = tuple(n for n, _ in build_takes)
+    model = None
+    if shipped:
+        for path in default_model_paths():
+            candidate = load_model(path)
+            if candidate.frame == "canonical" and candidate.takes == names:
+                model = candidate
+    map_only = replace(DEFAULT_BUILD, discriminator=None)
+    if model is None:
+        console.print("canonical model: built now (map only)")
+        model = build_canonical_model([m for _, m in build_takes], list(names), map_only)
+    else:
+        console.print("canonical model: the shipped one (same build takes)")
+    occ = model.occupancy_params
+    console.print(
+        f"map: bin {occ.bin_deg}°, dilation {occ.dilation_bins}, twist margin "
+        f"{occ.tau_margin_deg}°, interpolated {occ.interpolate}; {len(names)} build takes; "
+        f"injected offsets {min_offset_deg:.0f}–180°, seed {seed}; [95 % bootstrap over takes]"
+    )
+    rigs = corpus_rigs(corpus_dir)
+    table = Table(title="held-back takes per rig: canonical model vs the rig's own map")
+    for column in (
+        "rig", "held-back takes", "canonical false flags %", "canonical injected flagged %",
+        "rig map false flags %", "rig map injected flagged %",
+    ):  # fmt: skip
+        table.add_column(column)
+    per_joint: dict[str, tuple[dict[str, float], dict[str, float]]] = {}
+    for rig_takes in rigs:
+        canon = count_takes(model, rig_takes.held_back, seed, min_offset_deg)
+        own_build = [t for t in rig_takes.build if t[0] not in EVALUATION_ONLY]
+        own = build_model([m for _, m in own_build], [n for n, _ in own_build], map_only)
+        mine = count_takes(own, rig_takes.held_back, seed, min_offset_deg)
+        table.add_row(
+            rig_takes.family,
+            str(sum(1 for n, _ in rig_takes.held_back if n not in EVALUATION_ONLY)),
+            _ci(canon.false_flag_rate, bootstrap_interval(canon.flagged, canon.joint_frames)),
+            _ci(canon.recall, bootstrap_interval(canon.hits, canon.injected))
+            + f" (n={int(canon.injected.sum())})",
+            _ci(mine.false_flag_rate, bootstrap_interval(mine.flagged, mine.joint_frames)),
+            _ci(mine.recall, bootstrap_interval(mine.hits, mine.injected)),
+        )
+        per_joint[rig_takes.family] = (
+            {r: canon.per_joint_flagged[r] / max(canon.per_joint_frames[r], 1)
+             for r in canon.per_joint_flagged},
+            {r: mine.per_joint_flagged[r] / max(mine.per_joint_frames[r], 1)
+             for r in mine.per_joint_flagged},
+        )  # fmt: skip
+    console.print(table)
+    joints = Table(title="false flags % per joint on held-back takes (canonical / rig map)")
+    joints.add_column("role")
+    for family in per_joint:
+        joints.add_column(family)
+    for role in (j.role for j in model.joints):
+        joints.add_row(
+            role,
+            *(
+                f"{_pct(c.get(role, float('nan')))} / {_pct(o.get(role, float('nan')))}"
+                for c, o in per_joint.values()
+            ),
+        )
+    console.print(joints)
+    grouped: dict[str, list[tuple[str, Motion]]] = {}
+    for name, motion in role_takes(corpus_dir):
+        grouped.setdefault(rig_family(motion.skeleton), []).append((name, motion))
+    groups = {family: tuple(takes) for family, takes in grouped.items()}
+    loro = leave_one_rig_out(groups, DEFAULT_BUILD, seed, min_offset_deg)
+    table = Table(title="leave one rig out: canonical map built without the rig, all its takes")
+    for column in ("left-out rig", "takes", "build takes", "false flags %", "injected flagged %"):
+        table.add_column(column)
+    for family, (left_model, counts) in loro.items():
+        table.add_row(
+            family,
+            str(len(counts.flagged)),
+            str(len(left_model.takes)),
+            _ci(counts.false_flag_rate, bootstrap_interval(counts.flagged, counts.joint_frames)),
+            _ci(counts.recall, bootstrap_interval(counts.hits, counts.injected))
+            + f" (n={int(counts.injected.sum())})",
+        )
+    rates = [c.false_flag_rate for _, c in loro.values()]
+    console.print(table)
+    console.print(f"mean false flags over left-out rigs: {_pct(float(sum(rates) / len(rates)))} %")
+    scores = Table(title="canonical discriminators: held-out synthetic test accuracy")
+    for column in ("role", "accuracy %", "precision %", "recall %", "hidden", "n test"):
+        scores.add_column(column)
+    for joint in model.joints:
+        sc = joint.scores
+        if sc is None:
+            scores.add_row(joint.role, "—", "—", "—", "—", "—")
+        else:
+            scores.add_row(
+                joint.role, _pct(sc.accuracy), _pct(sc.precision), _pct(sc.recall),
+                str(sc.hidden_size), str(sc.n_test),
+            )  # fmt: skip
+    console.print(scores)
+    for rig_takes in rigs:
+        longest = max((m for _, m in rig_takes.held_back), key=lambda m: m.n_frames)
+        speed = canonical_speed(model, longest)
+        console.print(
+            f"speed {rig_takes.family} ({longest.skeleton.n_joints} joints): "
+            f"{speed / 1e6:.2f} M joint-frames per CPU second (map check, canonical frames "
+            "included)"
+        )
+
+
+def _bench_per_rig(
+    corpus_dir: Path, rig: str | None, networks: bool, min_offset_deg: float, seed: int,
+    shipped: bool,
+) -> None:  # fmt: skip
+
+    from dataclasses import replace
+
+    from mocapqa.bench.limits import bench_rig, corpus_rigs
+    from mocapqa.limits.build import DEFAULT_BUILD
+    from mocapqa.limits.storage import default_model_paths, load_model
+
+    models = {p.stem: load_model(p) for p in default_model_paths()} if shipped and networks else {}
+    settings = DEFAULT_BUILD if networks else replace(DEFAULT_BUILD, discriminator=None)
+    console.print(
+        f"map: bin {settings.occupancy.bin_deg}°, dilation {settings.occupancy.dilation_bins} "
+        f"bins, twist margin {settings.occupancy.tau_margin_deg}°, reference {settings.reference}"
+    )
+    summary = Table(title="limits per rig (held-back takes)")
+    for column in (
+        "rig", "build takes/frames", "held-back takes/frames", "false flags % (map)",
+        "false flags % (net)", f"injected ≥{min_offset_deg:.0f}° flagged %", "lookup jf/s",
+        "map check jf/s", "net check jf/s",
+    ):  # fmt: skip
+        summary.add_column(column)
+    for rig_takes in corpus_rigs(corpus_dir, (rig,) if rig else None):
+        model = models.get(rig_takes.family)
+        if model is not None and model.takes != tuple(n for n, _ in rig_takes.build):
+            model = None
+        console.print(
+            f"{rig_takes.family}: {'shipped model' if model else 'model built now'}, "
+            f"{len(rig_takes.build)} build takes, {len(rig_takes.held_back)} held back"
+        )
+        _, figures = bench_rig(
+            rig_takes, settings, seed=seed, min_offset_deg=min_offset_deg, model=model
+        )
+        table = Table(title=f"{figures.family}: per joint")
+        for column in ("joint", "accuracy %", "precision %", "recall %", "hidden", "false flags %"):
+            table.add_column(column)
+        for j in figures.joints:
+            table.add_row(
+                j.name, _pct(j.accuracy), _pct(j.precision), _pct(j.recall), str(j.hidden_size),
+                _pct(j.false_flag_rate),
+            )  # fmt: skip
+        console.print(table)
+        summary.add_row(
+            figures.family,
+            f"{figures.n_build_takes}/{figures.n_build_frames}",
+            f"{figures.n_held_back_takes}/{figures.n_held_back_frames}",
+            _pct(figures.false_flag_rate),
+            _pct(figures.network_false_flag_rate),
+            f"{_pct(figures.injected_flag_rate)} (n={figures.n_injected})",
+            f"{figures.lookup_joint_frames_per_s:.3g}",
+            f"{figures.map_joint_frames_per_s:.3g}",
+            f"{figures.network_joint_frames_per_s:.3g}",
+        )
+    console.print(summary)
