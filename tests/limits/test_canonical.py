@@ -9,11 +9,12 @@ import numpy as np
 import pytest
 
 from mocapqa.core.motion import EndSite, Motion, Skeleton
+from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.kinematics.quaternion import conjugate, geodesic_angle, multiply, rotate
-from mocapqa.limits.analysis import check_limits
-from mocapqa.limits.build import BuildParams, build_canonical_model
+from mocapqa.limits.analysis import LimitsReport, check_limits
+from mocapqa.limits.build import BuildParams, build_canonical_model, with_rig_frames
 from mocapqa.limits.canonical import CANONICAL_AXIS, rig_frames, rig_key
 from mocapqa.limits.charting import canonical_quats
 from mocapqa.limits.expmap import expmap_from_quats
@@ -222,3 +223,48 @@ def test_an_unseen_rig_s_hands_are_not_flagged_by_a_model_of_the_other_rigs(
         report = check_limits(motion, model)
         hands = [report.roles.index(f"{side}_hand") for side in ("left", "right")]
         assert (~report.valid[:, hands]).mean() < 0.01, name
+
+
+def test_a_new_rig_framed_once_from_its_takes_keeps_its_frames_through_a_damaged_take(
+    corpus_dir: Path, bandai_model: LimitsModel
+) -> None:
+    # A short take mostly corrupted by one twist offset on the left thigh: framed from itself,
+    # its thigh frame follows the offset and the error reads as no twist at all; framed once
+    # from the rig's clean takes, every corrupted frame is 90° off.
+    root = corpus_dir / "bvh" / "cmu"
+    names = ["cmu_12_01_walk.bvh"]
+    walk = read_bvh(root / names[0])
+    thigh = walk.skeleton.index("LeftUpLeg")
+    short = Motion(walk.skeleton, walk.quats[1:61].copy(), walk.translations[1:61], walk.fps)
+    turn = quat_about(short, thigh, 90.0)
+    quats = short.quats.copy()
+    quats[5:55, thigh] = multiply(quats[5:55, thigh], turn)
+    for child in short.skeleton.children(thigh):
+        quats[5:55, child] = multiply(conjugate(turn), quats[5:55, child])
+    damaged = Motion(short.skeleton, quats, short.translations, short.fps)
+    assert rig_key(damaged) not in bandai_model.rig_frames
+    alone = check_limits(damaged, bandai_model)
+    framed = with_rig_frames(bandai_model, [walk], names)
+    assert rig_key(damaged) in framed.rig_frames
+    once = check_limits(damaged, framed)
+    truth = check_limits(short, framed)  # the undamaged take, framed once
+    k = once.roles.index("left_upper_leg")
+
+    def shift(report: LimitsReport) -> np.ndarray:
+        offset = report.params_deg[5:55, k, 2] - truth.params_deg[5:55, k, 2]
+        return np.abs((offset + 180.0) % 360.0 - 180.0)
+
+    assert np.median(shift(alone)) < 30
+    assert np.median(shift(once)) > 80
+    assert (~once.valid[5:55, k]).mean() > (~alone.valid[5:55, k]).mean()
+    # A per-rig model cannot take frames.
+    with pytest.raises(InputError):
+        with_rig_frames(replace(bandai_model, frame="rig"), [walk], names)
+
+
+def quat_about(motion: Motion, joint: int, degrees: float) -> np.ndarray:
+    """Rotation of ``degrees`` about the joint's bone (its child's OFFSET), scalar-last."""
+    child = motion.skeleton.children(joint)[0]
+    axis = motion.skeleton.offsets[child] / np.linalg.norm(motion.skeleton.offsets[child])
+    half = np.deg2rad(degrees) / 2
+    return np.r_[np.sin(half) * axis, np.cos(half)]

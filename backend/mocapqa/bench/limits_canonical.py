@@ -11,7 +11,8 @@ frames of one take are not independent, so takes are resampled, not frames):
   beside it the same rig's own map (per-rig frame, map only) built on its build split;
 * **leave one rig out** — a canonical map built on every take of the other rigs (map only:
   networks take ~75 s per joint), tested on every take of the left-out rig, whose canonical
-  frames the model has never seen (they are estimated from each take).
+  frames the model has never seen: estimated from each take checked, or (``framed_once``)
+  once over all the rig's clean takes, as a user would register a new rig's frames.
 
 ``005_05`` (the only real twist errors) is in no build and no clean figure.
 """
@@ -25,7 +26,12 @@ import numpy as np
 
 from mocapqa.core.motion import Motion
 from mocapqa.limits.analysis import check_limits
-from mocapqa.limits.build import DEFAULT_BUILD, BuildParams, build_canonical_model
+from mocapqa.limits.build import (
+    DEFAULT_BUILD,
+    BuildParams,
+    build_canonical_model,
+    with_rig_frames,
+)
 from mocapqa.limits.model import LimitsModel
 from mocapqa.twist.inject import inject_twist_errors
 
@@ -143,6 +149,7 @@ def leave_one_rig_out(
     settings: BuildParams = DEFAULT_BUILD,
     seed: int = 0,
     min_offset_deg: float = 60.0,
+    framed_once: bool = False,
 ) -> dict[str, tuple[LimitsModel, TakeCounts]]:
     """For each rig, a canonical map built without it and its counts on all its takes.
 
@@ -152,6 +159,10 @@ def leave_one_rig_out(
         Family → every take of that rig.
     settings : BuildParams
         The discriminator is dropped (map only).
+    framed_once : bool
+        Frame the left-out rig once over all its clean takes
+        (:func:`mocapqa.limits.build.with_rig_frames`: no label, nothing added to the maps)
+        instead of from each take checked, which is then framed with its injected errors.
 
     Returns
     -------
@@ -166,6 +177,9 @@ def leave_one_rig_out(
             if t[0] not in EVALUATION_ONLY
         ]  # fmt: skip
         model = build_canonical_model([m for _, m in train], [n for n, _ in train], settings)
+        if framed_once:
+            own = [t for t in takes if t[0] not in EVALUATION_ONLY]
+            model = with_rig_frames(model, [m for _, m in own], [n for n, _ in own])
         out[family] = (model, count_takes(model, takes, seed, min_offset_deg))
     return out
 

@@ -128,22 +128,34 @@ def _bench_canonical(corpus_dir: Path, shipped: bool, seed: int, min_offset_deg:
     for name, motion in role_takes(corpus_dir):
         grouped.setdefault(rig_family(motion.skeleton), []).append((name, motion))
     groups = {family: tuple(takes) for family, takes in grouped.items()}
-    loro = leave_one_rig_out(groups, DEFAULT_BUILD, seed, min_offset_deg)
-    table = Table(title="leave one rig out: canonical map built without the rig, all its takes")
-    for column in ("left-out rig", "takes", "build takes", "false flags %", "injected flagged %"):
-        table.add_column(column)
-    for family, (left_model, counts) in loro.items():
-        table.add_row(
-            family,
-            str(len(counts.flagged)),
-            str(len(left_model.takes)),
-            _ci(counts.false_flag_rate, bootstrap_interval(counts.flagged, counts.joint_frames)),
-            _ci(counts.recall, bootstrap_interval(counts.hits, counts.injected))
-            + f" (n={int(counts.injected.sum())})",
-        )
-    rates = [c.false_flag_rate for _, c in loro.values()]
-    console.print(table)
-    console.print(f"mean false flags over left-out rigs: {_pct(float(sum(rates) / len(rates)))} %")
+    for framed_once in (False, True):
+        loro = leave_one_rig_out(groups, DEFAULT_BUILD, seed, min_offset_deg, framed_once)
+        how = "framed once from all its clean takes" if framed_once else "each take framed alone"
+        table = Table(title=f"leave one rig out: canonical map built without the rig ({how})")
+        for column in (
+            "left-out rig", "takes", "build takes", "false flags %", "injected flagged %",
+            "false flags % per joint (> 0)",
+        ):  # fmt: skip
+            table.add_column(column)
+        for family, (left_model, counts) in loro.items():
+            worst = sorted(counts.per_joint_flagged, key=lambda r: -counts.per_joint_flagged[r])
+            flags = bootstrap_interval(counts.flagged, counts.joint_frames)
+            table.add_row(
+                family,
+                str(len(counts.flagged)),
+                str(len(left_model.takes)),
+                _ci(counts.false_flag_rate, flags),
+                _ci(counts.recall, bootstrap_interval(counts.hits, counts.injected))
+                + f" (n={int(counts.injected.sum())})",
+                ", ".join(
+                    f"{r} {_pct(counts.per_joint_flagged[r] / counts.per_joint_frames[r])}"
+                    for r in worst
+                    if counts.per_joint_flagged[r]
+                ),
+            )
+        rates = [c.false_flag_rate for _, c in loro.values()]
+        console.print(table)
+        console.print(f"mean false flags over left-out rigs: {_pct(sum(rates) / len(rates))} %")
     scores = Table(title="canonical discriminators: held-out synthetic test accuracy")
     for column in ("role", "accuracy %", "precision %", "recall %", "hidden", "n test"):
         scores.add_column(column)

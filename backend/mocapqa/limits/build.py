@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -40,6 +40,7 @@ __all__ = [
     "build_canonical_model",
     "build_model",
     "mean_rotation",
+    "with_rig_frames",
 ]
 
 
@@ -206,26 +207,7 @@ def build_canonical_model(
             f"Expected one name per take and at least one take, got {len(motions)} takes and "
             f"{len(take_names)} names"
         )
-    groups: dict[str, list[int]] = {}
-    for i, motion in enumerate(motions):
-        groups.setdefault(rig_key(motion), []).append(i)
-    stored: dict[str, StoredFrames] = {}
-    known: dict[str, CanonicalFrames] = {}
-    for key, members in groups.items():
-        try:
-            frames = rig_frames([motions[i] for i in members])
-        except InputError as e:
-            raise InputError(f"{take_names[members[0]]}: {e}") from e
-        names = motions[members[0]].skeleton.names
-        known[key] = frames
-        stored[key] = StoredFrames(
-            family=rig_family(motions[members[0]].skeleton),
-            roles=frames.roles,
-            joints=tuple(names[j] for j in frames.joints),
-            parents=tuple(names[j] for j in frames.parents),
-            frames=frames.frames,
-            parent_frames=frames.parent_frames,
-        )
+    known, stored = _frames_by_rig(motions, take_names)
     samples: dict[str, list[FloatArray]] = {}
     digest = hashlib.sha256()
     for motion, name in zip(motions, take_names, strict=True):
@@ -275,3 +257,53 @@ def build_canonical_model(
         frame="canonical",
         rig_frames=stored,
     )
+
+
+def _frames_by_rig(
+    motions: Sequence[Motion], take_names: Sequence[str]
+) -> tuple[dict[str, CanonicalFrames], dict[str, StoredFrames]]:
+    """Canonical frames of every rig among ``motions``, each estimated over all its takes,
+    keyed by :func:`mocapqa.limits.canonical.rig_key`; and the same as stored in a model."""
+    groups: dict[str, list[int]] = {}
+    for i, motion in enumerate(motions):
+        groups.setdefault(rig_key(motion), []).append(i)
+    known: dict[str, CanonicalFrames] = {}
+    stored: dict[str, StoredFrames] = {}
+    for key, members in groups.items():
+        try:
+            frames = rig_frames([motions[i] for i in members])
+        except InputError as e:
+            raise InputError(f"{take_names[members[0]]}: {e}") from e
+        names = motions[members[0]].skeleton.names
+        known[key] = frames
+        stored[key] = StoredFrames(
+            family=rig_family(motions[members[0]].skeleton),
+            roles=frames.roles,
+            joints=tuple(names[j] for j in frames.joints),
+            parents=tuple(names[j] for j in frames.parents),
+            frames=frames.frames,
+            parent_frames=frames.parent_frames,
+        )
+    return known, stored
+
+
+def with_rig_frames(
+    model: LimitsModel, motions: Sequence[Motion], take_names: Sequence[str]
+) -> LimitsModel:
+    """A canonical model that also knows the frames of the rigs of ``motions``.
+
+    Each rig the model has not seen is framed once over all its takes given here (as a build
+    does), instead of from each take checked: a short take whose frames are mostly damaged
+    would otherwise be framed by its own errors. The takes are not added to the maps, so they
+    need not be clean in every frame, only mostly; rigs the model knows keep their frames.
+
+    Raises
+    ------
+    InputError
+        If the model is not canonical, or a take has no limb roles.
+    """
+    if model.frame != "canonical":
+        raise InputError(f"Expected a canonical limits model, got a {model.rig_family!r} one")
+    _, stored = _frames_by_rig(motions, take_names)
+    added = {k: v for k, v in stored.items() if k not in model.rig_frames}
+    return replace(model, rig_frames={**model.rig_frames, **added})
