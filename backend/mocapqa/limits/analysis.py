@@ -291,8 +291,10 @@ def check_limits(
                     f"Expected a discriminator for joint {joint.name!r}, got none"
                 )
             valid[:, j] = network_valid(joint.network, params[:, j])
-    score = np.where(valid & (method == "map"), 0.0, np.hypot(swing, twist))
-    excess = np.where(valid[..., None], 0.0, excess)
+    # The map's distances and excess are already 0 wherever the map finds a frame valid.
+    score = np.hypot(swing, twist)
+    if method == "network":
+        excess = np.where(valid[..., None], 0.0, excess)
     return LimitsReport(
         joint_names=names,
         roles=tuple(j.role for j in joints),
