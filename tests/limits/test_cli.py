@@ -92,3 +92,44 @@ def test_a_mapping_decides_which_joint_the_canonical_model_checks(
     mapped = {j["role"]: j["name"] for j in after["joints"]}
     assert mapped["left_foot"] == "Toes_L"
     assert "Foot_L" in after["not_checked"]
+
+
+def test_check_frames_an_unseen_rig_from_a_folder_of_its_takes(
+    corpus_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mocapqa.io.bvh import read_bvh
+    from mocapqa.limits.analysis import check_limits
+    from mocapqa.limits.build import with_rig_frames
+    from mocapqa.limits.canonical import rig_key
+
+    bandai = tmp_path / "bandai"
+    bandai.mkdir()
+    (bandai / "walk.bvh").symlink_to(
+        corpus_dir / "bvh" / "bandai" / "dataset-1_walk_normal_001.bvh"
+    )
+    model_path = tmp_path / "model.npz"
+    # A tight map (5° bins, no widening), so that the frames' small differences show.
+    build = ["limits", "build", str(bandai), "-o", str(model_path), "--no-networks"]
+    assert main([*build, "--bin-deg", "5", "--dilation", "0", "--margin-deg", "0"]) == 0
+    folder = tmp_path / "character_creator"
+    folder.mkdir()
+    iclone = corpus_dir / "bvh" / "cmu" / "iclone"
+    walks = [iclone / n for n in ("003_02.bvh", "002_09.bvh", "005_12.bvh")]
+    for walk in walks:
+        (folder / walk.name).symlink_to(walk)
+    take = str(walks[0])
+    capsys.readouterr()
+    assert main(["limits", "check", take, "--model", str(model_path), "--json",
+                 "--frame-from", str(folder)]) == 0  # fmt: skip
+    framed = json.loads(capsys.readouterr().out)
+    model = load_model(model_path)
+    motions = [read_bvh(w) for w in walks]
+    assert rig_key(motions[0]) not in model.rig_frames
+    expected = check_limits(motions[0], with_rig_frames(model, motions, [w.name for w in walks]))
+    assert framed["flagged_fraction"] == pytest.approx(expected.flagged_fraction)
+    alone = check_limits(motions[0], model)  # framed from the take itself
+    assert alone.flagged_fraction != pytest.approx(expected.flagged_fraction)
+    # A folder without a take of the rig is refused, naming the folder.
+    assert main(["limits", "check", take, "--model", str(model_path),
+                 "--frame-from", str(bandai)]) == 3  # fmt: skip
+    assert "got none" in capsys.readouterr().err

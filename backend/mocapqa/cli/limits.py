@@ -15,7 +15,9 @@ from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
 from mocapqa.errors import InputError
 
 if TYPE_CHECKING:
+    from mocapqa.core.motion import Motion
     from mocapqa.limits.build import BuildParams
+    from mocapqa.limits.model import LimitsModel
 
 __all__ = ["limits_build", "limits_check", "limits_show"]
 
@@ -127,6 +129,14 @@ def limits_check(
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     network: Annotated[bool, typer.Option(help="Let the discriminator decide.")] = False,
     mapping: MappingOption = None,
+    frame_from: Annotated[
+        Path | None,
+        typer.Option(
+            "--frame-from",
+            help="Folder of takes of this take's rig: frame a rig the canonical model has not "
+            "seen once from all of them (mostly clean takes), not from this take alone.",
+        ),
+    ] = None,
 ) -> None:
     """Check a take against joint limits: share of frames outside and the worst frames.
 
@@ -143,6 +153,8 @@ def limits_check(
     motion = read_bvh(path)
     missing = missing_roles(motion.skeleton, roles)
     model = load_model(model_path) if model_path is not None else None
+    if frame_from is not None:
+        model = _framed_from(motion, model, frame_from)
     report = check_limits(motion, model, method="network" if network else "map", mapping=roles)
     data = report.to_json(max_points=0)
     for joint in data["joints"]:
@@ -217,3 +229,24 @@ def limits_show(
     figure.savefig(output, dpi=80)
     plt.close(figure)
     console.print(f"wrote {output}")
+
+
+def _framed_from(motion: Motion, model: LimitsModel | None, folder: Path) -> LimitsModel:
+    """``model`` (default: the shipped one) with the frames of ``motion``'s rig estimated over
+    the takes of that rig under ``folder``."""
+    from mocapqa.io.bvh import read_bvh
+    from mocapqa.limits.build import with_rig_frames
+    from mocapqa.limits.canonical import rig_key
+    from mocapqa.limits.storage import load_default_model
+
+    model = load_default_model(motion.skeleton) if model is None else model
+    if model.frame != "canonical":
+        raise InputError(
+            f"Expected a canonical limits model with --frame-from, got the {model.rig_family!r} "
+            "rig's own model (pass --model with a canonical model)"
+        )
+    key = rig_key(motion)
+    takes = [(p.name, m) for p in sorted(folder.rglob("*.bvh")) if rig_key(m := read_bvh(p)) == key]
+    if not takes:
+        raise InputError(f"Expected BVH takes of the checked take's rig under {folder}, got none")
+    return with_rig_frames(model, [m for _, m in takes], [n for n, _ in takes])
