@@ -114,18 +114,18 @@ def test_check_frames_an_unseen_rig_from_a_folder_of_its_takes(
     folder = tmp_path / "character_creator"
     folder.mkdir()
     iclone = corpus_dir / "bvh" / "cmu" / "iclone"
-    walks = [iclone / n for n in ("003_02.bvh", "002_09.bvh", "005_12.bvh")]
-    for walk in walks:
-        (folder / walk.name).symlink_to(walk)
-    take = str(walks[0])
+    takes = [iclone / n for n in ("003_02.bvh", "002_09.bvh", "005_12.bvh")]
+    for take_path in takes:
+        (folder / take_path.name).symlink_to(take_path)
+    take = str(takes[0])
     capsys.readouterr()
     assert main(["limits", "check", take, "--model", str(model_path), "--json",
                  "--frame-from", str(folder)]) == 0  # fmt: skip
     framed = json.loads(capsys.readouterr().out)
     model = load_model(model_path)
-    motions = [read_bvh(w) for w in walks]
+    motions = [read_bvh(t) for t in takes]
     assert rig_key(motions[0]) not in model.rig_frames
-    expected = check_limits(motions[0], with_rig_frames(model, motions, [w.name for w in walks]))
+    expected = check_limits(motions[0], with_rig_frames(model, motions, [t.name for t in takes]))
     assert framed["flagged_fraction"] == pytest.approx(expected.flagged_fraction)
     alone = check_limits(motions[0], model)  # framed from the take itself
     assert alone.flagged_fraction != pytest.approx(expected.flagged_fraction)
