@@ -211,3 +211,47 @@ def test_the_noise_allowance_admits_a_shift_read_through_a_noisy_child() -> None
     loose = detect_robust(dp, dc, FPS, RobustParams(noise_factor=0.0, mismatch_noise=1.0))
     ends = [f for pair in shifts for f in pair]
     assert loose.candidates[ends, 0].sum() > strict.candidates[ends, 0].sum()
+
+
+def test_ends_cancel_within_their_measurement_uncertainty() -> None:
+    # A 9.8° level shift held over frames 40–59: the child counter-rotates exactly, the
+    # parent's release is read 4.4° too large (natural jitter on that frame). The jumps
+    # (means of the two readings) are −9.4° and +12.0°: their net 2.6° exceeds the closure
+    # tolerance max(2°, 0.2 × 12°), but not that plus the root sum of squares of half the
+    # gaps between the readings (0.4° and 2.2°).
+    n = 120
+    parent = np.zeros(n)
+    child = np.zeros(n)
+    parent[40], child[40] = np.deg2rad(-9.0), np.deg2rad(9.8)
+    parent[60], child[60] = np.deg2rad(14.2), np.deg2rad(-9.8)
+    strict = detect_robust(parent[:, None], child[:, None], FPS, RobustParams())
+    assert strict.candidates[[40, 60], 0].all()
+    assert strict.intervals == ()
+    assert np.all(strict.offsets == 0.0)
+    loose = detect_robust(parent[:, None], child[:, None], FPS, RobustParams(closure_noise=1.0))
+    (interval,) = loose.intervals
+    assert (interval.start_frame, interval.end_frame) == (40, 59)
+    assert -11.0 < np.rad2deg(interval.offset_rad) < -9.0
+    assert np.all(loose.offsets[:40] == 0.0)
+    assert np.all(loose.offsets[60:] == 0.0)
+
+
+def test_chain_intervals_take_each_jumps_uncertainty() -> None:
+    n = 100
+    frames = np.array([30, 50])
+    jumps = np.deg2rad([-9.0, 11.6])  # net 2.6° against a tolerance of 2.32°
+    increments = np.zeros(n)
+    increments[frames] = jumps
+    args = (frames, jumps, np.zeros(2), increments, np.zeros(n), np.deg2rad(2.0),
+            np.deg2rad(0.1), FPS, 0.2, 0.5, 0.1, 2.0, None, 0.0)  # fmt: skip
+    without, none = chain_intervals(*args)
+    assert none == []
+    assert np.all(without == 0.0)
+    _, still_none = chain_intervals(*args, np.deg2rad([0.1, 0.1]))
+    assert still_none == []
+    offsets, (found,) = chain_intervals(*args, np.deg2rad([0.05, 1.7]))
+    assert (found.start_frame, found.end_frame) == (30, 49)
+    # The level accumulated from the jumps, their net spread evenly: −9.0 − 1.3.
+    assert np.allclose(np.rad2deg(offsets[30:50]), -10.3, atol=1e-6)
+    assert np.all(offsets[:30] == 0.0)
+    assert np.all(offsets[50:] == 0.0)

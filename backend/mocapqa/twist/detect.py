@@ -119,6 +119,10 @@ class RobustParams:
     mismatch_noise : float
         Widen the counter-rotation check by this many robust noise scales of ``rP`` and
         ``rC`` combined (0: off; more events are found in noisy chains, and more false ones).
+    closure_noise : float
+        Jumps also cancel within this many times the root sum of squares of their
+        uncertainties, each half the gap between the parent's step and the child's
+        counter-step (0: off).
     """
 
     min_threshold_deg: float = 2.0
@@ -135,6 +139,7 @@ class RobustParams:
     tail_factor: float = 0.1
     weighted_jumps: bool = False
     mismatch_noise: float = 0.0
+    closure_noise: float = 0.0
     parent_source: str = "increment"
     child_source: str = "increment"
     min_conditioning: float = 0.4
@@ -156,10 +161,14 @@ class RobustParams:
                 "Expected neighbour_s > 0, max_interval_s > 0 and passes ≥ 1, got "
                 f"{self.neighbour_s}, {self.max_interval_s}, {self.passes}"
             )
-        if min(self.speed_factor, self.tail_s, self.tail_factor, self.mismatch_noise) < 0:
+        if (
+            min(self.speed_factor, self.tail_s, self.tail_factor, self.mismatch_noise,
+                self.closure_noise) < 0
+        ):  # fmt: skip
             raise InputError(
-                "Expected speed_factor, tail_s, tail_factor and mismatch_noise ≥ 0, got "
-                f"{self.speed_factor}, {self.tail_s}, {self.tail_factor}, {self.mismatch_noise}"
+                "Expected speed_factor, tail_s, tail_factor, mismatch_noise and closure_noise "
+                f"≥ 0, got {self.speed_factor}, {self.tail_s}, {self.tail_factor}, "
+                f"{self.mismatch_noise}, {self.closure_noise}"
             )
         if self.burst_gap_s <= 0 or self.agreement < 0 or self.min_fps < 0:
             raise InputError(
@@ -399,6 +408,8 @@ def detect_robust(
     small[rows_w, cols_w] = np.angle(np.exp(1j * rp[weak]) + np.exp(-1j * rc[weak]))
     ratio = np.zeros_like(dp)
     ratio[rows, cols] = mismatch[rows, cols] / np.maximum(smaller[rows, cols], 1e-12)
+    # Each jump is read twice (parent step, child counter-step): half their gap is its error.
+    uncertainty = 0.5 * params.closure_noise * mismatch
     # The chain's natural roll per frame: noise or typical velocity, whichever is larger.
     roll_scale = np.maximum(
         np.maximum(scale, np.median(np.abs(natural_p), axis=0)), np.deg2rad(0.01)
@@ -414,7 +425,7 @@ def detect_robust(
                 frames, jumps[frames, c], ratio[frames, c], dp[:, c], natural_p[:, c],
                 float(threshold[c]), float(roll_scale[c]), fps, params.closure_fraction,
                 params.agreement, params.burst_gap_s, params.max_interval_s, small[:, c],
-                params.tail_s,
+                params.tail_s, uncertainty[frames, c],
             )  # fmt: skip
         else:
             steps = np.zeros(n_frames)

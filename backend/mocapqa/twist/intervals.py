@@ -72,8 +72,10 @@ class IntervalEstimate:
     features: tuple[float, ...]
 
 
-def _closes(level: float, largest: float, threshold: float, fraction: float) -> bool:
-    return abs(level) <= max(threshold, fraction * largest)
+def _closes(
+    level: float, largest: float, threshold: float, fraction: float, slack: float = 0.0
+) -> bool:
+    return abs(level) <= max(threshold, fraction * largest) + slack
 
 
 def _groups(
@@ -83,6 +85,7 @@ def _groups(
     closure_fraction: float,
     burst_gap: int,
     max_frames: int,
+    uncertainty: FloatArray,
 ) -> list[list[int]]:
     """Event indices of each interval, sorted and frame-disjoint.
 
@@ -92,7 +95,8 @@ def _groups(
     are open together, they may only be closed from inside that burst, so a burst's last flip
     is never paired with an unrelated event far away. Events left unmatched that lie within
     ``burst_gap`` of each other form a burst. Groups whose spans overlap (a burst inside a held
-    level shift) are merged.
+    level shift) are merged. A net cancels within the closure tolerance plus the root sum of
+    squares of its jumps' ``uncertainty``.
     """
     groups: list[list[int]] = []
     paired = np.zeros(len(frames), dtype=bool)
@@ -102,12 +106,14 @@ def _groups(
     for k in range(len(frames)):
         stack = [i for i in stack if frames[k] - frames[i] <= max_frames]
         level, largest, closed = float(jumps[k]), abs(float(jumps[k])), -1
+        variance = float(uncertainty[k]) ** 2
         for p in range(len(stack) - 1, -1, -1):
             if bound[stack[p]] and cluster[stack[p]] != cluster[k]:
                 break
             level = float(wrap_angle(np.array(level + jumps[stack[p]])))
             largest = max(largest, abs(float(jumps[stack[p]])))
-            if _closes(level, largest, threshold, closure_fraction):
+            variance += float(uncertainty[stack[p]]) ** 2
+            if _closes(level, largest, threshold, closure_fraction, np.sqrt(variance)):
                 closed = p
                 break
         if closed < 0:
@@ -131,7 +137,8 @@ def _groups(
     for burst in np.split(np.arange(len(frames)), cuts):
         largest = float(np.max(np.abs(jumps[burst])))
         net = float(wrap_angle(np.array(np.sum(jumps[burst]))))
-        if len(burst) >= 3 and _closes(net, largest, threshold, closure_fraction):
+        slack = float(np.sqrt(np.sum(uncertainty[burst] ** 2)))
+        if len(burst) >= 3 and _closes(net, largest, threshold, closure_fraction, slack):
             groups.append(list(burst))
     groups.sort(key=lambda g: frames[min(g)])
     merged: list[list[int]] = []
@@ -158,6 +165,7 @@ def chain_intervals(
     max_interval_s: float,
     small_steps: FloatArray | None = None,
     tail_s: float = 0.0,
+    uncertainty: FloatArray | None = None,
 ) -> tuple[FloatArray, list[IntervalEstimate]]:
     """Offsets and intervals of one chain.
 
@@ -194,6 +202,10 @@ def chain_intervals(
         right after the last event, in the direction of its jump and adding up to less than
         it, is the roll returning to its natural level; its frames get the level still to
         go. 0 (or no ``small_steps``) disables tails.
+    uncertainty : ndarray, shape (E,), optional
+        Measurement uncertainty of each jump, radians (e.g. half the difference between the
+        parent's step and the child's counter-step): a net cancels within the closure
+        tolerance plus the root sum of squares of its jumps' uncertainties. None: 0.
 
     Returns
     -------
@@ -208,13 +220,14 @@ def chain_intervals(
     # Frame 0 has no increment, so no event can sit there.
     keep = frames >= 1
     frames, jumps, mismatch = frames[keep], jumps[keep], mismatch[keep]
+    sigma = np.zeros(len(frames)) if uncertainty is None else np.asarray(uncertainty)[keep]
     if len(frames) < 2:
         return offsets, found
     burst_gap = max(1, round(burst_gap_s * fps))
     max_frames = max(2, round(max_interval_s * fps))
     tail_frames = max(0, round(tail_s * fps)) if small_steps is not None else 0
     roll = np.cumsum(increments)
-    groups = _groups(frames, jumps, threshold, closure_fraction, burst_gap, max_frames)
+    groups = _groups(frames, jumps, threshold, closure_fraction, burst_gap, max_frames, sigma)
     # Anchors must sit where the roll is at its natural level: outside every interval and
     # away from events that belong to none.
     forbidden = np.zeros(n_frames, dtype=bool)
@@ -261,7 +274,8 @@ def chain_intervals(
         )
         deviation = wrap_angle(roll[before : after + 1] - continuation)
         net = float(wrap_angle(np.array(np.sum(steps) + np.sum(tail))))
-        closed = _closes(net, float(np.max(np.abs(steps))), threshold, closure_fraction)
+        slack = float(np.sqrt(np.sum(sigma[group] ** 2)))
+        closed = _closes(net, float(np.max(np.abs(steps))), threshold, closure_fraction, slack)
         accumulated = wrap_angle(np.cumsum(steps - net / len(steps)))[:-1]
         disagreement = 0.0
         for m in range(len(events) - 1):
