@@ -11,6 +11,7 @@ import pytest
 from mocapqa.errors import InputError
 from mocapqa.twist.choice import choose_intervals
 from mocapqa.twist.confidence import (
+    MAX_DISAGREEMENT,
     MIN_LEVEL_DEG,
     Calibration,
     default_calibration,
@@ -101,6 +102,54 @@ def test_a_step_within_the_local_roll_speed_is_not_an_event() -> None:
 def _interval(level_deg: float, confidence: float) -> DetectedInterval:
     features = (5.0, 0.0, 0.0, 0.0, -2.0, float(np.log(level_deg)))
     return DetectedInterval(0, 10, 12, np.deg2rad(level_deg), confidence, features)
+
+
+def test_an_interval_the_outside_roll_contradicts_is_not_applied_by_default() -> None:
+    index = FEATURES.index("disagreement")
+    agreeing = list(_interval(20.0, 0.99).features)
+    contradicted = list(agreeing)
+    agreeing[index] = 0.9 * MAX_DISAGREEMENT
+    contradicted[index] = MAX_DISAGREEMENT
+    assert has_evidence(agreeing)
+    assert not has_evidence(contradicted)
+    detected = np.zeros((20, 1))
+    detected[10:13, 0] = np.deg2rad(20.0)
+
+    class _Chain:
+        parent, side, segment = 0, "left", "upper_arm"
+
+    class _Geometry:
+        chain = _Chain()
+
+    for features, expected in ((agreeing, True), (contradicted, False)):
+        interval = DetectedInterval(0, 10, 12, np.deg2rad(20.0), 0.99, tuple(features))
+        _, (entry,) = choose_intervals(
+            [interval], detected, [_Geometry()], ["UpperArm_L"], "confident", True
+        )  # type: ignore[list-item]
+        assert entry.applied is expected
+
+
+def test_a_fast_natural_roll_of_a_clean_take_is_reported_not_applied(corpus_dir: Path) -> None:
+    # The kick's right upper arm rolls 2–9° per frame at 30 fps around frames 186–200; the
+    # counter-rotated steps there pair into a 5.3° interval that the roll outside the interval
+    # contradicts (disagreement 1.8).
+    from mocapqa.io.bvh import read_bvh
+    from mocapqa.twist.analysis import analyze_twist
+
+    motion = read_bvh(corpus_dir / "bvh" / "bandai" / "dataset-1_kick_normal_001.bvh")
+    analysis = analyze_twist(motion)
+    found = [
+        (i, f)
+        for i, f in zip(analysis.intervals, analysis.found, strict=True)
+        if i.joint == "UpperArm_R" and i.start_frame <= 194 and i.end_frame >= 193
+    ]
+    assert len(found) == 1
+    interval, detected = found[0]
+    assert interval.confidence >= 0.5
+    assert detected.features[FEATURES.index("disagreement")] >= MAX_DISAGREEMENT
+    assert not interval.applied
+    assert not any(i.applied for i in analysis.intervals)
+    assert np.array_equal(analysis.refined.quats, motion.quats)
 
 
 def test_small_intervals_are_reported_but_not_applied_by_default() -> None:

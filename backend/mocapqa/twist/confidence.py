@@ -15,7 +15,8 @@ and raises no frame's error by more than 1°.
 ``APPLY_THRESHOLD`` is the probability from which ``apply="confident"`` applies an interval, and
 :func:`has_evidence` the minimum-evidence rule it also requires: the interval's largest level
 must be at least ``MIN_LEVEL_DEG``, so a small interval inside the natural roll noise is reported
-but not applied.
+but not applied, and the roll outside the interval must not contradict its jumps by more than
+``MAX_DISAGREEMENT`` times the level (then nothing outside the events shows a level shift).
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ from mocapqa.twist.intervals import FEATURES
 __all__ = [
     "APPLY_THRESHOLD",
     "CALIBRATION_FILE",
+    "MAX_DISAGREEMENT",
     "MIN_LEVEL_DEG",
     "Calibration",
     "default_calibration",
@@ -48,6 +50,11 @@ APPLY_THRESHOLD = 0.5
 MIN_LEVEL_DEG = 5.0
 """Smallest largest level, degrees, of an interval that ``apply="confident"`` applies: the
 smallest offset of the injection protocol (no interval on the fit takes is smaller)."""
+MAX_DISAGREEMENT = 1.5
+"""Largest disagreement between the level measured from the roll outside an interval and the
+level accumulated from its jumps, relative to the latter (the ``disagreement`` feature), of an
+interval that ``apply="confident"`` applies. Chosen on the injected takes as the smallest of
+1, 1.25, 1.5 and 1.75 that keeps every right interval: by each pair of rigs, 1.5 each time."""
 CALIBRATION_FILE = "calibration.json"
 """Name of the stored calibration in the package's ``data/twist`` folder."""
 
@@ -136,7 +143,8 @@ class Calibration:
 
 
 def has_evidence(features: Sequence[float]) -> bool:
-    """Whether an interval's largest level reaches :data:`MIN_LEVEL_DEG`.
+    """Whether an interval's largest level reaches :data:`MIN_LEVEL_DEG` and the roll outside it
+    disagrees with its jumps by less than :data:`MAX_DISAGREEMENT`.
 
     Parameters
     ----------
@@ -146,7 +154,8 @@ def has_evidence(features: Sequence[float]) -> bool:
     """
     if not features:
         return True
-    return bool(features[FEATURES.index("log_level_deg")] >= np.log(MIN_LEVEL_DEG))
+    large = features[FEATURES.index("log_level_deg")] >= np.log(MIN_LEVEL_DEG)
+    return bool(large and features[FEATURES.index("disagreement")] < MAX_DISAGREEMENT)
 
 
 _LOADED: dict[str, Calibration] = {}
