@@ -304,3 +304,37 @@ def test_chain_intervals_take_each_jumps_uncertainty() -> None:
     assert np.allclose(np.rad2deg(offsets[30:50]), -10.3, atol=1e-6)
     assert np.all(offsets[:30] == 0.0)
     assert np.all(offsets[50:] == 0.0)
+
+
+def _held_shift(jitter_deg: float) -> np.ndarray:
+    """Roll increments of a −10° shift held over frames 30–49 of 100, the roll inside
+    alternating by ``jitter_deg`` (+ on even frames from 32 to 48), degrees."""
+    roll = np.zeros(100)
+    roll[30:50] = -10.0
+    roll[32:49:2] += jitter_deg
+    return np.deg2rad(np.diff(roll, prepend=0.0))
+
+
+def test_the_outside_roll_overrules_the_jumps_only_beyond_its_own_scatter() -> None:
+    frames = np.array([30, 50])
+    jumps = np.deg2rad([-10.0, 10.0])
+
+    def levels(increments: np.ndarray, precision: float) -> np.ndarray:
+        offsets, _ = chain_intervals(
+            frames, jumps, np.zeros(2), increments, np.zeros(100), np.deg2rad(2.0),
+            np.deg2rad(0.1), FPS, 0.2, 0.5, 0.1, 2.0, None, 0.0, None, precision,
+        )  # fmt: skip
+        return np.rad2deg(offsets)
+
+    # Inside, the roll swings by 26° from frame to frame: its mean (1.7°) contradicts the
+    # jumps' −10°, but by less than twice its own scatter (17°), so the jumps' level stays.
+    jittery = _held_shift(26.0)
+    assert np.all(levels(jittery, 0.0) == 0.0)
+    kept = levels(jittery, 2.0)
+    assert np.allclose(kept[30:50], -10.0)
+    assert np.all(kept[:30] == 0.0)
+    assert np.all(kept[50:] == 0.0)
+    # A calm roll that stays at its natural level while two events claim a shift: the
+    # contradiction is far beyond the scatter, and no frame is moved.
+    calm = np.zeros(100)
+    assert np.all(levels(calm, 2.0) == 0.0)

@@ -123,6 +123,11 @@ class RobustParams:
         Jumps also cancel within this many times the root sum of squares of their
         uncertainties, each half the gap between the parent's step and the child's
         counter-step (0: off).
+    precision : float
+        A stretch whose outside level is below ``agreement`` times its accumulated level is
+        left unchanged only when the two differ by more than this many robust scales of the
+        roll's deviation from its continuation inside the stretch (0: always); a contradiction
+        within the roll's own scatter inside the stretch is no evidence against the jumps.
     """
 
     min_threshold_deg: float = 2.0
@@ -140,6 +145,7 @@ class RobustParams:
     weighted_jumps: bool = False
     mismatch_noise: float = 0.0
     closure_noise: float = 0.0
+    precision: float = 2.0
     parent_source: str = "increment"
     child_source: str = "increment"
     min_conditioning: float = 0.4
@@ -163,7 +169,7 @@ class RobustParams:
             )
         if (
             min(self.speed_factor, self.tail_s, self.tail_factor, self.mismatch_noise,
-                self.closure_noise) < 0
+                self.closure_noise, self.precision) < 0
         ):  # fmt: skip
             raise InputError(
                 "Expected speed_factor, tail_s, tail_factor, mismatch_noise and closure_noise "
@@ -425,7 +431,7 @@ def detect_robust(
                 frames, jumps[frames, c], ratio[frames, c], dp[:, c], natural_p[:, c],
                 float(threshold[c]), float(roll_scale[c]), fps, params.closure_fraction,
                 params.agreement, params.burst_gap_s, params.max_interval_s, small[:, c],
-                params.tail_s, uncertainty[frames, c],
+                params.tail_s, uncertainty[frames, c], params.precision,
             )  # fmt: skip
         else:
             steps = np.zeros(n_frames)

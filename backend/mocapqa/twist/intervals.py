@@ -22,8 +22,10 @@ Conventions
   continuation. Where the interval's jumps cancel, the level accumulated from its jumps (less
   noisy over long holds) is used instead, unless the outside level is less than ``agreement``
   times it: a stretch whose roll sits near the natural continuation gets level 0 and is left
-  bit-identical, so a mismatched pair of events cannot shift clean frames. Where the jumps do
-  not cancel (a burst whose ends disagree), the outside level is used.
+  bit-identical, so a mismatched pair of events cannot shift clean frames — when that
+  contradiction exceeds ``precision`` times the roll's own scatter inside the stretch (a roll
+  jittering by more than the level cannot contradict it). Where the jumps do not cancel (a
+  burst whose ends disagree), the outside level is used.
 """
 
 from __future__ import annotations
@@ -150,6 +152,12 @@ def _groups(
     return merged
 
 
+def _spread(values: FloatArray) -> float:
+    """Robust scale (1.4826 × median absolute deviation from the circular mean) of angles."""
+    centre = np.angle(np.mean(np.exp(1j * values)))
+    return float(1.4826 * np.median(np.abs(wrap_angle(values - centre))))
+
+
 def chain_intervals(
     frames: IntArray,
     jumps: FloatArray,
@@ -166,6 +174,7 @@ def chain_intervals(
     small_steps: FloatArray | None = None,
     tail_s: float = 0.0,
     uncertainty: FloatArray | None = None,
+    precision: float = 0.0,
 ) -> tuple[FloatArray, list[IntervalEstimate]]:
     """Offsets and intervals of one chain.
 
@@ -206,6 +215,10 @@ def chain_intervals(
         Measurement uncertainty of each jump, radians (e.g. half the difference between the
         parent's step and the child's counter-step): a net cancels within the closure
         tolerance plus the root sum of squares of its jumps' uncertainties. None: 0.
+    precision : float
+        The ``agreement`` rule leaves a stretch at level 0 only when its outside and
+        accumulated levels differ by more than this many robust scales (1.4826 × MAD) of the
+        deviation from the continuation inside the stretch; 0: whatever the scatter.
 
     Returns
     -------
@@ -286,7 +299,9 @@ def chain_intervals(
             disagreement = max(disagreement, gap / max(abs(jumped), threshold))
             if not closed:
                 level = outside
-            elif abs(outside) < agreement * abs(jumped):
+            elif abs(outside) < agreement * abs(jumped) and gap > precision * _spread(
+                deviation[lo - before : hi - before]
+            ):
                 level = 0.0
             else:
                 level = jumped
