@@ -172,9 +172,9 @@ class RobustParams:
                 self.closure_noise, self.precision) < 0
         ):  # fmt: skip
             raise InputError(
-                "Expected speed_factor, tail_s, tail_factor, mismatch_noise and closure_noise "
-                f"≥ 0, got {self.speed_factor}, {self.tail_s}, {self.tail_factor}, "
-                f"{self.mismatch_noise}, {self.closure_noise}"
+                "Expected speed_factor, tail_s, tail_factor, mismatch_noise, closure_noise and "
+                f"precision ≥ 0, got {self.speed_factor}, {self.tail_s}, {self.tail_factor}, "
+                f"{self.mismatch_noise}, {self.closure_noise}, {self.precision}"
             )
         if self.burst_gap_s <= 0 or self.agreement < 0 or self.min_fps < 0:
             raise InputError(
