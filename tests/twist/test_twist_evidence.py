@@ -338,3 +338,30 @@ def test_the_outside_roll_overrules_the_jumps_only_beyond_its_own_scatter() -> N
     # contradiction is far beyond the scatter, and no frame is moved.
     calm = np.zeros(100)
     assert np.all(levels(calm, 2.0) == 0.0)
+
+
+def test_the_disagreement_limit_is_chosen_without_the_rig_it_is_checked_on() -> None:
+    from mocapqa.bench.calibration import disagreement_loro
+    from mocapqa.bench.twist import IntervalRecord
+
+    def record(rig: str, disagreement: float, right: bool) -> IntervalRecord:
+        features = (5.0, 0.1, 0.0, disagreement, -2.0, float(np.log(20.0)))
+        return IntervalRecord(rig, False, f"{rig}.bvh", features, 0.9, right)
+
+    records = [
+        record("a", 1.1, True),  # a right interval at 1.1: without "b", 1.0 is ruled out
+        record("a", 0.2, True),
+        record("b", 1.3, True),  # without "a", 1.0 and 1.25 are ruled out
+        record("b", 1.6, False),
+        record("c", 0.1, True),
+        record("c", 1.8, False),
+        record("c", 1.2, True),
+    ]
+    checks = {c.rig: c for c in disagreement_loro(records)}
+    assert checks["a"].chosen == 1.5  # chosen on b and c: 1.3 and 1.2 are right
+    assert (checks["a"].right_blocked, checks["a"].wrong_blocked) == (0, 0)
+    assert checks["b"].chosen == 1.25  # chosen on a and c: right up to 1.2
+    assert (checks["b"].right_blocked, checks["b"].wrong_blocked) == (1, 1)
+    assert checks["c"].chosen == 1.5
+    assert (checks["c"].right_blocked, checks["c"].wrong_blocked) == (0, 1)
+    assert (checks["c"].right_applied, checks["c"].wrong_applied) == (2, 1)

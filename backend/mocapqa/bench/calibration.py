@@ -4,6 +4,9 @@
   records of the *fit* takes only (never held-out takes, never the real-error take).
 * :func:`reliability` bins calibrated probabilities and compares them with how often the
   intervals were right.
+* :func:`disagreement_loro` checks the ``MAX_DISAGREEMENT`` rule by leaving one rig out: the
+  smallest value of a grid that blocks no right interval on two rigs, and what it blocks on the
+  third.
 * :func:`real_interval_records` labels the intervals found on a take with real errors: right
   when it holds at least one counter-rotated roll jump over 20° (onset or release), applying it
   alone leaves none of those jumps over 20°, and it moves no frame farther than 0.25 s from
@@ -23,9 +26,17 @@ from mocapqa.bench.twist import IntervalRecord
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
 from mocapqa.twist.analysis import analyze_twist, detect_chains
-from mocapqa.twist.confidence import Calibration, fit_calibration
+from mocapqa.twist.confidence import APPLY_THRESHOLD, MIN_LEVEL_DEG, Calibration, fit_calibration
+from mocapqa.twist.intervals import FEATURES
 
-__all__ = ["ReliabilityBin", "fit_on_fit_takes", "real_interval_records", "reliability"]
+__all__ = [
+    "DisagreementCheck",
+    "ReliabilityBin",
+    "disagreement_loro",
+    "fit_on_fit_takes",
+    "real_interval_records",
+    "reliability",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -46,6 +57,63 @@ class ReliabilityBin:
     count: int
     mean_probability: float
     right_share: float
+
+
+@dataclass(frozen=True, slots=True)
+class DisagreementCheck:
+    """The disagreement limit chosen without one rig, and what it does on that rig.
+
+    Parameters
+    ----------
+    rig : str
+        The rig left out.
+    chosen : float or None
+        Smallest limit of the grid that blocks no right interval on the other rigs (None: none).
+    right_blocked, wrong_blocked, right_applied, wrong_applied : int
+        On the rig left out: right and wrong intervals the limit blocks among those applied
+        without it (probability ≥ ``APPLY_THRESHOLD``, level ≥ ``MIN_LEVEL_DEG``), and all of
+        those.
+    """
+
+    rig: str
+    chosen: float | None
+    right_blocked: int
+    wrong_blocked: int
+    right_applied: int
+    wrong_applied: int
+
+
+def disagreement_loro(
+    records: Sequence[IntervalRecord], grid: Sequence[float] = (1.0, 1.25, 1.5, 1.75)
+) -> list[DisagreementCheck]:
+    """Leave-one-rig-out check of the ``MAX_DISAGREEMENT`` rule on benchmark interval records."""
+    rows = [r for r in records if r.features]
+    if not rows:
+        return []
+    rigs = np.array([r.rig for r in rows])
+    features = np.array([r.features for r in rows])
+    right = np.array([r.right for r in rows])
+    applied = (np.array([r.confidence for r in rows]) >= APPLY_THRESHOLD) & (
+        features[:, FEATURES.index("log_level_deg")] >= np.log(MIN_LEVEL_DEG)
+    )
+    disagreement = features[:, FEATURES.index("disagreement")]
+    out = []
+    for rig in sorted(set(rigs.tolist())):
+        others, mine = rigs != rig, rigs == rig
+        free = [d for d in grid if not np.any(others & applied & right & (disagreement >= d))]
+        chosen = min(free) if free else None
+        blocked = applied & (disagreement >= (chosen if chosen is not None else np.inf))
+        out.append(
+            DisagreementCheck(
+                rig,
+                chosen,
+                int(np.sum(mine & blocked & right)),
+                int(np.sum(mine & blocked & ~right)),
+                int(np.sum(mine & applied & right)),
+                int(np.sum(mine & applied & ~right)),
+            )
+        )
+    return out
 
 
 def fit_on_fit_takes(records: Sequence[IntervalRecord], path: Path | None = None) -> Calibration:

@@ -326,10 +326,11 @@ def bench_twist(
     calibration and (optionally) leave-one-rig-out figures, and the speed."""
     import numpy as np
 
-    from mocapqa.bench.calibration import fit_on_fit_takes, reliability
+    from mocapqa.bench.calibration import disagreement_loro, fit_on_fit_takes, reliability
     from mocapqa.bench.twist import find_bench_files, speed_frames_per_s
     from mocapqa.cli.twist_tables import (
         calibration_table,
+        disagreement_table,
         loro_table,
         loro_variants,
         rates_table,
@@ -387,6 +388,11 @@ def bench_twist(
                     reliability([r.confidence for r in held], [r.right for r in held]),
                 )
             )
+        console.print(
+            disagreement_table(
+                disagreement_loro([*main_methods["robust"].records, *bursts["robust"].records])
+            )
+        )
     if ablation:
         console.print(_ablation_table(result.methods))
     if loro:

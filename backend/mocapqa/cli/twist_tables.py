@@ -13,6 +13,7 @@ from rich.table import Table
 __all__ = [
     "calibration_table",
     "clean_takes_table",
+    "disagreement_table",
     "loro_table",
     "loro_variants",
     "natural_table",
@@ -133,5 +134,19 @@ def loro_table(grid: dict[str, Any]) -> Table:
             rig, "+".join(others), chosen, f"{100 * res.accuracy(others).fsr:.2f}",
             f"{100 * acc.fsr:.2f}", _pct(*res.bootstrap_fsr((rig,))),
             f"{acc.mae_after_deg:.2f}",
+        )  # fmt: skip
+    return table
+
+
+def disagreement_table(rows: Sequence[Any]) -> Table:
+    """The ``MAX_DISAGREEMENT`` rule chosen on two rigs, checked on the third."""
+    table = Table(title="Disagreement limit chosen on two rigs (blocks no right interval there)")
+    for column in ("held-out rig", "limit chosen", "right blocked", "wrong blocked",
+                   "right applied without it", "wrong applied without it"):  # fmt: skip
+        table.add_column(column, justify="right")
+    for row in rows:
+        table.add_row(
+            row.rig, "–" if row.chosen is None else f"{row.chosen:.2f}", str(row.right_blocked),
+            str(row.wrong_blocked), str(row.right_applied), str(row.wrong_applied),
         )  # fmt: skip
     return table
