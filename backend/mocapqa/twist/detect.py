@@ -120,9 +120,9 @@ class RobustParams:
         Widen the counter-rotation check by this many robust noise scales of ``rP`` and
         ``rC`` combined (0: off; more events are found in noisy chains, and more false ones).
     closure_noise : float
-        Jumps also cancel within this many times the root sum of squares of their
-        uncertainties, each half the gap between the parent's step and the child's
-        counter-step (0: off).
+        Two or more events more than ``burst_gap_s`` apart also cancel within this many times
+        the root sum of squares of their jumps' uncertainties, each half the gap between the
+        parent's step and the child's counter-step (0: off; never inside a burst).
     precision : float
         A stretch whose outside level is below ``agreement`` times its accumulated level is
         left unchanged only when the two differ by more than this many robust scales of the
@@ -144,7 +144,7 @@ class RobustParams:
     tail_factor: float = 0.1
     weighted_jumps: bool = False
     mismatch_noise: float = 0.0
-    closure_noise: float = 0.0
+    closure_noise: float = 1.0
     precision: float = 2.0
     parent_source: str = "increment"
     child_source: str = "increment"

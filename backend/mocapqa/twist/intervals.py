@@ -97,8 +97,9 @@ def _groups(
     are open together, they may only be closed from inside that burst, so a burst's last flip
     is never paired with an unrelated event far away. Events left unmatched that lie within
     ``burst_gap`` of each other form a burst. Groups whose spans overlap (a burst inside a held
-    level shift) are merged. A net cancels within the closure tolerance plus the root sum of
-    squares of its jumps' ``uncertainty``.
+    level shift) are merged. Events farther apart than ``burst_gap`` cancel within the closure
+    tolerance plus the root sum of squares of their jumps' ``uncertainty``; flips inside one
+    burst get no such allowance.
     """
     groups: list[list[int]] = []
     paired = np.zeros(len(frames), dtype=bool)
@@ -115,7 +116,8 @@ def _groups(
             level = float(wrap_angle(np.array(level + jumps[stack[p]])))
             largest = max(largest, abs(float(jumps[stack[p]])))
             variance += float(uncertainty[stack[p]]) ** 2
-            if _closes(level, largest, threshold, closure_fraction, np.sqrt(variance)):
+            slack = np.sqrt(variance) if frames[k] - frames[stack[p]] > burst_gap else 0.0
+            if _closes(level, largest, threshold, closure_fraction, slack):
                 closed = p
                 break
         if closed < 0:
@@ -139,8 +141,7 @@ def _groups(
     for burst in np.split(np.arange(len(frames)), cuts):
         largest = float(np.max(np.abs(jumps[burst])))
         net = float(wrap_angle(np.array(np.sum(jumps[burst]))))
-        slack = float(np.sqrt(np.sum(uncertainty[burst] ** 2)))
-        if len(burst) >= 3 and _closes(net, largest, threshold, closure_fraction, slack):
+        if len(burst) >= 3 and _closes(net, largest, threshold, closure_fraction):
             groups.append(list(burst))
     groups.sort(key=lambda g: frames[min(g)])
     merged: list[list[int]] = []
@@ -213,8 +214,9 @@ def chain_intervals(
         go. 0 (or no ``small_steps``) disables tails.
     uncertainty : ndarray, shape (E,), optional
         Measurement uncertainty of each jump, radians (e.g. half the difference between the
-        parent's step and the child's counter-step): a net cancels within the closure
-        tolerance plus the root sum of squares of its jumps' uncertainties. None: 0.
+        parent's step and the child's counter-step): events farther apart than
+        ``burst_gap_s`` cancel within the closure tolerance plus the root sum of squares of
+        their jumps' uncertainties (never inside a burst). None: 0.
     precision : float
         The ``agreement`` rule leaves a stretch at level 0 only when its outside and
         accumulated levels differ by more than this many robust scales (1.4826 × MAD) of the
@@ -287,7 +289,8 @@ def chain_intervals(
         )
         deviation = wrap_angle(roll[before : after + 1] - continuation)
         net = float(wrap_angle(np.array(np.sum(steps) + np.sum(tail))))
-        slack = float(np.sqrt(np.sum(sigma[group] ** 2)))
+        spread_out = bool(np.all(np.diff(events) > burst_gap))
+        slack = float(np.sqrt(np.sum(sigma[group] ** 2))) if spread_out else 0.0
         closed = _closes(net, float(np.max(np.abs(steps))), threshold, closure_fraction, slack)
         accumulated = wrap_angle(np.cumsum(steps - net / len(steps)))[:-1]
         disagreement = 0.0
