@@ -146,7 +146,7 @@ def _ablations() -> dict[str, tuple[str, Any]]:
         "no local-speed rule": ("robust", replace(base, speed_factor=0.0)),
         "jump weighted by parent/child noise": ("robust", replace(base, weighted_jumps=True)),
         "mismatch allowance + 1 noise scale": ("robust", replace(base, mismatch_noise=1.0)),
-        "closure within the jumps' uncertainty": ("robust", replace(base, closure_noise=1.0)),
+        "no closure allowance (closure_noise 0)": ("robust", replace(base, closure_noise=0.0)),
         "outside level overrules within its scatter": ("robust", replace(base, precision=0.0)),
     }
 
