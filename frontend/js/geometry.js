@@ -237,6 +237,22 @@ export function orbitPosition(target, azimuth, elevation, distance) {
 }
 
 /** Camera presets as orbit angles (radians): front looks along −Z, side along −X, top down. */
+/**
+ * The camera's target for a focus mode, in the data's (Y-up) coordinates: "joint" the point
+ * `joint`, "root" the point `root` (the whole body's centre when it has none), "body" the
+ * body's centre over the floor (the height of `target` kept). A missing point keeps `target`.
+ */
+export function focusTarget(mode, points, root, joint, target) {
+  const at = (j) => (j != null && j >= 0 && present(points[j]) ? [points[j][0], points[j][1], points[j][2]] : null);
+  const centre = centreOf(points); // Z-up: (x, −z, y)
+  if (mode === "joint" && at(joint)) return at(joint);
+  if (mode === "root" || mode === "joint") return at(root) || (centre ? [centre[0], centre[2], -centre[1]] : target);
+  return centre ? [centre[0], target[1], -centre[1]] : target;
+}
+
+/** Camera distance of a focus mode, for a body `size` across (close-in is nearer). */
+export const focusDistance = (mode, size) => size * (mode === "joint" ? 0.7 : 1.5);
+
 export const PRESETS = {
   front: { azimuth: 0, elevation: 0.3 },
   side: { azimuth: Math.PI / 2, elevation: 0.3 },

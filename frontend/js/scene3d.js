@@ -97,6 +97,8 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   tooltip.hidden = true;
   document.body.append(tooltip);
 
+  const root = oriented ? parents.indexOf(-1) : -1;
+  let focus = "body";
   let frame = null, triadsOn = false, overlayOn = false, renders = 0, drawn = 0, scheduled = 0, marked = false;
   const sizeOf = (view) => [view.div.clientWidth, view.div.clientHeight];
   const render = () => {
@@ -166,9 +168,9 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
     write(views.raw, next.raw, next.rawRotations, next.flagged, next.selected);
     write(views.corrected, next.corrected, next.correctedRotations, next.flagged, next.selected);
     if (overlayOn) writeLines(views.corrected.ghost.geometry.attributes.position, next.raw, bones);
-    // Auto-framing: the orbit's target follows the body over the floor.
-    const centre = geo.centreOf(next.corrected); // Z-up: (x, −z, y)
-    if (centre) { orbit.target[0] = centre[0]; orbit.target[2] = -centre[1]; }
+    // Auto-framing: the orbit's target follows the body over the floor, the root (follow) or
+    // the selected joint (close-in).
+    orbit.target = geo.focusTarget(focus, next.corrected, root, next.selected, orbit.target);
     drawn += 1;
     requestRender();
   };
@@ -249,6 +251,15 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
       camera.lookAt(...orbit.target);
       return project(view, (viewName === "raw" ? frame.raw : frame.corrected)[index]);
     },
+    /** Centre the camera on "body", "joint" (close-in on the selected joint) or "root" (follow). */
+    setFocus(mode) {
+      const resting = [focus, mode].includes("joint") && focus !== mode; // into or out of close-in
+      focus = mode;
+      if (resting) orbit.distance = geo.focusDistance(mode, size);
+      if (mode === "body" && frame) orbit.target[1] = floorY + size * 0.4;
+      if (frame) show(frame); else requestRender();
+    },
+    get focus() { return focus; },
     setCamera(name) { Object.assign(orbit, geo.PRESETS[name]); requestRender(); },
     setTriads(on) { triadsOn = on && oriented; for (const v of Object.values(views)) v.axes.visible = triadsOn; if (frame) show(frame); },
     setOverlay(on) { overlayOn = on; views.corrected.ghost.visible = on; if (frame) show(frame); },

@@ -1,8 +1,11 @@
 // The take view: two 3D views with one camera, the player, findings, charts, review, re-run.
 import * as api from "./api.js";
 import * as charts from "./charts.js";
-import { activatable, badge, h } from "./dom.js";
-import { findingStops, fmt, nextStop, seconds, sortFindings, stepsRan } from "./format.js";
+import { badge, h } from "./dom.js";
+import { fmt, nextStop, seconds, stepsRan } from "./format.js";
+import { findingAt, loopOfFinding } from "./findings.js";
+import { findingsList } from "./findings-list.js";
+import { createTimebar, withIn, withOut } from "./timebar.js";
 import { createPlayer } from "./player.js";
 import { loadPlotly } from "./plotly.js";
 import * as store from "./state.js";
@@ -15,6 +18,7 @@ const OVERVIEW_FRAMES = 800; // frames of a take drawn before any window is load
 const FIRST_FRAMES = 100; // a first, light overview: the skeletons do not wait for the full one
 const LIMITS_COLOR = "#e67e22";
 const DECISIONS = { a: "approved", f: "needs_fix", r: "rejected" }; // review keys
+const LOOP_MARGIN_S = 0.5; // "loop this finding": seconds shown before and after it
 
 export async function takeView(main, takeId, params, onTeardown) {
   const runParam = params.get("run");
@@ -64,23 +68,37 @@ export async function takeView(main, takeId, params, onTeardown) {
   const corrTitle = h("h3", { class: "view-title" }, "corrected");
   const rawPanel = h("div", { class: "col panel", id: "panel-raw" }, rawTitle, rawDiv);
   const presets = ["front", "side", "top"].map((name) => h("button", { id: `camera-${name}`, class: "small" }, name));
+  const closeButton = h("button", { id: "camera-close", class: "small", "aria-pressed": "false", title: "frame the selected joint (or the current finding's joint) close (C)" }, "close-in");
+  const followButton = h("button", { id: "camera-follow", class: "small", "aria-pressed": "false", title: "keep the root in the centre while playing" }, "follow");
+  const loopButton = h("button", { id: "loop", "aria-pressed": "false", "aria-keyshortcuts": "L", title: "loop playback over the in/out range (L)" }, "⟲ loop");
+  const loopFindingButton = h("button", { id: "loop-finding", class: "small", "aria-keyshortcuts": "Shift+L", title: "loop the current finding with a margin (shift+L)" }, "loop finding");
+  const clearLoopButton = h("button", { id: "loop-clear", class: "small", title: "clear the in/out range" }, "clear in/out");
+  const loopLabel = h("span", { id: "loop-label", class: "muted" }, "in/out: none (I / O or drag on the bar)");
   const triadsBox = h("input", { type: "checkbox", id: "show-axes", disabled: !oriented });
   const overlayBox = h("input", { type: "checkbox", id: "overlay" });
   const viewsRow = h("div", { class: "row", id: "views" }, rawPanel, h("div", { class: "col panel" }, corrTitle, corrDiv));
   main.append(
     runPicker(take, run),
-    h("div", { class: "controls view-options" }, "camera ", presets,
+    h("div", { class: "controls view-options" }, "camera ", presets, closeButton, followButton,
       h("label", {}, triadsBox, " joint axes"), h("label", {}, overlayBox, " overlay (raw as ghost)"),
       h("span", { class: "muted" }, oriented ? "bones are drawn in their parent joint's frame; the orange side marks the roll" : "")),
     viewsRow,
-    h("div", { class: "controls panel player", id: "player" }, playButton, "speed ", speed, scrubber, frameLabel, jointLabel),
+    h("div", { class: "panel player", id: "player" },
+      h("div", { class: "controls" }, playButton, "speed ", speed, scrubber, frameLabel, jointLabel),
+      h("div", { class: "controls" }, loopButton, loopFindingButton, clearLoopButton, loopLabel)),
   );
   const help = h("p", { class: "muted", id: "keys-help" },
-    "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · A/F/R approve, needs fix, reject the take (saves) · Y/X accept, reject the focused or last opened twist interval (saves) · Enter on a row opens it · ? shows or hides this line");
+    "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · I/O in/out point · L loop in/out · shift+L loop the finding · C close-in · A/F/R approve, needs fix, reject the take (saves) · Y/X accept, reject the focused or last opened twist interval (saves) · Enter on a row opens it · ? shows or hides this line");
   const timelines = h("div", {});
   const review = reviewPanel(take);
   const decided = intervalDecisions(run, result);
-  main.append(help, findingsTable(result.findings, decided, (f) => { decided.opened(f); store.set({ joint: f.joint }); focusCharts(); jump(f.start_frame); viewsRow.scrollIntoView({ block: "start" }); }),
+  const list = findingsList(result.findings, decided, (f) => { decided.opened(f); store.set({ joint: f.joint }); focusCharts(); jump(f.start_frame); viewsRow.scrollIntoView({ block: "start" }); });
+  const timebar = createTimebar({
+    nFrames, marks: result.findings.map((f) => ({ start: f.start_frame, end: f.end_frame, color: findingColor(f), label: `${f.kind} · ${f.joint} · ${f.start_frame}–${f.end_frame}` })),
+    onJump: (f) => { if (player.playing) togglePlay(); jump(f); }, onRange: (r) => setRange(r),
+  });
+  document.getElementById("player").append(timebar.el);
+  main.append(help, list.panel,
     timelines, review, stepsPanel(result), downloadsPanel(run, result), rerunPanel(take, run, filters));
 
   // Frames: the overview (whole take, decimated) or, when paused, a full-rate window around.
@@ -127,6 +145,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     rawTitle.textContent = `raw — frame ${frame.shown}`;
     corrTitle.textContent = store.state.overlay ? `corrected (solid) and raw (ghost) — frame ${frame.shown}` : `corrected — frame ${frame.shown}`;
     scrubber.value = f;
+    timebar.setFrame(f);
     if (timeline) timeline.setFrame(f);
   };
   const remember = () => {
@@ -158,6 +177,43 @@ export async function takeView(main, takeId, params, onTeardown) {
   scrubber.addEventListener("change", () => { remember(); loadDetail(); });
   speed.addEventListener("change", () => player.setSpeed(Number(speed.value)));
   presets.forEach((button) => button.addEventListener("click", () => views.setCamera(button.textContent)));
+  // Camera focus: "body" (the body's centre over the floor), "joint" (close-in on the selected
+  // joint) or "root" (follow: the root in the centre).
+  const setFocus = (mode) => {
+    if (mode === "joint" && !store.state.joint) {
+      const f = list.current || findingAt(list.shown, store.state.frame) || list.shown[0];
+      if (f) store.set({ joint: f.joint });
+    }
+    store.set({ focus: mode });
+    closeButton.setAttribute("aria-pressed", String(mode === "joint"));
+    followButton.setAttribute("aria-pressed", String(mode === "root"));
+    views.setFocus(mode);
+    render();
+  };
+  closeButton.addEventListener("click", () => setFocus(store.state.focus === "joint" ? "body" : "joint"));
+  followButton.addEventListener("click", () => setFocus(store.state.focus === "root" ? "body" : "root"));
+  // Loop: an in/out range (I / O keys, or a drag on the time bar) and a toggle (L).
+  const showLoop = () => {
+    const r = store.state.loop;
+    loopLabel.textContent = r ? `in ${r[0]} · out ${r[1]} (${r[1] - r[0] + 1} frames)${store.state.looping ? " · looping" : ""}` : "in/out: none (I / O or drag on the bar)";
+    loopButton.setAttribute("aria-pressed", String(store.state.looping));
+    timebar.setRange(r, store.state.looping);
+    player.setLoop(store.state.looping ? r : null);
+  };
+  const setRange = (r) => { store.set({ loop: r }); showLoop(); };
+  const setLooping = (on) => { store.set({ looping: on }); showLoop(); };
+  const loopFinding = () => {
+    const f = list.current || findingAt(list.shown, store.state.frame);
+    if (!f) { loopLabel.textContent = "open a finding (click, Enter or N/P) to loop it"; return; }
+    list.mark(f);
+    store.set({ joint: f.joint, loop: loopOfFinding(f, Math.round(LOOP_MARGIN_S * fps), nFrames), looping: true });
+    showLoop();
+    jump(store.state.loop[0]);
+    if (!player.playing) togglePlay();
+  };
+  loopButton.addEventListener("click", () => setLooping(!store.state.looping));
+  loopFindingButton.addEventListener("click", loopFinding);
+  clearLoopButton.addEventListener("click", () => { store.set({ loop: null, looping: false }); showLoop(); });
   triadsBox.addEventListener("change", () => views.setTriads(triadsBox.checked));
   overlayBox.addEventListener("change", () => {
     store.set({ overlay: overlayBox.checked });
@@ -166,7 +222,6 @@ export async function takeView(main, takeId, params, onTeardown) {
     render();
   });
 
-  const stops = findingStops(result.findings);
   const onKey = (e) => {
     const target = e.target;
     const typing = target instanceof HTMLElement && (target.matches("input, textarea, select, [contenteditable]") || target.isContentEditable);
@@ -177,8 +232,23 @@ export async function takeView(main, takeId, params, onTeardown) {
       if (player.playing) togglePlay();
       jump(store.state.frame + (e.key === "ArrowRight" ? 1 : -1) * (e.shiftKey ? 10 : 1));
     } else if (e.key === "n" || e.key === "N" || e.key === "p" || e.key === "P") {
-      const stop = nextStop(stops, store.state.frame, e.key.toLowerCase() === "n" ? 1 : -1);
-      if (stop != null) { if (player.playing) togglePlay(); jump(stop); }
+      // N/P walk the findings the list's filters keep, across its groups.
+      const stop = nextStop(list.stops(), store.state.frame, e.key.toLowerCase() === "n" ? 1 : -1);
+      if (stop != null) {
+        if (player.playing) togglePlay();
+        list.mark(list.shown.find((f) => f.start_frame === stop));
+        jump(stop);
+      }
+    } else if (e.key === "i" || e.key === "I") {
+      setRange(withIn(store.state.loop, store.state.frame, nFrames));
+    } else if (e.key === "o" || e.key === "O") {
+      setRange(withOut(store.state.loop, store.state.frame));
+    } else if (e.key === "L" && e.shiftKey) {
+      loopFinding();
+    } else if (e.key === "l") {
+      setLooping(!store.state.looping);
+    } else if (e.key === "c" || e.key === "C") {
+      setFocus(store.state.focus === "joint" ? "body" : "joint");
     } else if (decided.onKey(e)) {
       e.preventDefault();
     } else if (DECISIONS[e.key.toLowerCase()]) {
@@ -239,27 +309,6 @@ function runPicker(take, run) {
   return h("div", { class: "controls" }, "Run ", select,
     run.server_time_s != null ? h("span", { class: "muted" }, `server time ${fmt(run.server_time_s, 2)} s`) : null,
     h("a", { href: `#/compare?a=${run.id}` }, "compare…"));
-}
-
-function findingsTable(findings, decided, onOpen) {
-  const columns = [["kind", "kind"], ["joint", "joint"], ["start_frame", "frames"], ["duration", "frames long"], ["value", "offset / outside"], ["confidence", "confidence"]];
-  let key = "start_frame", dir = 1;
-  const body = h("tbody");
-  const render = () => {
-    body.replaceChildren(...sortFindings(findings, key, dir).map((f) => activatable(h("tr", { class: "clickable finding", "data-start": f.start_frame, "data-interval": f.kind === "twist" ? f.id : null },
-      h("td", {}, f.kind), h("td", {}, f.joint), h("td", {}, `${f.start_frame}–${f.end_frame}`), h("td", {}, f.end_frame - f.start_frame + 1),
-      h("td", {}, f.value == null ? "–" : `${fmt(f.value, 1)} ${f.unit === "deg" ? "°" : f.unit}`), h("td", {}, f.kind === "twist" ? `${fmt(100 * f.confidence, 0)} %` : fmt(f.confidence, 2)),
-      decided.enabled ? decided.cell(f) : null), () => onOpen(f))));
-  };
-  const head = h("tr", {}, columns.map(([k, label]) => activatable(h("th", { class: "sortable", "data-key": k, "aria-sort": "none" }, label), (e) => {
-    dir = key === k ? -dir : 1; key = k;
-    for (const th of e.currentTarget.parentNode.children) th.setAttribute("aria-sort", "none");
-    e.currentTarget.setAttribute("aria-sort", dir > 0 ? "ascending" : "descending");
-    render();
-  })), decided.enabled ? h("th", {}, "applied · decision") : null);
-  render();
-  return h("div", { class: "panel" }, h("h2", {}, `Findings (${findings.length})`),
-    findings.length ? h("table", { id: "findings" }, h("thead", {}, head), body) : h("p", { class: "muted" }, "No findings."), decided.footer());
 }
 
 function downloadsPanel(run, result) {

@@ -278,7 +278,11 @@ def test_keyboard_only_review_from_the_take_list(
     assert page.frame() == next(s for s in starts if s > 91)
     p.keyboard.press("p")
     assert page.frame() == max(s for s in starts if s < next(s for s in starts if s > 91))
-    # The "offset / outside" header sorts by magnitude from the keyboard.
+    # Ungrouped (space on the "group by joint" box), the "offset / outside" header sorts the whole
+    # list by magnitude from the keyboard.
+    p.locator("#group-joints").focus()
+    p.keyboard.press("Space")
+    assert not p.is_checked("#group-joints")
     header = p.locator("#findings th[data-key='value']")
     header.focus()
     p.keyboard.press("Enter")
@@ -288,7 +292,7 @@ def test_keyboard_only_review_from_the_take_list(
     assert [abs(v) for v in values] == sorted(abs(v) for v in values)
     assert any(v < 0 for v in values)
     # A focused finding opens with Enter: its frame, and the 3D views scrolled into sight.
-    row = p.locator("#findings tbody tr").last
+    row = p.locator("#findings tr.finding").last
     start = int(row.get_attribute("data-start"))
     row.focus()
     p.keyboard.press("Enter")
@@ -297,7 +301,7 @@ def test_keyboard_only_review_from_the_take_list(
     assert 0 <= top < p.viewport_size["height"] / 2, top
     page.settle()
     # A twist finding focuses its joint: the twist chart shows that chain only.
-    twist_row = p.locator("#findings tbody tr", has_text="twist").first
+    twist_row = p.locator("#findings tr.finding", has_text="twist").first
     chain = twist_row.locator("td").nth(1).inner_text()
     twist_row.focus()
     p.keyboard.press("Enter")

@@ -1,0 +1,116 @@
+// The findings list of the take view: grouped by joint (collapsible groups with counts and the
+// worst value), sortable, filtered by kind, joint, smallest value and text. N/P walk the
+// findings the filters keep, across groups; the one reached is marked and its group opened.
+import { activatable, h } from "./dom.js";
+import { findingStops, fmt, sortFindings } from "./format.js";
+import { filterFindings, groupByJoint, jointsOf, kindsOf, listOrder } from "./findings.js";
+
+const COLUMNS = [["kind", "kind"], ["joint", "joint"], ["start_frame", "frames"], ["duration", "frames long"], ["value", "offset / outside"], ["confidence", "confidence"]];
+const UNITS = { deg: "°" };
+const unitOf = (f) => UNITS[f.unit] ?? f.unit ?? "";
+
+/**
+ * @param findings  the run's findings
+ * @param decided   the interval decisions (cells of twist rows, footer)
+ * @param onOpen    called with a finding opened by a click or Enter
+ */
+export function findingsList(findings, decided, onOpen) {
+  let key = "start_frame", dir = 1, grouped = true, current = null;
+  const collapsed = new Set();
+  const filter = { kinds: new Set(), joint: "", minValue: null, text: "" };
+  let shown = findings;
+  const table = h("table", { id: "findings" });
+  const title = h("h2", {}, "");
+  const units = [...new Set(findings.map(unitOf))].filter(Boolean).join(" / ");
+
+  const kindBoxes = kindsOf(findings).map((k) => {
+    const box = h("input", { type: "checkbox", id: `filter-kind-${k}`, value: k, checked: true });
+    box.addEventListener("change", () => {
+      filter.kinds = new Set(kindBoxes.filter((b) => b.checked).map((b) => b.value));
+      if (!filter.kinds.size) filter.kinds = new Set(["none"]); // nothing ticked shows nothing
+      render();
+    });
+    return box;
+  });
+  const joint = h("select", { id: "filter-joint", "aria-label": "joint filter" }, h("option", { value: "" }, "all joints"),
+    jointsOf(findings).map((j) => h("option", { value: j }, j)));
+  joint.addEventListener("change", () => { filter.joint = joint.value; render(); });
+  const least = h("input", { type: "number", id: "filter-min", min: 0, step: "any", size: 5, "aria-label": `smallest offset or distance outside (${units})` });
+  least.addEventListener("input", () => { filter.minValue = least.value === "" ? null : Number(least.value); render(); });
+  const text = h("input", { type: "search", id: "filter-text", placeholder: "search joint, kind, frames…", "aria-label": "search findings" });
+  text.addEventListener("input", () => { filter.text = text.value; render(); });
+  const groupBox = h("input", { type: "checkbox", id: "group-joints", checked: true });
+  groupBox.addEventListener("change", () => { grouped = groupBox.checked; render(); });
+
+  const sortHeader = ([k, label]) => activatable(h("th", { class: "sortable", "data-key": k, "aria-sort": "none" }, label), (e) => {
+    dir = key === k ? -dir : 1; key = k;
+    for (const th of e.currentTarget.parentNode.children) th.setAttribute("aria-sort", "none");
+    e.currentTarget.setAttribute("aria-sort", dir > 0 ? "ascending" : "descending");
+    render();
+  });
+  const head = h("thead", {}, h("tr", {}, COLUMNS.map(sortHeader), decided.enabled ? h("th", {}, "applied · decision") : null));
+  const span = COLUMNS.length + (decided.enabled ? 1 : 0);
+
+  const row = (f) => activatable(h("tr", {
+    class: `clickable finding${f === current ? " current" : ""}`, "data-start": f.start_frame, "data-joint": f.joint,
+    "data-interval": f.kind === "twist" ? f.id : null, "aria-current": f === current ? "true" : null,
+  },
+  h("td", {}, f.kind), h("td", {}, f.joint), h("td", {}, `${f.start_frame}–${f.end_frame}`), h("td", {}, f.end_frame - f.start_frame + 1),
+  h("td", {}, f.value == null ? "–" : `${fmt(f.value, 1)} ${unitOf(f)}`), h("td", {}, f.kind === "twist" ? `${fmt(100 * f.confidence, 0)} %` : fmt(f.confidence, 2)),
+  decided.enabled ? decided.cell(f) : null), () => { mark(f); onOpen(f); });
+
+  const groupHead = (g) => {
+    const open = !collapsed.has(g.joint);
+    const unit = unitOf(g.rows[0]);
+    return activatable(h("tr", { class: "group-head", "data-joint": g.joint, "aria-expanded": String(open) },
+      h("th", { colspan: span },
+        h("span", { class: "caret", "aria-hidden": "true" }, open ? "▾ " : "▸ "), h("b", {}, g.joint),
+        ` · ${g.count} finding${g.count === 1 ? "" : "s"}`,
+        g.worst == null ? "" : ` · worst ${fmt(g.worst, 1)} ${unit}`, ` · ${[...g.kinds].join(", ")}`)), () => {
+      if (collapsed.has(g.joint)) collapsed.delete(g.joint); else collapsed.add(g.joint);
+      render();
+      table.querySelector(`tr.group-head[data-joint="${CSS.escape(g.joint)}"]`)?.focus();
+    });
+  };
+
+  function render() {
+    shown = filterFindings(findings, filter);
+    title.textContent = shown.length === findings.length ? `Findings (${findings.length})` : `Findings (${shown.length} of ${findings.length} shown)`;
+    const bodies = grouped
+      ? groupByJoint(shown, key, dir).map((g) => h("tbody", { class: "group", "data-joint": g.joint }, groupHead(g), collapsed.has(g.joint) ? null : g.rows.map(row)))
+      : [h("tbody", {}, sortFindings(shown, key, dir).map(row))];
+    table.replaceChildren(head, ...bodies);
+  }
+
+  /** Mark `f` as the current finding: its row highlighted, its group opened. */
+  function mark(f) {
+    current = f;
+    if (f && collapsed.delete(f.joint)) render();
+    for (const tr of table.querySelectorAll("tr.finding")) {
+      const on = tr.dataset.start === String(f?.start_frame) && tr.dataset.joint === f?.joint;
+      tr.classList.toggle("current", on);
+      if (on) tr.setAttribute("aria-current", "true"); else tr.removeAttribute("aria-current");
+    }
+  }
+
+  render();
+  const panel = h("div", { class: "panel", id: "findings-panel" }, title,
+    findings.length ? [
+      h("div", { class: "controls findings-filters" },
+        kindBoxes.map((b) => h("label", {}, b, ` ${b.value}`)),
+        joint,
+        h("label", {}, "at least ", least, ` ${units}`),
+        text,
+        h("label", {}, groupBox, " group by joint")),
+      table] : h("p", { class: "muted" }, "No findings."),
+    decided.footer());
+  return {
+    panel,
+    /** The findings the filters keep, in list order. */
+    get shown() { return grouped ? listOrder(groupByJoint(shown, key, dir)) : sortFindings(shown, key, dir); },
+    /** Start frames of the kept findings: N/P stops. */
+    stops: () => findingStops(shown),
+    mark,
+    get current() { return current; },
+  };
+}

@@ -1,0 +1,294 @@
+"""The reviewer's tools in the take view, driven as a reviewer drives them, on 005_05.
+
+The findings list grouped by joint with its filters and N/P across the groups; the loop range
+(I/O keys, a drag on the time bar, L) and "loop this finding"; the close-in and follow cameras.
+Screenshots go to ``tests/artifacts/`` (gitignored): ``review-findings-grouped.png``,
+``review-findings-filtered.png``, ``review-loop.png``, ``review-close-in.png``,
+``review-follow.png``, and the same at 900 px (``…-900px.png``).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from tests.browser.test_workstation import ARTIFACTS, KNEES_TAKE, Page, scrub, upload
+
+pytestmark = pytest.mark.browser
+
+
+@pytest.fixture(scope="module")
+def knees(live_server: str, corpus_dir: Path) -> dict[str, Any]:
+    return upload(live_server, corpus_dir / KNEES_TAKE)
+
+
+@pytest.fixture(params=[1280, 900], ids=["1280px", "900px"])
+def page(chromium: Any, request: pytest.FixtureRequest) -> Iterator[Page]:
+    opened = Page(chromium, width=request.param, height=900)
+    yield opened
+    assert opened.page.evaluate("() => document.documentElement.scrollWidth <= window.innerWidth")
+    opened.close()
+
+
+def shot(page: Page, name: str) -> None:
+    width = page.page.viewport_size["width"]
+    ARTIFACTS.mkdir(exist_ok=True)
+    suffix = "" if width >= 1000 else f"-{width}px"
+    page.page.screenshot(path=str(ARTIFACTS / f"review-{name}{suffix}.png"))
+
+
+def rows(page: Page) -> list[dict[str, Any]]:
+    """The finding rows shown, as the page lists them."""
+    return page.page.locator("#findings tr.finding").evaluate_all(
+        "rs => rs.map((r) => ({ kind: r.cells[0].innerText, joint: r.dataset.joint,"
+        " start: Number(r.dataset.start), value: r.cells[4].innerText,"
+        " current: r.classList.contains('current') }))"
+    )
+
+
+def test_findings_grouped_by_joint_filtered_and_walked(
+    live_server: str, knees: dict[str, Any], page: Page
+) -> None:
+    p = page.page
+    findings = knees["result"]["findings"]
+    joints = {f["joint"] for f in findings}
+    page.open_take(live_server, knees)
+    # One collapsible group per joint, its count and worst value in the heading.
+    heads = p.locator("#findings tr.group-head")
+    assert heads.count() == len(joints)
+    for k in range(heads.count()):
+        joint = heads.nth(k).get_attribute("data-joint")
+        count = sum(f["joint"] == joint for f in findings)
+        assert f"{count} finding" in heads.nth(k).inner_text()
+        worst = max((abs(f["value"]) for f in findings if f["joint"] == joint), default=None)
+        if worst is not None:
+            assert f"worst {worst:.1f}" in heads.nth(k).inner_text()
+    assert len(rows(page)) == len(findings)
+    p.locator("#findings-panel").scroll_into_view_if_needed()
+    shot(page, "findings-grouped")
+
+    # A click folds a group; Enter on its focused heading opens it again.
+    busiest = max(joints, key=lambda j: sum(f["joint"] == j for f in findings))
+    head = p.locator(f"#findings tr.group-head[data-joint='{busiest}']")
+    head.click()
+    assert head.get_attribute("aria-expanded") == "false"
+    assert not any(r["joint"] == busiest for r in rows(page))
+    p.locator(f"#findings tr.group-head[data-joint='{busiest}']").focus()
+    p.keyboard.press("Enter")
+    assert sum(r["joint"] == busiest for r in rows(page)) == sum(
+        f["joint"] == busiest for f in findings
+    )
+
+    # Filters: kind, joint, smallest magnitude, words.
+    p.uncheck("#filter-kind-limits")
+    assert {r["kind"] for r in rows(page)} == {"twist"}
+    assert "shown" in p.inner_text("#findings-panel h2")
+    p.check("#filter-kind-limits")
+    p.select_option("#filter-joint", busiest)
+    assert {r["joint"] for r in rows(page)} == {busiest}
+    p.select_option("#filter-joint", "")
+    p.fill("#filter-min", "20")
+    shown = rows(page)
+    assert shown
+    assert all(abs(float(r["value"].split()[0])) >= 20 for r in shown)
+    assert len(shown) == sum(f["value"] is not None and abs(f["value"]) >= 20 for f in findings)
+    p.fill("#filter-min", "")
+    p.fill("#filter-text", "calf")
+    assert rows(page)
+    assert all("calf" in r["joint"].lower() for r in rows(page))
+    shot(page, "findings-filtered")
+    p.fill("#filter-text", "")
+
+    # N walks every finding kept, across groups, from the first frame: a folded group opens.
+    p.locator(f"#findings tr.group-head[data-joint='{busiest}']").click()
+    scrub(page, 0)
+    p.evaluate("() => document.activeElement.blur()")
+    starts = sorted({f["start_frame"] for f in findings if f["start_frame"] > 0})
+    for start in starts:
+        p.keyboard.press("n")
+        assert page.frame() == start
+        current = [r for r in rows(page) if r["current"]]
+        assert len(current) == 1
+        assert current[0]["start"] == start
+    p.keyboard.press("p")
+    assert page.frame() == starts[-2]
+    # With only the twist kind kept, N and P stop at twist findings only.
+    p.uncheck("#filter-kind-limits")
+    p.evaluate("() => document.activeElement.blur()")
+    scrub(page, 0)
+    twist_starts = sorted({f["start_frame"] for f in findings if f["kind"] == "twist"})
+    p.keyboard.press("n")
+    assert page.frame() == twist_starts[0]
+    p.keyboard.press("n")
+    assert page.frame() == twist_starts[1]
+
+    # A click on a finding jumps the player and the time bar's cursor to its start.
+    row = p.locator("#findings tr.finding").last
+    start = int(row.get_attribute("data-start"))
+    row.click()
+    assert page.frame() == start
+    cursor = p.evaluate(
+        "() => { const b = document.getElementById('timebar').getBoundingClientRect();"
+        " const c = document.querySelector('.tb-cursor').getBoundingClientRect();"
+        " return (c.left - b.left) / b.width; }"
+    )
+    assert cursor == pytest.approx((start + 0.5) / knees["result"]["summary"]["n_frames"], abs=0.01)
+
+
+def loop_range(page: Page) -> list[int] | None:
+    value: list[int] | None = page.page.evaluate("() => window.mocapqaPlayer.loop")
+    return value
+
+
+def frames_while_playing(page: Page, seconds: float) -> list[int]:
+    seen = []
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        seen.append(page.frame())
+        time.sleep(0.05)
+    return seen
+
+
+def test_loop_a_range_and_loop_the_finding(
+    live_server: str, knees: dict[str, Any], page: Page
+) -> None:
+    p = page.page
+    n_frames = knees["result"]["summary"]["n_frames"]
+    page.open_take(live_server, knees)
+    # I and O at two frames, then L: playback stays inside.
+    scrub(page, 100)
+    p.evaluate("() => document.activeElement.blur()")
+    p.keyboard.press("i")
+    scrub(page, 130)
+    p.evaluate("() => document.activeElement.blur()")
+    p.keyboard.press("o")
+    assert "in 100 · out 130" in p.inner_text("#loop-label")
+    assert loop_range(page) is None  # set, not looping yet
+    p.keyboard.press("l")
+    assert p.get_attribute("#loop", "aria-pressed") == "true"
+    assert loop_range(page) == [100, 130]
+    p.keyboard.press("Space")
+    seen = frames_while_playing(page, 2.5)
+    p.keyboard.press("Space")
+    p.wait_for_function("() => document.getElementById('play').textContent.endsWith('play')")
+    assert all(100 <= f <= 130 for f in seen), seen
+    assert len(set(seen)) > 3  # it played
+    # 31 frames at 60 fps loop in about half a second: 2.5 s went round (frames went back).
+    assert any(b < a for a, b in zip(seen, seen[1:], strict=False)), seen
+    p.locator("#player").scroll_into_view_if_needed()
+    shot(page, "loop")
+
+    # A drag along the time bar sets a new range; a drag of its in handle moves the in point.
+    bar = p.locator("#timebar").bounding_box()
+    y = bar["y"] + bar["height"] / 2
+
+    def x_of(frame: int) -> float:
+        return float(bar["x"] + bar["width"] * frame / (n_frames - 1))
+
+    p.mouse.move(x_of(200), y)
+    p.mouse.down()
+    for k in range(1, 11):
+        p.mouse.move(x_of(200) + k * (x_of(300) - x_of(200)) / 10, y)
+    p.mouse.up()
+    dragged = loop_range(page)
+    assert dragged is not None
+    assert abs(dragged[0] - 200) <= 2 and abs(dragged[1] - 300) <= 2, dragged
+    handle = p.locator(".tb-in").bounding_box()
+    p.mouse.move(handle["x"] + handle["width"] / 2, y)
+    p.mouse.down()
+    for k in range(1, 6):
+        p.mouse.move(handle["x"] + handle["width"] / 2 - k * (x_of(50) - x_of(0)) / 5, y)
+    p.mouse.up()
+    moved = loop_range(page)
+    assert moved is not None
+    assert abs(moved[0] - 150) <= 3 and moved[1] == dragged[1], moved
+    # A click on the bar (no drag) goes to its frame and keeps the range.
+    p.mouse.click(x_of(400), y)
+    assert abs(page.frame() - 400) <= 2
+    assert loop_range(page) == moved
+    # L again stops looping; "clear in/out" forgets the range.
+    p.keyboard.press("l")
+    assert loop_range(page) is None
+    p.click("#loop-clear")
+    assert "none" in p.inner_text("#loop-label")
+    assert p.locator("#loop-band").is_hidden()
+
+    # Loop this finding: open a twist finding, shift+L plays its frames with a margin.
+    twist = next(f for f in knees["result"]["findings"] if f["kind"] == "twist")
+    p.locator(
+        f"#findings tr.finding[data-start='{twist['start_frame']}'][data-joint='{twist['joint']}']"
+    ).click()
+    p.evaluate("() => document.activeElement.blur()")
+    p.keyboard.press("Shift+L")
+    margin = round(0.5 * knees["result"]["summary"]["fps"])
+    expected = [max(0, twist["start_frame"] - margin), min(n_frames - 1, twist["end_frame"] + margin)]
+    assert loop_range(page) == expected
+    assert p.inner_text("#play").endswith("pause")
+    seen = frames_while_playing(page, 1.5)
+    p.click("#play")
+    assert all(expected[0] <= f <= expected[1] for f in seen), (seen, expected)
+    assert p.locator("#findings tr.finding.current").get_attribute("data-joint") == twist["joint"]
+
+
+def test_close_in_on_a_joint_and_follow_the_root(
+    live_server: str, knees: dict[str, Any], page: Page
+) -> None:
+    p = page.page
+    result = knees["result"]
+    names, parents = result["points"]["names"], result["points"]["parents"]
+    knee = max(
+        (f for f in result["findings"] if f["kind"] == "twist" and "Calf" in f["joint"]),
+        key=lambda f: abs(f["value"]),
+    )
+    page.open_take(live_server, knees)
+    p.locator(
+        f"#findings tr.finding[data-start='{knee['start_frame']}'][data-joint='{knee['joint']}']"
+    ).click()
+    page.settle()
+    before = p.evaluate("() => window.mocapqaViews.orbit")
+
+    def off_centre(index: int) -> float:
+        """Distance of a point from the corrected view's centre, as a share of its width."""
+        x, y = p.evaluate("(j) => window.mocapqaViews.screenOf('corrected', j)", index)
+        box = p.locator("#view-corrected").bounding_box()
+        cx, cy = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+        return float(((x - cx) ** 2 + (y - cy) ** 2) ** 0.5 / box["width"])
+
+    joint = names.index(knee["joint"])
+    p.click("#camera-close")
+    page.settle()
+    close = p.evaluate("() => window.mocapqaViews.orbit")
+    assert p.get_attribute("#camera-close", "aria-pressed") == "true"
+    assert close["distance"] < 0.5 * before["distance"]
+    assert off_centre(joint) < 0.02
+    # The camera stays on the joint while the frame changes.
+    p.evaluate("() => document.activeElement.blur()")
+    p.keyboard.press("Shift+ArrowRight")
+    page.settle()
+    assert off_centre(joint) < 0.02
+    shot(page, "close-in")
+    # C leaves close-in.
+    p.keyboard.press("c")
+    page.settle()
+    assert p.get_attribute("#camera-close", "aria-pressed") == "false"
+    assert p.evaluate("() => window.mocapqaViews.orbit.distance") == pytest.approx(
+        before["distance"]
+    )
+
+    # Follow: the root stays in the centre while playing.
+    root = parents.index(-1)
+    p.click("#camera-follow")
+    assert p.get_attribute("#camera-follow", "aria-pressed") == "true"
+    p.click("#play")
+    offsets = []
+    for _ in range(5):
+        time.sleep(0.3)
+        offsets.append(p.evaluate("() => window.mocapqaViews.focus"))
+    p.click("#play")
+    page.settle()
+    assert set(offsets) == {"root"}
+    assert off_centre(root) < 0.02
+    shot(page, "follow")

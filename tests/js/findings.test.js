@@ -1,0 +1,90 @@
+// Unit tests of the findings list's pure functions, the time bar's helpers, loop playback and
+// the camera's focus (node --test).
+import assert from "node:assert/strict";
+import { test } from "node:test";
+import * as findings from "../../frontend/js/findings.js";
+import { focusDistance, focusTarget } from "../../frontend/js/geometry.js";
+import { playbackFrame } from "../../frontend/js/player.js";
+import { frameAtX, runsOf, spanOf, withIn, withOut } from "../../frontend/js/timebar.js";
+
+const f = (kind, joint, start, end, value, readout) => ({ kind, joint, start_frame: start, end_frame: end, value, unit: "deg", confidence: 0.5, readout });
+const rows = [
+  f("twist", "R_Calf", 10, 20, -77), f("limits", "R_Calf", 50, 60, 5), f("twist", "L_Calf", 30, 35, 12),
+  f("limits", "Spine", 5, 8, 40, "flexion 40° past"), f("limits", "L_Calf", 70, 71, null),
+];
+
+test("filters keep kinds, one joint, a smallest magnitude and words", () => {
+  assert.equal(findings.filterFindings(rows, {}).length, 5);
+  assert.deepEqual(findings.filterFindings(rows, { kinds: new Set(["twist"]) }).map((x) => x.start_frame), [10, 30]);
+  assert.deepEqual(findings.filterFindings(rows, { joint: "L_Calf" }).map((x) => x.start_frame), [30, 70]);
+  // −77° is 77° away: magnitude, not the signed value; a finding without a value drops out.
+  assert.deepEqual(findings.filterFindings(rows, { minValue: 12 }).map((x) => x.start_frame), [10, 30, 5]);
+  assert.deepEqual(findings.filterFindings(rows, { text: "calf TWIST" }).map((x) => x.start_frame), [10, 30]);
+  assert.deepEqual(findings.filterFindings(rows, { text: "flexion" }).map((x) => x.joint), ["Spine"]);
+  assert.deepEqual(findings.filterFindings(rows, { text: "50–60" }).map((x) => x.start_frame), [50]);
+  assert.equal(findings.filterFindings(rows, { kinds: new Set(["twist"]), joint: "Spine" }).length, 0);
+});
+
+test("groups by joint carry counts, the worst magnitude and the kinds, sorted alike", () => {
+  const byStart = findings.groupByJoint(rows);
+  assert.deepEqual(byStart.map((g) => g.joint), ["Spine", "R_Calf", "L_Calf"]);
+  const calf = byStart.find((g) => g.joint === "R_Calf");
+  assert.equal(calf.count, 2);
+  assert.equal(calf.worst, 77);
+  assert.deepEqual([...calf.kinds], ["twist", "limits"]);
+  assert.equal(byStart.find((g) => g.joint === "L_Calf").worst, 12);
+  // Sorted by magnitude, largest first: the joint of the worst finding leads, rows in order.
+  const worst = findings.groupByJoint(rows, "value", -1);
+  assert.deepEqual(worst.map((g) => g.joint), ["R_Calf", "Spine", "L_Calf"]);
+  assert.deepEqual(worst[0].rows.map((x) => x.value), [-77, 5]);
+  assert.deepEqual(worst[2].rows.map((x) => x.value), [12, null]);
+  assert.deepEqual(findings.listOrder(worst).map((x) => x.start_frame), [10, 50, 5, 30, 70]);
+});
+
+test("the finding at a frame, its loop with a margin, kinds and joints", () => {
+  assert.equal(findings.findingAt(rows, 15).joint, "R_Calf");
+  assert.equal(findings.findingAt(rows, 25), null);
+  assert.deepEqual(findings.loopOfFinding(rows[0], 30, 100), [0, 50]);
+  assert.deepEqual(findings.loopOfFinding(rows[4], 30, 90), [40, 89]);
+  assert.deepEqual(findings.kindsOf(rows), ["twist", "limits"]);
+  assert.deepEqual(findings.jointsOf(rows), ["L_Calf", "R_Calf", "Spine"]);
+});
+
+test("playback wraps at the take's end, or inside the loop range", () => {
+  assert.equal(playbackFrame(90, 15, 100), 5);
+  assert.equal(playbackFrame(10, 0, 100, [20, 29]), 20); // started outside: from the in point
+  assert.equal(playbackFrame(25, 4, 100, [20, 29]), 29);
+  assert.equal(playbackFrame(25, 5, 100, [20, 29]), 20); // past the out point: back to in
+  assert.equal(playbackFrame(20, 1000, 100, [20, 29]), 20);
+  for (let k = 0; k < 50; k++) { const x = playbackFrame(22, k, 100, [20, 29]); assert.ok(x >= 20 && x <= 29); }
+});
+
+test("the time bar maps pixels to frames and frames to spans; in/out points keep order", () => {
+  assert.equal(frameAtX(0, 500, 101), 0);
+  assert.equal(frameAtX(250, 500, 101), 50);
+  assert.equal(frameAtX(900, 500, 101), 100);
+  assert.equal(frameAtX(-5, 500, 101), 0);
+  assert.deepEqual(spanOf(10, 19, 100), [10, 10]);
+  assert.deepEqual(spanOf(19, 10, 100), [10, 10]);
+  assert.deepEqual(withIn(null, 30, 100), [30, 99]);
+  assert.deepEqual(withIn([10, 50], 30, 100), [30, 50]);
+  assert.deepEqual(withIn([10, 20], 30, 100), [30, 99]); // an out point before the new in point goes
+  assert.deepEqual(withOut(null, 30), [0, 30]);
+  assert.deepEqual(withOut([10, 50], 30), [10, 30]);
+  assert.deepEqual(withOut([40, 50], 30), [0, 30]);
+  assert.deepEqual(runsOf([0, 1, 2, 3, 4, 5], [false, true, true, false, true, true]), [[1, 2], [4, 5]]);
+  assert.deepEqual(runsOf([0, 2, 4], [true, false, false]), [[0, 0]]);
+  assert.deepEqual(runsOf([], []), []);
+});
+
+test("the camera's focus: body centre over the floor, the root, the selected joint", () => {
+  const points = [[0, 10, 0], [2, 14, 4], [4, 2, 8], null];
+  const target = [9, 7, 9];
+  assert.deepEqual(focusTarget("body", points, 0, 2, target), [2, 7, 4]); // height kept
+  assert.deepEqual(focusTarget("root", points, 0, 2, target), [0, 10, 0]);
+  assert.deepEqual(focusTarget("joint", points, 0, 2, target), [4, 2, 8]);
+  // No point for the joint: the root; no root: the whole body's centre.
+  assert.deepEqual(focusTarget("joint", points, 0, 3, target), [0, 10, 0]);
+  assert.deepEqual(focusTarget("root", points, -1, null, target), [2, 26 / 3, 4]);
+  assert.ok(focusDistance("joint", 2) < focusDistance("body", 2));
+});
