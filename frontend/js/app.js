@@ -18,7 +18,7 @@ function route() {
   const parts = (path || "/").split("/").filter(Boolean);
   const view = parts[0] === "take" ? takeView(main, parts[1], params, (t) => teardowns.push(t))
     : parts[0] === "upload" ? uploadView(main)
-    : parts[0] === "compare" ? compareView(main, params)
+    : parts[0] === "compare" ? compareView(main, params, (t) => teardowns.push(t))
     : parts[0] === "shoots" ? shootsView(main)
     : parts[0] === "shoot" && parts[2] === "review" ? reviewQueueView(main, parts[1], (t) => teardowns.push(t))
     : parts[0] === "shoot" ? shootView(main, parts[1], params, (t) => teardowns.push(t))

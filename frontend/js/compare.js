@@ -1,11 +1,13 @@
-// Compare two runs: their counts and options side by side.
+// Compare two runs: counts, options that differ, findings matched, both side by side in 3D, and
+// their twist curves overlaid.
 import * as api from "./api.js";
 import { h } from "./dom.js";
 import { MARGIN } from "./charts.js";
+import { compareViews } from "./compare3d.js";
 import { fmt, matchFindings, optionsDiff } from "./format.js";
 import { loadPlotly, untabbableModebar } from "./plotly.js";
 
-export async function compareView(main, params) {
+export async function compareView(main, params, onTeardown = () => {}) {
   const page = await api.listTakes({ limit: 500 });
   const options = [];
   for (const t of page.items) {
@@ -40,6 +42,8 @@ export async function compareView(main, params) {
     diff.length ? h("table", { class: "kv", id: "compare-options" }, h("thead", {}, h("tr", {}, h("th", {}, "option"), h("th", {}, "A"), h("th", {}, "B"))),
       h("tbody", {}, diff.map(([k, x, y]) => h("tr", {}, h("td", {}, k), h("td", {}, x), h("td", {}, y)))))
       : h("p", { class: "muted", id: "compare-options" }, "Same options."));
+  const label = (r) => options.find(([v]) => v === r.run.id)?.[1] || r.run.id;
+  await compareViews(main, results[0], results[1], results.map(label), onTeardown);
   const matched = matchFindings(a.findings, b.findings);
   const span = (f) => `${f.start_frame}–${f.end_frame}`;
   const rows = [
@@ -53,7 +57,7 @@ export async function compareView(main, params) {
   const chainsA = a.series.twist ? a.series.twist.chains : [];
   const chainsB = new Map((b.series.twist ? b.series.twist.chains : []).map((c) => [c.joint, c]));
   const common = chainsA.filter((c) => chainsB.has(c.joint));
-  if (!common.length) return;
+  if (!common.length) { main.dataset.ready = "1"; return; }
   const flagged = new Set([...a.findings, ...b.findings].filter((f) => f.kind === "twist").map((f) => f.joint));
   const joint = h("select", { id: "compare-joint", "aria-label": "joint" }, common.map((c) => h("option", { value: c.joint, selected: c.joint === [...flagged][0] }, c.joint)));
   const chart = h("div", { id: "compare-twist", class: "chart" });

@@ -165,7 +165,7 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   };
   const show = (next) => {
     frame = next;
-    write(views.raw, next.raw, next.rawRotations, next.flagged, next.selected);
+    write(views.raw, next.raw, next.rawRotations, next.rawFlagged || next.flagged, next.selected);
     write(views.corrected, next.corrected, next.correctedRotations, next.flagged, next.selected);
     if (overlayOn) writeLines(views.corrected.ghost.geometry.attributes.position, next.raw, bones);
     // Auto-framing: the orbit's target follows the body over the floor, the root (follow) or

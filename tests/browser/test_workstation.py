@@ -509,4 +509,25 @@ def test_compare_matches_findings_and_diffs_options(
     # B ran no limits check: A's limits findings are only in A.
     assert "only in A" in matches
     assert p.evaluate("() => document.getElementById('compare-twist').data.length") == 4
+    # Both runs side by side in 3D, one camera: a drag in A's view turns B's too.
+    views = p.evaluate("() => window.mocapqaCompareViews.points")
+    assert views == len(knees["result"]["points"]["names"])
+    before = p.evaluate("() => window.mocapqaCompareViews.orbit.azimuth")
+    p.locator("#compare-view-a").scroll_into_view_if_needed()
+    box = p.locator("#compare-view-a").bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    p.mouse.move(x, y)
+    p.mouse.down()
+    for step in range(1, 8):
+        p.mouse.move(x + 10 * step, y)
+    p.mouse.up()
+    assert p.evaluate("() => window.mocapqaCompareViews.orbit.azimuth") != pytest.approx(before)
+    # The scrubber moves both; an offset moves B only (same fps: B = A + offset).
+    p.locator("#compare-scrubber").fill("200")
+    assert "frame 200" in p.inner_text("#compare-3d .col:first-child .view-title")
+    assert "frame 200" in p.inner_text("#compare-3d .col:last-child .view-title")
+    p.fill("#compare-offset", "-10")
+    assert "frame 190" in p.inner_text("#compare-3d .col:last-child .view-title")
+    p.locator("#compare-3d").scroll_into_view_if_needed()
+    p.screenshot(path=str(ARTIFACTS / "workstation-compare-3d.png"))
     p.screenshot(path=str(ARTIFACTS / "workstation-compare.png"), full_page=True)

@@ -88,3 +88,13 @@ test("the camera's focus: body centre over the floor, the root, the selected joi
   assert.deepEqual(focusTarget("root", points, -1, null, target), [2, 26 / 3, 4]);
   assert.ok(focusDistance("joint", 2) < focusDistance("body", 2));
 });
+
+test("compare: B's frame is the one at A's instant, moved by the offset, inside B", async () => {
+  const { sampleOf, syncedFrame } = await import("../../frontend/js/compare3d.js");
+  assert.equal(syncedFrame(60, 60, 120, 0, 1000), 120);
+  assert.equal(syncedFrame(60, 60, 30, 5, 1000), 35);
+  assert.equal(syncedFrame(60, 60, 30, -100, 1000), 0);
+  assert.equal(syncedFrame(900, 60, 60, 0, 500), 499);
+  assert.equal(sampleOf({ frames: [0, 4, 8, 12], step: 4 }, 9), 2);
+  assert.equal(sampleOf({ frames: [0, 4, 8, 12], step: 4 }, 99), 3);
+});
