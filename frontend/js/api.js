@@ -55,6 +55,7 @@ export const getDecisions = (runId) => request("GET", `/runs/${runId}/decisions`
 export const addDecision = (runId, intervalId, body) => request("POST", `/runs/${runId}/intervals/${intervalId}/decisions`, body);
 export const decidedUrl = (runId) => `${BASE}/runs/${runId}/decisions/bvh`;
 export const listFilters = () => request("GET", "/filters");
+export const getRunOptions = () => request("GET", "/run-options");
 export const downloadUrl = (runId, kind) => `${BASE}/runs/${runId}/download/${kind}`;
 export const thumbnailUrl = (takeId, runId) => `${BASE}/takes/${takeId}/thumbnail?run=${runId || ""}`;
 export const takeLink = (takeId, runId) => `#/take/${takeId}${runId ? `?run=${runId}` : ""}`;

@@ -1,46 +1,118 @@
-// Re-run with other options: only the checks a take of this kind can run are offered.
+// Re-run with other options: a form grouped by check (twist, joint limits, filter, advanced),
+// every field from the server's one definition of the run options (GET /run-options, from
+// pipeline/options.py) and the filter registry (GET /filters), every number with its unit, the
+// named presets, and the values checked in the page before anything is sent.
 import * as api from "./api.js";
 import { h } from "./dom.js";
 import { checksFor } from "./format.js";
+import { formOptions, paramLabel, usablePresets } from "./run-options.js";
 
-export function rerunPanel(take, run, filters) {
+const SHOWN_PARAMS = 4; // filter parameters shown before "more parameters"
+
+const unitText = (unit) => (unit ? h("span", { class: "unit" }, unit) : null);
+
+export function rerunPanel(take, run, filters, described) {
   const target = take.kind === "motion" ? "rotations" : "keypoints";
   const usable = filters.filter((f) => f.applies_to.includes(target));
-  const available = checksFor(take.kind);
-  const checks = available.map((c) => h("label", {}, h("input", { type: "checkbox", value: c, name: "check", checked: run.options.checks.includes(c) }), ` ${c}`));
-  const twist = take.kind === "motion"
-    ? h("select", { id: "twist-method", "aria-label": "twist method" }, ["robust", "paper"].map((m) => h("option", { value: m, selected: m === run.options.twist_method }, m)))
-    : null;
+  const available = checksFor(take.kind).filter((c) => described.checks.includes(c));
+  const fields = Object.fromEntries(described.groups.flatMap((g) => g.fields).map((f) => [f.name, f]));
+  const inputs = {}; // option name -> its control
+  const checks = {}; // check name -> its box
+
+  const choiceControl = (field) => {
+    const current = run.options[field.name] ?? field.default;
+    const choices = field.choices.includes(current) ? field.choices : [...field.choices, current]; // e.g. interval ids "0,3"
+    return h("select", { id: `option-${field.name}`, name: field.name }, choices.map((c) => h("option", { value: c, selected: c === current }, c)));
+  };
+  // Numbers are typed as text and checked here (a number input would hide a typo as "").
+  const numberControl = (field) => h("input", {
+    type: "text", inputmode: field.type === "int" ? "numeric" : "decimal", id: `option-${field.name}`, name: field.name, size: 8,
+    placeholder: String(field.default), value: run.options[field.name] ?? "",
+  });
+
+  // Filter: method, the filter's preset, its parameters (with units; past the first few, folded).
   const method = h("select", { id: "filter-method", "aria-label": "filter" }, h("option", { value: "" }, take.kind === "motion" ? "no filter" : "adaptive (default)"),
     usable.map((f) => h("option", { value: f.name, selected: f.name === run.options.filter_method }, f.label)));
-  const preset = h("select", { id: "filter-preset", "aria-label": "preset" });
-  const params = h("div", { id: "filter-params" });
+  const preset = h("select", { id: "filter-preset", "aria-label": "filter preset" });
+  const params = h("div", { id: "filter-params", class: "option-fields" });
+  let paramFields = [];
   const fillParams = () => {
     const entry = usable.find((f) => f.name === method.value) || (take.kind === "keypoints" ? usable.find((f) => f.name === "adaptive") : null);
-    preset.replaceChildren(...(entry ? entry.presets : []).map((p) => h("option", { value: p }, p)));
-    params.replaceChildren(...(entry ? entry.parameters : []).map((p) => h("label", {}, `${p.name}${p.unit ? ` (${p.unit})` : ""} `,
-      h("input", { "data-param": p.name, "data-type": p.type, placeholder: String(p.default), size: 8 }))));
+    preset.replaceChildren(...(entry ? entry.presets : []).map((p) => h("option", { value: p, selected: p === run.options.filter_preset }, p)));
+    paramFields = entry ? entry.parameters : [];
+    const given = method.value === (run.options.filter_method || "") ? run.options.filter_params || {} : {};
+    const rows = paramFields.map((p) => {
+      const input = p.type === "bool"
+        ? h("select", { "data-param": p.name }, h("option", { value: "" }, `default (${p.default})`), ["true", "false"].map((v) => h("option", { value: v, selected: String(given[p.name]) === v }, v)))
+        : h("input", { type: "text", inputmode: p.type === "str" ? "text" : "decimal", size: 8, "data-param": p.name, placeholder: String(p.default), value: given[p.name] ?? "" });
+      return h("label", { class: "option-field", title: p.name }, h("span", { class: "option-name" }, paramLabel(p.name)), input, unitText(p.unit));
+    });
+    const more = rows.length > SHOWN_PARAMS
+      ? [h("details", { class: "more-params" }, h("summary", {}, `${rows.length - SHOWN_PARAMS} more parameters`), h("div", { class: "option-fields" }, rows.slice(SHOWN_PARAMS)))]
+      : [];
+    params.replaceChildren(...rows.slice(0, SHOWN_PARAMS), ...more);
   };
   method.addEventListener("change", fillParams);
   fillParams();
-  const message = h("span", { class: "muted" });
+
+  const group = (g) => {
+    const check = g.check && available.includes(g.check) ? h("input", { type: "checkbox", name: "check", value: g.check, checked: run.options.checks.includes(g.check) }) : null;
+    if (g.check && !check) return null; // a check this kind of take cannot run
+    if (check) checks[g.check] = check;
+    const body = g.name === "filter"
+      ? [h("div", { class: "option-fields" },
+        h("label", { class: "option-field" }, h("span", { class: "option-name" }, "filter"), method),
+        h("label", { class: "option-field" }, h("span", { class: "option-name" }, "preset"), preset)), params]
+      : g.fields.length ? h("div", { class: "option-fields" }, g.fields.map((f) => {
+        inputs[f.name] = f.type === "choice" ? choiceControl(f) : numberControl(f);
+        return h("label", { class: "option-field" }, h("span", { class: "option-name" }, f.label), inputs[f.name], unitText(f.unit));
+      })) : h("p", { class: "muted" }, g.name === "limits" ? "the rig's joint-limit model; no settings" : "");
+    const legend = h("legend", {}, check ? h("label", {}, check, ` ${g.label}`) : g.label);
+    const set = h("fieldset", { class: "option-group", "data-group": g.name }, g.advanced ? null : legend, body);
+    return g.advanced ? h("details", { class: "option-advanced", id: `options-${g.name}` }, h("summary", {}, g.label), set) : set;
+  };
+  const groups = described.groups.map(group);
+
+  // Presets fill the form; every field stays editable.
+  const presets = usablePresets(described.presets, available);
+  const presetPick = h("select", { id: "run-preset", "aria-label": "options preset" }, h("option", { value: "" }, "— as this run —"),
+    presets.map(([name]) => h("option", { value: name }, name)));
+  presetPick.addEventListener("change", () => {
+    const chosen = presets.find(([name]) => name === presetPick.value);
+    if (!chosen) return;
+    const options = chosen[1];
+    for (const [name, box] of Object.entries(checks)) box.checked = options.checks.includes(name);
+    for (const [name, control] of Object.entries(inputs)) control.value = options[name] ?? "";
+    if ([...method.options].some((o) => o.value === (options.filter_method || ""))) { method.value = options.filter_method || ""; fillParams(); }
+  });
+
+  const message = h("span", { class: "muted", id: "rerun-message", role: "status" });
   const start = h("button", { class: "primary", id: "rerun", onclick: async () => {
-    const filterParams = {};
-    for (const input of params.querySelectorAll("input")) {
-      if (input.value === "") continue;
-      const type = input.dataset.type;
-      filterParams[input.dataset.param] = type === "str" ? input.value : type === "bool" ? input.value === "true" : Number(input.value);
+    for (const el of document.querySelectorAll("#rerun-panel [aria-invalid]")) el.removeAttribute("aria-invalid");
+    const paramInputs = [...params.querySelectorAll("[data-param]")];
+    const values = {
+      checks: Object.entries(checks).filter(([, box]) => box.checked).map(([name]) => name),
+      twist_method: take.kind === "motion" && inputs.twist_method ? inputs.twist_method.value : undefined,
+      twist_apply: take.kind === "motion" && inputs.twist_apply ? inputs.twist_apply.value : undefined,
+      filter_method: method.value, filter_preset: preset.value, max_points: inputs.max_points ? inputs.max_points.value : "",
+      params: paramInputs.map((input) => [paramFields.find((p) => p.name === input.dataset.param), input.value]),
+    };
+    const built = formOptions(values, fields);
+    if (built.errors) {
+      for (const error of built.errors) {
+        const name = error.split(":")[0];
+        const bad = params.querySelector(`[data-param="${CSS.escape(name)}"]`) || inputs[name];
+        if (bad) bad.setAttribute("aria-invalid", "true");
+      }
+      message.textContent = built.errors.join(" · "); message.className = "error";
+      return;
     }
     try {
-      const created = await api.startRun(take.id, {
-        checks: checks.map((l) => l.firstChild).filter((c) => c.checked).map((c) => c.value),
-        ...(twist ? { twist_method: twist.value } : {}),
-        filter_method: method.value || null, filter_preset: preset.value || null, filter_params: filterParams,
-      });
+      const created = await api.startRun(take.id, built.options);
       location.hash = api.takeLink(take.id, created.id);
     } catch (e) { message.textContent = e.message; message.className = "error"; }
   } }, "re-run");
   return h("div", { class: "panel", id: "rerun-panel" }, h("h2", {}, "Re-run with other options (earlier runs are kept)"),
-    h("div", { class: "controls" }, checks), h("div", { class: "controls" }, twist ? ["twist ", twist] : null, " filter ", method, " preset ", preset),
-    params, h("div", { class: "controls" }, start, message));
+    h("div", { class: "controls" }, h("label", {}, "preset ", presetPick)),
+    h("div", { class: "option-groups" }, groups), h("div", { class: "controls" }, start, message));
 }

@@ -39,8 +39,8 @@ export async function takeView(main, takeId, params, onTeardown) {
     if (final.status === "failed") { main.append(h("p", { class: "error" }, final.error)); return; }
     window.dispatchEvent(new HashChangeEvent("hashchange")); return;
   }
-  const [result, filters, first] = await Promise.all([
-    api.getResult(run.id).then((r) => { performance.mark("result-fetched"); return r; }), api.listFilters(),
+  const [result, filters, described, first] = await Promise.all([
+    api.getResult(run.id).then((r) => { performance.mark("result-fetched"); return r; }), api.listFilters(), api.getRunOptions(),
     api.getFrames(run.id, { maxFrames: FIRST_FRAMES }).then((f) => { performance.mark("frames-fetched"); return f; })]);
   let overview = first;
   const fuller = first.step > 1 ? api.getFrames(run.id, { maxFrames: OVERVIEW_FRAMES }) : Promise.resolve(first);
@@ -99,7 +99,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   });
   document.getElementById("player").append(timebar.el);
   main.append(help, list.panel,
-    timelines, review, stepsPanel(result), downloadsPanel(run, result), rerunPanel(take, run, filters));
+    timelines, review, stepsPanel(result), downloadsPanel(run, result), rerunPanel(take, run, filters, described));
 
   // Frames: the overview (whole take, decimated) or, when paused, a full-rate window around.
   const pick = (source, f) => {

@@ -9,11 +9,13 @@ Screenshots go to ``tests/artifacts/`` (gitignored): ``review-findings-grouped.p
 
 from __future__ import annotations
 
+import itertools
 import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import httpx
 import pytest
 from tests.browser.test_workstation import ARTIFACTS, KNEES_TAKE, Page, scrub, upload
 
@@ -177,7 +179,7 @@ def test_loop_a_range_and_loop_the_finding(
     assert all(100 <= f <= 130 for f in seen), seen
     assert len(set(seen)) > 3  # it played
     # 31 frames at 60 fps loop in about half a second: 2.5 s went round (frames went back).
-    assert any(b < a for a, b in zip(seen, seen[1:], strict=False)), seen
+    assert any(b < a for a, b in itertools.pairwise(seen)), seen
     p.locator("#player").scroll_into_view_if_needed()
     shot(page, "loop")
 
@@ -195,7 +197,8 @@ def test_loop_a_range_and_loop_the_finding(
     p.mouse.up()
     dragged = loop_range(page)
     assert dragged is not None
-    assert abs(dragged[0] - 200) <= 2 and abs(dragged[1] - 300) <= 2, dragged
+    assert abs(dragged[0] - 200) <= 2, dragged
+    assert abs(dragged[1] - 300) <= 2, dragged
     handle = p.locator(".tb-in").bounding_box()
     p.mouse.move(handle["x"] + handle["width"] / 2, y)
     p.mouse.down()
@@ -204,7 +207,8 @@ def test_loop_a_range_and_loop_the_finding(
     p.mouse.up()
     moved = loop_range(page)
     assert moved is not None
-    assert abs(moved[0] - 150) <= 3 and moved[1] == dragged[1], moved
+    assert abs(moved[0] - 150) <= 3, moved
+    assert moved[1] == dragged[1], moved
     # A click on the bar (no drag) goes to its frame and keeps the range.
     p.mouse.click(x_of(400), y)
     assert abs(page.frame() - 400) <= 2
@@ -224,7 +228,10 @@ def test_loop_a_range_and_loop_the_finding(
     p.evaluate("() => document.activeElement.blur()")
     p.keyboard.press("Shift+L")
     margin = round(0.5 * knees["result"]["summary"]["fps"])
-    expected = [max(0, twist["start_frame"] - margin), min(n_frames - 1, twist["end_frame"] + margin)]
+    expected = [
+        max(0, twist["start_frame"] - margin),
+        min(n_frames - 1, twist["end_frame"] + margin),
+    ]
     assert loop_range(page) == expected
     assert p.inner_text("#play").endswith("pause")
     seen = frames_while_playing(page, 1.5)
@@ -292,3 +299,61 @@ def test_close_in_on_a_joint_and_follow_the_root(
     assert set(offsets) == {"root"}
     assert off_centre(root) < 0.02
     shot(page, "follow")
+
+
+def test_options_form_grouped_with_units_presets_and_checks(
+    live_server: str, knees: dict[str, Any], page: Page
+) -> None:
+    p = page.page
+    page.open_take(live_server, knees)
+    panel = p.locator("#rerun-panel")
+    panel.scroll_into_view_if_needed()
+    groups = panel.locator("fieldset.option-group").evaluate_all(
+        "fs => fs.map(f => f.dataset.group)"
+    )
+    assert groups == ["twist", "limits", "filter", "advanced"]
+    # Every numeric field carries its unit: the advanced one, and the filter's parameters.
+    p.click("#options-advanced summary")
+    assert "samples" in p.inner_text("#options-advanced")
+    # A preset fills the form from the server's presets (pipeline/options.py).
+    p.select_option("#run-preset", "twist only")
+    ticked = panel.locator("input[name=check]").evaluate_all(
+        "bs => bs.filter(b => b.checked).map(b => b.value)"
+    )
+    assert ticked == ["twist"]
+    p.select_option("#run-preset", "twist, apply none (decide each interval)")
+    assert p.input_value("#option-twist_apply") == "none"
+    # The filter's parameters come from the registry, each with its unit.
+    p.select_option("#filter-method", "butterworth")
+    cutoff = panel.locator("[data-param='cutoff_hz']")
+    assert cutoff.locator("xpath=..").locator(".unit").inner_text() == "Hz"
+    # A typo is refused in the page, naming the field; nothing is sent.
+    runs_before = len(
+        httpx.get(f"{live_server}/api/v1/takes/{knees['id']}", timeout=30).json()["runs"]
+    )
+    cutoff.fill("fast")
+    p.fill("#option-max_points", "5")
+    p.click("#rerun")
+    message = p.inner_text("#rerun-message")
+    assert "cutoff_hz: expected a number" in message
+    assert "max_points: expected at least 10" in message
+    assert cutoff.get_attribute("aria-invalid") == "true"
+    shot(page, "options-form")
+    time.sleep(0.5)
+    runs_after = len(
+        httpx.get(f"{live_server}/api/v1/takes/{knees['id']}", timeout=30).json()["runs"]
+    )
+    assert runs_after == runs_before
+    # Fixed, the run starts with exactly those options.
+    p.select_option("#run-preset", "twist only")
+    p.select_option("#filter-method", "butterworth")
+    panel.locator("[data-param='cutoff_hz']").fill("4")
+    p.fill("#option-max_points", "300")
+    p.click("#rerun")
+    p.wait_for_function("(n) => !location.hash.includes(n)", arg=knees["run"])
+    run_id = p.evaluate("() => new URLSearchParams(location.hash.split('?')[1]).get('run')")
+    options = httpx.get(f"{live_server}/api/v1/runs/{run_id}", timeout=30).json()["options"]
+    assert options["checks"] == ["twist"]
+    assert options["filter_method"] == "butterworth"
+    assert options["filter_params"] == {"cutoff_hz": 4}
+    assert options["max_points"] == 300

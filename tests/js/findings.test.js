@@ -98,3 +98,25 @@ test("compare: B's frame is the one at A's instant, moved by the offset, inside 
   assert.equal(sampleOf({ frames: [0, 4, 8, 12], step: 4 }, 9), 2);
   assert.equal(sampleOf({ frames: [0, 4, 8, 12], step: 4 }, 99), 3);
 });
+
+test("the re-run form checks values against their fields and builds the options", async () => {
+  const form = await import("../../frontend/js/run-options.js");
+  const cutoff = { name: "cutoff_hz", type: "float" }, order = { name: "order", type: "int", minimum: 1, maximum: 8 };
+  assert.deepEqual(form.checkValue(cutoff, " 6.5 "), { value: 6.5 });
+  assert.deepEqual(form.checkValue(cutoff, ""), { value: undefined });
+  assert.match(form.checkValue(cutoff, "fast").error, /^cutoff_hz: expected a number/);
+  assert.match(form.checkValue(cutoff, "Infinity").error, /expected a number/);
+  assert.match(form.checkValue(order, "2.5").error, /^order: expected a whole number/);
+  assert.match(form.checkValue(order, "9").error, /^order: expected at most 8/);
+  assert.deepEqual(form.checkValue({ name: "on", type: "bool" }, "false"), { value: false });
+  assert.match(form.checkValue({ name: "on", type: "bool" }, "yes").error, /true or false/);
+  const fields = { max_points: { name: "max_points", type: "int", minimum: 10, maximum: 100000 } };
+  const values = { checks: ["filter"], filter_method: "butterworth", filter_preset: "", max_points: "500", params: [[cutoff, "4"], [order, ""]] };
+  assert.deepEqual(form.formOptions(values, fields).options,
+    { checks: ["filter"], filter_method: "butterworth", filter_preset: null, filter_params: { cutoff_hz: 4 }, max_points: 500 });
+  assert.deepEqual(form.formOptions({ ...values, checks: [], max_points: "5", params: [[order, "0"]] }, fields).errors,
+    ["order: expected at least 1, got 0", "max_points: expected at least 10, got 5", "checks: tick at least one check"]);
+  const presets = { full: { checks: ["twist", "limits", "filter"] }, twist: { checks: ["twist"] }, filter: { checks: ["filter"] } };
+  assert.deepEqual(form.usablePresets(presets, ["filter"]).map(([n, o]) => [n, o.checks]), [["full", ["filter"]], ["filter", ["filter"]]]);
+  assert.equal(form.paramLabel("kalman.process_noise"), "kalman · process noise");
+});

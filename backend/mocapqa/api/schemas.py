@@ -8,7 +8,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, Field, field_validator
 
 from mocapqa.errors import InputError
-from mocapqa.pipeline.options import check_mapping
+from mocapqa.pipeline.options import MAX_POINTS_RANGE, check_mapping
 
 __all__ = [
     "AnalysisOptionsIn",
@@ -74,7 +74,7 @@ class AnalysisOptionsIn(BaseModel):
     filter_method: str | None = None
     filter_preset: str | None = None
     filter_params: dict[str, float | int | bool | str] = Field(default_factory=dict, max_length=64)
-    max_points: int = Field(2000, ge=10, le=100_000)
+    max_points: int = Field(2000, ge=MAX_POINTS_RANGE[0], le=MAX_POINTS_RANGE[1])
     mapping: dict[str, str] = Field(
         default_factory=dict,
         description='Rig roles by hand, role key → joint name ({"left_upper_arm": "LeftArm"}); '
@@ -190,6 +190,14 @@ class FilterInfo(BaseModel):
     parameters: list[dict[str, Any]]
     presets: list[str]
     applies_to: list[str]
+
+
+class RunOptionsInfo(BaseModel):
+    """The run options for the UI form: fields grouped by check, and named presets."""
+
+    checks: list[str]
+    groups: list[dict[str, Any]]
+    presets: dict[str, dict[str, Any]]
 
 
 TakeDetailOut.model_rebuild()

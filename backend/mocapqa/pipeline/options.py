@@ -21,11 +21,14 @@ from mocapqa.twist.choice import APPLY_CHOICES, parse_apply
 
 __all__ = [
     "CHECKS",
+    "MAX_POINTS_RANGE",
+    "RUN_PRESETS",
     "TWIST_APPLY_CHOICES",
     "TWIST_METHODS",
     "AnalysisOptions",
     "ParamValue",
     "check_mapping",
+    "describe_options",
 ]
 
 ParamValue = float | int | bool | str
@@ -37,6 +40,8 @@ TWIST_METHODS = METHODS
 """Twist detection methods (those of :mod:`mocapqa.twist.analysis`)."""
 TWIST_APPLY_CHOICES = APPLY_CHOICES
 """Which twist intervals a run applies (besides a list of interval ids such as ``"0,3"``)."""
+MAX_POINTS_RANGE = (10, 100_000)
+"""Smallest and largest ``max_points`` (time samples per plotted series)."""
 
 
 def _same_kind(value: Any, current: Any) -> bool:
@@ -106,8 +111,9 @@ class AnalysisOptions:
                 "filter_method",
                 f"Expected one of {sorted(FILTERS)}, got {self.filter_method!r}",
             )
-        if not 10 <= self.max_points <= 100_000:
-            raise OptionError("max_points", f"Expected 10 to 100000, got {self.max_points}")
+        low, high = MAX_POINTS_RANGE
+        if not low <= self.max_points <= high:
+            raise OptionError("max_points", f"Expected {low} to {high}, got {self.max_points}")
         object.__setattr__(self, "checks", tuple(self.checks))
         object.__setattr__(self, "mapping", check_mapping(self.mapping))
         self._check_filter(self.filter_method or "adaptive")
@@ -240,3 +246,103 @@ def check_mapping(mapping: object) -> dict[str, str]:
         return normalise_mapping(mapping)
     except InputError as e:
         raise InputError(f"mapping: {e}") from e
+
+
+RUN_PRESETS: dict[str, AnalysisOptions] = {
+    "full check": AnalysisOptions(),
+    "twist only": AnalysisOptions(checks=("twist",)),
+    "twist, apply none (decide each interval)": AnalysisOptions(twist_apply="none"),
+    "twist, apply all": AnalysisOptions(twist_apply="all"),
+    "limits only": AnalysisOptions(checks=("limits",)),
+    "filter only": AnalysisOptions(checks=("filter",)),
+}
+"""Named option sets offered by the re-run form (a preset fills the form; every field stays
+editable). The filter's own presets are the filter registry's."""
+
+
+def describe_options() -> dict[str, Any]:
+    """The run options for a form: fields grouped by check, with types, units, choices, bounds,
+    defaults and the check each field belongs to, and :data:`RUN_PRESETS` as JSON options.
+
+    Derived from :class:`AnalysisOptions` and the constants above, so a form offers exactly
+    what ``from_json`` accepts. Filter parameters come from the filter registry
+    (``GET /filters``): they depend on the filter chosen.
+    """
+    default = AnalysisOptions()
+    low, high = MAX_POINTS_RANGE
+
+    def choice(name: str, label: str, choices: tuple[str, ...], check: str) -> dict[str, Any]:
+        value = getattr(default, name)
+        return {
+            "name": name,
+            "label": label,
+            "type": "choice",
+            "choices": list(choices),
+            "default": value,
+            "unit": "",
+            "check": check,
+        }
+
+    groups = [
+        {
+            "name": "twist",
+            "label": "Twist",
+            "check": "twist",
+            "fields": [
+                choice("twist_method", "detection method", TWIST_METHODS, "twist"),
+                choice(
+                    "twist_apply",
+                    "intervals removed in the corrected take",
+                    TWIST_APPLY_CHOICES,
+                    "twist",
+                ),
+            ],
+        },
+        {"name": "limits", "label": "Joint limits", "check": "limits", "fields": []},
+        {
+            "name": "filter",
+            "label": "Filter",
+            "check": "filter",
+            "fields": [
+                {
+                    "name": "filter_method",
+                    "label": "filter",
+                    "type": "filter",
+                    "default": None,
+                    "unit": "",
+                    "check": "filter",
+                },
+                {
+                    "name": "filter_preset",
+                    "label": "filter preset",
+                    "type": "filter_preset",
+                    "default": None,
+                    "unit": "",
+                    "check": "filter",
+                },
+            ],
+        },
+        {
+            "name": "advanced",
+            "label": "Advanced",
+            "check": None,
+            "advanced": True,
+            "fields": [
+                {
+                    "name": "max_points",
+                    "label": "samples per plotted series",
+                    "type": "int",
+                    "default": default.max_points,
+                    "minimum": low,
+                    "maximum": high,
+                    "unit": "samples",
+                    "check": None,
+                },
+            ],
+        },
+    ]
+    return {
+        "checks": list(CHECKS),
+        "groups": groups,
+        "presets": {name: options.to_json() for name, options in RUN_PRESETS.items()},
+    }
