@@ -250,6 +250,15 @@ export function focusTarget(mode, points, root, joint, target) {
   return centre ? [centre[0], target[1], -centre[1]] : target;
 }
 
+/**
+ * A colour ([r, g, b] in 0–1) faded toward white by a detection confidence in [0, 1]: full at
+ * 1, a pale `floor` share of it at 0 (a missing detection still shows where it was bridged).
+ */
+export function fade(color, confidence, floor = 0.15) {
+  const k = floor + (1 - floor) * Math.max(0, Math.min(1, confidence));
+  return color.map((v) => 1 - k * (1 - v));
+}
+
 /** Camera distance of a focus mode, for a body `size` across (close-in is nearer). */
 export const focusDistance = (mode, size) => size * (mode === "joint" ? 0.7 : 1.5);
 

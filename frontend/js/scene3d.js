@@ -8,6 +8,7 @@ const BODY = new THREE.Color("#5b84b1");
 const MARKED = new THREE.Color("#f39c12");
 const JOINT = new THREE.Color("#1f4e79");
 const SELECTED = new THREE.Color("#f1c40f");
+const BRIDGED = new THREE.Color("#8e44ad"); // a keypoint the filter bridged (no valid input)
 const AXES = ["#d62728", "#2ca02c", "#1f77b4"].map((c) => new THREE.Color(c));
 
 function viewScene(bonesCount, nPoints, nJoints, oriented) {
@@ -80,6 +81,9 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
     // rate (15.6 → 25.7 frames/s in playback); the pixel ratio still smooths HiDPI screens.
     const renderer = new THREE.WebGLRenderer({ canvas, antialias: false });
     renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
+    // No depth sorting of objects: it needs bounding spheres, which a missing keypoint (NaN, not
+    // drawn) would spoil; opaque parts go before the transparent ghost all the same.
+    renderer.sortObjects = false;
     const parts = viewScene(bones.length, names.length, nJoints, oriented);
     const grid = new THREE.GridHelper(size * 3, 12, 0xc0c7cf, 0xe3e7ec);
     grid.position.y = floorY;
@@ -121,7 +125,7 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   new ResizeObserver(requestRender).observe(divs.raw.parentNode.parentNode);
 
   const soupScratch = new Float32Array(bones.length * 24 * 3);
-  const write = (view, points, rotations, flagged, selected) => {
+  const write = (view, points, rotations, flagged, selected, confidence = null, bridged = null) => {
     const colorOf = (j) => (j === selected ? SELECTED : flagged.has(j) ? new THREE.Color(flagged.get(j)) : null);
     if (oriented) {
       const vertices = geo.boneVertices(points, rotations, bones, sides, geo.identity);
@@ -146,7 +150,10 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
     points.forEach((p, j) => {
       const ok = geo.present(p);
       jp.array[3 * j] = ok ? p[0] : NaN; jp.array[3 * j + 1] = ok ? p[1] : NaN; jp.array[3 * j + 2] = ok ? p[2] : NaN;
-      const c = colorOf(j) || JOINT;
+      // A bridged keypoint is drawn purple at full strength (the filter's value, not a detection).
+      const isBridged = bridged && bridged[j];
+      let c = colorOf(j) || (isBridged ? BRIDGED : JOINT);
+      if (confidence && !colorOf(j) && !isBridged) c = new THREE.Color(...geo.fade([c.r, c.g, c.b], confidence[j]));
       jc.array[3 * j] = c.r; jc.array[3 * j + 1] = c.g; jc.array[3 * j + 2] = c.b;
     });
     jp.needsUpdate = true; jc.needsUpdate = true;
@@ -165,8 +172,8 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   };
   const show = (next) => {
     frame = next;
-    write(views.raw, next.raw, next.rawRotations, next.rawFlagged || next.flagged, next.selected);
-    write(views.corrected, next.corrected, next.correctedRotations, next.flagged, next.selected);
+    write(views.raw, next.raw, next.rawRotations, next.rawFlagged || next.flagged, next.selected, next.confidence);
+    write(views.corrected, next.corrected, next.correctedRotations, next.flagged, next.selected, next.confidence, next.bridged);
     if (overlayOn) writeLines(views.corrected.ghost.geometry.attributes.position, next.raw, bones);
     // Auto-framing: the orbit's target follows the body over the floor, the root (follow) or
     // the selected joint (close-in).
@@ -224,7 +231,8 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
     const best = nearest(view, e);
     tooltip.hidden = best == null;
     if (best != null) {
-      tooltip.textContent = names[best];
+      const marks = frame.confidence ? ` · confidence ${frame.confidence[best].toFixed(2)}${frame.bridged && frame.bridged[best] && view === views.corrected ? " · bridged" : ""}` : "";
+      tooltip.textContent = names[best] + marks;
       tooltip.style.left = `${e.pageX + 12}px`;
       tooltip.style.top = `${e.pageY + 12}px`;
     }

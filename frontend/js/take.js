@@ -81,7 +81,8 @@ export async function takeView(main, takeId, params, onTeardown) {
     runPicker(take, run),
     h("div", { class: "controls view-options" }, "camera ", presets, closeButton, followButton,
       h("label", {}, triadsBox, " joint axes"), h("label", {}, overlayBox, " overlay (raw as ghost)"),
-      h("span", { class: "muted" }, oriented ? "bones are drawn in their parent joint's frame; the orange side marks the roll" : "")),
+      h("span", { class: "muted", id: "view-legend" }, oriented ? "bones are drawn in their parent joint's frame; the orange side marks the roll"
+        : "keypoints fade with their detection confidence; purple: bridged by the filter (hatched on the time bar)")),
     viewsRow,
     h("div", { class: "panel player", id: "player" },
       h("div", { class: "controls" }, playButton, "speed ", speed, scrubber, frameLabel, jointLabel),
@@ -98,6 +99,8 @@ export async function takeView(main, takeId, params, onTeardown) {
     onJump: (f) => { if (player.playing) togglePlay(); jump(f); }, onRange: (r) => setRange(r),
   });
   document.getElementById("player").append(timebar.el);
+  const bridgedRuns = result.series.filter && result.series.filter.bridged_runs;
+  if (bridgedRuns) timebar.setGaps(bridgedRuns);
   main.append(help, list.panel,
     timelines, review, stepsPanel(result), downloadsPanel(run, result), rerunPanel(take, run, filters, described));
 
@@ -119,6 +122,7 @@ export async function takeView(main, takeId, params, onTeardown) {
       shown: source.frames[k], raw: source.raw[k], corrected: source.corrected[k],
       rawRotations: oriented ? source.raw_rotations[k] : null, correctedRotations: oriented ? source.corrected_rotations[k] : null,
       flagged: flaggedAt(f), selected: jointIndex.get(store.state.joint),
+      confidence: source.confidence ? source.confidence[k] : null, bridged: source.bridged ? source.bridged[k] : null,
     };
   };
 

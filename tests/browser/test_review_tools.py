@@ -17,7 +17,7 @@ from typing import Any
 
 import httpx
 import pytest
-from tests.browser.test_workstation import ARTIFACTS, KNEES_TAKE, Page, scrub, upload
+from tests.browser.test_workstation import ARTIFACTS, KNEES_TAKE, TRC_TAKE, Page, scrub, upload
 
 pytestmark = pytest.mark.browser
 
@@ -357,3 +357,61 @@ def test_options_form_grouped_with_units_presets_and_checks(
     assert options["filter_method"] == "butterworth"
     assert options["filter_params"] == {"cutoff_hz": 4}
     assert options["max_points"] == 300
+
+
+def trc_with_a_gap(corpus_dir: Path, folder: Path) -> Path:
+    """The Pose2Sim balancing TRC with RWrist blanked in frames 40–49 (file numbering)."""
+    lines = (corpus_dir / TRC_TAKE).read_text().splitlines()
+    names = lines[3].split("\t")[2:]
+    wrist = [n for n in names if n].index("RWrist")
+    out = []
+    for k, line in enumerate(lines):
+        cells = line.split("\t")
+        if k >= 5 and 40 <= int(cells[0]) <= 49:
+            for c in range(2 + 3 * wrist, 5 + 3 * wrist):
+                cells[c] = ""
+        out.append("\t".join(cells))
+    path = folder / "balancing_wrist_gap.trc"
+    path.write_text("\n".join(out) + "\n")
+    return path
+
+
+def test_keypoint_confidence_fades_and_bridged_gaps_show(
+    live_server: str, corpus_dir: Path, tmp_path: Path, page: Page
+) -> None:
+    p = page.page
+    take = upload(live_server, trc_with_a_gap(corpus_dir, tmp_path))
+    names = take["result"]["points"]["names"]
+    wrist = names.index("RWrist")
+    assert take["result"]["series"]["filter"]["bridged_runs"] == [[39, 48]]
+    page.open_take(live_server, take, frame=44)
+    # The gap is hatched on the time bar, over frames 39–48.
+    gap = p.locator("#timebar .tb-gap")
+    assert gap.count() == 1
+    assert gap.get_attribute("title") == "bridged gap: frames 39–48"
+    bar, mark = p.locator("#timebar").bounding_box(), gap.bounding_box()
+    n_frames = take["result"]["summary"]["n_frames"]
+    assert (mark["x"] - bar["x"]) / bar["width"] == pytest.approx(39 / n_frames, abs=0.01)
+    # In the filtered view the bridged wrist says so on hover, with its confidence (0: missing).
+    p.locator("#views").scroll_into_view_if_needed()
+    page.settle()
+    x, y = p.evaluate("(j) => window.mocapqaViews.screenOf('corrected', j)", wrist)
+    p.mouse.move(x, y)
+    p.wait_for_selector(".joint-tooltip:not([hidden])")
+    assert p.inner_text(".joint-tooltip") == "RWrist · confidence 0.00 · bridged"
+    # Outside the gap the same wrist is a full-confidence detection.
+    scrub(page, 20)
+    x, y = p.evaluate("(j) => window.mocapqaViews.screenOf('corrected', j)", wrist)
+    p.mouse.move(x + 1, y)
+    p.mouse.move(x, y)
+    p.wait_for_function(
+        "() => document.querySelector('.joint-tooltip').textContent.includes('1.00')"
+    )
+    scrub(page, 44)
+    x, y = p.evaluate("(j) => window.mocapqaViews.screenOf('corrected', j)", wrist)
+    p.mouse.move(x, y + 1)
+    p.mouse.move(x, y)
+    p.wait_for_function(
+        "() => document.querySelector('.joint-tooltip').textContent.includes('bridged')"
+    )
+    shot(page, "keypoint-gap")

@@ -120,3 +120,12 @@ test("the re-run form checks values against their fields and builds the options"
   assert.deepEqual(form.usablePresets(presets, ["filter"]).map(([n, o]) => [n, o.checks]), [["full", ["filter"]], ["filter", ["filter"]]]);
   assert.equal(form.paramLabel("kalman.process_noise"), "kalman · process noise");
 });
+
+test("a keypoint fades toward white with its confidence, never to nothing", async () => {
+  const { fade } = await import("../../frontend/js/geometry.js");
+  assert.deepEqual(fade([0, 0.5, 1], 1), [0, 0.5, 1]);
+  const faint = fade([0, 0, 0], 0);
+  assert.ok(Math.abs(faint[0] - 0.85) < 1e-12);
+  assert.ok(fade([0, 0, 0], 0.5)[0] < faint[0]);
+  assert.deepEqual(fade([0, 0, 0], 7), [0, 0, 0]); // clamped to 1
+});

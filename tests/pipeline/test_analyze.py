@@ -17,7 +17,7 @@ from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.frames import motion_points, motion_pose, sample_frames
 from mocapqa.pipeline.options import AnalysisOptions
-from mocapqa.pipeline.steps import violation_findings
+from mocapqa.pipeline.steps import true_runs, violation_findings
 from mocapqa.store.files import FileStore
 
 
@@ -141,3 +141,33 @@ def test_undetected_openpose_keypoints_stay_missing_in_the_stored_points(
         raw = data["raw"]
     np.testing.assert_array_equal(np.isnan(raw).any(axis=-1), undetected)
     assert not np.any(np.all(raw[~undetected] == 0, axis=-1))
+
+
+def test_keypoint_confidence_and_bridged_samples_are_stored_for_the_view(
+    corpus_dir: Path, tmp_path: Path
+) -> None:
+    folder = corpus_dir / "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-associated"
+    take = read_take(folder / "cam01_json")
+    assert isinstance(take, KeypointSequence)
+    undetected = np.isnan(take.positions).any(axis=-1)
+    result = analyze(take, AnalysisOptions())
+    files = FileStore(tmp_path)
+    write_outputs(files, "0123456789abcdef0123456789abcdef", result)
+    with np.load(files.run_dir("0123456789abcdef0123456789abcdef") / "points.npz") as data:
+        confidence, bridged = data["confidence"], data["bridged"]
+    np.testing.assert_allclose(confidence, take.confidence, atol=1e-3)
+    assert np.all(confidence[undetected] == 0)
+    # The filter bridges every undetected sample; the report's runs are the frames with one.
+    assert bridged[undetected].all()
+    runs = result.report["series"]["filter"]["bridged_runs"]
+    marked = np.zeros(take.n_frames, dtype=bool)
+    for first, last in runs:
+        marked[first : last + 1] = True
+    np.testing.assert_array_equal(marked, bridged.any(axis=1))
+    assert runs
+
+
+def test_true_runs_are_first_and_last_of_each_run() -> None:
+    flags = np.array([True, True, False, True, False, False, True])
+    assert true_runs(flags).tolist() == [[0, 1], [3, 3], [6, 6]]
+    assert true_runs(np.zeros(4, dtype=bool)).shape == (0, 2)

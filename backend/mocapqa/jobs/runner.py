@@ -68,6 +68,10 @@ def write_outputs(files: FileStore, run_id: str, result: AnalysisResult) -> list
         # Half precision (about 1e-3 per component) is finer than a drawn bone can show.
         arrays["raw_rotations"] = result.raw_rotations.astype(np.float16)
         arrays["corrected_rotations"] = result.corrected_rotations.astype(np.float16)
+    if result.confidence is not None:
+        arrays["confidence"] = result.confidence.astype(np.float16)
+    if result.bridged is not None:
+        arrays["bridged"] = result.bridged
     np.savez(buffer, **arrays)
     files.write_bytes(folder / "points.npz", buffer.getvalue())
     if result.corrected_motion is not None:

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from mocapqa import __version__
-from mocapqa.core.arrays import FloatArray
+from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles
@@ -61,6 +61,10 @@ class AnalysisResult:
     raw_rotations, corrected_rotations : ndarray, shape (F, P, 4), optional
         World unit quaternions (scalar-last) of the points, for motion takes: the 3D view
         orients each bone by its parent's rotation.
+    confidence : ndarray, shape (F, P), optional
+        Detection confidence in [0, 1] of each point, for keypoint takes (0 where missing).
+    bridged : ndarray of bool, shape (F, P), optional
+        Samples the keypoint filter bridged (no valid input), for filtered keypoint takes.
     """
 
     report: dict[str, Any]
@@ -70,6 +74,8 @@ class AnalysisResult:
     corrected_points: FloatArray
     raw_rotations: FloatArray | None = None
     corrected_rotations: FloatArray | None = None
+    confidence: FloatArray | None = None
+    bridged: BoolArray | None = None
 
 
 def _no_progress(percent: int, step: str) -> None:
@@ -228,7 +234,16 @@ def _analyze_keypoints(
         },
         "series": {"frames": frames.tolist(), "fps": sequence.fps, **series},
     }
-    return AnalysisResult(report, None, filtered, raw_points, corrected_points)
+    bridged = outcomes["filter"].bridged
+    return AnalysisResult(
+        report,
+        None,
+        filtered,
+        raw_points,
+        corrected_points,
+        confidence=sequence.confidence,
+        bridged=bridged,
+    )
 
 
 def _count_by_kind(findings: list[dict[str, Any]]) -> dict[str, int]:

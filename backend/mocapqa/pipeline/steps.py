@@ -61,6 +61,8 @@ class StepOutcome:
         A corrected motion, when the step makes one.
     keypoints : KeypointSequence, optional
         Filtered keypoints, when the step makes them.
+    bridged : ndarray of bool, shape (F, K), optional
+        Samples the keypoint filter bridged (no valid input), when the step filters keypoints.
     """
 
     state: str
@@ -69,6 +71,24 @@ class StepOutcome:
     series: dict[str, Any] | None = None
     motion: Motion | None = None
     keypoints: KeypointSequence | None = None
+    bridged: BoolArray | None = None
+
+
+def true_runs(flags: BoolArray) -> IntArray:
+    """Runs of consecutive true values.
+
+    Parameters
+    ----------
+    flags : ndarray of bool, shape (F,)
+
+    Returns
+    -------
+    ndarray of int, shape (R, 2)
+        First and last index (both inside the run) of each run, in order.
+    """
+    edges = np.diff(np.concatenate(([0], flags.astype(np.int8), [0])))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    return np.stack([starts, stops - 1], axis=1).astype(np.intp)
 
 
 def run_twist(
@@ -249,6 +269,9 @@ def run_filter_keypoints(
             "length_unit": sequence.length_unit,
             "weights": weights,
             "summary": detail,
+            # Frames where any keypoint was bridged (no valid input), as [first, last] runs.
+            "bridged_runs": true_runs(result.bridged.any(axis=1)).tolist(),
         },
         keypoints=result.sequence,
+        bridged=result.bridged,
     )

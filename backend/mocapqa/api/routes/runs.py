@@ -93,6 +93,8 @@ def get_frames(
     unit quaternion (scalar-last), by which the 3D view orients the bones.
 
     A missing point (a keypoint not detected in that frame) is ``[null, null, null]``.
+    Keypoint takes also carry ``confidence`` (per point, 0–1, two decimals) and, when they were
+    filtered, ``bridged`` (per point, 1 where the filter had no valid input and bridged it).
 
     The step grows so that at most ``max_frames`` frames come back; the answer states the
     frame indices it holds.
@@ -102,6 +104,8 @@ def get_frames(
     with np.load(path) as data:
         raw, corrected = data["raw"], data["corrected"]
         rotations = {k: data[k] for k in ("raw_rotations", "corrected_rotations") if k in data}
+        # Keypoint takes: detection confidence and the samples the filter bridged, per point.
+        marks = {k: data[k] for k in ("confidence", "bridged") if k in data}
     n_frames = int(raw.shape[0])
     stop = n_frames if stop is None else min(stop, n_frames)
     if start >= stop:
@@ -110,7 +114,7 @@ def get_frames(
     if count > max_frames:
         step = -(-(stop - start) // max_frames)
     frames = np.arange(start, stop, step)
-    if frames.size * raw.shape[1] * (6 + 4 * len(rotations)) > MAX_WINDOW_VALUES:
+    if frames.size * raw.shape[1] * (6 + 4 * len(rotations) + len(marks)) > MAX_WINDOW_VALUES:
         raise InputError(
             f"Expected a window of at most {MAX_WINDOW_VALUES} values, got {frames.size} frames"
         )
@@ -123,6 +127,10 @@ def get_frames(
     }
     for key, values in rotations.items():
         payload[key] = np.round(values[frames].astype(np.float64), 3).tolist()
+    if "confidence" in marks:
+        payload["confidence"] = np.round(marks["confidence"][frames].astype(np.float64), 2).tolist()
+    if "bridged" in marks:
+        payload["bridged"] = marks["bridged"][frames].astype(np.int8).tolist()
     # Plain json.dumps: FastAPI's encoder would walk each of the ~10^5 numbers in Python.
     # Missing points are NaN in the store; JSON has no NaN, so they go out as null (no number
     # literal contains "NaN", so the replacement touches nothing else).
