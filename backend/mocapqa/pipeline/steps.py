@@ -39,6 +39,7 @@ __all__ = [
     "run_filter_motion",
     "run_limits",
     "run_twist",
+    "true_runs",
     "violation_findings",
 ]
 
@@ -270,7 +271,7 @@ def run_filter_keypoints(
             "weights": weights,
             "summary": detail,
             # Frames where any keypoint was bridged (no valid input), as [first, last] runs.
-            "bridged_runs": true_runs(result.bridged.any(axis=1)).tolist(),
+            "bridged_runs": true_runs(np.any(result.bridged, axis=1)).tolist(),
         },
         keypoints=result.sequence,
         bridged=result.bridged,
