@@ -5,7 +5,7 @@ import { badge, h } from "./dom.js";
 import { fmt, nextStop, seconds, stepsRan } from "./format.js";
 import { findingAt, loopOfFinding } from "./findings.js";
 import { findingsList } from "./findings-list.js";
-import { createTimebar, withIn, withOut } from "./timebar.js";
+import { createTimebar, parseRange, withIn, withOut } from "./timebar.js";
 import { createPlayer } from "./player.js";
 import { loadPlotly } from "./plotly.js";
 import * as store from "./state.js";
@@ -155,6 +155,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   const remember = () => {
     const query = new URLSearchParams({ run: run.id, frame: store.state.frame });
     if (store.state.joint) query.set("joint", store.state.joint);
+    if (store.state.loop) query.set("loop", store.state.loop.join("-"));
     history.replaceState(null, "", `#/take/${take.id}?${query}`);
   };
   const loadDetail = async () => {
@@ -204,7 +205,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     timebar.setRange(r, store.state.looping);
     player.setLoop(store.state.looping ? r : null);
   };
-  const setRange = (r) => { store.set({ loop: r }); showLoop(); };
+  const setRange = (r) => { store.set({ loop: r }); showLoop(); remember(); };
   const setLooping = (on) => { store.set({ looping: on }); showLoop(); };
   const loopFinding = () => {
     const f = list.current || findingAt(list.shown, store.state.frame);
@@ -217,7 +218,10 @@ export async function takeView(main, takeId, params, onTeardown) {
   };
   loopButton.addEventListener("click", () => setLooping(!store.state.looping));
   loopFindingButton.addEventListener("click", loopFinding);
-  clearLoopButton.addEventListener("click", () => { store.set({ loop: null, looping: false }); showLoop(); });
+  clearLoopButton.addEventListener("click", () => { store.set({ loop: null, looping: false }); showLoop(); remember(); });
+  // A link may carry the in/out range (&loop=A-B): shown, not yet looping.
+  const linked = parseRange(params.get("loop"), nFrames);
+  if (linked) setRange(linked);
   triadsBox.addEventListener("change", () => views.setTriads(triadsBox.checked));
   overlayBox.addEventListener("change", () => {
     store.set({ overlay: overlayBox.checked });

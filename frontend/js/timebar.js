@@ -22,6 +22,14 @@ export const withIn = (range, frame, nFrames) => [frame, range && range[1] >= fr
 /** The range after setting its out point at `frame` (its in point kept when before, else 0). */
 export const withOut = (range, frame) => [range && range[0] <= frame ? range[0] : 0, frame];
 
+/** An in/out range from a link's "A-B" (frames inside the take, A ≤ B), else null. */
+export function parseRange(text, nFrames) {
+  const match = /^(\d+)-(\d+)$/.exec(String(text ?? ""));
+  if (!match) return null;
+  const [a, b] = [Number(match[1]), Number(match[2])];
+  return a <= b && b < nFrames ? [a, b] : null;
+}
+
 /** Runs of consecutive frames where `flags[k]` is true, as [start, end] pairs of `frames[k]`. */
 export function runsOf(frames, flags) {
   const runs = [];

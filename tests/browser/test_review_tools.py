@@ -168,6 +168,7 @@ def test_loop_a_range_and_loop_the_finding(
     p.evaluate("() => document.activeElement.blur()")
     p.keyboard.press("o")
     assert "in 100 · out 130" in p.inner_text("#loop-label")
+    assert "loop=100-130" in p.evaluate("() => location.hash")  # a link carries the range
     assert loop_range(page) is None  # set, not looping yet
     p.keyboard.press("l")
     assert p.get_attribute("#loop", "aria-pressed") == "true"
@@ -238,6 +239,12 @@ def test_loop_a_range_and_loop_the_finding(
     p.click("#play")
     assert all(expected[0] <= f <= expected[1] for f in seen), (seen, expected)
     assert p.locator("#findings tr.finding.current").get_attribute("data-joint") == twist["joint"]
+
+    # A link with a range opens with it set (not looping).
+    p.goto(f"{live_server}/#/take/{knees['id']}?run={knees['run']}&frame=5&loop=20-40")
+    p.wait_for_selector("main[data-ready='1']", timeout=60_000)
+    assert "in 20 · out 40" in p.inner_text("#loop-label")
+    assert loop_range(page) is None
 
 
 def test_close_in_on_a_joint_and_follow_the_root(

@@ -129,3 +129,12 @@ test("a keypoint fades toward white with its confidence, never to nothing", asyn
   assert.ok(fade([0, 0, 0], 0.5)[0] < faint[0]);
   assert.deepEqual(fade([0, 0, 0], 7), [0, 0, 0]); // clamped to 1
 });
+
+test("a link's loop range is read back only when it fits the take", async () => {
+  const { parseRange } = await import("../../frontend/js/timebar.js");
+  assert.deepEqual(parseRange("100-130", 458), [100, 130]);
+  assert.equal(parseRange("130-100", 458), null);
+  assert.equal(parseRange("100-458", 458), null);
+  assert.equal(parseRange("x-1", 458), null);
+  assert.equal(parseRange(null, 458), null);
+});
