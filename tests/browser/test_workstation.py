@@ -530,4 +530,13 @@ def test_compare_matches_findings_and_diffs_options(
     assert "frame 190" in p.inner_text("#compare-3d .col:last-child .view-title")
     p.locator("#compare-3d").scroll_into_view_if_needed()
     p.screenshot(path=str(ARTIFACTS / "workstation-compare-3d.png"))
+    # At 900 px the two views stay side by side, with no sideways scroll.
+    p.set_viewport_size({"width": 900, "height": 900})
+    p.wait_for_function("() => document.documentElement.scrollWidth <= window.innerWidth")
+    a_box, b_box = (p.locator(v).bounding_box() for v in ("#compare-view-a", "#compare-view-b"))
+    assert a_box["y"] == b_box["y"]
+    assert a_box["x"] < b_box["x"]
+    p.evaluate("() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))")
+    p.locator("#compare-3d").scroll_into_view_if_needed()
+    p.screenshot(path=str(ARTIFACTS / "workstation-compare-3d-900px.png"))
     p.screenshot(path=str(ARTIFACTS / "workstation-compare.png"), full_page=True)
