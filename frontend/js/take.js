@@ -307,6 +307,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   timeline.setFrame(store.state.frame);
   focusCharts();
   if (store.state.frame) loadDetail();
+  await fuller; // "ready" once the full overview replaced the light one (tests compare pixels)
   main.dataset.ready = "1";
 }
 
