@@ -231,7 +231,9 @@ def read_take(
         return _read(path, kind, fps, person_index, length_unit, number_reader, root_translation)
     check_take_input(path, kind, limits)
     try:
-        take = _read(path, kind, fps, person_index, length_unit, number_reader, root_translation)
+        take = _read(
+            path, kind, fps, person_index, length_unit, number_reader, root_translation, limits
+        )
     except RecursionError as e:  # a backstop: the depth check above refuses such files first
         raise ParseError("Expected a shallower document, got one nested too deep", path) from e
     if isinstance(take, Motion):
@@ -249,6 +251,7 @@ def _read(
     length_unit: str | None,
     number_reader: NumberReader,
     root_translation: Literal["auto", "add", "replace"],
+    limits: ReadLimits | None = None,
 ) -> Motion | KeypointSequence:
     if kind == "bvh":
         return read_bvh(
@@ -263,10 +266,12 @@ def _read(
         return read_openpose(path, fps=fps, person_index=person_index)
     if kind == "mediapipe-pbtxt":
         return read_mediapipe_pbtxt(path, fps=fps)
+    if kind == "csv":  # the long CSVs check frames × points again before making their arrays
+        return read_keypoint_csv(path, fps, length_unit, limits)
+    if kind == "mediapipe-csv":
+        return read_mediapipe_csv(path, fps, length_unit, limits)
     readers: dict[str, Callable[[Path, float | None, str | None], KeypointSequence]] = {
-        "mediapipe-csv": read_mediapipe_csv,
         "mediapipe-json": read_mediapipe_json,
-        "csv": read_keypoint_csv,
         "npy": read_keypoint_npy,
         "npz": read_keypoint_npz,
         "json": read_keypoint_json,

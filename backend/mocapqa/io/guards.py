@@ -6,7 +6,14 @@ half a gigabyte, a 100 MB BVH header can declare a million joints. :func:`check_
 looks at the bytes with C-speed scans (``bytes.find``/``count``, NumPy over fixed-size chunks,
 the ``.npy`` headers inside a zip directory) and raises :class:`~mocapqa.errors.TooLargeError`
 naming the limit before any reader runs; :func:`check_take_size` is the backstop after the
-read, for the formats whose frame count is only known by parsing.
+read, for the formats whose frame count is only known by parsing (the JSON formats).
+
+Frames × points before parsing, by format: BVH from ``Frames:`` and the joints of the header;
+``.npy``/``.npz`` from the array headers; TRC from its marker-name line times its data lines;
+the long CSVs (keypoint CSV, MediaPipe CSV), one line per frame and point, from their data
+lines (a lower bound of frames × points: the read take spans every frame number between the
+first and the last). Lines are counted with ``bytes.count`` in 1 MB chunks; blank lines count
+as data lines, so the estimate errs toward refusing, by the number of blank lines.
 
 The limits are parameters (:class:`ReadLimits`); the server builds them from its settings.
 """
@@ -27,6 +34,7 @@ __all__ = [
     "JSON_FORMATS",
     "TEXT_FORMATS",
     "ReadLimits",
+    "check_frame_points",
     "check_json_depth",
     "check_line_length",
     "check_take_input",
@@ -42,6 +50,7 @@ JSON_FORMATS = frozenset({"json", "mediapipe-json", "openpose"})
 
 _CHUNK = 1 << 20
 _JOINT = re.compile(rb"^[ \t]*(?:ROOT|JOINT)[ \t]", re.MULTILINE)
+_TRC_LABEL = re.compile(r"^[XYZ]\d+$", re.IGNORECASE)
 _OPEN = np.zeros(256, dtype=np.int8)
 _OPEN[[ord("["), ord("{")]] = 1
 _OPEN[[ord("]"), ord("}")]] = -1
@@ -86,21 +95,23 @@ def check_line_length(path: Path, max_line_bytes: int) -> None:
     TooLargeError
         Naming the line.
     """
-    line, run = 1, 0
+    line, run = 1, 0  # the line at the chunk's start, and its bytes before the chunk
     with path.open("rb") as handle:
         while chunk := handle.read(_CHUNK):
-            start = 0
-            while True:
-                newline = chunk.find(b"\n", start)
-                run += (len(chunk) if newline < 0 else newline) - start
-                if run > max_line_bytes:
-                    raise TooLargeError(
-                        f"{path.name}, line {line}: Expected lines of at most {max_line_bytes} "
-                        "bytes (setting max_line_bytes), got a longer one"
-                    )
-                if newline < 0:
-                    break
-                line, run, start = line + 1, 0, newline + 1
+            # Line lengths from the newline positions, with NumPy: no Python step per line.
+            newlines = np.flatnonzero(np.frombuffer(chunk, dtype=np.uint8) == ord("\n"))
+            lengths = np.diff(newlines, prepend=-1) - 1
+            if lengths.size:
+                lengths[0] += run
+            over = np.flatnonzero(lengths > max_line_bytes)
+            tail = run + len(chunk) if newlines.size == 0 else len(chunk) - int(newlines[-1]) - 1
+            if over.size or tail > max_line_bytes:
+                at = line + (int(over[0]) if over.size else int(newlines.size))
+                raise TooLargeError(
+                    f"{path.name}, line {at}: Expected lines of at most {max_line_bytes} "
+                    "bytes (setting max_line_bytes), got a longer one"
+                )
+            line, run = line + int(newlines.size), tail
 
 
 def check_json_depth(path: Path, max_depth: int) -> None:
@@ -210,6 +221,78 @@ def _check_bvh_header(path: Path, limits: ReadLimits) -> None:
         )
 
 
+def _count_lines(path: Path) -> int:
+    """Lines of a file (a last line without a newline counts), 1 MB at a time."""
+    lines, last = 0, b"\n"
+    with path.open("rb") as handle:
+        while chunk := handle.read(_CHUNK):
+            lines += chunk.count(b"\n")
+            last = chunk[-1:]
+    return lines + (last != b"\n")
+
+
+def _head(path: Path, n_lines: int) -> list[bytes]:
+    """The first ``n_lines`` lines (their length is already bounded by ``max_line_bytes``)."""
+    with path.open("rb") as handle:
+        return [line for line in (handle.readline() for _ in range(n_lines)) if line]
+
+
+def _long_csv_header_lines(path: Path, kind: str) -> int:
+    if kind == "mediapipe-csv":
+        return 1
+    lines = 0  # leading comment and blank lines (the keypoint CSV's old metadata), then the header
+    with path.open("rb") as handle:
+        for line in handle:
+            lines += 1
+            if line.strip() and not line.startswith(b"#"):
+                break
+    return lines
+
+
+def _trc_cells(line: bytes) -> list[str]:
+    text = line.decode("utf-8", "replace")
+    return text.split("\t") if "\t" in text else text.split()
+
+
+def _trc_size(path: Path) -> tuple[int, int]:
+    head = _head(path, 8)
+    if len(head) < 4:
+        return 0, 0  # the reader names what is missing
+    markers = sum(1 for c in _trc_cells(head[3])[2:] if c.strip())
+    labels = len(head) > 4 and any(_TRC_LABEL.match(c.strip()) for c in _trc_cells(head[4]))
+    start = 5 if labels else 4  # as the reader: a line of X1 Y1 Z1 ... labels, or none
+    while start < len(head) and not head[start].strip():
+        start += 1  # the blank line writers put before the data
+    return max(_count_lines(path) - start, 0), markers
+
+
+def check_frame_points(path: str | Path, kind: str, limits: ReadLimits) -> None:
+    """Refuse a TRC, keypoint CSV or MediaPipe CSV with more than ``max_frame_points``
+    frames × points, counting lines instead of parsing (see the module notes).
+
+    Raises
+    ------
+    TooLargeError
+        Naming the file, the setting and the count.
+    """
+    path = Path(path)
+    limit = limits.max_frame_points
+    if kind == "trc":
+        rows, markers = _trc_size(path)
+        if rows * markers > limit:
+            raise TooLargeError(
+                f"{path.name}: Expected at most {limit} frames × points (setting "
+                f"max_frame_points), got {rows} data lines × {markers} markers"
+            )
+    elif kind in ("csv", "mediapipe-csv"):
+        rows = _count_lines(path) - _long_csv_header_lines(path, kind)
+        if rows > limit:
+            raise TooLargeError(
+                f"{path.name}: Expected at most {limit} frames × points (setting "
+                f"max_frame_points), got {rows} data lines of one frame and point each"
+            )
+
+
 def check_take_input(path: str | Path, kind: str, limits: ReadLimits) -> None:
     """Refuse a take file (or OpenPose folder) that exceeds ``limits``, before reading it.
 
@@ -238,6 +321,7 @@ def check_take_input(path: str | Path, kind: str, limits: ReadLimits) -> None:
             check_json_depth(file, limits.max_json_depth)
     if kind == "bvh":
         _check_bvh_header(path, limits)
+    check_frame_points(path, kind, limits)
 
 
 def check_take_size(n_frames: int, n_points: int, name: str, limits: ReadLimits) -> None:

@@ -36,6 +36,7 @@ import numpy as np
 
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import ParseError
+from mocapqa.io.guards import ReadLimits, check_take_size
 from mocapqa.io.keypoint_input import (
     build_keypoint_sequence,
     decode_text,
@@ -132,6 +133,7 @@ def parse_keypoint_csv(
     fps: float | None = None,
     length_unit: str | None = None,
     sidecar: dict[str, Any] | None = None,
+    limits: ReadLimits | None = None,
 ) -> KeypointSequence:
     """Parse the long keypoint CSV into a :class:`~mocapqa.core.keypoints.KeypointSequence`.
 
@@ -148,6 +150,10 @@ def parse_keypoint_csv(
     sidecar : dict, optional
         The file's metadata sidecar (``fps``, ``length_unit``), read by
         :func:`read_keypoint_csv`.
+    limits : ReadLimits, optional
+        Refuse a take spanning more frames × keypoints than ``limits.max_frame_points``
+        before its arrays are made (the frame numbers and names can claim far more than the
+        rows hold).
 
     Returns
     -------
@@ -159,6 +165,8 @@ def parse_keypoint_csv(
     ParseError
         On a bad header, row, cell, duplicate (frame, keypoint), or a missing frame rate,
         naming the file, the line and the column.
+    TooLargeError
+        Beyond ``limits``.
     """
     path = str(path)
     lines = decode_text(data, path).splitlines()
@@ -212,6 +220,8 @@ def parse_keypoint_csv(
     n_frames = max(r[0] for r in rows) - first + 1
     if n_frames > _MAX_FRAME_GAP_FACTOR * len(rows):
         raise ParseError(f"Expected contiguous frame numbers, got a span of {n_frames}", path)
+    if limits is not None:
+        check_take_size(n_frames, len(names), Path(path).name, limits)
     positions = np.full((n_frames, len(names), 3), np.nan)
     confidence = np.zeros((n_frames, len(names)))
     seen = np.zeros((n_frames, len(names)), dtype=bool)
@@ -241,10 +251,14 @@ def parse_keypoint_csv(
 
 
 def read_keypoint_csv(
-    path: str | Path, fps: float | None = None, length_unit: str | None = None
+    path: str | Path,
+    fps: float | None = None,
+    length_unit: str | None = None,
+    limits: ReadLimits | None = None,
 ) -> KeypointSequence:
     """Read a long keypoint CSV file and its sidecar, if any. See :func:`parse_keypoint_csv`."""
-    return parse_keypoint_csv(read_file_bytes(path), path, fps, length_unit, _read_sidecar(path))
+    data = read_file_bytes(path)
+    return parse_keypoint_csv(data, path, fps, length_unit, _read_sidecar(path), limits)
 
 
 def _cell(value: float) -> str:

@@ -30,6 +30,7 @@ import numpy as np
 
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import ParseError
+from mocapqa.io.guards import ReadLimits, check_take_size
 from mocapqa.io.keypoint_input import (
     build_keypoint_sequence,
     decode_text,
@@ -80,6 +81,7 @@ def parse_mediapipe_csv(
     path: str | Path = "<mediapipe.csv>",
     fps: float | None = None,
     length_unit: str | None = None,
+    limits: ReadLimits | None = None,
 ) -> KeypointSequence:
     """Parse the long MediaPipe CSV ``frame_number,landmark,x,y,z[,visibility]``.
 
@@ -93,6 +95,9 @@ def parse_mediapipe_csv(
         Frames per second (not stored in the file); default 30, recorded.
     length_unit : str, optional
         Unit of x, y, z; default "m" (world landmarks), recorded.
+    limits : ReadLimits, optional
+        Refuse a take spanning more frames × 33 than ``limits.max_frame_points`` before its
+        arrays are made (the frame numbers can claim far more frames than the rows hold).
 
     Returns
     -------
@@ -103,6 +108,8 @@ def parse_mediapipe_csv(
     ------
     ParseError
         On a wrong header, bad cells, unknown landmarks or duplicate rows (file and line).
+    TooLargeError
+        Beyond ``limits``.
     """
     path = str(path)
     lines = decode_text(data, path).splitlines()
@@ -133,6 +140,8 @@ def parse_mediapipe_csv(
     n_frames = max(r[0] for r in rows) - first + 1
     if n_frames > _MAX_FRAME_GAP_FACTOR * len(rows):
         raise ParseError(f"Expected contiguous frame numbers, got a span of {n_frames}", path)
+    if limits is not None:
+        check_take_size(n_frames, _N, Path(path).name, limits)
     positions = np.full((n_frames, _N, 3), np.nan)
     confidence = np.zeros((n_frames, _N))
     seen = np.zeros((n_frames, _N), dtype=bool)
@@ -157,10 +166,13 @@ def parse_mediapipe_csv(
 
 
 def read_mediapipe_csv(
-    path: str | Path, fps: float | None = None, length_unit: str | None = None
+    path: str | Path,
+    fps: float | None = None,
+    length_unit: str | None = None,
+    limits: ReadLimits | None = None,
 ) -> KeypointSequence:
     """Read a long MediaPipe CSV. See :func:`parse_mediapipe_csv`."""
-    return parse_mediapipe_csv(read_file_bytes(path), path, fps, length_unit)
+    return parse_mediapipe_csv(read_file_bytes(path), path, fps, length_unit, limits)
 
 
 def _landmark_value(item: dict[str, Any], key: str, path: str, field: str) -> float:
