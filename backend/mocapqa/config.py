@@ -55,12 +55,15 @@ class Settings(BaseSettings):
         Deepest nesting of a JSON take.
     max_run_attempts : int
         Starts of a run interrupted by a server stop before it is failed with the reason.
-    max_queued_runs_per_client : int
-        Runs one client (address) may have queued or running at once; more get 429.
-    uploads_per_minute_per_client : int
-        Uploads one client may start per minute; more get 429 with ``Retry-After``.
+    max_queued_runs_per_user : int
+        Runs one user may have queued or running at once; more get 429 with ``Retry-After``.
+        Anonymous requests (a server without users) count per client address.
+    uploads_per_minute_per_user : int
+        Uploads (and shoot imports) one user may start per minute; more get 429 with
+        ``Retry-After``, before the body is read. Anonymous requests count per address.
     allowed_hosts : list of str
-        Accepted ``Host`` header names (``*`` accepts any); loopback names by default.
+        Accepted ``Host`` header names (``*`` accepts any, ``*.example.org`` a domain's);
+        IPv6 addresses with or without brackets. Loopback names by default.
     cors_origins : list of str
         Origins allowed to call the API from another site (CORS); none by default.
     stream_max_keypoints : int
@@ -93,11 +96,9 @@ class Settings(BaseSettings):
     max_line_bytes: int = 1_000_000
     max_json_depth: int = 64
     max_run_attempts: int = 2
-    max_queued_runs_per_client: int = 20
-    uploads_per_minute_per_client: int = 30
-    allowed_hosts: list[str] = Field(
-        default_factory=lambda: ["localhost", "127.0.0.1", "::1", "[::1]"]
-    )
+    max_queued_runs_per_user: int = 20
+    uploads_per_minute_per_user: int = 30
+    allowed_hosts: list[str] = Field(default_factory=lambda: ["localhost", "127.0.0.1", "::1"])
     cors_origins: list[str] = Field(default_factory=list)
     stream_max_keypoints: int = 1000
     stream_max_frame_bytes: int = 1_000_000

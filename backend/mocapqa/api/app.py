@@ -23,7 +23,7 @@ from fastapi.responses import FileResponse, HTMLResponse, RedirectResponse
 from fastapi.staticfiles import StaticFiles
 
 from mocapqa import __version__
-from mocapqa.api.auth import require
+from mocapqa.api.auth import quota_key_before_body, require
 from mocapqa.api.deps import Services
 from mocapqa.api.errors import install_error_handlers
 from mocapqa.api.http_guards import install_http_guards
@@ -158,6 +158,7 @@ def create_app(
         settings,
         f"{API_PREFIX}/takes",
         runner.pending,
+        lambda connection: quota_key_before_body(connection, accounts),
         re.compile(rf"{API_PREFIX}/shoots/[^/]+/takes"),
     )
     install_error_handlers(app)

@@ -39,6 +39,8 @@ __all__ = [
     "client_address",
     "get_accounts",
     "get_principal",
+    "quota_key",
+    "quota_key_before_body",
     "require",
     "require_owner",
 ]
@@ -89,6 +91,35 @@ def client_address(connection: HTTPConnection) -> str:
     return connection.client.host if connection.client else "unknown"
 
 
+def _credential(connection: HTTPConnection) -> tuple[str, str] | None:
+    """The credential a request presents: ``("api", token)`` from ``Authorization`` (token
+    ``""`` when the header has another form), ``("session", cookie)``, or None."""
+    header = connection.headers.get("authorization", "")
+    if header:
+        scheme, _, token = header.partition(" ")
+        return ("api", token.strip() if scheme.lower() == "bearer" else "")
+    cookie = connection.cookies.get(SESSION_COOKIE)
+    return ("session", cookie) if cookie else None
+
+
+def quota_key(user_id: int | None, address: str) -> str:
+    """Whose quotas (queued runs, upload rate) and fair-queue line a request uses: the
+    signed-in user's, else (anonymous) the client address's."""
+    return f"user:{user_id}" if user_id is not None else address
+
+
+def quota_key_before_body(connection: HTTPConnection, accounts: Accounts) -> str:
+    """:func:`quota_key` from the credential alone, before the body is read: a token or
+    session is looked up (a hash and one query by primary key, no write); an unknown one
+    falls back to the address (the route then answers 401)."""
+    credential = _credential(connection)
+    user_id = None
+    if credential is not None:
+        kind, token = credential
+        user_id = accounts.user_id_of(token, kind) if token else None
+    return quota_key(user_id, client_address(connection))
+
+
 def get_principal(connection: HTTPConnection, accounts: AccountsDep) -> Principal:
     """Who the request acts as (see the module notes).
 
@@ -99,16 +130,14 @@ def get_principal(connection: HTTPConnection, accounts: AccountsDep) -> Principa
     ForbiddenError
         A cookie-authenticated state-changing request without the session's CSRF token (403).
     """
-    header = connection.headers.get("authorization", "")
-    if header:
-        scheme, _, token = header.partition(" ")
-        if scheme.lower() != "bearer" or not token.strip():
-            raise AuthenticationError("Expected 'Authorization: Bearer TOKEN', got another form")
-        user, _ = accounts.verify(token.strip(), "api")
+    credential = _credential(connection)
+    if credential == ("api", ""):
+        raise AuthenticationError("Expected 'Authorization: Bearer TOKEN', got another form")
+    if credential is not None and credential[0] == "api":
+        user, _ = accounts.verify(credential[1], "api")
         return Principal(user, user.role, "token")
-    cookie = connection.cookies.get(SESSION_COOKIE)
-    if cookie:
-        user, csrf = accounts.verify(cookie, "session")
+    if credential is not None:
+        user, csrf = accounts.verify(credential[1], "session")
         method = connection.scope.get("method", "GET")
         if method in _STATE_CHANGING:
             sent = connection.headers.get(CSRF_HEADER, "")

@@ -7,7 +7,7 @@ from typing import Annotated, Any
 
 from fastapi import Depends, Request
 
-from mocapqa.api.auth import PrincipalDep
+from mocapqa.api.auth import PrincipalDep, client_address, quota_key
 from mocapqa.config import Settings
 from mocapqa.errors import RateLimitError
 from mocapqa.jobs.runner import JobRunner
@@ -61,10 +61,8 @@ TakeDep = Annotated[dict[str, Any], Depends(get_take)]
 
 def get_client(request: Request, principal: PrincipalDep) -> str:
     """Who is asking, for quotas and fair scheduling: the signed-in user, else (a server
-    without users) the client's address."""
-    if principal.user is not None:
-        return f"user:{principal.user.id}"
-    return request.client.host if request.client else "unknown"
+    without users) the client's address (:func:`~mocapqa.api.auth.quota_key`)."""
+    return quota_key(principal.user_id, client_address(request))
 
 
 ClientDep = Annotated[str, Depends(get_client)]
@@ -72,16 +70,16 @@ ClientDep = Annotated[str, Depends(get_client)]
 
 
 def require_run_slot(services: Services, client: str) -> None:
-    """Refuse (429) a new run from a client with ``max_queued_runs_per_client`` waiting.
+    """Refuse (429) a new run from a user with ``max_queued_runs_per_user`` waiting.
 
     Raises
     ------
     RateLimitError
     """
-    limit = services.settings.max_queued_runs_per_client
+    limit = services.settings.max_queued_runs_per_user
     if services.runner.pending(client) >= limit:
         raise RateLimitError(
-            f"Expected at most {limit} queued runs per client (setting "
-            "max_queued_runs_per_client), got that many waiting",
+            f"Expected at most {limit} queued runs per user (setting "
+            "max_queued_runs_per_user), got that many waiting",
             retry_after_s=10,
         )

@@ -11,15 +11,19 @@ One ASGI middleware (:class:`RequestGuard`), so each check answers before the bo
   ``max_upload_mb`` (plus the multipart envelope), a shoot import (many files or archives in
   one request) ``archive_max_unpacked_mb``, every other route ``max_request_kb``.
   Over the limit the request gets 413 and no more of the body is read.
-* **Upload rate and queued runs per client**: an upload beyond
-  ``uploads_per_minute_per_client``, or from a client with ``max_queued_runs_per_client`` runs
-  waiting, gets 429 with ``Retry-After`` before its body is read.
+* **Upload rate and queued runs per user**: an upload (or shoot import) beyond
+  ``uploads_per_minute_per_user``, or from a user with ``max_queued_runs_per_user`` runs
+  waiting, gets 429 with ``Retry-After`` before its body is read. The user is found from the
+  request's token or session cookie alone (a hash and one query by primary key, on a worker
+  thread); an anonymous request, or one whose credential is not valid (the route answers
+  401), counts against its client address.
 * **Security headers** on every answer: a Content-Security-Policy the dashboard satisfies (no
   inline script; Plotly sets inline styles), ``frame-ancestors 'none'``, ``nosniff``,
   ``Referrer-Policy: same-origin``.
 
-The ``Host`` header is checked by Starlette's ``TrustedHostMiddleware`` and CORS (off unless
-``cors_origins`` is set) by its ``CORSMiddleware``; :func:`install_http_guards` adds all three.
+The ``Host`` header is checked by :class:`~mocapqa.api.host_check.HostCheck` (IPv6 literals
+compared as addresses) and CORS (off unless ``cors_origins`` is set) by Starlette's
+``CORSMiddleware``; :func:`install_http_guards` adds all three.
 """
 
 from __future__ import annotations
@@ -33,13 +37,15 @@ from collections.abc import Callable
 from urllib.parse import urlsplit
 
 from fastapi import FastAPI
+from starlette.concurrency import run_in_threadpool
 from starlette.datastructures import Headers
 from starlette.middleware.body_limit import RequestBodyLimitMiddleware
 from starlette.middleware.cors import CORSMiddleware
-from starlette.middleware.trustedhost import TrustedHostMiddleware
+from starlette.requests import HTTPConnection
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from mocapqa.api.errors import error_body
+from mocapqa.api.host_check import HostCheck
 from mocapqa.config import Settings
 
 __all__ = [
@@ -47,7 +53,6 @@ __all__ = [
     "MULTIPART_SLACK_BYTES",
     "RateWindow",
     "RequestGuard",
-    "client_key",
     "install_http_guards",
     "origin_allowed",
 ]
@@ -67,13 +72,6 @@ _DOCS_PATHS = ("/docs", "/redoc")
 MULTIPART_SLACK_BYTES = 64_000
 """Allowance for the multipart envelope around an upload's file."""
 _STATE_CHANGING = frozenset({"POST", "PUT", "PATCH", "DELETE"})
-
-
-def client_key(scope: Scope) -> str:
-    """Who is asking, before the body is read: the client's address (the routes count queued
-    runs per signed-in user, ``deps.get_client``)."""
-    client = scope.get("client")
-    return str(client[0]) if client else "unknown"
 
 
 def origin_allowed(headers: Headers, cors_origins: list[str]) -> bool:
@@ -96,7 +94,7 @@ def origin_allowed(headers: Headers, cors_origins: list[str]) -> bool:
 
 
 class RateWindow:
-    """Events per client in a sliding window (thread-safe).
+    """Events per key (a user, or an address) in a sliding window (thread-safe).
 
     Parameters
     ----------
@@ -127,7 +125,7 @@ class RateWindow:
             if len(events) >= self.limit:
                 return events[0] + self.window_s - now
             events.append(now)
-            if len(self._events) > 10_000:  # forget idle clients
+            if len(self._events) > 10_000:  # forget idle keys
                 for idle in [k for k, v in self._events.items() if not v]:
                     del self._events[idle]
             return 0.0
@@ -150,15 +148,17 @@ class RequestGuard:
         settings: Settings,
         upload_path: str,
         pending_runs: Callable[[str], int],
+        quota_key: Callable[[HTTPConnection], str],
         import_paths: re.Pattern[str] | None = None,
     ) -> None:
         self.app = app
+        self.quota_key = quota_key
         self.settings = settings
         self.upload_path = upload_path
         self.import_paths = import_paths
         self.import_bytes = int(settings.archive_max_unpacked_mb * 1_000_000)
         self.pending_runs = pending_runs
-        self.uploads = RateWindow(settings.uploads_per_minute_per_client)
+        self.uploads = RateWindow(settings.uploads_per_minute_per_user)
         self.upload_bytes = int(settings.max_upload_mb * 1_000_000) + MULTIPART_SLACK_BYTES
         self.request_bytes = int(settings.max_request_kb * 1000)
 
@@ -183,7 +183,8 @@ class RequestGuard:
             await _send_json(secured, 403, error_body("ForbiddenError", detail))
             return
         if is_upload:
-            refused = self._upload_refusal(client_key(scope))
+            key = await run_in_threadpool(self.quota_key, HTTPConnection(scope))
+            refused = self._upload_refusal(key)
             if refused is not None:
                 await _send_json(secured, 429, refused[0], refused[1])
                 return
@@ -192,17 +193,17 @@ class RequestGuard:
             limit = self.import_bytes
         await RequestBodyLimitMiddleware(self.app, limit)(scope, receive, secured)
 
-    def _upload_refusal(self, client: str) -> tuple[dict[str, object], int] | None:
-        limit = self.settings.max_queued_runs_per_client
-        if self.pending_runs(client) >= limit:
-            detail = f"Expected at most {limit} queued runs per client (setting "
-            detail += "max_queued_runs_per_client), got that many waiting"
+    def _upload_refusal(self, key: str) -> tuple[dict[str, object], int] | None:
+        limit = self.settings.max_queued_runs_per_user
+        if self.pending_runs(key) >= limit:
+            detail = f"Expected at most {limit} queued runs per user (setting "
+            detail += "max_queued_runs_per_user), got that many waiting"
             return error_body("RateLimitError", detail), 10
-        wait = self.uploads.admit(client)
+        wait = self.uploads.admit(key)
         if wait > 0:
-            per_minute = self.settings.uploads_per_minute_per_client
-            detail = f"Expected at most {per_minute} uploads per minute per client (setting "
-            detail += "uploads_per_minute_per_client), got more"
+            per_minute = self.settings.uploads_per_minute_per_user
+            detail = f"Expected at most {per_minute} uploads per minute per user (setting "
+            detail += "uploads_per_minute_per_user), got more"
             return error_body("RateLimitError", detail), int(wait) + 1
         return None
 
@@ -249,16 +250,20 @@ def install_http_guards(
     settings: Settings,
     upload_path: str,
     pending_runs: Callable[[str], int],
+    quota_key: Callable[[HTTPConnection], str],
     import_paths: re.Pattern[str] | None = None,
 ) -> None:
     """Add the request guard, CORS (when ``cors_origins`` is set) and the Host check, in the
-    order that makes the Host check run first. ``import_paths`` matches the routes that take
-    many files in one request (uploads with the import body limit)."""
+    order that makes the Host check run first. ``pending_runs`` counts a quota key's queued
+    runs, ``quota_key`` names a request's key from its headers (a blocking call: it runs on a
+    worker thread); ``import_paths`` matches the routes that take many files in one request
+    (uploads with the import body limit)."""
     app.add_middleware(
         RequestGuard,
         settings=settings,
         upload_path=upload_path,
         pending_runs=pending_runs,
+        quota_key=quota_key,
         import_paths=import_paths,
     )
     if settings.cors_origins:
@@ -269,4 +274,4 @@ def install_http_guards(
             allow_headers=["Content-Type", "Authorization"],
             max_age=600,
         )
-    app.add_middleware(TrustedHostMiddleware, allowed_hosts=settings.allowed_hosts)
+    app.add_middleware(HostCheck, allowed_hosts=settings.allowed_hosts)

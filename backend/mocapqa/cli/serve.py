@@ -89,7 +89,8 @@ def serve(
         # The address served on is a name clients use; others go in MOCAPQA_ALLOWED_HOSTS.
         settings = settings.model_copy(update={"allowed_hosts": [*settings.allowed_hosts, host]})
     link = _sign_in(host, port)
-    typer.echo(f"mocapqa: data in {settings.data_dir}, dashboard at http://{host}:{port}/")
+    shown = f"[{host}]" if ":" in host else host  # an IPv6 address is bracketed in a URL
+    typer.echo(f"mocapqa: data in {settings.data_dir}, dashboard at http://{shown}:{port}/")
     if link:
         typer.echo(f"mocapqa: sign in (once, within 15 minutes) at {link}")
     uvicorn.run(

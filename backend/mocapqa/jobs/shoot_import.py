@@ -19,6 +19,7 @@ from mocapqa.jobs.archive import archive_kind, unpack
 from mocapqa.jobs.batch import MOTION_SUFFIXES
 from mocapqa.jobs.intake import CHUNK_BYTES, ingest_take
 from mocapqa.jobs.runner import JobRunner
+from mocapqa.pipeline.loading import ReadLimits
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
 
@@ -37,11 +38,14 @@ class ImportLimits:
         Most members of an archive.
     max_unpacked_bytes : int
         Most bytes an archive may unpack to.
+    read : ReadLimits, optional
+        Each take's read limits (frames × points, joints, ...), as for a single upload.
     """
 
     max_upload_bytes: int
     max_members: int
     max_unpacked_bytes: int
+    read: ReadLimits | None = None
 
 
 @dataclass
@@ -76,8 +80,10 @@ def import_uploads(
     files: FileStore,
     runner: JobRunner,
     limits: ImportLimits,
+    client: str = "local",
 ) -> ImportReport:
-    """Import uploaded files (takes or archives of takes) into a shoot; analyses start.
+    """Import uploaded files (takes or archives of takes) into a shoot; analyses start, in
+    ``client``'s line of the runner's fair queue (and counted in its queued runs).
 
     Raises
     ------
@@ -91,7 +97,15 @@ def import_uploads(
     def ingest(source: BinaryIO, name: str, label: str | None = None) -> None:
         try:
             take_id, run_id = ingest_take(
-                source, name, repository, files, runner, limits.max_upload_bytes, shoot_id=shoot_id
+                source,
+                name,
+                repository,
+                files,
+                runner,
+                limits.max_upload_bytes,
+                limits=limits.read,
+                client=client,
+                shoot_id=shoot_id,
             )
         except MocapQAError as e:
             report.failed.append({"name": label or name, "error": str(e)})

@@ -82,6 +82,18 @@ def _digest(secret: str) -> str:
     return hashlib.sha256(secret.encode()).hexdigest()
 
 
+def _usable(row: Any, kind: str, secret: str, now: datetime | None = None) -> bool:
+    """Whether a token row (joined with its user) is a live credential of ``kind`` for
+    ``secret``."""
+    return bool(
+        row.kind == kind
+        and hmac.compare_digest(row.secret_sha256, _digest(secret))
+        and row.revoked_at is None
+        and _aware(row.expires_at) > (now or utc_now())
+        and not row.disabled
+    )
+
+
 def _aware(value: datetime) -> datetime:
     return value if value.tzinfo else value.replace(tzinfo=UTC)
 
@@ -280,14 +292,7 @@ class Accounts:
                 .join(users, users.c.id == tokens.c.user_id)
                 .where(tokens.c.id == token_id)
             ).first()
-            if (
-                row is None
-                or row.kind != kind
-                or not hmac.compare_digest(row.secret_sha256, _digest(secret))
-                or row.revoked_at is not None
-                or _aware(row.expires_at) <= now
-                or row.disabled
-            ):
+            if row is None or not _usable(row, kind, secret, now):
                 raise refused
             values: dict[str, Any] = {"last_used_at": now}
             if consume:
@@ -301,6 +306,31 @@ class Accounts:
                 raise refused
             user = self.user_by_id(int(row.user_id))
         return user, row.csrf
+
+    def user_id_of(self, token: str, kind: str) -> int | None:
+        """The id of the user a valid credential of ``kind`` names, else None; reads only.
+
+        The cheap lookup for a quota before a request's body is read (a hash and one query
+        by primary key); :meth:`verify` is the full check a route makes.
+        """
+        match = _TOKEN.match(token)
+        if match is None:
+            return None
+        token_id, secret = match.groups()
+        with self.engine.connect() as conn:
+            row = conn.execute(
+                select(
+                    tokens.c.user_id,
+                    tokens.c.kind,
+                    tokens.c.secret_sha256,
+                    tokens.c.revoked_at,
+                    tokens.c.expires_at,
+                    users.c.disabled,
+                )
+                .join(users, users.c.id == tokens.c.user_id)
+                .where(tokens.c.id == token_id)
+            ).first()
+        return None if row is None or not _usable(row, kind, secret) else int(row.user_id)
 
     def list_tokens(self, user_id: int | None = None) -> list[dict[str, Any]]:
         """Personal tokens (never their secrets), newest first; of one user or of all."""

@@ -13,7 +13,7 @@ from fastapi import APIRouter, Depends, File, Query, Request, Response, UploadFi
 from fastapi.responses import StreamingResponse
 
 from mocapqa.api.auth import Principal, audit, require, require_owner
-from mocapqa.api.deps import ServicesDep
+from mocapqa.api.deps import ClientDep, ServicesDep
 from mocapqa.api.errors import responses
 from mocapqa.api.shoot_schemas import (
     HeatmapOut,
@@ -126,6 +126,7 @@ def import_takes(
     principal: Maker,
     shoot_id: str,
     services: ServicesDep,
+    client: ClientDep,
     files: Annotated[list[UploadFile], File(description="Takes, .zip or .tar.gz archives")],
 ) -> ImportOut:
     """Import takes into a shoot: many files at once (multipart field ``files``, repeated),
@@ -141,6 +142,7 @@ def import_takes(
         max_upload_bytes=int(settings.max_upload_mb * 1_000_000),
         max_members=settings.archive_max_members,
         max_unpacked_bytes=int(settings.archive_max_unpacked_mb * 1_000_000),
+        read=settings.read_limits,
     )
     report = import_uploads(
         [(f.file, f.filename or "take") for f in files],
@@ -149,6 +151,7 @@ def import_takes(
         services.files,
         services.runner,
         limits,
+        client,
     )
     for take in report.created:
         services.repository.set_owner(take["take_id"], principal.user_id)
