@@ -168,15 +168,15 @@ def test_a_database_without_the_attempts_column_still_opens(tmp_path: Path) -> N
 def test_settings_document_every_limit() -> None:
     docs = (Path(__file__).resolve().parents[2] / "docs" / "api.md").read_text()
     limits = [name for name in Settings.model_fields if name.startswith(("max_", "stream_"))]
-    limits += ["uploads_per_minute_per_client", "allowed_hosts", "cors_origins"]
+    limits += ["uploads_per_minute_per_user", "allowed_hosts", "cors_origins"]
     missing = [name for name in limits if name not in docs]
     assert missing == []
 
 
-def test_queued_runs_per_client_are_limited(
+def test_queued_runs_per_user_are_limited(
     tmp_path: Path, cmu_walk: Path, renderer: RenderService, upload: Uploader
 ) -> None:
-    settings = make_settings("sqlite", tmp_path, max_queued_runs_per_client=2, job_workers=1)
+    settings = make_settings("sqlite", tmp_path, max_queued_runs_per_user=2, job_workers=1)
     with TestClient(create_app(settings, renderer=renderer)) as client:
         runner = client.app.state.services.runner  # type: ignore[attr-defined]
         take = upload(client, cmu_walk)
@@ -186,7 +186,7 @@ def test_queued_runs_per_client_are_limited(
         assert 429 in statuses
         refused = answers[statuses.index(429)]
         assert refused.json()["error"] == "RateLimitError"
-        assert "max_queued_runs_per_client" in refused.json()["detail"]
+        assert "max_queued_runs_per_user" in refused.json()["detail"]
         assert int(refused.headers["retry-after"]) >= 1
         for answer in answers:
             if answer.status_code == 201:

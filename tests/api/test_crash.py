@@ -20,7 +20,7 @@ from typing import Any
 
 import httpx
 import pytest
-from tests.api.live_server import free_port
+from tests.live_server import free_port
 
 from mocapqa.cli.serve import FIRST_ADMIN
 from mocapqa.store.accounts import Accounts

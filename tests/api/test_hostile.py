@@ -13,23 +13,28 @@ from __future__ import annotations
 
 import io
 import json
+import socket
 import threading
 import time
 import tracemalloc
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from datetime import timedelta
 from pathlib import Path
 from typing import Any
+from urllib.parse import urlsplit
 
 import httpx
 import numpy as np
 import pytest
 from tests.api.conftest import make_settings
-from tests.api.live_server import live_server
+from tests.live_server import live_server, serve
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
+from mocapqa.api.app import create_app
 from mocapqa.config import Settings
+from mocapqa.store.roles import Role
 
 ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts"
 MAX_SECONDS = 20.0
@@ -68,8 +73,8 @@ def settings(data_dir: Path) -> Settings:
         data_dir,
         max_upload_mb=8.0,
         max_unpacked_mb=20.0,
-        uploads_per_minute_per_client=1000,
-        allowed_hosts=["127.0.0.1", "localhost"],
+        uploads_per_minute_per_user=1000,
+        allowed_hosts=["127.0.0.1", "localhost", "::1"],
     )
 
 
@@ -363,19 +368,238 @@ def test_stream_refuses_other_origins(url: str) -> None:
     assert response.status_code == 403
 
 
-def test_upload_rate_is_limited_per_client(tmp_path: Path, cmu_walk: Path) -> None:
+def test_anonymous_upload_rate_is_limited_per_address(tmp_path: Path, cmu_walk: Path) -> None:
+    """A server without users: the budget is the client address's."""
     settings = make_settings(
-        "sqlite", tmp_path, uploads_per_minute_per_client=2, allowed_hosts=["127.0.0.1"]
+        "sqlite", tmp_path, uploads_per_minute_per_user=2, allowed_hosts=["127.0.0.1"]
     )
     data = cmu_walk.read_bytes()
     with live_server(settings) as base:
         statuses = [upload(base, "walk.bvh", data).status_code for _ in range(2)]
         response, _ = measure(
-            "3rd upload in a minute (limit 2)", base, lambda: upload(base, "w.bvh", data)
+            "3rd anonymous upload in a minute from one address (limit 2)",
+            base,
+            lambda: upload(base, "w.bvh", data),
         )
     assert statuses == [201, 201]
     assert response.status_code == 429
     assert 1 <= int(response.headers["retry-after"]) <= 61
+
+
+def raw_request(url: str, head: str, body: bytes = b"", wait_s: float = 120.0) -> httpx.Response:
+    """Send a request's head (and the start of its body) on a socket, then read the answer
+    without sending the rest: a server waiting for the body would never answer (the read
+    then times out after ``wait_s`` and the test fails)."""
+    address = urlsplit(url)
+    with socket.create_connection((address.hostname, address.port), timeout=wait_s) as sock:
+        sock.sendall(head.encode() + body)
+        data = b""
+        while b"\r\n\r\n" not in data:
+            chunk = sock.recv(65536)
+            if not chunk:
+                return httpx.Response(599, text="closed before answering")
+            data += chunk
+        start, _, rest = data.partition(b"\r\n\r\n")
+        lines = start.decode("latin-1").split("\r\n")
+        headers = dict(line.split(": ", 1) for line in lines[1:])
+        length = int({k.lower(): v for k, v in headers.items()}.get("content-length", "0"))
+        while len(rest) < length and (chunk := sock.recv(65536)):
+            rest += chunk
+    return httpx.Response(int(lines[0].split()[1]), headers=headers, content=rest[:length])
+
+
+@pytest.fixture
+def team(tmp_path: Path) -> Iterator[tuple[str, Settings, dict[str, dict[str, str]]]]:
+    """A server with two reviewers, ``alice`` and ``bob`` (both on 127.0.0.1), two uploads a
+    minute each; yields the URL, the settings and each one's Bearer header."""
+    settings = make_settings(
+        "sqlite", tmp_path, uploads_per_minute_per_user=2, allowed_hosts=["127.0.0.1"]
+    )
+    app = create_app(settings)
+    accounts = app.state.accounts
+    bearers = {
+        name: {
+            "Authorization": "Bearer "
+            + accounts.issue(
+                accounts.add_user(name, Role.REVIEWER).id, "api", timedelta(days=1)
+            ).token
+        }
+        for name in ("alice", "bob")
+    }
+    with serve(app) as url:
+        yield url, settings, bearers
+
+
+def test_upload_rate_is_per_user_and_checked_before_the_body(
+    team: tuple[str, Settings, dict[str, dict[str, str]]], cmu_walk: Path
+) -> None:
+    """Two users behind one address each have their own budget; the one over it gets 429 with
+    ``Retry-After`` before a byte of the body is read (an endless chunked body, a 2 GB
+    Content-Length), while the other one's uploads still succeed."""
+    url, settings, bearers = team
+    alice, bob = bearers["alice"], bearers["bob"]
+    data = cmu_walk.read_bytes()
+    assert [upload(url, "walk.bvh", data, **alice).status_code for _ in range(2)] == [201, 201]
+
+    refused, _ = measure(
+        "3rd upload of a user in a minute (limit 2)",
+        url,
+        lambda: upload(url, "walk.bvh", data, **alice),
+    )
+    assert refused.status_code == 429, refused.text
+    assert 1 <= int(refused.headers["retry-after"]) <= 61
+    assert refused.json()["error"] == "RateLimitError"
+    assert "uploads_per_minute_per_user" in refused.json()["detail"]
+
+    host = urlsplit(url).netloc
+    head = f"POST /api/v1/takes HTTP/1.1\r\nHost: {host}\r\n"
+    head += f"Authorization: {alice['Authorization']}\r\n"
+    head += "Content-Type: multipart/form-data; boundary=b\r\n"
+    chunked, _ = measure(
+        "user over the upload rate: chunked body, 1 MB of an endless one sent",
+        url,
+        lambda: raw_request(
+            url, head + "Transfer-Encoding: chunked\r\n\r\n", b"100000\r\n" + b"0" * (1 << 20)
+        ),
+    )
+    assert chunked.status_code == 429, chunked.text
+    assert int(chunked.headers["retry-after"]) >= 1
+    declared, _ = measure(
+        "user over the upload rate: Content-Length 2 GB, no body sent",
+        url,
+        lambda: raw_request(url, head + "Content-Length: 2000000000\r\n\r\n"),
+    )
+    assert declared.status_code == 429, declared.text
+
+    other, _ = measure(
+        "another user behind the same address, meanwhile",
+        url,
+        lambda: upload(url, "walk.bvh", data, **bob),
+    )
+    assert other.status_code == 201, other.text
+    assert upload(url, "walk.bvh", data, **bob).status_code == 201
+    assert upload(url, "walk.bvh", data, **bob).status_code == 429  # bob's own budget is 2
+
+    takes = httpx.get(f"{url}/api/v1/takes", headers=alice, timeout=60).json()
+    assert takes["total"] == 4  # two of alice's, two of bob's; nothing of the refused ones
+    assert sorted(p.name for p in (settings.data_dir / "takes").iterdir()) == sorted(
+        t["id"] for t in takes["items"]
+    )
+    assert list((settings.data_dir / "incoming").iterdir()) == []
+
+
+FRAME_POINTS_PEAK_MB = 30.0
+"""Bound on the traced memory of these refusals: parsed, they take 59–335 MB (measured with
+``tracemalloc``: 76 MB the TRC, 170 and 335 MB the long CSVs, 59 and 169 MB the sparse ones)."""
+FRAME_POINT_UPLOADS: dict[str, tuple[str, Callable[[], bytes]]] = {
+    "keypoint CSV of 500,000 lines (limit 200,000 frames × points)": (
+        "long.csv",
+        lambda: (
+            b"frame,keypoint,x,y,z\n"
+            + b"".join(b"%d,k%d,0,0,0\n" % (i // 17, i % 17) for i in range(500_000))
+        ),
+    ),
+    "MediaPipe CSV of 400,000 lines (limit 200,000 frames × points)": (
+        "landmarks.csv",
+        lambda: (
+            b"frame_number,landmark,x,y,z,visibility\n"
+            + b"".join(b"%d,%d,0,0,0,1\n" % (i // 33, i % 33) for i in range(400_000))
+        ),
+    ),
+    "TRC of 5,000 frames × 100 markers (limit 200,000)": (
+        "markers.trc",
+        lambda: trc_bytes(5000, 100),
+    ),
+    # Few lines, but frame numbers and names that span far more (refused before the arrays).
+    "keypoint CSV of 1,000 lines spanning 4,000 frames × 1,000 keypoints": (
+        "sparse.csv",
+        lambda: (
+            b"frame,keypoint,x,y\n" + b"".join(b"%d,k%d,0,0\n" % (4 * i, i) for i in range(1000))
+        ),
+    ),
+    "MediaPipe CSV of 10,000 lines spanning 40,000 frames × 33": (
+        "sparse_landmarks.csv",
+        lambda: (
+            b"frame_number,landmark,x,y,z\n"
+            + b"".join(b"%d,0,0,0,0\n" % (4 * i) for i in range(10_000))
+        ),
+    ),
+}
+
+
+def trc_bytes(n_frames: int, n_markers: int) -> bytes:
+    """A TRC of ``n_frames`` rows of ``n_markers`` markers at the origin."""
+    names = "\t\t\t".join(f"M{i}" for i in range(n_markers))
+    labels = "\t".join(f"X{i}\tY{i}\tZ{i}" for i in range(1, n_markers + 1))
+    head = [
+        "PathFileType\t4\t(X/Y/Z)\tmarkers.trc",
+        "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame"
+        "\tOrigNumFrames",
+        f"60\t60\t{n_frames}\t{n_markers}\tm\t60\t1\t{n_frames}",
+        f"Frame#\tTime\t{names}",
+        f"\t\t{labels}",
+        "",
+    ]
+    row = "\t".join(["0"] * (3 * n_markers))
+    rows = [f"{i + 1}\t{i / 60:.5f}\t{row}" for i in range(n_frames)]
+    return ("\n".join(head + rows) + "\n").encode()
+
+
+@pytest.fixture(scope="module")
+def small_frames_url(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[str, Settings]]:
+    """A server allowing 200,000 frames × points (so an 8 MB upload can cross it by far)."""
+    settings = make_settings(
+        "sqlite",
+        tmp_path_factory.mktemp("frames"),
+        max_upload_mb=8.0,
+        max_frame_points=200_000,
+        uploads_per_minute_per_user=1000,
+        allowed_hosts=["127.0.0.1"],
+    )
+    with live_server(settings) as base:
+        yield base, settings
+
+
+@pytest.mark.parametrize("case", sorted(FRAME_POINT_UPLOADS))
+def test_frames_times_points_are_counted_before_parsing(
+    case: str, small_frames_url: tuple[str, Settings]
+) -> None:
+    url, settings = small_frames_url
+    name, make = FRAME_POINT_UPLOADS[case]
+    data = make()
+    assert len(data) < 8_000_000
+    response, measured = measure(case, url, lambda: upload(url, name, data))
+    assert response.status_code == 413, response.text
+    assert measured.peak_mb < FRAME_POINTS_PEAK_MB, measured
+    body = response.json()
+    assert body["error"] == "TooLargeError"
+    assert "max_frame_points" in body["detail"]
+    assert body["detail"].startswith(f"{name}:")
+    assert stored(settings, url) == (0, [])
+
+
+@pytest.mark.parametrize(
+    ("host", "status"),
+    [
+        ("[::1]:8000", 200),
+        ("[::1]", 200),
+        ("[0:0:0:0:0:0:0:1]:80", 200),
+        ("[::2]:8000", 400),
+        ("[evil.example]:8000", 400),
+        ("[::1", 400),
+        ("::1", 400),
+    ],
+)
+def test_ipv6_host_header(host: str, status: int, url: str) -> None:
+    """The module's server allows ``::1`` (written without brackets in the setting)."""
+    response, _ = measure(
+        f"Host: {host}",
+        url,
+        lambda: httpx.get(f"{url}/api/v1/health", headers={"Host": host}),
+    )
+    assert response.status_code == status, response.text
+    if status == 400:
+        assert response.json()["error"] == "HostError"
 
 
 def test_stream_work_stays_off_the_event_loop(url: str) -> None:

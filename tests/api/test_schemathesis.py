@@ -20,7 +20,7 @@ from pathlib import Path
 import httpx
 import pytest
 from tests.api.conftest import make_settings
-from tests.api.live_server import live_server
+from tests.live_server import live_server
 
 from mocapqa.render.service import RenderService
 from mocapqa.store.accounts import Accounts
@@ -41,7 +41,7 @@ def test_schemathesis_finds_nothing(
     tmp_path: Path, corpus_dir: Path, renderer: RenderService
 ) -> None:
     settings = make_settings(
-        "sqlite", tmp_path, allowed_hosts=["127.0.0.1"], uploads_per_minute_per_client=120
+        "sqlite", tmp_path, allowed_hosts=["127.0.0.1"], uploads_per_minute_per_user=120
     )
     # Signed in as an admin through a personal token (the server has users, so an anonymous
     # request would get 401).

@@ -1,60 +1,21 @@
-"""The dashboard in Debian's Chromium (headless, through Playwright) against a real uvicorn.
+"""The dashboard in Debian's Chromium (headless, through Playwright) against a real uvicorn
+(``conftest.live_server``, its own per module).
 
 Screenshots go to ``test-artifacts/`` at the repository root.
 """
 
 from __future__ import annotations
 
-import socket
-import threading
-import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-import uvicorn
 
-from headless_chromium import CHROMIUM_ARGS, CHROMIUM_PATH
-from mocapqa.api.app import create_app
-from mocapqa.config import Settings
 from mocapqa.io.bvh import parse_bvh, read_bvh
 from mocapqa.jobs.demo import demo_paths
 
 pytestmark = pytest.mark.browser
 
 ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts"
-
-
-@pytest.fixture(scope="module")
-def server_url(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
-    """A uvicorn server on a free loopback port, with an empty data folder."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
-    settings = Settings(data_dir=tmp_path_factory.mktemp("dashboard"))
-    config = uvicorn.Config(create_app(settings), host="127.0.0.1", port=port, log_level="warning")
-    server = uvicorn.Server(config)
-    thread = threading.Thread(target=server.run, daemon=True)
-    thread.start()
-    deadline = time.monotonic() + 30
-    while not server.started:
-        if time.monotonic() > deadline:
-            raise TimeoutError("uvicorn did not start")
-        time.sleep(0.05)
-    yield f"http://127.0.0.1:{port}"
-    server.should_exit = True
-    thread.join(timeout=10)
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[object]:
-    """Headless Chromium."""
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as playwright:
-        chromium = playwright.chromium.launch(executable_path=CHROMIUM_PATH, args=CHROMIUM_ARGS)
-        yield chromium
-        chromium.close()
 
 
 def drawn_points(page: object) -> int:
@@ -82,10 +43,10 @@ def upload_through_page(page: object, path: Path) -> None:
 
 
 def test_upload_view_scrub_jump_review_and_download(
-    server_url: str, browser: object, cmu_walk: Path, tmp_path: Path
+    live_server: str, chromium: object, cmu_walk: Path, tmp_path: Path
 ) -> None:
     ARTIFACTS.mkdir(exist_ok=True)
-    page = browser.new_page(viewport={"width": 1400, "height": 1000})  # type: ignore[attr-defined]
+    page = chromium.new_page(viewport={"width": 1400, "height": 1000})  # type: ignore[attr-defined]
     errors: list[str] = []
     page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
     page.on("pageerror", lambda e: errors.append(str(e)))
@@ -93,7 +54,7 @@ def test_upload_view_scrub_jump_review_and_download(
     # A rejected upload shows the API's message, with the file's line.
     bad = tmp_path / "broken.bvh"
     bad.write_text("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 zero\n")
-    page.goto(f"{server_url}/#/upload")
+    page.goto(f"{live_server}/#/upload")
     page.set_input_files("#file-input", str(bad))
     page.wait_for_selector("#upload-error")
     assert "broken.bvh, line 4" in page.inner_text("#upload-error")

@@ -3,8 +3,6 @@ hidden and the API refuses it), sign out; the account pages load under the CSP."
 
 from __future__ import annotations
 
-import socket
-import threading
 import time
 from collections.abc import Iterator
 from datetime import timedelta
@@ -12,9 +10,8 @@ from pathlib import Path
 
 import httpx
 import pytest
-import uvicorn
+from tests.live_server import serve
 
-from headless_chromium import CHROMIUM_ARGS, CHROMIUM_PATH
 from mocapqa.api.app import create_app
 from mocapqa.config import Settings
 from mocapqa.store.accounts import Accounts
@@ -33,51 +30,23 @@ def team_server(
 ) -> Iterator[tuple[str, str]]:
     """A server with a reviewer ``rita``, a viewer ``vic`` and an admin ``ada``, and a take
     rita uploaded (analysed). Yields the URL and the take's id."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
-    settings = Settings(data_dir=tmp_path_factory.mktemp("accounts"))
-    app = create_app(settings)
-    config = uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning")
-    server = uvicorn.Server(config)
-    thread = threading.Thread(target=server.run, daemon=True)
-    thread.start()
-    deadline = time.monotonic() + 30
-    while not server.started:
-        if time.monotonic() > deadline:
-            raise TimeoutError("uvicorn did not start")
-        time.sleep(0.05)
-    url = f"http://127.0.0.1:{port}"
+    app = create_app(Settings(data_dir=tmp_path_factory.mktemp("accounts")))
     accounts: Accounts = app.state.accounts
     rita = accounts.add_user("rita", Role.REVIEWER, PASSWORD)
     accounts.add_user("vic", Role.VIEWER, PASSWORD)
     accounts.add_user("ada", Role.ADMIN, PASSWORD)
     bearer = {"Authorization": f"Bearer {accounts.issue(rita.id, 'api', timedelta(days=1)).token}"}
     walk = corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh"
-    take = httpx.post(
-        f"{url}/api/v1/takes", files={"file": ("walk.bvh", walk.read_bytes())}, headers=bearer
-    ).json()
-    deadline = time.monotonic() + RUN_BOUND_S
-    while httpx.get(f"{url}/api/v1/runs/{take['run_id']}", headers=bearer).json()["status"] not in (
-        "done",
-        "failed",
-    ):
-        assert time.monotonic() < deadline, "the take's analysis did not finish"
-        time.sleep(0.2)
-    yield url, str(take["id"])
-    server.should_exit = True
-    thread.join(timeout=10)
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[object]:
-    """Headless Chromium."""
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as playwright:
-        chromium = playwright.chromium.launch(executable_path=CHROMIUM_PATH, args=CHROMIUM_ARGS)
-        yield chromium
-        chromium.close()
+    with serve(app) as url:
+        take = httpx.post(
+            f"{url}/api/v1/takes", files={"file": ("walk.bvh", walk.read_bytes())}, headers=bearer
+        ).json()
+        deadline = time.monotonic() + RUN_BOUND_S
+        run_url = f"{url}/api/v1/runs/{take['run_id']}"
+        while httpx.get(run_url, headers=bearer).json()["status"] not in ("done", "failed"):
+            assert time.monotonic() < deadline, "the take's analysis did not finish"
+            time.sleep(0.2)
+        yield url, str(take["id"])
 
 
 def sign_in(page: object, url: str, name: str) -> None:
@@ -94,10 +63,10 @@ def sign_out(page: object) -> None:
     page.wait_for_selector("#signin-form", timeout=60_000)  # type: ignore[attr-defined]
 
 
-def test_reviewer_reviews_viewer_cannot(team_server: tuple[str, str], browser: object) -> None:
+def test_reviewer_reviews_viewer_cannot(team_server: tuple[str, str], chromium: object) -> None:
     url, take_id = team_server
     ARTIFACTS.mkdir(exist_ok=True)
-    context = browser.new_context()  # type: ignore[attr-defined]
+    context = chromium.new_context()  # type: ignore[attr-defined]
     page = context.new_page()
     errors: list[str] = []
     page.on("pageerror", lambda e: errors.append(str(e)))

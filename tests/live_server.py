@@ -1,5 +1,6 @@
-"""A real uvicorn server for tests that need concurrency (``/health`` while another request
-is refused) or a client outside the process (schemathesis)."""
+"""A real uvicorn server in a thread, for every test that needs one: the browser tests, the
+hostile-input suite (``/health`` while another request is refused), schemathesis (a client
+outside the process) and the crash test's free port."""
 
 from __future__ import annotations
 
@@ -10,10 +11,14 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 import uvicorn
+from fastapi import FastAPI
 
 from mocapqa.api.app import create_app
 from mocapqa.config import Settings
 from mocapqa.render.service import RenderService
+
+START_BOUND_S = 120.0
+"""Generous bound on the server's start (a loaded 2-core machine)."""
 
 
 def free_port() -> int:
@@ -24,15 +29,14 @@ def free_port() -> int:
 
 
 @contextmanager
-def live_server(settings: Settings, renderer: RenderService | None = None) -> Iterator[str]:
-    """Serve ``create_app(settings)`` on a free loopback port in a thread; yields the URL."""
+def serve(app: FastAPI) -> Iterator[str]:
+    """Serve ``app`` on a free loopback port in a thread; yields its URL, stops it after."""
     port = free_port()
-    app = create_app(settings, renderer=renderer)
     config = uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning", ws="websockets")
     server = uvicorn.Server(config)
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
-    deadline = time.monotonic() + 120
+    deadline = time.monotonic() + START_BOUND_S
     while not server.started:
         if time.monotonic() > deadline or not thread.is_alive():
             raise TimeoutError("uvicorn did not start")
@@ -42,3 +46,10 @@ def live_server(settings: Settings, renderer: RenderService | None = None) -> It
     finally:
         server.should_exit = True
         thread.join(timeout=60)
+
+
+@contextmanager
+def live_server(settings: Settings, renderer: RenderService | None = None) -> Iterator[str]:
+    """Serve ``create_app(settings)`` (see :func:`serve`); yields the URL."""
+    with serve(create_app(settings, renderer=renderer)) as url:
+        yield url
