@@ -9,10 +9,11 @@ from typing import Any
 
 import pytest
 from fastapi.testclient import TestClient
+from starlette.requests import HTTPConnection
 from tests.api.conftest import make_settings
 
 from mocapqa.api.app import create_app
-from mocapqa.api.auth import CSRF_COOKIE, CSRF_HEADER
+from mocapqa.api.auth import CSRF_COOKIE, CSRF_HEADER, SESSION_COOKIE, quota_key_before_body
 from mocapqa.api.routes.session import sign_in_link
 from mocapqa.config import Settings
 from mocapqa.render.service import RenderService
@@ -328,3 +329,42 @@ def test_password_guessing_is_slowed(team: tuple[TestClient, dict[str, dict[str,
     assert int(right.headers["retry-after"]) >= 1
     page = client.get("/api/v1/audit", headers=headers["admin"]).json()
     assert sum(e["action"] == "sign_in_failed" for e in page["items"]) == 12
+
+
+def test_quota_key_before_body_names_the_user_of_a_valid_credential_only(
+    team: tuple[TestClient, dict[str, dict[str, str]]],
+) -> None:
+    """The upload quotas' key, found before the body: the user of a live token or session,
+    else the address; a read-only lookup (``last_used_at`` stays as it was)."""
+    client, headers = team
+    accounts: Accounts = client.app.state.accounts  # type: ignore[attr-defined]
+    day = __import__("datetime").timedelta(days=1)
+    rev1 = accounts.get_user("rev1")
+    session = accounts.issue(rev1.id, "session", day, with_csrf=True).token
+    expired = accounts.issue(rev1.id, "api", -day).token
+    revoked = accounts.issue(rev1.id, "api", day)
+    accounts.revoke(revoked.id)
+    rev2_token = headers["rev2"]["Authorization"].split()[1]
+    accounts.update_user("rev2", disabled=True)
+
+    def key(header: tuple[bytes, bytes] | None) -> str:
+        scope = {
+            "type": "http",
+            "method": "POST",
+            "path": "/api/v1/takes",
+            "headers": [header] if header else [],
+            "client": ("10.1.2.3", 5000),
+        }
+        return quota_key_before_body(HTTPConnection(scope), accounts)
+
+    def bearer(token: str) -> tuple[bytes, bytes]:
+        return (b"authorization", f"Bearer {token}".encode())
+
+    used_before = {t["id"]: t["last_used_at"] for t in accounts.list_tokens()}
+    assert key(bearer(headers["rev1"]["Authorization"].split()[1])) == f"user:{rev1.id}"
+    assert key((b"cookie", f"{SESSION_COOKIE}={session}".encode())) == f"user:{rev1.id}"
+    assert key(None) == "10.1.2.3"
+    for refused in (expired, revoked.token, rev2_token, session, "mqa_nonsense", ""):
+        assert key(bearer(refused)) == "10.1.2.3", refused
+    assert key((b"authorization", b"Basic eDp5")) == "10.1.2.3"
+    assert {t["id"]: t["last_used_at"] for t in accounts.list_tokens()} == used_before

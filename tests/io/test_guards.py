@@ -15,7 +15,15 @@ from mocapqa.errors import TooLargeError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.io.bvh_write import format_bvh
 from mocapqa.io.formats import read_take
-from mocapqa.io.guards import ReadLimits, check_json_depth, check_line_length, check_take_input
+from mocapqa.io.guards import (
+    ReadLimits,
+    check_frame_points,
+    check_json_depth,
+    check_line_length,
+    check_take_input,
+)
+from mocapqa.io.keypoint_csv import parse_keypoint_csv
+from mocapqa.io.mediapipe import parse_mediapipe_csv
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.options import AnalysisOptions
 
@@ -77,3 +85,47 @@ def test_a_999_joint_chain_is_read_analysed_and_written(tmp_path: Path) -> None:
 def _write(path: Path, text: str) -> Path:
     path.write_text(text)
     return path
+
+
+TRC_TAKE = "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d/" + (
+    "S00_P00_T01_BalancingTrial_0-100_filt_butterworth_LSTM.trc"
+)
+MEDIAPIPE_TAKE = "keypoints/mediapipe/etfrobotics_full-body-kinematics/landmarks.csv"
+
+
+@pytest.mark.parametrize("take", [TRC_TAKE, MEDIAPIPE_TAKE])
+def test_frame_points_counted_before_parsing_are_exact_on_real_takes(
+    corpus_dir: Path, take: str
+) -> None:
+    """A real TRC (header, labels, a blank line) and a real MediaPipe CSV: the line count
+    gives exactly the frames × points the reader reads, so the limit holds at its boundary."""
+    path = corpus_dir / take
+    read = read_take(path)
+    size = read.n_frames * read.n_keypoints
+    kind = "trc" if path.suffix == ".trc" else "mediapipe-csv"
+    check_frame_points(path, kind, ReadLimits(max_frame_points=size))
+    with pytest.raises(TooLargeError, match=rf"^{path.name}: .*max_frame_points"):
+        check_frame_points(path, kind, ReadLimits(max_frame_points=size - 1))
+
+
+def test_keypoint_csv_lines_skip_its_comment_header(tmp_path: Path) -> None:
+    path = tmp_path / "old.csv"
+    rows = [f"{f},{k},0,0,0" for f in range(10) for k in "abc"]
+    path.write_text("# fps: 30\n# unit: m\n\nframe,keypoint,x,y,z\n" + "\n".join(rows))
+    assert read_take(path).n_frames * 3 == 30
+    check_frame_points(path, "csv", ReadLimits(max_frame_points=30))
+    with pytest.raises(TooLargeError, match="got 30 data lines"):
+        check_frame_points(path, "csv", ReadLimits(max_frame_points=29))
+
+
+def test_sparse_frame_numbers_are_refused_by_the_readers_before_the_arrays() -> None:
+    """Three lines whose frame numbers (and names) span 9 frames: within the line count,
+    refused by the long-CSV readers themselves, before they make the arrays."""
+    data = b"frame,keypoint,x,y\n0,a,0,0\n4,b,0,0\n8,c,0,0\n"
+    assert parse_keypoint_csv(data, "s.csv", 30, limits=ReadLimits(max_frame_points=27))
+    with pytest.raises(TooLargeError, match=r"^s.csv: .*got 9 × 3"):
+        parse_keypoint_csv(data, "s.csv", 30, limits=ReadLimits(max_frame_points=26))
+    landmarks = b"frame_number,landmark,x,y,z\n0,0,0,0,0\n4,0,0,0,0\n8,0,0,0,0\n"
+    assert parse_mediapipe_csv(landmarks, "m.csv", limits=ReadLimits(max_frame_points=9 * 33))
+    with pytest.raises(TooLargeError, match=r"^m.csv: .*got 9 × 33"):
+        parse_mediapipe_csv(landmarks, "m.csv", limits=ReadLimits(max_frame_points=9 * 33 - 1))
