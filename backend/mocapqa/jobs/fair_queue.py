@@ -1,9 +1,10 @@
 """A queue of runs that serves clients in turn, so one client's flood does not starve others.
 
-Each client (today the client's address; a user once there are accounts) has its own FIFO;
-:meth:`FairQueue.get` takes the next run of the client after the one served last, round robin.
-A client with 50 queued runs and another with 1 see the second one's run start after at most one
-of the first one's per worker, not after all 50.
+Each client has its own FIFO: the API queues a run under its user (``user:<id>``; the client
+address for anonymous requests on a server without users), uploads, new runs and shoot imports
+alike. :meth:`FairQueue.get` takes the next run of the client after the one served last, round
+robin. A user with 50 queued runs and another with 1 see the second one's run start after at
+most one of the first one's per worker, not after all 50.
 """
 
 from __future__ import annotations

@@ -319,14 +319,7 @@ class Accounts:
         token_id, secret = match.groups()
         with self.engine.connect() as conn:
             row = conn.execute(
-                select(
-                    tokens.c.user_id,
-                    tokens.c.kind,
-                    tokens.c.secret_sha256,
-                    tokens.c.revoked_at,
-                    tokens.c.expires_at,
-                    users.c.disabled,
-                )
+                select(tokens, users.c.disabled)
                 .join(users, users.c.id == tokens.c.user_id)
                 .where(tokens.c.id == token_id)
             ).first()
