@@ -302,6 +302,10 @@ def test_open_without_users(tmp_path: Path, renderer: RenderService, cmu_walk: P
         accounts: Accounts = client.app.state.accounts  # type: ignore[attr-defined]
         accounts.add_user("first", Role.ADMIN)
         assert client.get("/api/v1/takes").status_code == 401
+        refused = _upload(client, cmu_walk, {})  # refused before its body is read
+        assert refused.status_code == 401
+        assert refused.headers["www-authenticate"] == "Bearer"
+        assert refused.json()["error"] == "AuthenticationError"
 
 
 def test_stream_needs_a_user(team: tuple[TestClient, dict[str, dict[str, str]]]) -> None:
@@ -335,7 +339,7 @@ def test_quota_key_before_body_names_the_user_of_a_valid_credential_only(
     team: tuple[TestClient, dict[str, dict[str, str]]],
 ) -> None:
     """The upload quotas' key, found before the body: the user of a live token or session,
-    else the address; a read-only lookup (``last_used_at`` stays as it was)."""
+    None for what the routes refuse with 401; a read-only lookup (``last_used_at`` stays)."""
     client, headers = team
     accounts: Accounts = client.app.state.accounts  # type: ignore[attr-defined]
     day = __import__("datetime").timedelta(days=1)
@@ -363,8 +367,10 @@ def test_quota_key_before_body_names_the_user_of_a_valid_credential_only(
     used_before = {t["id"]: t["last_used_at"] for t in accounts.list_tokens()}
     assert key(bearer(headers["rev1"]["Authorization"].split()[1])) == f"user:{rev1.id}"
     assert key((b"cookie", f"{SESSION_COOKIE}={session}".encode())) == f"user:{rev1.id}"
-    assert key(None) == "10.1.2.3"
+    # what the routes refuse with 401 is refused before the body (None)
+    assert key(None) is None
     for refused in (expired, revoked.token, rev2_token, session, "mqa_nonsense", ""):
-        assert key(bearer(refused)) == "10.1.2.3", refused
-    assert key((b"authorization", b"Basic eDp5")) == "10.1.2.3"
+        assert key(bearer(refused)) is None, refused
+    assert key((b"authorization", b"Basic eDp5")) is None
+    assert key((b"cookie", f"{SESSION_COOKIE}={expired}".encode())) is None
     assert {t["id"]: t["last_used_at"] for t in accounts.list_tokens()} == used_before

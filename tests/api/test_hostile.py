@@ -464,12 +464,24 @@ def test_upload_rate_is_per_user_and_checked_before_the_body(
     )
     assert chunked.status_code == 429, chunked.text
     assert int(chunked.headers["retry-after"]) >= 1
+    assert "uploads_per_minute_per_user" in chunked.json()["detail"]
     declared, _ = measure(
         "user over the upload rate: Content-Length 2 GB, no body sent",
         url,
         lambda: raw_request(url, head + "Content-Length: 2000000000\r\n\r\n"),
     )
     assert declared.status_code == 429, declared.text
+    anonymous, _ = measure(
+        "anonymous upload to a server with users: Content-Length 2 GB, no body sent",
+        url,
+        lambda: raw_request(
+            url,
+            f"POST /api/v1/takes HTTP/1.1\r\nHost: {host}\r\n"
+            "Content-Type: multipart/form-data; boundary=b\r\nContent-Length: 2000000000\r\n\r\n",
+        ),
+    )
+    assert anonymous.status_code == 401, anonymous.text
+    assert anonymous.json()["error"] == "AuthenticationError"
 
     other, _ = measure(
         "another user behind the same address, meanwhile",

@@ -108,16 +108,17 @@ def quota_key(user_id: int | None, address: str) -> str:
     return f"user:{user_id}" if user_id is not None else address
 
 
-def quota_key_before_body(connection: HTTPConnection, accounts: Accounts) -> str:
-    """:func:`quota_key` from the credential alone, before the body is read: a token or
-    session is looked up (a hash and one query by primary key, no write); an unknown one
-    falls back to the address (the route then answers 401)."""
+def quota_key_before_body(connection: HTTPConnection, accounts: Accounts) -> str | None:
+    """:func:`quota_key` from the credential alone, before the body is read, or None when
+    :func:`get_principal` would refuse the request (401): a credential that is not valid, or
+    none while users exist. A token or session is looked up by a hash and one query by
+    primary key, with no write (``last_used_at`` is the route's to set)."""
     credential = _credential(connection)
-    user_id = None
-    if credential is not None:
-        kind, token = credential
-        user_id = accounts.user_id_of(token, kind) if token else None
-    return quota_key(user_id, client_address(connection))
+    if credential is None:
+        return None if accounts.has_users() else client_address(connection)
+    kind, token = credential
+    user_id = accounts.user_id_of(token, kind) if token else None
+    return None if user_id is None else quota_key(user_id, client_address(connection))
 
 
 def get_principal(connection: HTTPConnection, accounts: AccountsDep) -> Principal:

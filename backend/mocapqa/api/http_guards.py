@@ -15,8 +15,9 @@ One ASGI middleware (:class:`RequestGuard`), so each check answers before the bo
   ``uploads_per_minute_per_user``, or from a user with ``max_queued_runs_per_user`` runs
   waiting, gets 429 with ``Retry-After`` before its body is read. The user is found from the
   request's token or session cookie alone (a hash and one query by primary key, on a worker
-  thread); an anonymous request, or one whose credential is not valid (the route answers
-  401), counts against its client address.
+  thread); an anonymous request to a server without users counts against its client address.
+  An upload the routes would refuse with 401 (a credential that is not valid, or none while
+  users exist) gets its 401 here, before its body is read too.
 * **Security headers** on every answer: a Content-Security-Policy the dashboard satisfies (no
   inline script; Plotly sets inline styles), ``frame-ancestors 'none'``, ``nosniff``,
   ``Referrer-Policy: same-origin``.
@@ -131,12 +132,20 @@ class RateWindow:
             return 0.0
 
 
-async def _send_json(send: Send, status: int, body: dict[str, object], retry: int = 0) -> None:
-    headers = [(b"content-type", b"application/json")]
+async def _send_json(
+    send: Send,
+    status: int,
+    body: dict[str, object],
+    retry: int = 0,
+    extra: list[tuple[bytes, bytes]] | None = None,
+) -> None:
+    data = json.dumps(body).encode()
+    headers = [(b"content-type", b"application/json"), (b"content-length", b"%d" % len(data))]
+    headers += extra or []
     if retry:
         headers.append((b"retry-after", str(retry).encode()))
     await send({"type": "http.response.start", "status": status, "headers": headers})
-    await send({"type": "http.response.body", "body": json.dumps(body).encode()})
+    await send({"type": "http.response.body", "body": data})
 
 
 class RequestGuard:
@@ -148,7 +157,7 @@ class RequestGuard:
         settings: Settings,
         upload_path: str,
         pending_runs: Callable[[str], int],
-        quota_key: Callable[[HTTPConnection], str],
+        quota_key: Callable[[HTTPConnection], str | None],
         import_paths: re.Pattern[str] | None = None,
     ) -> None:
         self.app = app
@@ -184,6 +193,12 @@ class RequestGuard:
             return
         if is_upload:
             key = await run_in_threadpool(self.quota_key, HTTPConnection(scope))
+            if key is None:
+                detail = "Expected a signed-in user (a valid session cookie or 'Authorization: "
+                detail += "Bearer TOKEN') to upload, got none or an invalid one"
+                body = error_body("AuthenticationError", detail)
+                await _send_json(secured, 401, body, extra=[(b"www-authenticate", b"Bearer")])
+                return
             refused = self._upload_refusal(key)
             if refused is not None:
                 await _send_json(secured, 429, refused[0], refused[1])
@@ -250,14 +265,14 @@ def install_http_guards(
     settings: Settings,
     upload_path: str,
     pending_runs: Callable[[str], int],
-    quota_key: Callable[[HTTPConnection], str],
+    quota_key: Callable[[HTTPConnection], str | None],
     import_paths: re.Pattern[str] | None = None,
 ) -> None:
     """Add the request guard, CORS (when ``cors_origins`` is set) and the Host check, in the
     order that makes the Host check run first. ``pending_runs`` counts a quota key's queued
-    runs, ``quota_key`` names a request's key from its headers (a blocking call: it runs on a
-    worker thread); ``import_paths`` matches the routes that take many files in one request
-    (uploads with the import body limit)."""
+    runs, ``quota_key`` names a request's key from its headers, None for a request to refuse
+    with 401 (a blocking call: it runs on a worker thread); ``import_paths`` matches the
+    routes that take many files in one request (uploads with the import body limit)."""
     app.add_middleware(
         RequestGuard,
         settings=settings,
