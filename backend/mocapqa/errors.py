@@ -11,6 +11,7 @@ from pathlib import Path
 
 __all__ = [
     "AuthenticationError",
+    "ClusterError",
     "ConflictError",
     "ForbiddenError",
     "FormatError",
@@ -142,6 +143,10 @@ class RateLimitError(MocapQAError):
     def __init__(self, message: str, retry_after_s: int) -> None:
         self.retry_after_s = max(1, int(retry_after_s))
         super().__init__(message)
+
+
+class ClusterError(MocapQAError):
+    """The Dask scheduler cannot be reached, or the connection to it was lost while working."""
 
 
 class RenderUnavailableError(MocapQAError):

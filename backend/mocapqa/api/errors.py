@@ -21,6 +21,7 @@ from starlette.routing import compile_path
 from mocapqa.api.schemas import ErrorOut
 from mocapqa.errors import (
     AuthenticationError,
+    ClusterError,
     ConflictError,
     ForbiddenError,
     FormatError,
@@ -57,6 +58,7 @@ STATUS_CODES: tuple[tuple[type[MocapQAError], int], ...] = (
     (ForbiddenError, 403),
     (AuthenticationError, 401),
     (RateLimitError, 429),
+    (ClusterError, 503),
     (MocapQAError, 400),
 )
 
@@ -71,6 +73,7 @@ STATUS_MEANING: dict[int, str] = {
     415: "Unsupported media: the file's format is not recognised",
     422: "Invalid: a parameter, an option or the file's content (field or line named)",
     429: "Too many requests from this client (see Retry-After)",
+    503: "Unavailable: the Dask scheduler cannot be reached",
 }
 """What each error status means, for the OpenAPI ``responses`` of every route."""
 

@@ -10,6 +10,7 @@ import typer
 from rich.console import Console
 
 from mocapqa.errors import (
+    ClusterError,
     ConflictError,
     InputError,
     LimitsFileError,
@@ -45,6 +46,7 @@ EXIT_CODES: tuple[tuple[type[MocapQAError], int], ...] = (
     (NotFoundError, 4),
     (ConflictError, 5),
     (RenderUnavailableError, 7),
+    (ClusterError, 8),
     (MocapQAError, 1),
 )
 

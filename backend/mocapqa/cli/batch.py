@@ -12,6 +12,7 @@ and its data folder; running the same command again skips what is already done.
 from __future__ import annotations
 
 import json
+import logging
 import os
 from pathlib import Path
 from typing import Annotated, Any
@@ -20,7 +21,10 @@ import typer
 
 from mocapqa.cli.app import app
 
-__all__ = ["batch"]
+__all__ = ["DASK_LOGGERS", "batch"]
+
+DASK_LOGGERS = ("distributed", "distributed.client")
+"""Dask's client-side loggers (each has its own level and handler)."""
 
 
 def _options(text: str | None) -> Any:
@@ -60,8 +64,9 @@ def batch(
 
     Takes whose content, options and mocapqa version already have a done run are skipped, so
     an interrupted batch finishes when run again. Exit code 0 when no take failed, 2 when
-    some did.
+    some did, 8 when the Dask scheduler cannot be reached or is lost.
     """
+    import distributed  # noqa: F401  - sets its loggers up; then quiet them below warnings
     from rich.console import Console
     from rich.progress import (
         BarColumn,
@@ -73,6 +78,7 @@ def batch(
     )
 
     from mocapqa.config import get_settings
+    from mocapqa.errors import ClusterError
     from mocapqa.jobs.batch import run_batch
     from mocapqa.jobs.batch_output import ResultWriter
     from mocapqa.jobs.engine import Engine
@@ -80,6 +86,8 @@ def batch(
     from mocapqa.store.repository import Repository
     from mocapqa.store.shoots import ShootStore
 
+    for name in DASK_LOGGERS:
+        logging.getLogger(name).setLevel(logging.WARNING)
     run_options = _options(options)
     writer = ResultWriter(output) if output is not None else None
     settings = get_settings()
@@ -139,6 +147,13 @@ def batch(
                 shoot_id=shoot_id,
                 on_total=on_total,
             )
+    except ClusterError as e:
+        for name in DASK_LOGGERS:  # closing the lost client logs its reconnect loop's end
+            logging.getLogger(name).setLevel(logging.CRITICAL)
+        raise ClusterError(
+            f"{e}; {state['done']} take(s) analysed and stored, "
+            "the same command finishes the rest once the scheduler is back"
+        ) from e
     finally:
         if writer is not None:
             writer.close()

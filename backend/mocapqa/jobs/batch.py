@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from mocapqa.errors import InputError, MocapQAError
+from mocapqa.errors import ClusterError, InputError, MocapQAError
 from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.take_task import analyse_path, content_sha256
 from mocapqa.pipeline.loading import detect_take_format as detect_format
@@ -155,6 +155,12 @@ def run_batch(
     Returns
     -------
     BatchCounts
+
+    Raises
+    ------
+    ClusterError
+        When the Dask scheduler cannot be reached or is lost mid-batch; the takes finished
+        before are stored and have their rows, the others have neither.
     """
     counts = BatchCounts()
     options_json = options.to_json()
@@ -245,6 +251,24 @@ def _run_on_dask(
     finish: Callable[[Path, str, str, str, dict[str, Any]], None],
     emit: Callable[[Row], None],
 ) -> None:
+    try:
+        _submit_and_collect(engine, pending, options_json, folder, task, finish, emit)
+    except OSError as e:  # a call to the scheduler (CommClosedError is one) found it gone
+        raise engine.lost(e) or ClusterError(
+            f"Lost the connection to the Dask scheduler at {engine.address} "
+            f"({type(e).__name__}: {e})"
+        ) from e
+
+
+def _submit_and_collect(
+    engine: Engine,
+    pending: list[tuple[Path, str]],
+    options_json: dict[str, Any],
+    folder: str | None,
+    task: Task,
+    finish: Callable[[Path, str, str, str, dict[str, Any]], None],
+    emit: Callable[[Row], None],
+) -> None:
     from distributed import as_completed
 
     client = engine.client()
@@ -278,6 +302,9 @@ def _run_on_dask(
         try:
             outcome = future.result()
         except Exception as e:  # a crashed worker (KilledWorker) or a bug in one take
+            lost = engine.lost(e)
+            if lost is not None:  # every task in flight is cancelled: stop, store nothing
+                raise lost from e
             name = type(e).__name__
             reason = (
                 f"worker died while analysing this take ({name}: {e})"

@@ -9,6 +9,13 @@ itself (paths on storage the workers share) and return small results.
 A task whose worker dies is retried on another worker; on the local cluster the scheduler's
 ``allowed-failures`` is 1, so a take that kills two workers fails with ``KilledWorker`` and
 the batch goes on (an existing cluster keeps its own setting, Dask's default being 3).
+
+A scheduler that cannot be reached, or is lost while working, is a :class:`ClusterError`
+naming its address. How long the client tries (to connect, then to reconnect before it gives
+up) is Dask's ``distributed.comm.timeouts.connect`` (30 s by default; the environment variable
+``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT`` sets it). Dask cancels every task in flight the
+moment the connection drops, so a lost scheduler is known at once; a later :meth:`Engine.client`
+connects afresh (to the restarted scheduler).
 """
 
 from __future__ import annotations
@@ -18,10 +25,14 @@ import os
 import threading
 from typing import Any
 
-__all__ = ["ALLOWED_FAILURES", "Engine", "default_workers"]
+from mocapqa.errors import ClusterError
+
+__all__ = ["ALLOWED_FAILURES", "SCHEDULER_LOST", "Engine", "default_workers"]
 
 ALLOWED_FAILURES = 1
 """Worker deaths a task may cause on the local cluster before it is failed (Dask: 3)."""
+SCHEDULER_LOST = "scheduler-connection-lost"
+"""Dask's reason for the tasks it cancels when the client loses its scheduler."""
 log = logging.getLogger(__name__)
 
 
@@ -56,16 +67,42 @@ class Engine:
         """Whether the client is connected."""
         return self._client is not None
 
+    @property
+    def address(self) -> str:
+        """The scheduler's address (the local cluster's once started), for messages."""
+        if self.scheduler:
+            return self.scheduler
+        if self._cluster is not None:
+            return str(self._cluster.scheduler_address)
+        return "the local cluster"
+
     def client(self) -> Any:
-        """The ``distributed.Client``, connecting (or starting the local cluster) on first use."""
+        """The ``distributed.Client``, connecting (or starting the local cluster) on first use
+        and again after the connection was lost.
+
+        Raises
+        ------
+        ClusterError
+            When the scheduler cannot be reached within Dask's connect timeout.
+        """
         with self._lock:
+            if self._client is not None and self._client.status in ("closing", "closed"):
+                log.warning("the Dask client of %s was closed; connecting again", self.address)
+                self._drop_client()
             if self._client is None:
                 import dask
                 from distributed import Client, LocalCluster
 
                 if self.scheduler:
                     log.info("connecting to the Dask scheduler at %s", self.scheduler)
-                    self._client = Client(self.scheduler, timeout="30s")  # type: ignore[no-untyped-call]
+                    timeout = dask.config.get("distributed.comm.timeouts.connect")
+                    try:
+                        self._client = Client(self.scheduler)  # type: ignore[no-untyped-call]
+                    except (OSError, TimeoutError) as e:
+                        raise ClusterError(
+                            f"Expected a Dask scheduler at {self.scheduler}, could not reach "
+                            f"it within {timeout} ({e})"
+                        ) from e
                 else:
                     dask.config.set(
                         {
@@ -83,18 +120,35 @@ class Engine:
                     self._client = Client(self._cluster)  # type: ignore[no-untyped-call]
             return self._client
 
+    def lost(self, error: BaseException) -> ClusterError | None:
+        """The :class:`ClusterError` to raise when ``error`` (a task's result) means the
+        scheduler was lost: Dask cancelled the task for that, or the client is no longer
+        running; None for any other error (a killed worker, a bug in one take)."""
+        reason = getattr(error, "reason", None)
+        status = getattr(self._client, "status", None)
+        if reason == SCHEDULER_LOST or status in ("connecting", "closing", "closed"):
+            return ClusterError(
+                f"Lost the connection to the Dask scheduler at {self.address} "
+                f"({type(error).__name__}: {error})"
+            )
+        return None
+
     def n_workers(self) -> int:
         """Workers connected now."""
         return len(self.client().scheduler_info(n_workers=-1)["workers"])
+
+    def _drop_client(self) -> None:
+        client, self._client = self._client, None
+        try:
+            client.close(timeout=5)
+        except Exception as e:  # a client already closing may refuse; it is dropped anyway
+            log.debug("closing the lost Dask client: %s", e)
 
     def close(self) -> None:
         """Disconnect, and stop the local cluster if this engine started it."""
         with self._lock:
             if self._client is not None:
-                try:
-                    self._client.close()
-                finally:
-                    self._client = None
+                self._drop_client()
             if self._cluster is not None:
                 try:
                     self._cluster.close()

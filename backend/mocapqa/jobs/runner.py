@@ -309,7 +309,13 @@ class JobRunner:
             key=f"run-{run_id}",
             pure=False,
         )
-        summary = future.result()
+        try:
+            summary = future.result()
+        except Exception as e:  # a lost scheduler fails the run with its address
+            lost = self.engine.lost(e)
+            if lost is not None:
+                raise lost from e
+            raise
         if self.renderer is not None:
             self.repository.set_progress(run_id, 97, "rendering the thumbnail")
             folder = self.files.run_dir(run_id)
