@@ -92,6 +92,8 @@ export async function waitForRun(runId, onProgress, intervalMs = 300) {
 export const listShoots = () => request("GET", "/shoots");
 export const getShoot = (id) => request("GET", `/shoots/${id}`);
 export const createShoot = (name) => request("POST", "/shoots", { name });
+export const renameShoot = (id, name) => request("PATCH", `/shoots/${id}`, { name });
+export const deleteShoot = (id, confirm) => request("DELETE", `/shoots/${id}?confirm=${encodeURIComponent(confirm)}`);
 export const shootTakes = (id, query) => request("GET", `/shoots/${id}/takes?${query}`);
 export const shootProgress = (id) => request("GET", `/shoots/${id}/progress`);
 export const shootHeatmap = (id, query) => request("GET", `/shoots/${id}/heatmap?${query}`);

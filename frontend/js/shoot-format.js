@@ -131,3 +131,19 @@ export function heatmapRows(data) {
     return share == null ? null : 100 * share;
   }));
 }
+
+/** Which of a shoot's controls the caller may use, from GET /me (`can`, `user_id`) and the
+ * shoot (its `owner_id` when the API sends one): renaming needs "upload"; deleting (the shoot
+ * and all its takes) needs "delete_any", or "delete_own" on a shoot the caller owns. No `me`
+ * (it failed): neither. The API refuses the others with 403 anyway. */
+export function shootControls(me, shoot) {
+  const can = new Set((me && me.can) || []);
+  const owns = shoot.owner_id != null && me != null && me.user_id != null && shoot.owner_id === me.user_id;
+  return { rename: can.has("upload"), delete: can.has("delete_any") || (can.has("delete_own") && owns) };
+}
+
+/** Whether the name typed to confirm a deletion is the shoot's: exactly (the API compares
+ * the `confirm` parameter with the name as stored, spaces and case included). */
+export function deleteConfirmed(typed, name) {
+  return typeof typed === "string" && typed.length > 0 && typed === name;
+}

@@ -2,12 +2,13 @@
 // the violations heat map (#/shoot/ID), and its review queue (#/shoot/ID/review).
 // The table is sorted, filtered and paged on the server; its state lives in the URL.
 import * as api from "./api.js";
+import { me } from "./account-api.js";
 import { activatable, badge, h, REVIEW } from "./dom.js";
 import { loadPlotly, untabbableModebar } from "./plotly.js";
 import { fmt } from "./format.js";
 import {
-  decisionForKey, formatCell, heatmapRows, importLines, nextSort, pageInfo, progressSummary, scoreColor,
-  TAKE_COLUMNS, tableState, takesQuery, viewQuery,
+  decisionForKey, deleteConfirmed, formatCell, heatmapRows, importLines, nextSort, pageInfo, progressSummary, scoreColor,
+  shootControls, TAKE_COLUMNS, tableState, takesQuery, viewQuery,
 } from "./shoot-format.js";
 
 const POLL_MS = 1000;
@@ -96,6 +97,63 @@ function importPanel(shootId, onImported) {
   return h("div", {}, zone, result);
 }
 
+/** A modal dialog (native <dialog>: focus moves into it, Escape closes it and the focus goes
+ * back to the button that opened it) holding a form; `submit` gets the form's message line. */
+function formDialog(id, title, fields, submitLabel, submit) {
+  const message = h("p", { class: "error", id: `${id}-message`, role: "alert" });
+  const save = h("button", { type: "submit", class: "primary", id: `${id}-submit` }, submitLabel);
+  const dialog = h("dialog", { id, "aria-labelledby": `${id}-title` });
+  const form = h("form", { class: "dialog-form" }, h("h2", { id: `${id}-title` }, title), ...fields, message,
+    h("div", { class: "controls" }, save, h("button", { type: "button", id: `${id}-cancel`, onclick: () => dialog.close() }, "cancel")));
+  form.addEventListener("submit", async (e) => {
+    e.preventDefault();
+    save.disabled = true;
+    try { await submit(); } catch (error) { message.textContent = error.message; } finally { save.disabled = false; }
+  });
+  dialog.append(form);
+  dialog.addEventListener("close", () => { message.textContent = ""; });
+  return { dialog, save, message };
+}
+
+/** Rename and delete controls of a shoot, for the roles that may use them (shootControls). */
+function manageControls(shoot, who, onRenamed) {
+  const allowed = shootControls(who, shoot);
+  const out = [];
+  if (allowed.rename) {
+    const name = h("input", { id: "rename-name", "aria-label": "new name", required: true, autocomplete: "off" });
+    const { dialog } = formDialog("rename-dialog", "Rename the shoot", [h("label", {}, "name ", name)], "rename", async () => {
+      const renamed = await api.renameShoot(shoot.id, name.value.trim());
+      shoot.name = renamed.name;
+      dialog.close();
+      onRenamed(renamed);
+    });
+    const open = h("button", { type: "button", id: "shoot-rename-open", onclick: () => { name.value = shoot.name; dialog.showModal(); name.select(); } }, "rename…");
+    out.push(open, dialog);
+  }
+  if (allowed.delete) {
+    const typed = h("input", { id: "delete-confirm", "aria-label": "shoot name, to confirm", autocomplete: "off", spellcheck: "false" });
+    const what = h("p", { id: "delete-what" });
+    const { dialog, save } = formDialog("delete-dialog", "Delete the shoot", [what, h("label", {}, "shoot name ", typed)], "delete shoot and takes", async () => {
+      if (!deleteConfirmed(typed.value, shoot.name)) return;
+      await api.deleteShoot(shoot.id, typed.value);
+      dialog.close();
+      location.hash = "#/shoots";
+    });
+    save.classList.add("danger");
+    const check = () => { save.disabled = !deleteConfirmed(typed.value, shoot.name); };
+    typed.addEventListener("input", check);
+    const describe = (n) => what.replaceChildren("This deletes ", h("strong", {}, shoot.name), ` and its ${n} take(s), with their runs, reviews and files. `,
+      "It cannot be undone. Type the shoot's name to confirm.");
+    const open = h("button", { type: "button", id: "shoot-delete-open", class: "danger", onclick: () => {
+      describe(shoot.n_takes);
+      typed.value = ""; check(); dialog.showModal(); typed.focus();
+      api.getShoot(shoot.id).then((now) => { shoot.n_takes = now.n_takes; describe(now.n_takes); }).catch(() => {}); // imports since
+    } }, "delete…");
+    out.push(open, dialog);
+  }
+  return out;
+}
+
 function filterBar(state, apply) {
   const select = (key, label, options) => h("label", {}, `${label} `, h("select", { id: `shoot-${key}`, onchange: (e) => apply({ [key]: e.target.value }) },
     options.map(([v, text]) => h("option", { value: v, selected: String(state[key]) === v }, text))));
@@ -138,7 +196,8 @@ function takeTable(page, state, apply) {
 
 export async function shootView(main, shootId, params, onTeardown) {
   let state = tableState(params);
-  const shoot = await api.getShoot(shootId);
+  const [shoot, who] = await Promise.all([api.getShoot(shootId), me().catch(() => null)]);
+  const title = h("span", { id: "shoot-title" }, shoot.name);
   const progressBar = h("progress", { id: "shoot-progress", max: 1, value: 0 });
   const progressText = h("span", { id: "shoot-progress-text" });
   const tableBox = h("div", {});
@@ -213,11 +272,12 @@ export async function shootView(main, shootId, params, onTeardown) {
   const progressPanel = h("div", { class: "panel", id: "progress-panel" }, "analysis ", progressBar, " ", progressText);
 
   main.replaceChildren(
-    h("h1", {}, h("a", { href: "#/shoots" }, "Shoots"), ` / ${shoot.name}`),
-    h("div", { class: "controls" },
+    h("h1", {}, h("a", { href: "#/shoots" }, "Shoots"), " / ", title),
+    h("div", { class: "controls", id: "shoot-actions" },
       h("a", { class: "button primary", id: "review-queue", href: `#/shoot/${shootId}/review` }, "review queue"),
       h("a", { class: "download", id: "export-csv", href: api.summaryUrl(shootId, "csv"), download: "" }, "summary CSV"),
-      h("a", { class: "download", id: "export-json", href: api.summaryUrl(shootId, "json"), download: "" }, "summary JSON")),
+      h("a", { class: "download", id: "export-json", href: api.summaryUrl(shootId, "json"), download: "" }, "summary JSON"),
+      manageControls(shoot, who, (renamed) => { title.textContent = renamed.name; })),
     importPanel(shootId, () => { clearTimeout(timer); wasRunning = true; poll().catch(showError); }),
     progressPanel,
     tableArea, heatmap);

@@ -1,8 +1,8 @@
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import {
-  decisionForKey, formatCell, heatmapRows, importLines, nextSort, pageInfo, progressSummary, scoreColor,
-  tableState, takesQuery, viewQuery, TABLE_DEFAULTS,
+  decisionForKey, deleteConfirmed, formatCell, heatmapRows, importLines, nextSort, pageInfo, progressSummary, scoreColor,
+  shootControls, tableState, takesQuery, viewQuery, TABLE_DEFAULTS,
 } from "../../frontend/js/shoot-format.js";
 
 test("tableState parses numbers, clamps the page size and rejects unknown orders", () => {
@@ -100,4 +100,27 @@ test("heatmapRows turns joints × takes shares into takes × joints percent", ()
   const data = { joints: ["knee", "elbow"], takes: [{ name: "a" }, { name: "b" }, { name: "c" }], values: [[0.5, 0, null], [0.25, 0.1, null]] };
   assert.deepEqual(heatmapRows(data), [[50, 25], [0, 10], [null, null]]);
   assert.deepEqual(heatmapRows({ joints: [], takes: [{ name: "a" }], values: [] }), [[]]);
+});
+
+test("shootControls: viewers get neither, reviewers rename and delete only shoots they own", () => {
+  const viewer = { user_id: 3, can: ["read", "own_tokens"] };
+  const reviewer = { user_id: 2, can: ["read", "upload", "run", "review", "delete_own", "own_tokens"] };
+  const admin = { user_id: 1, can: [...reviewer.can, "delete_any", "manage_users", "read_audit"] };
+  const unowned = { id: "s", name: "Day 1" };
+  assert.deepEqual(shootControls(viewer, unowned), { rename: false, delete: false });
+  assert.deepEqual(shootControls(reviewer, unowned), { rename: true, delete: false });
+  assert.deepEqual(shootControls(reviewer, { ...unowned, owner_id: 2 }), { rename: true, delete: true });
+  assert.deepEqual(shootControls(reviewer, { ...unowned, owner_id: 7 }), { rename: true, delete: false });
+  assert.deepEqual(shootControls(admin, { ...unowned, owner_id: 7 }), { rename: true, delete: true });
+  assert.deepEqual(shootControls(null, unowned), { rename: false, delete: false });
+  // A caller without a user id (no users on the server) never "owns" an unowned shoot.
+  assert.deepEqual(shootControls({ user_id: null, can: ["delete_own"] }, { ...unowned, owner_id: null }).delete, false);
+});
+
+test("deleteConfirmed wants the exact name", () => {
+  assert.equal(deleteConfirmed("Day 1", "Day 1"), true);
+  assert.equal(deleteConfirmed("day 1", "Day 1"), false);
+  assert.equal(deleteConfirmed("Day 1 ", "Day 1"), false);
+  assert.equal(deleteConfirmed("", ""), false);
+  assert.equal(deleteConfirmed(undefined, "Day 1"), false);
 });

@@ -1,0 +1,163 @@
+"""Renaming and deleting a shoot in Debian's Chromium, with the keyboard: the controls are in
+the shoot view for the roles that may use them (hidden for a viewer; the API answers 403 to
+it anyway), deleting asks for the shoot's name to be typed, and the takes go with the shoot."""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+from collections.abc import Iterator
+from datetime import timedelta
+from pathlib import Path
+from typing import Any
+
+import httpx
+import pytest
+import uvicorn
+
+from mocapqa.api.app import create_app
+from mocapqa.config import Settings
+from mocapqa.store.accounts import Accounts
+from mocapqa.store.roles import Role
+
+pytestmark = pytest.mark.browser
+
+ARTIFACTS = Path(__file__).resolve().parents[1] / "artifacts"
+PASSWORD = "correct horse battery"
+TAKE = "bvh/bandai/dataset-1_bow_sad_001.bvh"
+
+
+@pytest.fixture(scope="module")
+def team(tmp_path_factory: pytest.TempPathFactory, corpus_dir: Path) -> Iterator[dict[str, Any]]:
+    """A server with an admin ``ada``, a reviewer ``rita`` and a viewer ``vic``, and a shoot
+    ``Day 1`` (made by ada) holding one real take."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    app = create_app(Settings(data_dir=tmp_path_factory.mktemp("manage")))
+    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
+    thread = threading.Thread(target=server.run, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 30
+    while not server.started:
+        if time.monotonic() > deadline:
+            raise TimeoutError("uvicorn did not start")
+        time.sleep(0.05)
+    url = f"http://127.0.0.1:{port}"
+    accounts: Accounts = app.state.accounts
+    ada = accounts.add_user("ada", Role.ADMIN, PASSWORD)
+    accounts.add_user("rita", Role.REVIEWER, PASSWORD)
+    accounts.add_user("vic", Role.VIEWER, PASSWORD)
+    bearer = {"Authorization": f"Bearer {accounts.issue(ada.id, 'api', timedelta(days=1)).token}"}
+    shoot = httpx.post(f"{url}/api/v1/shoots", json={"name": "Day 1"}, headers=bearer).json()
+    imported = httpx.post(
+        f"{url}/api/v1/shoots/{shoot['id']}/takes",
+        files=[("files", ("bow.bvh", (corpus_dir / TAKE).read_bytes()))],
+        headers=bearer,
+        timeout=120,
+    ).json()
+    assert len(imported["created"]) == 1, imported
+    yield {"url": url, "shoot": shoot, "take": imported["created"][0], "bearer": bearer}
+    server.should_exit = True
+    thread.join(timeout=10)
+
+
+def sign_in(page: Any, url: str, name: str) -> None:
+    page.goto(f"{url}/")
+    page.wait_for_selector("#signin-form", timeout=60_000)
+    page.fill("#signin-name", name)
+    page.fill("#signin-password", PASSWORD)
+    page.click("#signin-submit")
+    page.wait_for_selector("#whoami", timeout=60_000)
+
+
+def open_shoot(page: Any, url: str, shoot_id: str) -> None:
+    page.goto(f"{url}/#/shoot/{shoot_id}")
+    page.wait_for_selector("main[data-ready='1'] #shoot-title", timeout=60_000)
+
+
+def focused(page: Any) -> str:
+    return str(page.evaluate("() => document.activeElement && document.activeElement.id"))
+
+
+def test_rename_and_delete_a_shoot_with_the_keyboard(team: dict[str, Any], chromium: Any) -> None:
+    url, shoot_id = team["url"], team["shoot"]["id"]
+    ARTIFACTS.mkdir(exist_ok=True)
+    context = chromium.new_context(viewport={"width": 1300, "height": 900})
+    page = context.new_page()
+    errors: list[str] = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+
+    # A viewer sees neither control, and the API refuses the rename anyway.
+    sign_in(page, url, "vic")
+    open_shoot(page, url, shoot_id)
+    assert page.locator("#shoot-rename-open, #shoot-delete-open").count() == 0
+    status = page.evaluate(
+        """async (id) => {
+          const csrf = document.cookie.match(/mocapqa_csrf=([^;]*)/)[1];
+          const r = await fetch(`/api/v1/shoots/${id}`, {method: "PATCH",
+            headers: {"Content-Type": "application/json", "X-CSRF-Token": csrf},
+            body: JSON.stringify({name: "mine now"})});
+          return r.status; }""",
+        shoot_id,
+    )
+    assert status == 403
+    page.click("#sign-out")
+    page.wait_for_selector("#signin-form", timeout=60_000)
+
+    # A reviewer may rename, but not delete a shoot someone else made.
+    sign_in(page, url, "rita")
+    open_shoot(page, url, shoot_id)
+    assert page.is_visible("#shoot-rename-open")
+    assert page.locator("#shoot-delete-open").count() == 0
+    page.click("#sign-out")
+    page.wait_for_selector("#signin-form", timeout=60_000)
+
+    # The admin renames with the keyboard: Tab to the button, Enter, type, Enter.
+    sign_in(page, url, "ada")
+    open_shoot(page, url, shoot_id)
+    page.focus("#export-json")
+    page.keyboard.press("Tab")
+    assert focused(page) == "shoot-rename-open"
+    page.keyboard.press("Enter")
+    page.wait_for_selector("#rename-dialog[open]", timeout=10_000)
+    assert focused(page) == "rename-name"
+    page.keyboard.type("Day 1 — stage B")  # the old name is selected: typing replaces it
+    page.keyboard.press("Enter")
+    page.wait_for_selector("#rename-dialog:not([open])", state="attached", timeout=30_000)
+    assert page.inner_text("#shoot-title") == "Day 1 — stage B"
+    assert focused(page) == "shoot-rename-open"  # the focus is back on the button
+    stored = httpx.get(f"{url}/api/v1/shoots/{shoot_id}", headers=team["bearer"]).json()
+    assert stored["name"] == "Day 1 — stage B"
+
+    # Delete: Tab on, Enter; a wrong name keeps the button disabled and Enter does nothing;
+    # Escape closes without deleting.
+    page.keyboard.press("Tab")
+    assert focused(page) == "shoot-delete-open"
+    page.keyboard.press("Enter")
+    page.wait_for_selector("#delete-dialog[open]", timeout=10_000)
+    assert focused(page) == "delete-confirm"
+    assert "1 take(s)" in page.inner_text("#delete-what")
+    page.keyboard.type("Day 1")
+    assert page.is_disabled("#delete-dialog-submit")
+    page.keyboard.press("Enter")
+    page.screenshot(path=str(ARTIFACTS / "shoot-delete-dialog.png"))
+    page.keyboard.press("Escape")
+    page.wait_for_selector("#delete-dialog:not([open])", state="attached", timeout=10_000)
+    assert httpx.get(f"{url}/api/v1/shoots/{shoot_id}", headers=team["bearer"]).status_code == 200
+
+    # Typing the exact name enables the button; Enter deletes the shoot and its take.
+    page.keyboard.press("Enter")  # the focus went back to the delete button
+    page.wait_for_selector("#delete-dialog[open]", timeout=10_000)
+    page.keyboard.type("Day 1 — stage B")
+    assert page.is_enabled("#delete-dialog-submit")
+    page.keyboard.press("Enter")
+    page.wait_for_url("**/#/shoots", timeout=60_000)
+    page.wait_for_selector("main[data-ready='1'] #shoot-list", timeout=60_000)
+    assert "stage B" not in page.inner_text("#shoot-list")
+    assert httpx.get(f"{url}/api/v1/shoots/{shoot_id}", headers=team["bearer"]).status_code == 404
+    take = httpx.get(f"{url}/api/v1/takes/{team['take']['take_id']}", headers=team["bearer"])
+    assert take.status_code == 404
+    context.close()
+    assert not errors, errors
