@@ -147,3 +147,45 @@ export function shootControls(me, shoot) {
 export function deleteConfirmed(typed, name) {
   return typeof typed === "string" && typed.length > 0 && typed === name;
 }
+
+/** Heat map page sizes offered, and the API's largest (GET /shoots/{id}/heatmap `limit`). */
+export const HEATMAP_SIZES = [100, 200, 500];
+export const HEATMAP_MAX_TAKES = 1000;
+const HEATMAP_ROW_PX = 22;
+
+/** The heat map's paging state, made safe: a whole page size in [1, HEATMAP_MAX_TAKES], an
+ * offset that is a multiple of it, ≥ 0, and (once the total is known) not past the last page. */
+export function heatmapPage(offset, limit, total = null) {
+  const size = Math.max(1, Math.min(HEATMAP_MAX_TAKES, Number.parseInt(limit, 10) || 200));
+  let start = Math.max(0, Number.parseInt(offset, 10) || 0);
+  start -= start % size;
+  if (total != null && total > 0 && start >= total) start = Math.floor((total - 1) / size) * size;
+  if (total === 0) start = 0;
+  return { offset: start, limit: size };
+}
+
+/** The query string of GET /shoots/{id}/heatmap for a page, in the take table's sort. */
+export function heatmapQuery(page, sort = "score", order = "asc") {
+  const safe = heatmapPage(page.offset, page.limit);
+  return new URLSearchParams({ limit: String(safe.limit), offset: String(safe.offset), sort, order }).toString();
+}
+
+/** What the pager shows: "takes 201–230 of 230" and the offsets of the pages before and
+ * after (null at either end). */
+export function heatmapPager(page, total) {
+  const info = pageInfo(page.offset, page.limit, total);
+  return { ...info, text: `takes ${info.text}` };
+}
+
+/** The chart of one page: one row per take, labelled with its rank in the shoot (so takes
+ * with the same name stay separate rows), z in percent (heatmapRows), and a height that gives
+ * every row the same number of pixels whatever the page size. */
+export function heatmapFigure(data, offset) {
+  const labels = data.takes.map((t, k) => `${offset + k + 1}. ${t.name}`);
+  return {
+    x: data.joints,
+    y: labels,
+    z: heatmapRows(data),
+    height: Math.max(260, 120 + HEATMAP_ROW_PX * data.takes.length),
+  };
+}

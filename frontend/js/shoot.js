@@ -7,8 +7,8 @@ import { activatable, badge, h, REVIEW } from "./dom.js";
 import { loadPlotly, untabbableModebar } from "./plotly.js";
 import { fmt } from "./format.js";
 import {
-  decisionForKey, deleteConfirmed, formatCell, heatmapRows, importLines, nextSort, pageInfo, progressSummary, scoreColor,
-  shootControls, TAKE_COLUMNS, tableState, takesQuery, viewQuery,
+  decisionForKey, deleteConfirmed, formatCell, HEATMAP_SIZES, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
+  importLines, nextSort, pageInfo, progressSummary, scoreColor, shootControls, TAKE_COLUMNS, tableState, takesQuery, viewQuery,
 } from "./shoot-format.js";
 
 const POLL_MS = 1000;
@@ -230,26 +230,49 @@ export async function shootView(main, shootId, params, onTeardown) {
   }
   const showError = (e) => tableArea.prepend(h("p", { class: "error" }, e.message));
 
+  // The heat map pages through the shoot (lowest score first) `heat.limit` takes at a time;
+  // the chart scrolls inside its box, and the pager keeps its place across redraws.
+  let heat = heatmapPage(0, 200);
   const drawHeatmap = async () => {
-    const [Plotly, data] = await Promise.all([loadPlotly(), api.shootHeatmap(shootId, "limit=200&sort=score")]);
+    const [Plotly, first] = await Promise.all([loadPlotly(), api.shootHeatmap(shootId, heatmapQuery(heat))]);
+    let data = first;
+    const safe = heatmapPage(heat.offset, heat.limit, data.total);
+    if (safe.offset !== heat.offset) { // the shoot shrank under the page: show its last page
+      heat = safe;
+      data = await api.shootHeatmap(shootId, heatmapQuery(heat));
+    }
     if (!alive) return;
-    if (!data.joints.length || !data.takes.length) {
-      const why = data.takes.length ? "No joint outside its limits in these takes." : "No joint-limit results yet.";
-      heatmap.replaceChildren(h("h2", {}, "Joint limits"), h("p", { class: "muted", id: "heatmap-empty" }, why));
+    const title = h("h2", {}, "Share of frames outside the joint limits (joint × take)");
+    if (!data.total) {
+      heatmap.replaceChildren(h("h2", {}, "Joint limits"), h("p", { class: "muted", id: "heatmap-empty" }, "No joint-limit results yet."));
       return;
     }
-    const chart = h("div", { id: "heatmap-chart" });
-    heatmap.replaceChildren(h("h2", {}, "Share of frames outside the joint limits (joint × take)"), chart);
+    const pager = heatmapPager(heat, data.total);
+    const go = (offset) => { heat = heatmapPage(offset, heat.limit, data.total); drawHeatmap().catch(showHeatmapError); };
+    const previous = h("button", { type: "button", id: "heatmap-previous", disabled: pager.previous == null, onclick: () => go(pager.previous) }, "‹ previous");
+    const next = h("button", { type: "button", id: "heatmap-next", disabled: pager.next == null, onclick: () => go(pager.next) }, "next ›");
+    const size = h("select", { id: "heatmap-size", "aria-label": "takes per heat map page", onchange: (e) => {
+      heat = heatmapPage(heat.offset, e.target.value, data.total); drawHeatmap().catch(showHeatmapError);
+    } }, HEATMAP_SIZES.map((n) => h("option", { value: n, selected: n === heat.limit }, `${n} takes a page`)));
+    const controls = h("div", { class: "controls", id: "heatmap-pager" }, previous, h("span", { id: "heatmap-page", "aria-live": "polite" }, pager.text), next, size);
+    if (!data.joints.length) {
+      heatmap.replaceChildren(title, controls, h("p", { class: "muted", id: "heatmap-empty" }, "No joint outside its limits in these takes."));
+      return;
+    }
+    const figure = heatmapFigure(data, heat.offset);
+    const chart = h("div", { id: "heatmap-chart", "data-offset": heat.offset });
+    heatmap.replaceChildren(title, controls, h("div", { class: "heatmap-scroll", id: "heatmap-scroll", tabindex: "0", "aria-label": "heat map, scrolls" }, chart));
     await Plotly.newPlot(chart, [{
-      type: "heatmap", x: data.joints, y: data.takes.map((t) => t.name), z: heatmapRows(data),
+      type: "heatmap", x: figure.x, y: figure.y, z: figure.z,
       colorscale: "YlOrRd", reversescale: true, zmin: 0, hoverongaps: false,
       colorbar: { title: { text: "%" } }, hovertemplate: "%{y}<br>%{x}: %{z:.1f} %<extra></extra>",
     }], {
-      height: Math.max(260, 120 + 22 * data.takes.length), margin: { l: 180, r: 20, t: 10, b: 110 },
+      height: figure.height, margin: { l: 180, r: 20, t: 10, b: 110 },
       yaxis: { autorange: "reversed", automargin: true }, xaxis: { tickangle: -45, automargin: true },
     }, { responsive: true, displaylogo: false });
     untabbableModebar(chart);
   };
+  const showHeatmapError = (e) => heatmap.replaceChildren(h("p", { class: "error" }, e.message));
 
   // Poll while anything is queued or running; when it all finishes, redraw table and heat map.
   let wasRunning = false;
@@ -285,7 +308,7 @@ export async function shootView(main, shootId, params, onTeardown) {
   await drawTable();
   await poll();
   main.dataset.ready = "1";
-  drawHeatmap().catch((e) => heatmap.replaceChildren(h("p", { class: "error" }, e.message)));
+  drawHeatmap().catch(showHeatmapError);
 }
 
 export async function reviewQueueView(main, shootId, onTeardown) {

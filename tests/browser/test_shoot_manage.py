@@ -1,6 +1,7 @@
 """Renaming and deleting a shoot in Debian's Chromium, with the keyboard: the controls are in
 the shoot view for the roles that may use them (hidden for a viewer; the API answers 403 to
-it anyway), deleting asks for the shoot's name to be typed, and the takes go with the shoot."""
+it anyway), deleting asks for the shoot's name to be typed, and the takes go with the shoot.
+And the heat map of a shoot of more than 200 takes, paged from the keyboard."""
 
 from __future__ import annotations
 
@@ -18,8 +19,13 @@ import uvicorn
 
 from mocapqa.api.app import create_app
 from mocapqa.config import Settings
+from mocapqa.jobs.demo import demo_paths
+from mocapqa.jobs.take_task import analyse_path
+from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.accounts import Accounts
+from mocapqa.store.repository import Repository, new_id
 from mocapqa.store.roles import Role
+from mocapqa.store.shoots import ShootStore
 
 pytestmark = pytest.mark.browser
 
@@ -35,7 +41,8 @@ def team(tmp_path_factory: pytest.TempPathFactory, corpus_dir: Path) -> Iterator
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
-    app = create_app(Settings(data_dir=tmp_path_factory.mktemp("manage")))
+    settings = Settings(data_dir=tmp_path_factory.mktemp("manage"))
+    app = create_app(settings)
     server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
@@ -58,7 +65,13 @@ def team(tmp_path_factory: pytest.TempPathFactory, corpus_dir: Path) -> Iterator
         timeout=120,
     ).json()
     assert len(imported["created"]) == 1, imported
-    yield {"url": url, "shoot": shoot, "take": imported["created"][0], "bearer": bearer}
+    yield {
+        "url": url,
+        "shoot": shoot,
+        "take": imported["created"][0],
+        "bearer": bearer,
+        "settings": settings,
+    }
     server.should_exit = True
     thread.join(timeout=10)
 
@@ -159,5 +172,73 @@ def test_rename_and_delete_a_shoot_with_the_keyboard(team: dict[str, Any], chrom
     assert httpx.get(f"{url}/api/v1/shoots/{shoot_id}", headers=team["bearer"]).status_code == 404
     take = httpx.get(f"{url}/api/v1/takes/{team['take']['take_id']}", headers=team["bearer"])
     assert take.status_code == 404
+    context.close()
+    assert not errors, errors
+
+
+def test_heatmap_pages_beyond_200_takes(
+    team: dict[str, Any], chromium: Any, corpus_dir: Path
+) -> None:
+    url = team["url"]
+    shoot = httpx.post(f"{url}/api/v1/shoots", json={"name": "Big"}, headers=team["bearer"])
+    shoot_id = shoot.json()["id"]
+    # 230 takes: real analyses of the demo twist-error walk (low score, joints outside their
+    # limits) and of the clean CMU walk (none outside), stored again under new names.
+    options = AnalysisOptions().to_json()
+    sources = [demo_paths()[0], corpus_dir / "bvh/cmu/cmu_12_01_walk.bvh"]
+    outcomes = [analyse_path(str(p), options, new_id(), new_id(), None) for p in sources]
+    assert all(o["status"] == "done" for o in outcomes), outcomes
+    repository = Repository(team["settings"].resolved_database_url)
+    store = ShootStore(repository.engine)
+    for index in range(230):
+        outcome = outcomes[index % 2]
+        take = {
+            **outcome["take"],
+            "id": new_id(),
+            "name": f"{index:03d}_{outcome['take']['name']}",
+            "sha256": f"{index + 1:064x}",
+            "shoot_id": shoot_id,
+        }
+        store.record_done(take, new_id(), options, outcome["summary"], 0.1)
+    repository.close()
+
+    context = chromium.new_context(viewport={"width": 1300, "height": 900})
+    page = context.new_page()
+    errors: list[str] = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    sign_in(page, url, "vic")  # reading is enough
+    open_shoot(page, url, shoot_id)
+    page.wait_for_selector("#heatmap-chart .main-svg", timeout=60_000)
+    assert page.inner_text("#heatmap-page") == "takes 1–200 of 230"
+    assert page.is_disabled("#heatmap-previous")
+    labels = page.evaluate("() => document.getElementById('heatmap-chart').data[0].y")
+    assert (len(labels), labels[0].split(". ")[0], labels[-1].split(". ")[0]) == (200, "1", "200")
+    # The chart scrolls inside its box, not the page.
+    box = page.evaluate(
+        "() => { const b = document.getElementById('heatmap-scroll');"
+        " return [b.scrollHeight, b.clientHeight]; }"
+    )
+    assert box[0] > box[1]
+    # Lowest score first: the 115 twist-error walks, then the clean walks from rank 116 on.
+    assert labels[114].endswith("_twist_errors.bvh")
+    assert labels[115].endswith("_cmu_12_01_walk.bvh")
+    page.focus("#heatmap-next")
+    page.keyboard.press("Enter")
+    page.wait_for_function(
+        "() => document.getElementById('heatmap-page')?.innerText === 'takes 201–230 of 230'",
+        timeout=60_000,
+    )
+    # Takes 201–230 are clean walks: the page says so, and the pager stays to go back.
+    assert "No joint outside its limits" in page.inner_text("#heatmap-empty")
+    assert page.is_disabled("#heatmap-next")
+    assert page.is_enabled("#heatmap-previous")
+    page.select_option("#heatmap-size", "500")
+    page.wait_for_function(
+        "() => document.getElementById('heatmap-page')?.innerText === 'takes 1–230 of 230'",
+        timeout=60_000,
+    )
+    labels = page.evaluate("() => document.getElementById('heatmap-chart').data[0].y")
+    assert (len(labels), labels[-1].split(". ")[0]) == (230, "230")
+    page.screenshot(path=str(ARTIFACTS / "shoot-heatmap-pages.png"))
     context.close()
     assert not errors, errors

@@ -210,9 +210,13 @@ def test_import_progress_sort_review_export(
     p.wait_for_selector("#heatmap-chart .main-svg", timeout=60_000)
     rows = p.evaluate(
         "() => { const d = document.getElementById('heatmap-chart').data[0];"
-        " return d.y.map((name, k) => [name, d.z[k]]); }"
+        " return d.y.map((label, k) => [label, d.z[k]]); }"
     )
+    assert [label.split(". ", 1)[0] for label, _ in rows] == ["1", "2", "3", "4"]  # ranks
+    rows = [[label.split(". ", 1)[1], z] for label, z in rows]
     assert rows[0][0] == "cmu_12_01_walk_twist_errors.bvh"
+    assert p.inner_text("#heatmap-page") == "takes 1–4 of 4"
+    assert p.is_disabled("#heatmap-next")
     by_name = dict(rows)
     assert max(by_name["cmu_12_01_walk_twist_errors.bvh"]) > 0
     assert all(v is None for v in by_name[Path(TAKES[2]).name])

@@ -1,8 +1,9 @@
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import {
-  decisionForKey, deleteConfirmed, formatCell, heatmapRows, importLines, nextSort, pageInfo, progressSummary, scoreColor,
-  shootControls, tableState, takesQuery, viewQuery, TABLE_DEFAULTS,
+  decisionForKey, deleteConfirmed, formatCell, HEATMAP_MAX_TAKES, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
+  heatmapRows, importLines, nextSort, pageInfo, progressSummary, scoreColor, shootControls, tableState, takesQuery, viewQuery,
+  TABLE_DEFAULTS,
 } from "../../frontend/js/shoot-format.js";
 
 test("tableState parses numbers, clamps the page size and rejects unknown orders", () => {
@@ -123,4 +124,62 @@ test("deleteConfirmed wants the exact name", () => {
   assert.equal(deleteConfirmed("Day 1 ", "Day 1"), false);
   assert.equal(deleteConfirmed("", ""), false);
   assert.equal(deleteConfirmed(undefined, "Day 1"), false);
+});
+
+test("heatmapPage keeps the page size within the API's bounds and the offset on a page start", () => {
+  assert.deepEqual(heatmapPage(0, 200), { offset: 0, limit: 200 });
+  assert.deepEqual(heatmapPage(250, 200), { offset: 200, limit: 200 });
+  assert.deepEqual(heatmapPage(-5, 200), { offset: 0, limit: 200 });
+  assert.deepEqual(heatmapPage(0, 5000), { offset: 0, limit: HEATMAP_MAX_TAKES });
+  assert.deepEqual(heatmapPage(0, 0), { offset: 0, limit: 200 });
+  assert.deepEqual(heatmapPage(0, "junk"), { offset: 0, limit: 200 });
+  assert.deepEqual(heatmapPage(400, "100"), { offset: 400, limit: 100 });
+  // Past the end (the shoot shrank): the last page.
+  assert.deepEqual(heatmapPage(1000, 200, 230), { offset: 200, limit: 200 });
+  assert.deepEqual(heatmapPage(200, 200, 200), { offset: 0, limit: 200 });
+  assert.deepEqual(heatmapPage(600, 200, 0), { offset: 0, limit: 200 });
+});
+
+test("heatmapQuery asks the API for one bounded page in the table's order", () => {
+  const q = new URLSearchParams(heatmapQuery({ offset: 450, limit: 200 }));
+  assert.equal(q.get("limit"), "200");
+  assert.equal(q.get("offset"), "400");
+  assert.equal(q.get("sort"), "score");
+  assert.equal(q.get("order"), "asc");
+  assert.equal(new URLSearchParams(heatmapQuery({ offset: 0, limit: 99999 })).get("limit"), String(HEATMAP_MAX_TAKES));
+  assert.equal(new URLSearchParams(heatmapQuery({ offset: 0, limit: 100 }, "name", "desc")).get("order"), "desc");
+});
+
+test("heatmapPager pages through more than 200 takes", () => {
+  const first = heatmapPager({ offset: 0, limit: 200 }, 1234);
+  assert.equal(first.text, "takes 1–200 of 1234");
+  assert.equal(first.previous, null);
+  assert.equal(first.next, 200);
+  const last = heatmapPager({ offset: 1200, limit: 200 }, 1234);
+  assert.equal(last.text, "takes 1201–1234 of 1234");
+  assert.equal(last.previous, 1000);
+  assert.equal(last.next, null);
+  // Walking "next" from the first page visits every take once.
+  const seen = [];
+  for (let page = { offset: 0, limit: 200 }; page.offset != null; page = { offset: heatmapPager(page, 1234).next, limit: 200 }) {
+    seen.push(page.offset);
+  }
+  assert.deepEqual(seen, [0, 200, 400, 600, 800, 1000, 1200]);
+});
+
+test("heatmapFigure labels rows by rank (same names stay apart) and sizes rows evenly", () => {
+  const data = {
+    joints: ["LeftKnee", "RightElbow"],
+    takes: [{ name: "walk.bvh" }, { name: "walk.bvh" }, { name: "run.bvh" }],
+    values: [[0.5, 0, null], [0.25, 0.1, null]],
+  };
+  const figure = heatmapFigure(data, 200);
+  assert.deepEqual(figure.y, ["201. walk.bvh", "202. walk.bvh", "203. run.bvh"]);
+  assert.equal(new Set(figure.y).size, 3);
+  assert.deepEqual(figure.x, data.joints);
+  assert.deepEqual(figure.z, [[50, 25], [0, 10], [null, null]]);
+  assert.equal(figure.height, 260); // small pages keep a readable minimum
+  const big = heatmapFigure({ joints: ["A"], takes: Array.from({ length: 500 }, (_, k) => ({ name: `t${k}` })), values: [Array(500).fill(0)] }, 0);
+  assert.equal(big.height, 120 + 22 * 500);
+  assert.equal(big.y[499], "500. t499");
 });

@@ -102,10 +102,17 @@ class ProgressOut(BaseModel):
 class HeatmapOut(BaseModel):
     """Joint × take share of frames outside the joint limits, for a page of takes."""
 
-    joints: list[str]
-    takes: list[dict[str, str | float | None]]
-    values: list[list[float | None]]
-    total: int
+    joints: list[str] = Field(description="Joints violated on this page, most violated first")
+    takes: list[dict[str, str | float | None]] = Field(
+        description="The page's takes (take_id, name, score), in the table's order"
+    )
+    values: list[list[float | None]] = Field(
+        description="joints × takes shares of frames outside the limits, in [0, 1]; null where "
+        "the limits check did not run"
+    )
+    total: int = Field(description="Takes in the shoot")
+    limit: int = Field(description="Takes per page asked for")
+    offset: int = Field(description="Takes before this page")
 
 
 class NextTakeOut(BaseModel):

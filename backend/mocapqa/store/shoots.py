@@ -281,18 +281,25 @@ class ShootStore:
             offset += batch
 
     def heatmap(
-        self, shoot_id: str, limit: int = 200, offset: int = 0, sort: str = "score"
+        self,
+        shoot_id: str,
+        limit: int = 200,
+        offset: int = 0,
+        sort: str = "score",
+        descending: bool = False,
     ) -> dict[str, Any]:
-        """Joint × take share of frames outside the limits, for a page of the shoot's takes.
+        """Joint × take share of frames outside the limits, for a page of the shoot's takes
+        (in the order of :meth:`page`).
 
         Returns
         -------
         dict
             ``joints`` (those with any violation on the page, most violated first), ``takes``
             (``{"take_id", "name", "score"}`` in table order) and ``values`` (``joints × takes``
-            shares in [0, 1]; 0 where none, None where the limits check did not run).
+            shares in [0, 1]; 0 where none, None where the limits check did not run) and
+            ``total`` (takes in the shoot).
         """
-        page, total = self.page(shoot_id, limit, offset, sort=sort)
+        page, total = self.page(shoot_id, limit, offset, sort=sort, descending=descending)
         totals: dict[str, float] = {}
         for row in page:
             for joint, share in (row["joint_violations"] or {}).items():

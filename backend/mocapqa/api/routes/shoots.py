@@ -31,12 +31,16 @@ from mocapqa.jobs.shoot_import import ImportLimits, import_uploads
 from mocapqa.store.roles import Action
 from mocapqa.store.shoots import SORT_COLUMNS, ShootStore, TakeFilter
 
-__all__ = ["EXPORT_COLUMNS", "router"]
+__all__ = ["EXPORT_COLUMNS", "HEATMAP_MAX_TAKES", "MAX_OFFSET", "router"]
 
 # A shoot's maker (its owner) renames and deletes it, as a take's uploader deletes the take;
 # admins may do both to any shoot, and are the only ones for shoots without an owner.
 Maker = Annotated[Principal, Depends(require(Action.UPLOAD))]
 Deleter = Annotated[Principal, Depends(require(Action.DELETE_OWN))]
+HEATMAP_MAX_TAKES = 1000
+"""Most takes in one page of the heat map."""
+MAX_OFFSET = 10_000_000
+"""Largest page offset the take table and heat map accept (far beyond any shoot)."""
 router = APIRouter(prefix="/shoots", tags=["shoots"])
 """Routes of this resource, included under ``/api/v1``."""
 
@@ -164,7 +168,7 @@ def list_shoot_takes(
     shoot_id: str,
     services: ServicesDep,
     limit: Annotated[int, Query(ge=1, le=500)] = 50,
-    offset: Annotated[int, Query(ge=0)] = 0,
+    offset: Annotated[int, Query(ge=0, le=MAX_OFFSET)] = 0,
     sort: ShootSort = "score",
     order: Literal["asc", "desc"] = "asc",
     status: Literal["queued", "running", "done", "failed"] | None = None,
@@ -193,12 +197,16 @@ def shoot_progress(shoot_id: str, services: ServicesDep) -> ProgressOut:
 def shoot_heatmap(
     shoot_id: str,
     services: ServicesDep,
-    limit: Annotated[int, Query(ge=1, le=1000)] = 200,
-    offset: Annotated[int, Query(ge=0)] = 0,
+    limit: Annotated[int, Query(ge=1, le=HEATMAP_MAX_TAKES, description="Takes per page")] = 200,
+    offset: Annotated[int, Query(ge=0, le=MAX_OFFSET, description="Takes before the page")] = 0,
     sort: ShootSort = "score",
+    order: Literal["asc", "desc"] = "asc",
 ) -> HeatmapOut:
-    """Joint × take share of frames outside the joint limits, for a page of takes."""
-    return HeatmapOut(**_store(services).heatmap(shoot_id, limit, offset, sort))
+    """Joint × take share of frames outside the joint limits, for a page of takes in the
+    table's order (``sort``, ``order``); ``total`` takes in all, so a client pages through a
+    shoot of any size ``limit`` takes at a time."""
+    heat = _store(services).heatmap(shoot_id, limit, offset, sort, order == "desc")
+    return HeatmapOut(**heat, limit=limit, offset=offset)
 
 
 @router.get("/{shoot_id}/next", responses=responses(401, 404))
