@@ -249,26 +249,54 @@ class ShootStore:
     ) -> tuple[list[dict[str, Any]], int]:
         """A page of a shoot's takes (summary columns) and the total after filtering.
 
-        Rows without a value in the sort column come last in either direction.
+        Rows without a value in the sort column come last in either direction (ties, and
+        those rows, by name then id).
+
+        The page is found in two narrow steps, then read whole: the ids of the rows *with* a
+        value, in order, from ``offset`` (an index range on ``(shoot_id, column)`` where there
+        is one), then, if the page reaches past them, the ids of the rows without one, by name;
+        only the page's rows are then read with their JSON and joined to ``takes``. Sorting
+        whole rows (``ORDER BY score NULLS LAST`` over the shoot's rows with their per-joint
+        JSON, joined before the offset is skipped) made SQLite's sorted pages several times
+        slower (``docs/batch.md``).
         """
         if sort not in SORT_COLUMNS:
             raise InputError(f"Expected sort in {list(SORT_COLUMNS)}, got {sort!r}")
         self.require(shoot_id)
         where = and_(take_qa.c.shoot_id == shoot_id, *(filters or TakeFilter()).clauses())
         column = take_qa.c[sort]
-        order = column.desc().nulls_last() if descending else column.asc().nulls_last()
-        query = (
-            select(take_qa, takes.c.format, takes.c.fps, takes.c.n_joints)
-            .join(takes, takes.c.id == take_qa.c.take_id)
-            .where(where)
-            .order_by(order, take_qa.c.name, take_qa.c.take_id)
-            .limit(limit)
-            .offset(offset)
-        )
+        ties = (take_qa.c.name, take_qa.c.take_id)
         with self.engine.connect() as conn:
-            total = int(conn.execute(select(func.count()).where(where)).scalar_one())
-            rows = [_plain(r) for r in conn.execute(query).mappings()]
-        return rows, total
+            counted = conn.execute(select(func.count(), func.count(column)).where(where)).one()
+            total, valued = int(counted[0]), int(counted[1])
+            ids: list[str] = []
+            if offset < valued:
+                ids = list(
+                    conn.execute(
+                        select(take_qa.c.take_id)
+                        .where(where, column.is_not(None))
+                        .order_by(column.desc() if descending else column.asc(), *ties)
+                        .limit(limit)
+                        .offset(offset)
+                    ).scalars()
+                )
+            if len(ids) < limit and total > valued:
+                ids += conn.execute(
+                    select(take_qa.c.take_id)
+                    .where(where, column.is_(None))
+                    .order_by(*ties)
+                    .limit(limit - len(ids))
+                    .offset(max(0, offset - valued))
+                ).scalars()
+            found = {
+                str(r["take_id"]): _plain(r)
+                for r in conn.execute(
+                    select(take_qa, takes.c.format, takes.c.fps, takes.c.n_joints)
+                    .join(takes, takes.c.id == take_qa.c.take_id)
+                    .where(take_qa.c.take_id.in_(ids))
+                ).mappings()
+            }
+        return [found[i] for i in ids if i in found], total
 
     def rows(self, shoot_id: str, batch: int = 1000) -> Iterator[dict[str, Any]]:
         """Every take row of a shoot, by name, read ``batch`` at a time (for exports)."""
