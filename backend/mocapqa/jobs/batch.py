@@ -251,13 +251,20 @@ def _run_on_dask(
     finish: Callable[[Path, str, str, str, dict[str, Any]], None],
     emit: Callable[[Row], None],
 ) -> None:
+    from distributed.comm.core import CommClosedError
+
     try:
         _submit_and_collect(engine, pending, options_json, folder, task, finish, emit)
-    except OSError as e:  # a call to the scheduler (CommClosedError is one) found it gone
-        raise engine.lost(e) or ClusterError(
+    except CommClosedError as e:  # a call to the scheduler found it gone
+        raise ClusterError(
             f"Lost the connection to the Dask scheduler at {engine.address} "
             f"({type(e).__name__}: {e})"
         ) from e
+    except OSError as e:  # a timeout while the client reconnects; a full disk stays itself
+        lost = engine.lost(e)
+        if lost is None:
+            raise
+        raise lost from e
 
 
 def _submit_and_collect(
