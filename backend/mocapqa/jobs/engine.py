@@ -140,7 +140,10 @@ class Engine:
     def _drop_client(self) -> None:
         client, self._client = self._client, None
         try:
-            client.close(timeout=5)
+            if client.status == "running":
+                client.close()
+            else:  # lost: stop its reconnect loop, do not wait on the gone scheduler
+                client.close(timeout=5)
         except Exception as e:  # a client already closing may refuse; it is dropped anyway
             log.debug("closing the lost Dask client: %s", e)
 
