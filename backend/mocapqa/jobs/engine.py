@@ -8,7 +8,8 @@ itself (paths on storage the workers share) and return small results.
 
 A task whose worker dies is retried on another worker; on the local cluster the scheduler's
 ``allowed-failures`` is 1, so a take that kills two workers fails with ``KilledWorker`` and
-the batch goes on (an existing cluster keeps its own setting, Dask's default being 3).
+the batch goes on (an existing cluster keeps its own setting, Dask's default being 3). Its
+``worker-saturation`` is 1.0, so no other take waits on a worker that dies.
 
 A scheduler that cannot be reached, or is lost while working, is a :class:`ClusterError`
 naming its address. How long the client tries (to connect, then to reconnect before it gives
@@ -107,6 +108,10 @@ class Engine:
                     dask.config.set(
                         {
                             "distributed.scheduler.allowed-failures": ALLOWED_FAILURES,
+                            # One task per worker thread at a time: a take queued behind a
+                            # crashing one on the same worker would be counted among the
+                            # tasks its death killed (Dask's default 1.1 sends two).
+                            "distributed.scheduler.worker-saturation": 1.0,
                             "distributed.worker.daemon": False,
                         }
                     )
