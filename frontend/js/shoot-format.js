@@ -133,13 +133,15 @@ export function heatmapRows(data) {
 }
 
 /** Which of a shoot's controls the caller may use, from GET /me (`can`, `user_id`) and the
- * shoot (its `owner_id` when the API sends one): renaming needs "upload"; deleting (the shoot
- * and all its takes) needs "delete_any", or "delete_own" on a shoot the caller owns. No `me`
- * (it failed): neither. The API refuses the others with 403 anyway. */
+ * shoot's `owner_id` (the API's rule: its owner or an admin): renaming needs "upload" and
+ * deleting (the shoot and all its takes) "delete_own", each on a shoot the caller owns, or
+ * "delete_any" (an admin) on any shoot. No `me` (it failed): neither. The API refuses the
+ * others with 403 anyway. */
 export function shootControls(me, shoot) {
   const can = new Set((me && me.can) || []);
   const owns = shoot.owner_id != null && me != null && me.user_id != null && shoot.owner_id === me.user_id;
-  return { rename: can.has("upload"), delete: can.has("delete_any") || (can.has("delete_own") && owns) };
+  const admin = can.has("delete_any");
+  return { rename: can.has("upload") && (admin || owns), delete: admin || (can.has("delete_own") && owns) };
 }
 
 /** Whether the name typed to confirm a deletion is the shoot's: exactly (the API compares

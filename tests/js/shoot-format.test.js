@@ -109,9 +109,11 @@ test("shootControls: viewers get neither, reviewers rename and delete only shoot
   const admin = { user_id: 1, can: [...reviewer.can, "delete_any", "manage_users", "read_audit"] };
   const unowned = { id: "s", name: "Day 1" };
   assert.deepEqual(shootControls(viewer, unowned), { rename: false, delete: false });
-  assert.deepEqual(shootControls(reviewer, unowned), { rename: true, delete: false });
+  assert.deepEqual(shootControls(reviewer, unowned), { rename: false, delete: false });
   assert.deepEqual(shootControls(reviewer, { ...unowned, owner_id: 2 }), { rename: true, delete: true });
-  assert.deepEqual(shootControls(reviewer, { ...unowned, owner_id: 7 }), { rename: true, delete: false });
+  assert.deepEqual(shootControls(reviewer, { ...unowned, owner_id: 7 }), { rename: false, delete: false });
+  assert.deepEqual(shootControls(viewer, { ...unowned, owner_id: 3 }), { rename: false, delete: false });
+  assert.deepEqual(shootControls(admin, unowned), { rename: true, delete: true });
   assert.deepEqual(shootControls(admin, { ...unowned, owner_id: 7 }), { rename: true, delete: true });
   assert.deepEqual(shootControls(null, unowned), { rename: false, delete: false });
   // A caller without a user id (no users on the server) never "owns" an unowned shoot.
