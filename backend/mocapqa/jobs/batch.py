@@ -309,7 +309,7 @@ def _submit_and_collect(
         try:
             outcome = future.result()
         except Exception as e:  # a crashed worker (KilledWorker) or a bug in one take
-            lost = engine.lost(e)
+            lost = engine.lost_after_settling(e)
             if lost is not None:  # every task in flight is cancelled: stop, store nothing
                 raise lost from e
             name = type(e).__name__

@@ -24,6 +24,8 @@ from __future__ import annotations
 import logging
 import os
 import threading
+import time
+from concurrent.futures import CancelledError
 from typing import Any
 
 from mocapqa.errors import ClusterError
@@ -137,6 +139,33 @@ class Engine:
                 f"({type(error).__name__}: {error})"
             )
         return None
+
+    def lost_after_settling(self, error: BaseException, wait_s: float = 5.0) -> ClusterError | None:
+        """:meth:`lost`, for a task that failed while the client may not yet know its scheduler
+        is gone: a cancellation (a batch cancels nothing itself) or a closed connection gives
+        the client up to ``wait_s`` seconds to notice before the error is blamed on the take;
+        a cancellation is a lost scheduler either way.
+
+        Parameters
+        ----------
+        error : BaseException
+            What the task's result raised.
+        wait_s : float
+            Longest wait for the client to leave its running state (seconds).
+        """
+        cancelled = isinstance(error, CancelledError)
+        if not (cancelled or type(error).__name__ == "CommClosedError"):
+            return self.lost(error)
+        deadline = time.monotonic() + wait_s
+        while getattr(self._client, "status", None) == "running" and time.monotonic() < deadline:
+            time.sleep(0.05)
+        found = self.lost(error)
+        if found is None and cancelled:
+            return ClusterError(
+                f"Lost the connection to the Dask scheduler at {self.address} "
+                f"({type(error).__name__}: {error})"
+            )
+        return found
 
     def n_workers(self) -> int:
         """Workers connected now."""
