@@ -86,8 +86,16 @@ def sign_in(page: Any, url: str, name: str) -> None:
 
 
 def open_shoot(page: Any, url: str, shoot_id: str) -> None:
+    """Open the shoot view; it must be ready within a minute, or after one reload (a full
+    suite on a loaded 2-core machine once missed the first minute; what the page showed then
+    is printed so that a second miss says why)."""
     page.goto(f"{url}/#/shoot/{shoot_id}")
-    page.wait_for_selector("main[data-ready='1'] #shoot-title", timeout=60_000)
+    try:
+        page.wait_for_selector("main[data-ready='1'] #shoot-title", timeout=60_000)
+    except Exception:  # playwright's TimeoutError
+        print("shoot view not ready after 60 s, showing:", page.inner_text("main")[:500])
+        page.reload()
+        page.wait_for_selector("main[data-ready='1'] #shoot-title", timeout=60_000)
 
 
 def focused(page: Any) -> str:
@@ -207,6 +215,10 @@ def test_heatmap_pages_beyond_200_takes(
     page.on("pageerror", lambda e: errors.append(str(e)))
     sign_in(page, url, "vic")  # reading is enough
     open_shoot(page, url, shoot_id)
+    page.wait_for_function(
+        "() => document.getElementById('heatmap-chart')?.data?.[0]?.y?.length === 200",
+        timeout=60_000,
+    )
     page.wait_for_selector("#heatmap-chart .main-svg", timeout=60_000)
     assert page.inner_text("#heatmap-page") == "takes 1–200 of 230"
     assert page.is_disabled("#heatmap-previous")
@@ -234,6 +246,11 @@ def test_heatmap_pages_beyond_200_takes(
     page.select_option("#heatmap-size", "500")
     page.wait_for_function(
         "() => document.getElementById('heatmap-page')?.innerText === 'takes 1–230 of 230'",
+        timeout=60_000,
+    )
+    # The pager's text is set before Plotly has drawn the new chart: wait for its data too.
+    page.wait_for_function(
+        "() => document.getElementById('heatmap-chart')?.data?.[0]?.y?.length === 230",
         timeout=60_000,
     )
     labels = page.evaluate("() => document.getElementById('heatmap-chart').data[0].y")
