@@ -8,7 +8,8 @@ from typing import Any, Literal
 from pydantic import BaseModel, Field, field_validator
 
 from mocapqa.errors import InputError
-from mocapqa.pipeline.options import MAX_POINTS_RANGE, check_mapping
+from mocapqa.pipeline.options import CHECKS, MAX_POINTS_RANGE, Check, TwistMethod, check_mapping
+from mocapqa.store.repository import ReviewStatus, RunStatus
 
 __all__ = [
     "AnalysisOptionsIn",
@@ -26,11 +27,6 @@ __all__ = [
     "TakeOut",
     "TakePageOut",
 ]
-
-RunStatus = Literal["queued", "running", "done", "failed"]
-"""A run's status (an enum in the OpenAPI, also of the ``status`` query of the take list)."""
-ReviewStatus = Literal["unreviewed", "approved", "needs_fix", "rejected"]
-"""A take's review status."""
 
 
 class FieldError(BaseModel):
@@ -64,8 +60,8 @@ class AnalysisOptionsIn(BaseModel):
 
     model_config = {"extra": "forbid"}
 
-    checks: list[Literal["twist", "limits", "filter"]] = ["twist", "limits", "filter"]
-    twist_method: Literal["robust", "paper"] = "robust"
+    checks: list[Check] = list(CHECKS)
+    twist_method: TwistMethod = "robust"
     twist_apply: str = Field(
         "confident",
         description="Twist intervals to remove: confident, all, none, or interval ids ('0,3'); "

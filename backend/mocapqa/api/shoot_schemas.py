@@ -7,6 +7,8 @@ from typing import Literal
 
 from pydantic import BaseModel, Field
 
+from mocapqa.store.repository import ReviewStatus, RunStatus
+
 __all__ = [
     "HeatmapOut",
     "ImportOut",
@@ -55,8 +57,8 @@ class ShootTakeOut(BaseModel):
     n_joints: int
     created_at: datetime
     run_id: str | None
-    status: Literal["queued", "running", "done", "failed"] | None
-    review_status: Literal["unreviewed", "approved", "needs_fix", "rejected"]
+    status: RunStatus | None
+    review_status: ReviewStatus
     reviewer: str | None
     score: float | None = Field(description="QA score, 0–100 (100: nothing found)")
     n_frames: int | None

@@ -127,6 +127,7 @@ def _fill(database_url: str, rows: list[dict[str, Any]], n_takes: int) -> str:
     """A shoot of ``n_takes`` takes whose summaries repeat the batch's real ones."""
     from sqlalchemy import insert
 
+    from mocapqa.store.qa import QA_COLUMNS
     from mocapqa.store.repository import Repository, new_id, utc_now
     from mocapqa.store.shoots import ShootStore
     from mocapqa.store.tables import runs, take_qa, takes
@@ -179,22 +180,7 @@ def _fill(database_url: str, rows: list[dict[str, Any]], n_takes: int) -> str:
                 "review_status": "unreviewed",
                 "reviewer": None,
                 "n_findings": source["summary"]["n_findings"],
-                **{
-                    k: qa.get(k)
-                    for k in (
-                        "score",
-                        "n_frames",
-                        "duration_s",
-                        "rig",
-                        "twist_intervals",
-                        "corrected_joint_frames",
-                        "violation_share",
-                        "worst_joint",
-                        "filter_residual_mm",
-                        "missing_share",
-                        "joint_violations",
-                    )
-                },
+                **{k: qa.get(k) for k in QA_COLUMNS},
             }
         )
     with repository.engine.begin() as conn:

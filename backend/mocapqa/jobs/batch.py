@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from mocapqa.errors import ClusterError, InputError, MocapQAError
+from mocapqa.errors import InputError, MocapQAError
 from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.take_task import analyse_path, content_sha256
 from mocapqa.pipeline.loading import detect_take_format as detect_format
@@ -256,10 +256,7 @@ def _run_on_dask(
     try:
         _submit_and_collect(engine, pending, options_json, folder, task, finish, emit)
     except CommClosedError as e:  # a call to the scheduler found it gone
-        raise ClusterError(
-            f"Lost the connection to the Dask scheduler at {engine.address} "
-            f"({type(e).__name__}: {e})"
-        ) from e
+        raise engine.lost_connection(e) from e
     except OSError as e:  # a timeout while the client reconnects; a full disk stays itself
         lost = engine.lost(e)
         if lost is None:

@@ -134,11 +134,16 @@ class Engine:
         reason = getattr(error, "reason", None)
         status = getattr(self._client, "status", None)
         if reason == SCHEDULER_LOST or status in ("connecting", "closing", "closed"):
-            return ClusterError(
-                f"Lost the connection to the Dask scheduler at {self.address} "
-                f"({type(error).__name__}: {error})"
-            )
+            return self.lost_connection(error)
         return None
+
+    def lost_connection(self, error: BaseException) -> ClusterError:
+        """The :class:`ClusterError` that says the scheduler was lost, naming its address and
+        the ``error`` that showed it."""
+        return ClusterError(
+            f"Lost the connection to the Dask scheduler at {self.address} "
+            f"({type(error).__name__}: {error})"
+        )
 
     def lost_after_settling(self, error: BaseException, wait_s: float = 5.0) -> ClusterError | None:
         """:meth:`lost`, for a task that failed while the client may not yet know its scheduler
@@ -161,10 +166,7 @@ class Engine:
             time.sleep(0.05)
         found = self.lost(error)
         if found is None and cancelled:
-            return ClusterError(
-                f"Lost the connection to the Dask scheduler at {self.address} "
-                f"({type(error).__name__}: {error})"
-            )
+            return self.lost_connection(error)
         return found
 
     def n_workers(self) -> int:

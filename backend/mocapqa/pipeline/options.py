@@ -10,13 +10,13 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal, get_args
 
 from mocapqa.core.rig import normalise_mapping
 from mocapqa.errors import InputError, OptionError
 from mocapqa.filters.apply import apply_overrides
 from mocapqa.filters.registry import FILTERS, DataScale
-from mocapqa.twist.analysis import METHODS
+from mocapqa.twist.analysis import METHODS, Method
 from mocapqa.twist.choice import APPLY_CHOICES, parse_apply
 
 __all__ = [
@@ -26,7 +26,9 @@ __all__ = [
     "TWIST_APPLY_CHOICES",
     "TWIST_METHODS",
     "AnalysisOptions",
+    "Check",
     "ParamValue",
+    "TwistMethod",
     "check_mapping",
     "describe_options",
 ]
@@ -34,8 +36,12 @@ __all__ = [
 ParamValue = float | int | bool | str
 """Value of one filter parameter override."""
 
-CHECKS = ("twist", "limits", "filter")
+Check = Literal["twist", "limits", "filter"]
+"""A check a run can do."""
+CHECKS: tuple[Check, ...] = get_args(Check)
 """The checks a run can do."""
+TwistMethod = Method
+"""A twist detection method."""
 TWIST_METHODS = METHODS
 """Twist detection methods (those of :mod:`mocapqa.twist.analysis`)."""
 TWIST_APPLY_CHOICES = APPLY_CHOICES

@@ -11,23 +11,12 @@ from typing import Any
 from sqlalchemy import delete, insert, select
 from sqlalchemy.engine import Connection
 
+from mocapqa.pipeline.summary import SUMMARY_FIELDS
 from mocapqa.store.tables import reviews, runs, take_qa, takes
 
 __all__ = ["QA_COLUMNS", "lock_take", "qa_values", "sync_take"]
 
-QA_COLUMNS = (
-    "score",
-    "n_frames",
-    "duration_s",
-    "rig",
-    "twist_intervals",
-    "corrected_joint_frames",
-    "violation_share",
-    "worst_joint",
-    "filter_residual_mm",
-    "missing_share",
-    "joint_violations",
-)
+QA_COLUMNS = (*SUMMARY_FIELDS, "joint_violations")
 """Columns of ``take_qa`` copied from a done run's ``summary["qa"]``."""
 
 

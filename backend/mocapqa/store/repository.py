@@ -11,7 +11,7 @@ from __future__ import annotations
 import logging
 import uuid
 from datetime import UTC, datetime
-from typing import Any
+from typing import Any, Literal, get_args
 
 from sqlalchemy import (
     Engine,
@@ -32,13 +32,25 @@ from mocapqa.store.qa import lock_take, sync_take
 from mocapqa.store.tables import reviews, runs, take_qa, takes
 from mocapqa.store.upgrade import upgrade_database
 
-__all__ = ["REVIEW_STATUSES", "RUN_STATUSES", "Repository", "new_id", "utc_now"]
+__all__ = [
+    "REVIEW_STATUSES",
+    "RUN_STATUSES",
+    "Repository",
+    "ReviewStatus",
+    "RunStatus",
+    "new_id",
+    "utc_now",
+]
 
 log = logging.getLogger(__name__)
 
-RUN_STATUSES = ("queued", "running", "done", "failed")
+RunStatus = Literal["queued", "running", "done", "failed"]
+"""A run's state (an enum in the OpenAPI, also of the take tables' ``status`` filter)."""
+RUN_STATUSES: tuple[RunStatus, ...] = get_args(RunStatus)
 """A run's states, in life order."""
-REVIEW_STATUSES = ("unreviewed", "approved", "needs_fix", "rejected")
+ReviewStatus = Literal["unreviewed", "approved", "needs_fix", "rejected"]
+"""A take's review decision."""
+REVIEW_STATUSES: tuple[ReviewStatus, ...] = get_args(ReviewStatus)
 """The review decisions a take can have."""
 
 

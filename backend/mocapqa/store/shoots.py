@@ -16,6 +16,7 @@ from sqlalchemy.sql.elements import ColumnElement
 
 from mocapqa import __version__
 from mocapqa.errors import ConflictError, InputError, NotFoundError
+from mocapqa.pipeline.summary import SUMMARY_FIELDS
 from mocapqa.store.qa import sync_take
 from mocapqa.store.repository import RUN_STATUSES, new_id, utc_now
 from mocapqa.store.tables import reviews, runs, shoots, source_hashes, take_qa, takes
@@ -26,16 +27,7 @@ SORT_COLUMNS = (
     "name",
     "created_at",
     "status",
-    "score",
-    "n_frames",
-    "duration_s",
-    "rig",
-    "twist_intervals",
-    "corrected_joint_frames",
-    "violation_share",
-    "worst_joint",
-    "filter_residual_mm",
-    "missing_share",
+    *SUMMARY_FIELDS,
     "n_findings",
     "review_status",
     "reviewer",

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, Literal, get_args
 
 import numpy as np
 
@@ -42,6 +42,7 @@ from mocapqa.twist.refine import refine_quats
 
 __all__ = [
     "METHODS",
+    "Method",
     "TwistAnalysis",
     "TwistInterval",
     "analyze_twist",
@@ -49,8 +50,9 @@ __all__ = [
     "parse_apply",
 ]
 
-# Detection methods: the robust default and the paper as written.
-METHODS = ("robust", "paper")
+Method = Literal["robust", "paper"]
+"""A detection method: the robust default, or the paper as written."""
+METHODS: tuple[Method, ...] = get_args(Method)
 
 
 @dataclass(frozen=True, slots=True)

@@ -28,6 +28,7 @@ from mocapqa.api.shoot_schemas import (
 from mocapqa.errors import InputError
 from mocapqa.jobs.batch_output import COLUMNS
 from mocapqa.jobs.shoot_import import ImportLimits, import_uploads
+from mocapqa.store.repository import ReviewStatus, RunStatus
 from mocapqa.store.roles import Action
 from mocapqa.store.shoots import SORT_COLUMNS, ShootStore, TakeFilter
 
@@ -171,8 +172,8 @@ def list_shoot_takes(
     offset: Annotated[int, Query(ge=0, le=MAX_OFFSET)] = 0,
     sort: ShootSort = "score",
     order: Literal["asc", "desc"] = "asc",
-    status: Literal["queued", "running", "done", "failed"] | None = None,
-    review_status: Literal["unreviewed", "approved", "needs_fix", "rejected"] | None = None,
+    status: RunStatus | None = None,
+    review_status: ReviewStatus | None = None,
     rig: str | None = None,
     min_score: Annotated[float | None, Query(ge=0, le=100)] = None,
     max_score: Annotated[float | None, Query(ge=0, le=100)] = None,
