@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import dask
+import distributed  # noqa: F401  (loads its config defaults; see below)
 import pytest
 from fastapi.testclient import TestClient
 
@@ -210,6 +211,9 @@ def test_server_with_a_gone_scheduler_fails_runs_with_the_reason(
     settings = Settings(
         allowed_hosts=["testserver"], data_dir=tmp_path / "server", dask_scheduler=address
     )
+    # distributed is imported above, so its defaults are in the config before this block:
+    # leaving the block then restores them, where it would otherwise remove the whole
+    # "distributed" section that the first import inside the block had added.
     with (
         dask.config.set({"distributed.comm.timeouts.connect": "2s"}),
         TestClient(create_app(settings)) as client,
