@@ -76,4 +76,10 @@ def test_bench_twist_prints_both_tables_for_each_method(
     assert "Table 2 (robust)" in out
     assert "Table 2 (paper)" in out
     assert "held-out" in out
+    # The unpaired-burst row: both takes are long enough, one injection each.
+    unpaired = out[out.index("Unpaired bursts after a natural roll step") :]
+    rows = {line.split("│")[1].strip(): line.split("│")[2:] for line in unpaired.splitlines()
+            if line.startswith("│")}  # fmt: skip
+    assert rows["all"][0].strip() == "2"
+    assert rows["all: fit set"][0].strip() == rows["all: held-out"][0].strip() == "1"
     assert main(["bench", "twist", "--data", str(tmp_path / "bandai" / "none")]) == 3

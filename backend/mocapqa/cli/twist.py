@@ -328,12 +328,14 @@ def bench_twist(
 
     from mocapqa.bench.calibration import disagreement_loro, fit_on_fit_takes, reliability
     from mocapqa.bench.twist import find_bench_files, speed_frames_per_s
+    from mocapqa.bench.unpaired import run_unpaired_bench
     from mocapqa.cli.twist_tables import (
         calibration_table,
         disagreement_table,
         loro_table,
         loro_variants,
         rates_table,
+        unpaired_table,
     )
     from mocapqa.io.bvh import read_bvh
 
@@ -393,6 +395,13 @@ def bench_twist(
                 disagreement_loro([*main_methods["robust"].records, *bursts["robust"].records])
             )
         )
+        with Progress(console=console, transient=True) as progress:
+            task = progress.add_task("unpaired bursts", total=len(bench_files))
+            unpaired = run_unpaired_bench(
+                bench_files, seed=seed, repeats=repeats,
+                on_file=lambda f: progress.update(task, advance=1, description=f.path.name),
+            )  # fmt: skip
+        console.print(unpaired_table(unpaired))
     if ablation:
         console.print(_ablation_table(result.methods))
     if loro:

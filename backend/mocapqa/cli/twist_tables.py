@@ -18,6 +18,7 @@ __all__ = [
     "loro_variants",
     "natural_table",
     "rates_table",
+    "unpaired_table",
 ]
 
 
@@ -148,5 +149,37 @@ def disagreement_table(rows: Sequence[Any]) -> Table:
         table.add_row(
             row.rig, "–" if row.chosen is None else f"{row.chosen:.2f}", str(row.right_blocked),
             str(row.wrong_blocked), str(row.right_applied), str(row.wrong_applied),
+        )  # fmt: skip
+    return table
+
+
+def unpaired_table(figures: dict[Any, Any]) -> Table:
+    """Unpaired bursts after a natural step: jumps removed and far cells moved, per set."""
+    from mocapqa.bench.natural import wilson_interval
+    from mocapqa.bench.twist import RIGS
+    from mocapqa.bench.unpaired import unpaired_totals
+
+    table = Table(
+        title="Unpaired bursts after a natural roll step (injected; figures as on 005_05)"
+    )
+    for column in ("set", "injected takes", "jumps > 20°", "removed", "95 % Wilson",
+                   "far cells", "far moved > 5°", "takes with a far move",
+                   "far max move °"):  # fmt: skip
+        table.add_column(column, justify="left" if column == "set" else "right")
+    groups: list[tuple[str, tuple[str, ...], bool | None]] = [
+        *[(rig, (rig,), None) for rig in RIGS],
+        ("all", RIGS, None),
+        ("all: fit set", RIGS, False),
+        ("all: held-out", RIGS, True),
+    ]
+    for name, rigs, held in groups:
+        t = unpaired_totals(figures, rigs, held)
+        if not t.n_injected:
+            continue
+        share = t.n_removed / t.n_jumps if t.n_jumps else 0.0
+        table.add_row(
+            name, str(t.n_injected), str(t.n_jumps), f"{t.n_removed} ({100 * share:.1f} %)",
+            _pct(*wilson_interval(t.n_removed, t.n_jumps)), str(t.n_far_cells),
+            str(t.n_far_moved), str(t.n_takes_moved), f"{t.max_far_move_deg:.1f}",
         )  # fmt: skip
     return table

@@ -34,7 +34,7 @@ from mocapqa.kinematics.quaternion import multiply, quats_from_axis_angle
 from mocapqa.twist.angles import ChainGeometry, chain_geometry
 from mocapqa.twist.refine import refine_quats
 
-__all__ = ["InjectedInterval", "InjectionTruth", "inject_twist_errors"]
+__all__ = ["InjectedInterval", "InjectionTruth", "choose_targets", "inject_twist_errors"]
 
 TARGET_SEGMENTS = ("clavicle", "upper_arm", "forearm", "upper_leg", "lower_leg")
 _LIMB = {"clavicle": "arm", "upper_arm": "arm", "forearm": "arm", "upper_leg": "leg",
@@ -139,6 +139,29 @@ def _burst_parts(
     return parts
 
 
+def choose_targets(
+    motion: Motion, rng: np.random.Generator, n_targets: int, mapping: dict[str, str] | None
+) -> list[ChainGeometry]:
+    """Target chains of an injection: ``n_targets`` limbs drawn at random, one chain on each.
+
+    Raises
+    ------
+    InputError
+        If the rig has fewer limbs with twist chains than ``n_targets``.
+    """
+    skeleton = motion.skeleton
+    chains = [c for c in limb_chains(find_roles(skeleton, mapping)) if c.segment in TARGET_SEGMENTS]
+    limbs = sorted({(c.side, _LIMB[c.segment]) for c in chains})
+    if len(limbs) < n_targets:
+        raise InputError(f"Expected at least {n_targets} limbs with twist chains, got {len(limbs)}")
+    chosen_limbs = rng.choice(len(limbs), size=n_targets, replace=False)
+    geometries: list[ChainGeometry] = []
+    for index in sorted(int(i) for i in chosen_limbs):
+        options = [c for c in chains if (c.side, _LIMB[c.segment]) == limbs[index]]
+        geometries.append(chain_geometry(skeleton, options[int(rng.integers(len(options)))]))
+    return geometries
+
+
 def inject_twist_errors(
     motion: Motion,
     rng: np.random.Generator,
@@ -197,15 +220,7 @@ def inject_twist_errors(
             f"{min_intervals}, {max_intervals}, {max_interval_frames}"
         )
     skeleton = motion.skeleton
-    chains = [c for c in limb_chains(find_roles(skeleton, mapping)) if c.segment in TARGET_SEGMENTS]
-    limbs = sorted({(c.side, _LIMB[c.segment]) for c in chains})
-    if len(limbs) < n_targets:
-        raise InputError(f"Expected at least {n_targets} limbs with twist chains, got {len(limbs)}")
-    chosen_limbs = rng.choice(len(limbs), size=n_targets, replace=False)
-    geometries: list[ChainGeometry] = []
-    for index in sorted(int(i) for i in chosen_limbs):
-        options = [c for c in chains if (c.side, _LIMB[c.segment]) == limbs[index]]
-        geometries.append(chain_geometry(skeleton, options[int(rng.integers(len(options)))]))
+    geometries = choose_targets(motion, rng, n_targets, mapping)
     n_frames, n_joints = motion.quats.shape[:2]
     chain_offsets = np.zeros((n_frames, len(geometries)))
     error_mask = np.zeros((n_frames, n_joints), dtype=bool)
