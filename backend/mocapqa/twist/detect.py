@@ -128,6 +128,11 @@ class RobustParams:
         left unchanged only when the two differ by more than this many robust scales of the
         roll's deviation from its continuation inside the stretch (0: always); a contradiction
         within the roll's own scatter inside the stretch is no evidence against the jumps.
+    mirror : float
+        A group of events that pairs a burst with events farther than ``burst_gap_s`` is kept
+        only if, between them, the child's level measured from outside mirrors the parent's
+        (``|P + C| ≤ mirror × min(|P|, |C|)``); otherwise its bursts stand alone and its lone
+        events are left unmatched (0: off).
     """
 
     min_threshold_deg: float = 2.0
@@ -146,6 +151,7 @@ class RobustParams:
     mismatch_noise: float = 0.0
     closure_noise: float = 1.0
     precision: float = 2.0
+    mirror: float = 0.0
     parent_source: str = "increment"
     child_source: str = "increment"
     min_conditioning: float = 0.4
@@ -169,12 +175,13 @@ class RobustParams:
             )
         if (
             min(self.speed_factor, self.tail_s, self.tail_factor, self.mismatch_noise,
-                self.closure_noise, self.precision) < 0
+                self.closure_noise, self.precision, self.mirror) < 0
         ):  # fmt: skip
             raise InputError(
-                "Expected speed_factor, tail_s, tail_factor, mismatch_noise, closure_noise and "
-                f"precision ≥ 0, got {self.speed_factor}, {self.tail_s}, {self.tail_factor}, "
-                f"{self.mismatch_noise}, {self.closure_noise}, {self.precision}"
+                "Expected speed_factor, tail_s, tail_factor, mismatch_noise, closure_noise, "
+                f"precision and mirror ≥ 0, got {self.speed_factor}, {self.tail_s}, "
+                f"{self.tail_factor}, {self.mismatch_noise}, {self.closure_noise}, "
+                f"{self.precision}, {self.mirror}"
             )
         if self.burst_gap_s <= 0 or self.agreement < 0 or self.min_fps < 0:
             raise InputError(
@@ -432,6 +439,7 @@ def detect_robust(
                 float(threshold[c]), float(roll_scale[c]), fps, params.closure_fraction,
                 params.agreement, params.burst_gap_s, params.max_interval_s, small[:, c],
                 params.tail_s, uncertainty[frames, c], params.precision,
+                (dc[:, c], natural_c[:, c]), params.mirror,
             )  # fmt: skip
         else:
             steps = np.zeros(n_frames)

@@ -153,8 +153,7 @@ def inject_unpaired_bursts(
         parent_roll[t0:back, c] += step
         parent_roll[back:, c] += after
         child_roll[t0, c] -= step
-        child_roll[t0 + 1 : back, c] -= follow * step
-        child_roll[back, c] += step - after - follow * step
+        child_roll[t0 + 1 :, c] -= follow * step
         sign = float(rng.choice((-1.0, 1.0)))
         parent = geometry.chain.parent
         for frame in burst:
