@@ -151,7 +151,7 @@ class RobustParams:
     mismatch_noise: float = 0.0
     closure_noise: float = 1.0
     precision: float = 2.0
-    mirror: float = 0.0
+    mirror: float = 0.5
     parent_source: str = "increment"
     child_source: str = "increment"
     min_conditioning: float = 0.4
