@@ -17,14 +17,16 @@ burst's unbalanced part with the natural step and shifts the clean frames betwee
   stays there; the child counter-rotates by ``−s`` on that frame only and then keeps only
   ``−μ s`` (μ uniform in 0–0.5: the child follows part of the step, as the real foot does);
 * **the return** on the first frame after the burst: the parent's roll goes to ``η s``
-  (|η| uniform in 0.1–0.4, either sign: near, but not exactly at, the level before the step),
-  the child counter-rotating that step on that frame only and then back at its own level.
+  (|η| uniform in 0.1–0.4, either sign: near, but not exactly at, the level before the step);
+  the child does not counter-rotate it and keeps its ``−μ s`` (the real foot does not
+  counter-rotate the burst's net either).
 
 *Error* (``truth.error_mask``, ``truth.offsets_rad``): the **burst**, ``gap_s`` (0.35–0.6 s)
 after the step, 1–3 frames of holds of alternating sign, each 25–90°, counter-rotated by the
 child by ``(1 + ε)`` with ε uniform in ±0.2 (the child keeps its world orientation up to ε).
-Since the return coincides with the burst's release, the burst's jumps add up to about ``−s``
-(1 + η) and can close with the natural step.
+Since the return coincides with the burst's release, the parent's jumps in the burst add up to
+about ``−s (1 + η)`` and can close with the natural step (when the release, read against the
+child's counter-rotation of the last hold alone, still counts as counter-rotated).
 
 The parent's natural roll turns the whole limb below it (no compensation); the child's own
 roll is applied to its local rotation in the parent's frame, ``R(a, c) ⊗ qC``.
