@@ -59,8 +59,15 @@ def test_real_errors_are_removed_and_far_frames_barely_move(real_take: Motion) -
     figures = natural_error_figures(real_take, analyze_twist(real_take))
     # 18 counter-rotated calf roll jumps over 20° per frame (the data README lists 17 of them).
     assert figures.n_jumps >= 17
-    assert figures.n_removed >= 0.85 * figures.n_jumps
-    assert figures.max_far_move_deg < 15.0
+    # No frame farther than 0.25 s from a jump moves by more than 5° (the mirror check; 16
+    # cells up to 13.1° before it). The price, by default: the bursts it leaves on their own
+    # are found with probabilities under 0.5 (docs/twist.md), so 11 of 18 jumps are removed
+    # (17 before); applying every interval removes all of them.
+    assert figures.n_far_moved == 0
+    assert figures.n_removed >= 0.6 * figures.n_jumps
+    every = natural_error_figures(real_take, analyze_twist(real_take, apply="all"))
+    assert every.n_removed == every.n_jumps
+    assert every.n_far_moved == 0
     untouched = natural_error_figures(real_take, analyze_twist(real_take, apply="none"))
     assert untouched.n_removed == 0
     assert untouched.n_far_moved == 0
