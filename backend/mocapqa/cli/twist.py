@@ -148,6 +148,7 @@ def _ablations() -> dict[str, tuple[str, Any]]:
         "mismatch allowance + 1 noise scale": ("robust", replace(base, mismatch_noise=1.0)),
         "no closure allowance (closure_noise 0)": ("robust", replace(base, closure_noise=0.0)),
         "outside level overrules within its scatter": ("robust", replace(base, precision=0.0)),
+        "no mirror check (mirror 0)": ("robust", replace(base, mirror=0.0)),
     }
 
 
