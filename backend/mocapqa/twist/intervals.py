@@ -26,17 +26,19 @@ Conventions
   contradiction exceeds ``precision`` times the roll's own scatter inside the stretch (a roll
   jittering by more than the level cannot contradict it). Where the jumps do not cancel (a
   burst whose ends disagree), the outside level is used.
+* A group that pairs a burst with events far from it is kept only where the child's roll
+  mirrors the parent's between them (:func:`mocapqa.twist.outside.split_unmirrored`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from itertools import pairwise
 
 import numpy as np
 
-from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.core.arrays import FloatArray, IntArray
 from mocapqa.twist.angles import wrap_angle
+from mocapqa.twist.outside import anchors, forbidden_frames, hermite_deviation, split_unmirrored
 
 __all__ = ["FEATURES", "IntervalEstimate", "chain_intervals"]
 
@@ -160,104 +162,6 @@ def _spread(values: FloatArray) -> float:
     return float(1.4826 * np.median(np.abs(wrap_angle(values - centre))))
 
 
-def _deviation(roll: FloatArray, natural: FloatArray, before: int, after: int) -> FloatArray:
-    """The roll minus its cubic Hermite continuation between two anchors, frames before…after.
-
-    The continuation joins the integrated roll at the anchors with the natural velocities
-    there; its travel between them is taken modulo 2π.
-    """
-    span = after - before
-    travel = float(np.sum(natural[before + 1 : after + 1]))
-    end_value = roll[before] + travel + wrap_angle(roll[after] - roll[before] - travel)
-    u = np.arange(span + 1) / span
-    h00, h10 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u
-    h01, h11 = -2 * u**3 + 3 * u**2, u**3 - u**2
-    continuation = (
-        h00 * roll[before] + h10 * span * natural[before] + h01 * end_value
-        + h11 * span * natural[after]
-    )  # fmt: skip
-    result: FloatArray = wrap_angle(roll[before : after + 1] - continuation)
-    return result
-
-
-def _forbidden(
-    frames: IntArray, groups: list[list[int]], n_frames: int, burst_gap: int
-) -> BoolArray:
-    """Frames where no anchor may sit: inside every group, and near events of none."""
-    forbidden = np.zeros(n_frames, dtype=bool)
-    for group in groups:
-        forbidden[frames[group[0]] : frames[group[-1]]] = True
-    grouped = np.zeros(len(frames), dtype=bool)
-    grouped[[k for g in groups for k in g]] = True
-    for f in frames[~grouped]:
-        forbidden[max(0, f - burst_gap) : f + burst_gap + 1] = True
-    return forbidden
-
-
-def _anchors(forbidden: BoolArray, first: int, last: int) -> tuple[int, int]:
-    """The frame before ``first`` and the frame ``last``, moved outwards past forbidden frames."""
-    before, after = first - 1, last
-    while before > 0 and forbidden[before]:
-        before -= 1
-    while after < len(forbidden) - 1 and forbidden[after]:
-        after += 1
-    return before, after
-
-
-def _unmirrored_split(
-    frames: IntArray,
-    groups: list[list[int]],
-    rolls: tuple[FloatArray, FloatArray],
-    naturals: tuple[FloatArray, FloatArray],
-    burst_gap: int,
-    mirror: float,
-) -> list[list[int]]:
-    """Groups that pair a burst with events far from it, split where the child does not mirror.
-
-    A group whose events form two or more clusters (events within ``burst_gap``), one of them
-    a burst of two or more events, holds long stretches between clusters. On each, the
-    parent's and the child's levels are measured from outside (deviation from each roll's
-    continuation between the group's anchors); a twist error moves them oppositely, so
-    ``|wrap(P + C)| ≤ mirror × min(|P|, |C|)``. If a stretch fails, the group is split into
-    its bursts (each then an interval of its own, or not) and its lone events are left
-    unmatched.
-    """
-    n_frames = len(rolls[0])
-    forbidden = _forbidden(frames, groups, n_frames, burst_gap)
-    out: list[list[int]] = []
-    for group in groups:
-        events = frames[group]
-        cuts = np.flatnonzero(np.diff(events) > burst_gap) + 1
-        clusters = [list(c) for c in np.split(np.array(group), cuts)]
-        if len(clusters) < 2 or max(len(c) for c in clusters) < 2:
-            out.append(group)
-            continue
-        before, _ = _anchors(forbidden, int(events[0]), int(events[-1]))
-        stop = int(events[-1]) + 1
-        # Continued from the anchor before the group only: the group's last event may leave
-        # the roll inside the burst's error, which the child mirrors.
-        parent = wrap_angle(
-            rolls[0][before:stop] - rolls[0][before]
-            - np.concatenate(([0.0], np.cumsum(naturals[0][before + 1 : stop])))
-        )  # fmt: skip
-        child = wrap_angle(
-            rolls[1][before:stop] - rolls[1][before]
-            - np.concatenate(([0.0], np.cumsum(naturals[1][before + 1 : stop])))
-        )  # fmt: skip
-        mirrored = True
-        for left, right in pairwise(clusters):
-            lo, hi = int(frames[left[-1]]) - before, int(frames[right[0]]) - before
-            p_level = float(np.angle(np.mean(np.exp(1j * parent[lo:hi]))))
-            c_level = float(np.angle(np.mean(np.exp(1j * child[lo:hi]))))
-            gap = abs(float(wrap_angle(np.array(p_level + c_level))))
-            mirrored &= gap <= mirror * min(abs(p_level), abs(c_level))
-        if mirrored:
-            out.append(group)
-        else:
-            out += [c for c in clusters if len(c) >= 2]
-    return out
-
-
 def chain_intervals(
     frames: IntArray,
     jumps: FloatArray,
@@ -353,10 +257,10 @@ def chain_intervals(
     groups = _groups(frames, jumps, threshold, closure_fraction, burst_gap, max_frames, sigma)
     if mirror > 0 and child is not None:
         rolls = (roll, np.cumsum(child[0]))
-        groups = _unmirrored_split(frames, groups, rolls, (natural, child[1]), burst_gap, mirror)
+        groups = split_unmirrored(frames, groups, rolls, (natural, child[1]), burst_gap, mirror)
     # Anchors must sit where the roll is at its natural level: outside every interval and
     # away from events that belong to none.
-    forbidden = _forbidden(frames, groups, n_frames, burst_gap)
+    forbidden = forbidden_frames(frames, groups, n_frames, burst_gap)
     for group in groups:
         events = frames[group]
         first, last = int(events[0]), int(events[-1])
@@ -374,8 +278,8 @@ def chain_intervals(
         ):
             end += 1
         tail = small_steps[last + 1 : end + 1] if small_steps is not None else np.zeros(0)
-        before, after = _anchors(forbidden, first, end)
-        deviation = _deviation(roll, natural, before, after)
+        before, after = anchors(forbidden, first, end)
+        deviation = hermite_deviation(roll, natural, before, after)
         net = float(wrap_angle(np.array(np.sum(steps) + np.sum(tail))))
         spread_out = bool(np.all(np.diff(events) > burst_gap))
         slack = float(np.sqrt(np.sum(sigma[group] ** 2))) if spread_out else 0.0
