@@ -10,6 +10,7 @@ import pytest
 from mocapqa.bench.natural import natural_error_figures
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
+from mocapqa.errors import InputError
 from mocapqa.kinematics.quaternion import conjugate, multiply
 from mocapqa.twist.analysis import analyze_twist
 from mocapqa.twist.angles import chain_geometry, wrap_angle
@@ -124,3 +125,19 @@ def test_no_clean_frame_moves_on_a_jittery_step_before_a_burst(
     assert figures.n_far_moved == 0
     unchecked = analyze_twist(corrupted, params=replace(RobustParams(), mirror=0.0))
     assert natural_error_figures(corrupted, unchecked).n_far_moved > 0
+
+
+def test_the_shape_is_checked(takes: dict[str, Motion]) -> None:
+    for bad in (
+        {"step_deg": (15.0, 8.0)},
+        {"gap_s": (0.1, 0.6)},
+        {"max_burst_frames": 0},
+        {"jitter_deg": (-1.0, 2.0)},
+    ):
+        with pytest.raises(InputError, match="Expected"):
+            UnpairedShape(**bad)  # type: ignore[arg-type]
+    motion = takes["bandai"]
+    short = replace(motion, quats=motion.quats[:20], translations=motion.translations[:20],
+                    euler_hint_deg=None)  # fmt: skip
+    with pytest.raises(InputError, match="at least"):
+        inject_unpaired_bursts(short, np.random.default_rng(0))

@@ -84,6 +84,25 @@ class UnpairedShape:
     mismatch: float = 0.2
     return_fraction: tuple[float, float] = (0.1, 0.4)
 
+    def __post_init__(self) -> None:
+        ranges = {
+            "jitter_deg": self.jitter_deg, "step_deg": self.step_deg,
+            "child_follow": self.child_follow, "gap_s": self.gap_s,
+            "flip_deg": self.flip_deg, "return_fraction": self.return_fraction,
+        }  # fmt: skip
+        for name, (low, high) in ranges.items():
+            if not 0 <= low <= high:
+                raise InputError(f"Expected 0 ≤ low ≤ high for {name}, got ({low}, {high})")
+        if self.jitter_s <= 0 or self.max_burst_frames < 1 or not 0 <= self.mismatch < 1:
+            raise InputError(
+                "Expected jitter_s > 0, max_burst_frames ≥ 1 and 0 ≤ mismatch < 1, got "
+                f"{self.jitter_s}, {self.max_burst_frames}, {self.mismatch}"
+            )
+        if self.gap_s[0] <= 0.25:
+            raise InputError(
+                f"Expected gap_s to start above 0.25 s (the far-frame distance), got {self.gap_s}"
+            )
+
 
 def _first_child(geometry: ChainGeometry) -> int:
     return geometry.intermediates[0] if geometry.intermediates else geometry.chain.child
