@@ -25,6 +25,20 @@ def hermite_deviation(roll: FloatArray, natural: FloatArray, before: int, after:
 
     The continuation joins the integrated roll at the anchors with the natural velocities
     there; its travel between them is taken modulo 2π.
+
+    Parameters
+    ----------
+    roll : ndarray, shape (F,)
+        Integrated roll (cumulative sum of the increments), radians.
+    natural : ndarray, shape (F,)
+        Natural roll increment per frame, radians.
+    before, after : int
+        Anchor frames, ``before < after``.
+
+    Returns
+    -------
+    ndarray, shape (after − before + 1,)
+        Wrapped deviation, radians (0 at both anchors).
     """
     span = after - before
     travel = float(np.sum(natural[before + 1 : after + 1]))
@@ -43,7 +57,23 @@ def hermite_deviation(roll: FloatArray, natural: FloatArray, before: int, after:
 def forbidden_frames(
     frames: IntArray, groups: list[list[int]], n_frames: int, burst_gap: int
 ) -> BoolArray:
-    """Frames where no anchor may sit: inside every group, and near events of none."""
+    """Frames where no anchor may sit: inside every group, and near events of none.
+
+    Parameters
+    ----------
+    frames : ndarray of int, shape (E,)
+        Event frames, increasing.
+    groups : list of list of int
+        Event indices of each group, sorted.
+    n_frames : int
+        Frames of the take.
+    burst_gap : int
+        Frames on each side of an event of no group where no anchor may sit.
+
+    Returns
+    -------
+    ndarray of bool, shape (F,)
+    """
     forbidden = np.zeros(n_frames, dtype=bool)
     for group in groups:
         forbidden[frames[group[0]] : frames[group[-1]]] = True
@@ -55,7 +85,19 @@ def forbidden_frames(
 
 
 def anchors(forbidden: BoolArray, first: int, last: int) -> tuple[int, int]:
-    """The frame before ``first`` and the frame ``last``, moved outwards past forbidden frames."""
+    """The frame before ``first`` and the frame ``last``, moved outwards past forbidden frames.
+
+    Parameters
+    ----------
+    forbidden : ndarray of bool, shape (F,)
+        From :func:`forbidden_frames`.
+    first, last : int
+        First and last frame of a group's events (or its decay tail).
+
+    Returns
+    -------
+    before, after : int
+    """
     before, after = first - 1, last
     while before > 0 and forbidden[before]:
         before -= 1
