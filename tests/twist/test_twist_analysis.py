@@ -18,9 +18,12 @@ MODULES = [
     "mocapqa.twist.detect",
     "mocapqa.twist.refine",
     "mocapqa.twist.inject",
+    "mocapqa.twist.inject_unpaired",
+    "mocapqa.twist.outside",
     "mocapqa.twist.analysis",
     "mocapqa.metrics.twist",
     "mocapqa.bench.twist",
+    "mocapqa.bench.unpaired",
     "mocapqa.cli.twist",
 ]
 
