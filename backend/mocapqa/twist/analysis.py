@@ -53,6 +53,7 @@ __all__ = [
 Method = Literal["robust", "paper"]
 """A detection method: the robust default, or the paper as written."""
 METHODS: tuple[Method, ...] = get_args(Method)
+"""The detection methods, the default first."""
 
 
 @dataclass(frozen=True, slots=True)

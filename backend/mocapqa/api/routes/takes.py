@@ -9,19 +9,13 @@ from fastapi import APIRouter, Depends, File, Form, Query, Request, Response, Up
 from mocapqa.api.auth import Principal, audit, require, require_owner
 from mocapqa.api.deps import ClientDep, ServicesDep, TakeDep, require_run_slot
 from mocapqa.api.errors import responses
-from mocapqa.api.schemas import (
-    ReviewStatus,
-    RunStatus,
-    TakeCreatedOut,
-    TakeDetailOut,
-    TakeOut,
-    TakePageOut,
-)
+from mocapqa.api.schemas import TakeCreatedOut, TakeDetailOut, TakeOut, TakePageOut
 from mocapqa.api.views import review_out, run_out, take_fields
 from mocapqa.jobs.intake import ingest_take, reading_of
 from mocapqa.jobs.rendered import THUMBNAIL_PNG
 from mocapqa.jobs.thumbnails import thumbnail_svg
 from mocapqa.pipeline.loading import ReadOptions
+from mocapqa.store.repository import ReviewStatus, RunStatus
 from mocapqa.store.roles import Action
 
 __all__ = ["router"]
