@@ -22,9 +22,10 @@ def test_every_field_of_the_form_is_an_option_with_its_default() -> None:
     described = describe_options()
     fields = {f["name"]: f for g in described["groups"] for f in g["fields"]}
     option_names = {f.name for f in dataclasses.fields(AnalysisOptions)}
-    # Every field is an option (checks are the groups' own boxes; mapping is set per take).
+    # Every field is an option (checks are the groups' own boxes; mapping is set per take, the
+    # limits model per shoot).
     assert set(fields) <= option_names
-    assert option_names - set(fields) == {"checks", "filter_params", "mapping"}
+    assert option_names - set(fields) == {"checks", "filter_params", "mapping", "limits_model"}
     default = AnalysisOptions()
     for name, field in fields.items():
         assert field["default"] == getattr(default, name), name

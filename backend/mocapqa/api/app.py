@@ -31,6 +31,7 @@ from mocapqa.api.routes import (
     decisions,
     filters,
     health,
+    limits_models,
     reviews,
     runs,
     session,
@@ -66,6 +67,7 @@ ROUTERS: tuple[tuple[APIRouter, Sequence[Any]], ...] = (
     (filters.router, (_READ,)),
     (stream.router, (_READ,)),
     (shoots.router, (_READ,)),
+    (limits_models.router, (_READ,)),
 )
 """Every router with the dependencies that guard all its routes (``Depends(...)`` items):
 the one place where a router gets, for example, a sign-in requirement. Reading needs a

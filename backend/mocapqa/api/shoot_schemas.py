@@ -12,6 +12,8 @@ from mocapqa.store.repository import ReviewStatus, RunStatus
 __all__ = [
     "HeatmapOut",
     "ImportOut",
+    "LimitsModelIn",
+    "LimitsModelOut",
     "NextTakeOut",
     "ProgressOut",
     "ShootIn",
@@ -43,6 +45,11 @@ class ShootOut(BaseModel):
         None,
         description="The user who made it, who may rename and delete it besides admins (none "
         "for shoots made before shoots had owners, or without users).",
+    )
+    limits_model: str = Field(
+        "default",
+        description="The joint-limits model the runs of its takes use (`GET /limits-models`); "
+        "an admin chooses it",
     )
 
 
@@ -122,3 +129,32 @@ class NextTakeOut(BaseModel):
 
     take: ShootTakeOut | None
     remaining: int
+
+
+class LimitsModelIn(BaseModel):
+    """The limits model a shoot's runs use, by name."""
+
+    model_config = {"extra": "forbid"}
+
+    name: str = Field(
+        min_length=1,
+        max_length=64,
+        description="A name from `GET /limits-models`",
+        examples=["default", "canonical"],
+    )
+
+
+class LimitsModelOut(BaseModel):
+    """A choosable joint-limits model (``mocapqa.limits.catalog``)."""
+
+    name: str
+    kind: Literal["default", "shipped", "registered"] = Field(
+        description="default: the shipped choice per rig; shipped: a file shipped with mocapqa; "
+        "registered: built with `mocapqa limits build` and registered in the data folder"
+    )
+    frame: Literal["per rig", "canonical", "rig"] = Field(
+        description="canonical: any rig with limb roles; rig: only its own rig's skeleton"
+    )
+    rig_family: str
+    n_takes: int = Field(description="Takes the model was built from (0 for the default)")
+    n_frames: int = Field(description="Frames the model was built from (0 for the default)")

@@ -82,6 +82,7 @@ def batch(
     from mocapqa.jobs.batch import run_batch
     from mocapqa.jobs.batch_output import ResultWriter
     from mocapqa.jobs.engine import Engine
+    from mocapqa.limits.catalog import ModelCatalog
     from mocapqa.store.files import FileStore
     from mocapqa.store.repository import Repository
     from mocapqa.store.shoots import ShootStore
@@ -89,8 +90,10 @@ def batch(
     for name in DASK_LOGGERS:
         logging.getLogger(name).setLevel(logging.WARNING)
     run_options = _options(options)
-    writer = ResultWriter(output) if output is not None else None
     settings = get_settings()
+    if run_options.limits_model is not None:  # refused before any take is read
+        ModelCatalog.of_data_folder(settings.data_dir).require(run_options.limits_model)
+    writer = ResultWriter(output) if output is not None else None
     settings.data_dir.mkdir(parents=True, exist_ok=True)
     FileStore(settings.data_dir)
     repository = Repository(settings.resolved_database_url)

@@ -17,9 +17,10 @@ from mocapqa.errors import InputError
 if TYPE_CHECKING:
     from mocapqa.core.motion import Motion
     from mocapqa.limits.build import BuildParams
+    from mocapqa.limits.catalog import ModelCatalog
     from mocapqa.limits.model import LimitsModel
 
-__all__ = ["limits_build", "limits_check", "limits_show"]
+__all__ = ["limits_build", "limits_check", "limits_models", "limits_register", "limits_show"]
 
 console = Console(highlight=False)
 
@@ -124,7 +125,12 @@ def limits_build(
 def limits_check(
     path: Annotated[Path, typer.Argument(help="BVH take to check.")],
     model_path: Annotated[
-        Path | None, typer.Option("--model", help="Limits model; default: the shipped one.")
+        str | None,
+        typer.Option(
+            "--model",
+            help="Limits model: a .npz file, or a name of `mocapqa limits models`; default: "
+            "the shipped choice for the rig.",
+        ),
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     network: Annotated[bool, typer.Option(help="Let the discriminator decide.")] = False,
@@ -147,12 +153,11 @@ def limits_check(
     """
     from mocapqa.io.bvh import read_bvh
     from mocapqa.limits.analysis import check_limits
-    from mocapqa.limits.storage import load_model
 
     roles = load_mapping(mapping)
     motion = read_bvh(path)
     missing = missing_roles(motion.skeleton, roles)
-    model = load_model(model_path) if model_path is not None else None
+    model = _chosen_model(model_path, motion) if model_path is not None else None
     if frame_from is not None:
         model = _framed_from(motion, model, frame_from)
     report = check_limits(motion, model, method="network" if network else "map", mapping=roles)
@@ -182,6 +187,54 @@ def limits_check(
     console.print(
         f"model: {report.rig_family} ({kind}); not checked ({len(report.not_checked)}): "
         f"{', '.join(report.not_checked) or 'none'}"
+    )
+
+
+def _catalog() -> ModelCatalog:
+    from mocapqa.config import get_settings
+    from mocapqa.limits.catalog import ModelCatalog
+
+    return ModelCatalog.of_data_folder(get_settings().data_dir)
+
+
+def _chosen_model(value: str, motion: Motion) -> LimitsModel:
+    """``--model``: a model file when ``value`` names one, else a name of the catalog."""
+    from mocapqa.limits.storage import load_model
+
+    if value.endswith(".npz") or Path(value).is_file():
+        return load_model(value)
+    return _catalog().load(value, motion.skeleton)
+
+
+@limits_app.command("models")
+def limits_models() -> None:
+    """List the limits models a check, a batch or a shoot can name: the default choice, the
+    shipped models and those registered in the data folder ($MOCAPQA_DATA_DIR)."""
+    table = Table(title="limits models")
+    for column in ("name", "kind", "frame", "rig", "takes", "frames"):
+        table.add_column(column)
+    for entry in _catalog().entries():
+        table.add_row(
+            entry.name, entry.kind, entry.frame, entry.rig_family,
+            str(entry.n_takes), str(entry.n_frames),
+        )  # fmt: skip
+    console.print(table)
+
+
+@limits_app.command("register")
+def limits_register(
+    model_path: Annotated[Path, typer.Argument(help="Model file (.npz) from `limits build`.")],
+    name: Annotated[str, typer.Argument(help="Name to choose it by (a-z, 0-9, _ and -).")],
+    replace: Annotated[
+        bool, typer.Option("--replace", help="Overwrite a model registered under that name.")
+    ] = False,
+) -> None:
+    """Copy a built model into the data folder under NAME, so that an admin can choose it for a
+    shoot and `limits check --model NAME` / `batch --options` can name it."""
+    entry = _catalog().register(model_path, name, replace)
+    console.print(
+        f"registered {entry.name}: {entry.frame} model ({entry.rig_family}), "
+        f"{entry.n_takes} takes, {entry.n_frames} frames"
     )
 
 

@@ -12,6 +12,7 @@ duplicates (an interrupted task may leave an orphan output folder behind, never 
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from collections.abc import Callable, Iterable, Iterator
@@ -22,6 +23,7 @@ from typing import Any
 from mocapqa.errors import InputError, MocapQAError
 from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.take_task import analyse_path, content_sha256
+from mocapqa.limits.catalog import DEFAULT_MODEL
 from mocapqa.pipeline.loading import detect_take_format as detect_format
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.repository import new_id
@@ -163,6 +165,9 @@ def run_batch(
         before are stored and have their rows, the others have neither.
     """
     counts = BatchCounts()
+    if options.limits_model is None:  # the shoot's model, as for the server's runs
+        chosen = shoots.limits_model(shoot_id) if shoot_id else DEFAULT_MODEL
+        options = dataclasses.replace(options, limits_model=chosen)
     options_json = options.to_json()
     items = list(discover(paths))
     counts.total = len(items)

@@ -29,6 +29,7 @@ from mocapqa.io.keypoint_csv import csv_sidecar_path
 from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.fair_queue import FairQueue
 from mocapqa.jobs.rendered import render_thumbnail
+from mocapqa.limits.catalog import ModelCatalog
 from mocapqa.pipeline.analyze import AnalysisResult, analyze
 from mocapqa.pipeline.loading import (
     READING_FILE,
@@ -273,7 +274,8 @@ class JobRunner:
                     last[0] = now
                     self.repository.set_progress(run_id, percent, step)
 
-            result = analyze(motion_or_keypoints, options, progress)
+            catalog = ModelCatalog.of_data_folder(self.files.root)
+            result = analyze(motion_or_keypoints, options, progress, catalog)
             progress(96, "writing the outputs")
             write_outputs(self.files, run_id, result)
             if self.renderer is not None:

@@ -17,6 +17,7 @@ from typing import Any
 from mocapqa.core.motion import Motion
 from mocapqa.errors import MocapQAError, ParseError
 from mocapqa.jobs.runner import read_options, run_summary, write_outputs
+from mocapqa.limits.catalog import ModelCatalog
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.loading import (
     READING_FILE,
@@ -92,7 +93,8 @@ def analyse_path(
             ) from e
         if take.n_frames == 0:
             raise ParseError("Expected at least one frame, got 0", source)
-        result = analyze(take, AnalysisOptions.from_json(options))
+        catalog = ModelCatalog.of_data_folder(data_dir)
+        result = analyze(take, AnalysisOptions.from_json(options), catalog=catalog)
     except MocapQAError as e:
         return {"status": "failed", "error": str(e)}
     if isinstance(take, Motion):
@@ -147,6 +149,7 @@ def analyse_stored(
     """
     stored = Path(path)
     take = read_take_file(stored, format_name, name, read_options(stored.parent))
-    result = analyze(take, AnalysisOptions.from_json(options))
+    catalog = ModelCatalog.of_data_folder(data_dir)
+    result = analyze(take, AnalysisOptions.from_json(options), catalog=catalog)
     write_outputs(FileStore(Path(data_dir)), run_id, result)
     return run_summary(result)

@@ -25,6 +25,7 @@ from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles
 from mocapqa.errors import InputError
+from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
 from mocapqa.pipeline.frames import motion_pose, sample_frames
 from mocapqa.pipeline.loading import Take
 from mocapqa.pipeline.options import AnalysisOptions
@@ -87,7 +88,10 @@ def _steps_json(outcomes: dict[str, StepOutcome]) -> dict[str, dict[str, str]]:
 
 
 def _analyze_motion(
-    motion: Motion, options: AnalysisOptions, progress: ProgressCallback
+    motion: Motion,
+    options: AnalysisOptions,
+    progress: ProgressCallback,
+    catalog: ModelCatalog | None,
 ) -> AnalysisResult:
     outcomes: dict[str, StepOutcome] = {}
     series: dict[str, Any] = {}
@@ -120,7 +124,9 @@ def _analyze_motion(
     if "limits" in options.checks:
         progress(55, "joint-limit check")
         clock = time.perf_counter()
-        outcome = run_limits(motion, frames, options.mapping)
+        outcome = run_limits(
+            motion, frames, options.mapping, options.limits_model or DEFAULT_MODEL, catalog
+        )
         timings["limits_s"] = time.perf_counter() - clock
         outcomes["limits"] = outcome
         series["limits"] = outcome.series
@@ -255,7 +261,10 @@ def _count_by_kind(findings: list[dict[str, Any]]) -> dict[str, int]:
 
 
 def analyze(
-    take: Take, options: AnalysisOptions, progress: ProgressCallback | None = None
+    take: Take,
+    options: AnalysisOptions,
+    progress: ProgressCallback | None = None,
+    catalog: ModelCatalog | None = None,
 ) -> AnalysisResult:
     """Analyse a take.
 
@@ -267,6 +276,9 @@ def analyze(
         What to run.
     progress : callable, optional
         Called as ``progress(percent, step)`` with percent in 0–100.
+    catalog : ModelCatalog, optional
+        Where ``options.limits_model`` is looked up (the server's and the batch's: the data
+        folder's registered models too); None offers the shipped models only.
 
     Returns
     -------
@@ -274,7 +286,7 @@ def analyze(
     """
     report_progress = progress or _no_progress
     if isinstance(take, Motion):
-        result = _analyze_motion(take, options, report_progress)
+        result = _analyze_motion(take, options, report_progress, catalog)
     else:
         result = _analyze_keypoints(take, options, report_progress)
     report_progress(95, "analysis finished")

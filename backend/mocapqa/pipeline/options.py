@@ -16,6 +16,7 @@ from mocapqa.core.rig import normalise_mapping
 from mocapqa.errors import InputError, OptionError
 from mocapqa.filters.apply import apply_overrides
 from mocapqa.filters.registry import FILTERS, DataScale
+from mocapqa.limits.catalog import check_model_name
 from mocapqa.twist.analysis import METHODS, Method
 from mocapqa.twist.choice import APPLY_CHOICES, parse_apply
 
@@ -88,6 +89,10 @@ class AnalysisOptions:
         overriding the roles found from names and structure (:func:`mocapqa.core.rig.find_roles`).
         Checked here for its role keys; its joint names are checked against the take when the
         run reads it.
+    limits_model : str, optional
+        The limits model by name (:mod:`mocapqa.limits.catalog`). None: the take's shoot's
+        model, filled in when the run is recorded, else ``"default"``. Checked here for its
+        form; whether it exists, when the run is recorded and when it runs.
     """
 
     checks: tuple[str, ...] = CHECKS
@@ -98,6 +103,7 @@ class AnalysisOptions:
     filter_params: dict[str, ParamValue] = field(default_factory=dict)
     max_points: int = 2000
     mapping: dict[str, str] = field(default_factory=dict)
+    limits_model: str | None = None
 
     def __post_init__(self) -> None:
         unknown = [c for c in self.checks if c not in CHECKS]
@@ -122,6 +128,8 @@ class AnalysisOptions:
             raise OptionError("max_points", f"Expected {low} to {high}, got {self.max_points}")
         object.__setattr__(self, "checks", tuple(self.checks))
         object.__setattr__(self, "mapping", check_mapping(self.mapping))
+        if self.limits_model is not None:
+            check_model_name(self.limits_model)
         self._check_filter(self.filter_method or "adaptive")
 
     def _check_filter(self, method: str) -> None:
@@ -194,6 +202,7 @@ class AnalysisOptions:
             "filter_params": dict(self.filter_params),
             "max_points": self.max_points,
             "mapping": dict(self.mapping),
+            "limits_model": self.limits_model,
         }
 
     @classmethod
@@ -208,7 +217,7 @@ class AnalysisOptions:
         if not data:
             return cls()
         known = {"checks", "twist_method", "twist_apply", "filter_method", "filter_preset"}
-        known |= {"filter_params", "max_points", "mapping"}
+        known |= {"filter_params", "max_points", "mapping", "limits_model"}
         extra = sorted(set(data) - known)
         if extra:
             raise OptionError(extra[0], f"Expected option fields among {sorted(known)}")
@@ -223,7 +232,8 @@ class AnalysisOptions:
         max_points = data.get("max_points", 2000)
         if not isinstance(max_points, int) or isinstance(max_points, bool):
             raise OptionError("max_points", f"Expected an integer, got {max_points!r}")
-        for name in ("twist_method", "twist_apply", "filter_method", "filter_preset"):
+        strings = ("twist_method", "twist_apply", "filter_method", "filter_preset", "limits_model")
+        for name in strings:
             value = data.get(name)
             if value is not None and not isinstance(value, str):
                 raise OptionError(name, f"Expected a string, got {value!r}")
@@ -236,6 +246,7 @@ class AnalysisOptions:
             filter_params={str(k): v for k, v in params.items()},
             max_points=max_points,
             mapping=data.get("mapping") or {},
+            limits_model=data.get("limits_model"),
         )
 
 

@@ -1,8 +1,8 @@
 """The pipeline's steps: each calls one algorithm entry point and normalises its output.
 
 * twist — :func:`mocapqa.twist.analysis.analyze_twist`
-* limits — :func:`mocapqa.limits.storage.load_default_model` and
-  :func:`mocapqa.limits.analysis.check_limits`; a rig without a shipped model reports
+* limits — the run's model from :class:`mocapqa.limits.catalog.ModelCatalog` and
+  :func:`mocapqa.limits.analysis.check_limits`; a rig the model does not cover reports
   ``"no_model"`` ("no model for this rig") instead of failing the run
 * filters — :func:`mocapqa.filters.apply.filter_keypoints` and
   :func:`~mocapqa.filters.apply.filter_motion`
@@ -28,8 +28,8 @@ from mocapqa.core.rig import find_roles
 from mocapqa.errors import LimitsFileError
 from mocapqa.filters.apply import filter_keypoints, filter_motion
 from mocapqa.limits.analysis import check_limits
+from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
 from mocapqa.limits.model import LimitsModel
-from mocapqa.limits.storage import load_default_model
 from mocapqa.pipeline.options import ParamValue
 from mocapqa.twist.analysis import analyze_twist
 
@@ -181,32 +181,50 @@ def violation_findings(
 
 RigKey = tuple[tuple[str, ...], bytes, bytes]
 _RIGS: dict[RigKey, Skeleton] = {}
+_SHIPPED = ModelCatalog()
 
 
 @functools.lru_cache(maxsize=16)
-def _model_for_rig(key: RigKey) -> LimitsModel | str:
-    # The shipped models are read-only package data: load them once per rig layout (names,
-    # parents and rest offsets, which decide the fingerprint), not once per run.
+def _default_for_rig(key: RigKey) -> LimitsModel | str:
+    # The default choice reads only shipped, read-only package data: decide it once per rig
+    # layout (names, parents and rest offsets, which decide the fingerprint), not once per run.
     try:
-        return load_default_model(_RIGS[key])
+        return _SHIPPED.load(DEFAULT_MODEL, _RIGS[key])
     except LimitsFileError as e:
         return str(e)
 
 
 def run_limits(
-    motion: Motion, frames: IntArray, mapping: dict[str, str] | None = None
+    motion: Motion,
+    frames: IntArray,
+    mapping: dict[str, str] | None = None,
+    model_name: str = DEFAULT_MODEL,
+    catalog: ModelCatalog | None = None,
 ) -> StepOutcome:
-    """Check joint limits with the shipped model of the rig (loaded once per rig layout).
+    """Check joint limits with the model ``model_name`` of ``catalog`` (the shipped models
+    when None; the default choice is decided once per rig layout).
 
     ``mapping`` (role key → joint name) decides the roles the canonical model checks; the
     message counts the joints that are not checked and ``summary.not_checked`` names them.
+
+    Raises
+    ------
+    OptionError
+        ``model_name`` is not a model of the catalog.
     """
     skeleton = motion.skeleton
-    key = (skeleton.names, skeleton.parents.tobytes(), skeleton.offsets.tobytes())
-    _RIGS.setdefault(key, skeleton)
-    model = _model_for_rig(key)
+    model: LimitsModel | str
+    if model_name == DEFAULT_MODEL:
+        key = (skeleton.names, skeleton.parents.tobytes(), skeleton.offsets.tobytes())
+        _RIGS.setdefault(key, skeleton)
+        model = _default_for_rig(key)
+    else:
+        try:
+            model = (catalog or _SHIPPED).load(model_name, skeleton)
+        except LimitsFileError as e:
+            model = str(e)
     if isinstance(model, str):
-        return StepOutcome("no_model", f"no model for this rig ({model})")
+        return StepOutcome("no_model", f"no model for this rig ({model_name}: {model})")
     report = check_limits(motion, model, mapping=mapping)
     joints = list(report.joint_names)
     findings = violation_findings(report.valid, report.score_deg, joints, report.readout)
@@ -219,7 +237,7 @@ def run_limits(
         joint.pop("frames", None)  # the heat map carries the per-frame values
     return StepOutcome(
         "done",
-        f"{len(findings)} violation interval(s), model {report.rig_family}; "
+        f"{len(findings)} violation interval(s), model {model_name} ({report.rig_family}); "
         f"{len(report.not_checked)} joint(s) not checked (listed in summary.not_checked)",
         findings,
         {

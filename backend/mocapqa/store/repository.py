@@ -28,8 +28,9 @@ from sqlalchemy.engine import Connection
 from mocapqa import __version__
 from mocapqa.core.text import display_name
 from mocapqa.errors import ConflictError, InputError, NotFoundError
+from mocapqa.limits.catalog import DEFAULT_MODEL
 from mocapqa.store.qa import lock_take, sync_take
-from mocapqa.store.tables import reviews, runs, take_qa, takes
+from mocapqa.store.tables import reviews, runs, shoots, take_qa, takes
 from mocapqa.store.upgrade import upgrade_database
 
 __all__ = [
@@ -243,6 +244,16 @@ class Repository:
     def _insert_run(
         self, conn: Connection, take_id: str, sha256: str, options: dict[str, Any]
     ) -> str:
+        if options.get("limits_model") is None:
+            # A run of a take in a shoot checks limits with the shoot's model; the name is
+            # recorded with the run, so its options say which model it used.
+            query = (
+                select(shoots.c.limits_model)
+                .select_from(takes.join(shoots, takes.c.shoot_id == shoots.c.id))
+                .where(takes.c.id == take_id)
+            )
+            chosen = conn.execute(query).scalar()
+            options = {**options, "limits_model": chosen or DEFAULT_MODEL}
         run_id = new_id()
         conn.execute(
             insert(runs).values(

@@ -2,7 +2,8 @@
 
 A role allows what the roles below it allow and more: **viewer** reads; **reviewer** also
 uploads, runs analyses, reviews and deletes the takes (and shoots) it owns; **admin** also
-deletes anything, manages users and everyone's tokens, and reads the audit log. Each API route
+deletes anything, manages users and everyone's tokens, reads the audit log and chooses a
+shoot's joint-limits model. Each API route
 names the :class:`Action` it performs (``api/auth.py``'s ``require``); ``GET /api/v1/me``
 lists the actions the caller may perform, and the UI shows only those controls.
 """
@@ -39,6 +40,7 @@ class Action(StrEnum):
     OWN_TOKENS = "own_tokens"
     MANAGE_USERS = "manage_users"
     READ_AUDIT = "read_audit"
+    CHOOSE_LIMITS_MODEL = "choose_limits_model"
 
 
 NEEDS: dict[Action, Role] = {
@@ -51,6 +53,7 @@ NEEDS: dict[Action, Role] = {
     Action.DELETE_ANY: Role.ADMIN,
     Action.MANAGE_USERS: Role.ADMIN,
     Action.READ_AUDIT: Role.ADMIN,
+    Action.CHOOSE_LIMITS_MODEL: Role.ADMIN,
 }
 """The lowest role allowed each action."""
 

@@ -151,6 +151,23 @@ class ShootStore:
             raise ConflictError(f"Expected a new shoot name, got {clean!r} (taken)") from e
         return self.get(shoot_id)
 
+    def set_limits_model(self, shoot_id: str, name: str) -> dict[str, Any]:
+        """Give a shoot the limits model ``name`` (checked by the caller against the catalog);
+        runs recorded from now on for its takes use it."""
+        self.require(shoot_id)
+        with self.engine.begin() as conn:
+            conn.execute(update(shoots).where(shoots.c.id == shoot_id).values(limits_model=name))
+        return self.get(shoot_id)
+
+    def limits_model(self, shoot_id: str) -> str:
+        """The name of a shoot's limits model; :class:`NotFoundError` when it is missing."""
+        with self.engine.connect() as conn:
+            query = select(shoots.c.limits_model).where(shoots.c.id == shoot_id)
+            found = conn.execute(query).scalar()
+        if found is None:
+            raise NotFoundError(f"Expected shoot {shoot_id!r} to exist, got none")
+        return str(found)
+
     def require(self, shoot_id: str) -> None:
         """:class:`NotFoundError` unless the shoot exists (one indexed lookup, no counts)."""
         with self.engine.connect() as conn:

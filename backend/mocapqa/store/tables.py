@@ -49,9 +49,12 @@ shoots = Table(
     Column("name", String(255), nullable=False, unique=True),
     Column("created_at", DateTime(timezone=True), nullable=False),
     Column("owner_id", Integer, nullable=True),
+    Column("limits_model", String(64), nullable=False, server_default="default"),
 )
 """Named collections of takes; a take belongs to at most one. ``owner_id`` is the user who made
-the shoot (none for shoots made before shoots had owners, or while the server had no users)."""
+the shoot (none for shoots made before shoots had owners, or while the server had no users).
+``limits_model`` names the joint-limits model its takes' runs use (:mod:`mocapqa.limits.catalog`;
+an admin chooses it)."""
 
 takes = Table(
     "takes",
