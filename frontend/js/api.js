@@ -97,6 +97,8 @@ export const deleteShoot = (id, confirm) => request("DELETE", `/shoots/${id}?con
 export const shootTakes = (id, query) => request("GET", `/shoots/${id}/takes?${query}`);
 export const shootProgress = (id) => request("GET", `/shoots/${id}/progress`);
 export const shootHeatmap = (id, query) => request("GET", `/shoots/${id}/heatmap?${query}`);
+export const limitsModels = () => request("GET", "/limits-models");
+export const setShootLimitsModel = (id, name) => request("PUT", `/shoots/${id}/limits-model`, { name });
 export const nextForReview = (id, after) => request("GET", `/shoots/${id}/next${after ? `?after=${after}` : ""}`);
 export const summaryUrl = (id, kind) => `${BASE}/shoots/${id}/summary.${kind}`;
 export const shootLink = (id, query = "") => `#/shoot/${id}${query ? `?${query}` : ""}`;

@@ -6,6 +6,7 @@ import { me } from "./account-api.js";
 import { activatable, badge, h, REVIEW } from "./dom.js";
 import { loadPlotly, untabbableModebar } from "./plotly.js";
 import { fmt } from "./format.js";
+import { limitsModelPanel } from "./shoot-limits.js";
 import {
   decisionForKey, deleteConfirmed, formatCell, HEATMAP_SIZES, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
   importLines, nextSort, pageInfo, progressSummary, scoreColor, shootControls, TAKE_COLUMNS, tableState, takesQuery, viewQuery,
@@ -197,6 +198,7 @@ function takeTable(page, state, apply) {
 export async function shootView(main, shootId, params, onTeardown) {
   let state = tableState(params);
   const [shoot, who] = await Promise.all([api.getShoot(shootId), me().catch(() => null)]);
+  const modelPanel = await limitsModelPanel(shoot, who);
   const title = h("span", { id: "shoot-title" }, shoot.name);
   const progressBar = h("progress", { id: "shoot-progress", max: 1, value: 0 });
   const progressText = h("span", { id: "shoot-progress-text" });
@@ -301,6 +303,7 @@ export async function shootView(main, shootId, params, onTeardown) {
       h("a", { class: "download", id: "export-csv", href: api.summaryUrl(shootId, "csv"), download: "" }, "summary CSV"),
       h("a", { class: "download", id: "export-json", href: api.summaryUrl(shootId, "json"), download: "" }, "summary JSON"),
       manageControls(shoot, who, (renamed) => { title.textContent = renamed.name; })),
+    modelPanel,
     importPanel(shootId, () => { clearTimeout(timer); wasRunning = true; poll().catch(showError); }),
     progressPanel,
     tableArea, heatmap);

@@ -1,0 +1,46 @@
+// The shoot view's joint-limits model: which model the runs of the shoot's takes use. Everyone
+// who may read the shoot sees it; an admin (action "choose_limits_model") chooses it from the
+// models the server offers (GET /limits-models: the default, the shipped and the registered).
+import * as api from "./api.js";
+import { h } from "./dom.js";
+
+/** One line per model for the picker: its name and what it covers. */
+export function modelLabel(model) {
+  if (model.kind === "default") return "default (the shipped choice for each rig)";
+  const covers = model.frame === "canonical" ? "any rig with limb roles" : `${model.rig_family} rig only`;
+  const origin = model.kind === "registered" ? "registered" : "shipped";
+  return `${model.name} (${origin}; ${covers}; ${model.n_takes} take${model.n_takes === 1 ? "" : "s"})`;
+}
+
+/** Whether `me` (GET /me) may choose a shoot's limits model. */
+export const mayChooseModel = (me) => new Set((me && me.can) || []).has("choose_limits_model");
+
+/** The panel: the model's name, and for an admin a picker that saves on change. */
+export async function limitsModelPanel(shoot, me) {
+  const panel = h("div", { class: "controls", id: "limits-model-panel" });
+  const label = h("span", {}, "joint-limits model ");
+  if (!mayChooseModel(me)) {
+    panel.append(label, h("strong", { id: "limits-model-name" }, shoot.limits_model));
+    return panel;
+  }
+  const models = await api.limitsModels();
+  const message = h("span", { id: "limits-model-message", class: "muted", role: "status" });
+  const select = h("select", { id: "limits-model", "aria-label": "joint-limits model of this shoot" },
+    models.map((m) => h("option", { value: m.name, selected: m.name === shoot.limits_model }, modelLabel(m))));
+  select.addEventListener("change", async () => {
+    const chosen = select.value;
+    select.disabled = true;
+    try {
+      const saved = await api.setShootLimitsModel(shoot.id, chosen);
+      shoot.limits_model = saved.limits_model;
+      message.className = "muted";
+      message.textContent = `saved: runs started from now on use ${saved.limits_model}`;
+    } catch (error) {
+      select.value = shoot.limits_model;
+      message.className = "error";
+      message.textContent = error.message;
+    } finally { select.disabled = false; }
+  });
+  panel.append(h("label", {}, label, select), message);
+  return panel;
+}

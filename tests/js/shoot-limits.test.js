@@ -1,0 +1,18 @@
+import { test } from "node:test";
+import assert from "node:assert/strict";
+import { mayChooseModel, modelLabel } from "../../frontend/js/shoot-limits.js";
+
+test("modelLabel says what each kind of model covers", () => {
+  assert.equal(modelLabel({ name: "default", kind: "default", frame: "per rig", rig_family: "", n_takes: 0 }),
+    "default (the shipped choice for each rig)");
+  assert.equal(modelLabel({ name: "canonical", kind: "shipped", frame: "canonical", rig_family: "canonical", n_takes: 46 }),
+    "canonical (shipped; any rig with limb roles; 46 takes)");
+  assert.equal(modelLabel({ name: "studio", kind: "registered", frame: "rig", rig_family: "bandai", n_takes: 31 }),
+    "studio (registered; bandai rig only; 31 takes)");
+});
+
+test("only the choose_limits_model action shows the picker", () => {
+  assert.equal(mayChooseModel({ can: ["read", "upload", "choose_limits_model"] }), true);
+  assert.equal(mayChooseModel({ can: ["read", "upload", "delete_any"] }), false);
+  assert.equal(mayChooseModel(null), false);
+});
