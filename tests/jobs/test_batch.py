@@ -291,3 +291,35 @@ def test_batch_on_separate_scheduler_and_worker(corpus_copy: Path, tmp_path: Pat
                 process.wait(timeout=30)
             except subprocess.TimeoutExpired:
                 process.kill()
+
+
+def test_batch_uses_the_shoot_limits_model(engine: Engine, cmu_walk: Path, tmp_path: Path) -> None:
+    """A batch into a shoot checks limits with the shoot's model, resolved in the data folder's
+    catalog on the workers, and records it with each run."""
+    from mocapqa.limits.catalog import ModelCatalog
+    from mocapqa.limits.storage import default_model_paths
+
+    repository, shoots = _store(tmp_path)
+    data = tmp_path / "data"
+    bandai = next(p for p in default_model_paths() if p.stem == "bandai")
+    ModelCatalog.of_data_folder(data).register(bandai, "studio-b")
+    shoot = str(shoots.create("Day 3")["id"])
+    shoots.set_limits_model(shoot, "studio-b")
+    folder = tmp_path / "walks"
+    folder.mkdir()
+    (folder / cmu_walk.name).symlink_to(cmu_walk)
+    rows: list[dict[str, Any]] = []
+    counts = run_batch([folder], shoots, AnalysisOptions(), rows.append, engine, data, shoot)
+    assert counts.done == 1, rows
+    run = repository.list_runs(rows[0]["take_id"])[0]
+    assert run["options"]["limits_model"] == "studio-b"
+    # Bandai's own model does not cover the CMU skeleton: the check says so, naming the model.
+    assert run["summary"]["steps"]["limits"] == "no_model"
+    # An explicit model in the options wins over the shoot's.
+    counts = run_batch(
+        [folder], shoots, AnalysisOptions(limits_model="cmu"), rows.append, engine, data, shoot
+    )
+    run = repository.list_runs(rows[-1]["take_id"])[-1]
+    assert run["options"]["limits_model"] == "cmu"
+    assert run["summary"]["steps"]["limits"] == "done"
+    repository.close()

@@ -133,3 +133,40 @@ def test_check_frames_an_unseen_rig_from_a_folder_of_its_takes(
     assert main(["limits", "check", take, "--model", str(model_path),
                  "--frame-from", str(bandai)]) == 3  # fmt: skip
     assert "got none" in capsys.readouterr().err
+
+
+def test_register_list_and_check_by_name(
+    corpus_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
+    """A registered model is listed and checked by name; bad names and files exit non-zero."""
+    from mocapqa.limits.storage import default_model_paths
+
+    monkeypatch.setenv("MOCAPQA_DATA_DIR", str(tmp_path / "data"))
+    cmu = next(p for p in default_model_paths() if p.name == "cmu.npz")
+    walk = str(corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh")
+    assert main(["limits", "register", str(cmu), "walks"]) == 0
+    assert (tmp_path / "data" / "limits_models" / "walks.npz").read_bytes() == cmu.read_bytes()
+    capsys.readouterr()
+    assert main(["limits", "models"]) == 0
+    listed = capsys.readouterr().out
+    assert "walks" in listed
+    assert "registered" in listed
+    assert main(["limits", "check", walk, "--model", "walks", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["rig_family"] == "cmu"
+    # taken names, shipped names, malformed names, unknown names, files that are no model
+    assert main(["limits", "register", str(cmu), "walks"]) == 5
+    assert "--replace" in capsys.readouterr().err
+    assert main(["limits", "register", str(cmu), "walks", "--replace"]) == 0
+    assert main(["limits", "register", str(cmu), "canonical"]) == 3
+    assert main(["limits", "register", str(cmu), "Walks!"]) == 3
+    assert main(["limits", "check", walk, "--model", "nope"]) == 3
+    assert "Expected one of the limits models" in capsys.readouterr().err
+    junk = tmp_path / "junk.bin"
+    junk.write_bytes(b"not a model")
+    assert main(["limits", "register", str(junk), "junk"]) == 6
+    assert not (tmp_path / "data" / "limits_models" / "junk.npz").exists()
+    # a per-rig model of another rig: the limits exit code, naming the rig
+    bandai = next(p for p in default_model_paths() if p.name == "bandai.npz")
+    assert main(["limits", "register", str(bandai), "studio-b"]) == 0
+    assert main(["limits", "check", walk, "--model", "studio-b"]) == 6
