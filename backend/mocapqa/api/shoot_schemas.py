@@ -7,6 +7,7 @@ from typing import Literal
 
 from pydantic import BaseModel, Field
 
+from mocapqa.limits.catalog import MODEL_NAME_PATTERN
 from mocapqa.store.repository import ReviewStatus, RunStatus
 
 __all__ = [
@@ -139,6 +140,7 @@ class LimitsModelIn(BaseModel):
     name: str = Field(
         min_length=1,
         max_length=64,
+        pattern=MODEL_NAME_PATTERN,
         description="A name from `GET /limits-models`",
         examples=["default", "canonical"],
     )
