@@ -39,11 +39,56 @@ def bench_limits(
         bool,
         typer.Option(help="Also the per-rig models' own benchmark (networks, speeds)."),
     ] = False,
+    joint_margins: Annotated[
+        bool,
+        typer.Option(
+            "--joint-margins",
+            help="Only the experiment of per-joint twist margins chosen by nested "
+            "leave-one-rig-out (docs/limits.md).",
+        ),
+    ] = False,
 ) -> None:
     """Canonical model per rig and leave-one-rig-out; optionally the per-rig models."""
+    if joint_margins:
+        _bench_joint_margins(corpus_dir, seed)
+        return
     _bench_canonical(corpus_dir, shipped, seed, min_offset_deg)
     if per_rig:
         _bench_per_rig(corpus_dir, rig, networks, min_offset_deg, seed, shipped)
+
+
+def _bench_joint_margins(corpus_dir: Path, seed: int) -> None:
+    from mocapqa.bench.limits import role_takes
+    from mocapqa.bench.limits_margins import nested_margins
+    from mocapqa.core.motion import Motion
+    from mocapqa.limits.rig import rig_family
+
+    grouped: dict[str, list[tuple[str, Motion]]] = {}
+    for name, motion in role_takes(corpus_dir):
+        grouped.setdefault(rig_family(motion.skeleton), []).append((name, motion))
+    results = nested_margins({family: tuple(takes) for family, takes in grouped.items()}, seed=seed)
+    table = Table(title="leave one rig out: per-joint twist margins (nested) vs 40° everywhere")
+    for column in (
+        "left-out rig", "false flags % (per joint / 40°)", "injected flagged % (per joint / 40°)",
+        "margins chosen on the other rigs (°)",
+    ):  # fmt: skip
+        table.add_column(column)
+    for fold in results:
+        recall = fold.hits / max(fold.injected, 1)
+        uniform = fold.uniform_hits / max(fold.injected, 1)
+        table.add_row(
+            fold.family,
+            f"{_pct(fold.false_flags)} / {_pct(fold.uniform_false_flags)}",
+            f"{_pct(recall)} / {_pct(uniform)} (n={fold.injected})",
+            ", ".join(f"{role} {m:g}" for role, m in fold.margins_deg.items()),
+        )
+    console.print(table)
+    mean = sum(f.false_flags for f in results) / len(results)
+    mean_uniform = sum(f.uniform_false_flags for f in results) / len(results)
+    console.print(
+        f"mean false flags over left-out rigs: {_pct(mean)} % (40° everywhere: "
+        f"{_pct(mean_uniform)} %)"
+    )
 
 
 def _bench_canonical(corpus_dir: Path, shipped: bool, seed: int, min_offset_deg: float) -> None:

@@ -46,8 +46,9 @@ def circular_intervals(
     """
     centre = np.full(n * n, np.nan)
     half = np.full(n * n, np.nan)
-    order = np.lexsort((tau, flat))
-    flat_s, tau_s = flat[order], wrap(tau[order])
+    wrapped = wrap(tau)  # sorted after wrapping: a twist of exactly π (or beyond) wraps to −π
+    order = np.lexsort((wrapped, flat))
+    flat_s, tau_s = flat[order], wrapped[order]
     starts = np.flatnonzero(np.r_[True, flat_s[1:] != flat_s[:-1]])
     ends = np.r_[starts[1:], flat_s.size]
     for a, b in zip(starts, ends, strict=True):
