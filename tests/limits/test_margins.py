@@ -45,5 +45,7 @@ def test_the_smallest_margin_meeting_the_target_on_average_is_chosen() -> None:
     ]
     chosen = choose_margins(inner, 0.01)
     assert [MARGINS_DEG[c] for c in chosen] == [10.0, MARGINS_DEG[-1]]
+    # on the worst inner rig role 0 is at 2 % at 10°, so the worst-rig rule takes 20°
+    assert [MARGINS_DEG[c] for c in choose_margins(inner, 0.01, "worst")] == [20.0, MARGINS_DEG[-1]]
     with pytest.raises(ValueError, match="same roles"):
         choose_margins([inner[0], MarginCounts(("b", "a"), first, frames, [])], 0.01)

@@ -148,16 +148,17 @@ def _map(rigs: dict[str, Takes], left_out: set[str], settings: BuildParams) -> L
     return build_canonical_model([m for _, m in train], [n for n, _ in train], settings)
 
 
-def choose_margins(inner: list[MarginCounts], target: float) -> np.ndarray:
-    """Per role, the index of the smallest margin whose false-flag rate averaged over the
-    inner left-out rigs is ≤ ``target`` (else the one with the fewest)."""
+def choose_margins(inner: list[MarginCounts], target: float, rule: str = "mean") -> np.ndarray:
+    """Per role, the index of the smallest margin whose false-flag rate over the inner
+    left-out rigs is ≤ ``target`` (else the one with the fewest): averaged over them
+    (``rule="mean"``) or on the worst of them (``"worst"``)."""
     n_roles = len(inner[0].roles)
     if any(counts.roles != inner[0].roles for counts in inner):
         raise ValueError("Expected the inner maps to model the same roles in the same order")
-    rates = np.zeros((len(MARGINS_DEG), n_roles))
-    for counts in inner:
-        rates += counts.flagged / np.maximum(counts.frames, 1)
-    rates /= len(inner)
+    if rule not in ("mean", "worst"):
+        raise ValueError(f"Expected rule 'mean' or 'worst', got {rule!r}")
+    each = np.stack([c.flagged / np.maximum(c.frames, 1) for c in inner])
+    rates = each.mean(axis=0) if rule == "mean" else each.max(axis=0)
     chosen = np.zeros(n_roles, dtype=np.intp)
     for r in range(n_roles):
         fine = np.flatnonzero(rates[:, r] <= target)
@@ -184,6 +185,7 @@ def nested_margins(
     target: float = 0.01,
     uniform_deg: float = 40.0,
     seed: int = 0,
+    rule: str = "mean",
 ) -> list[FoldResult]:
     """Nested leave-one-rig-out choice of per-role twist margins (module notes).
 
@@ -197,6 +199,8 @@ def nested_margins(
         False-flag rate a role's margin must reach on the inner folds.
     uniform_deg : float
         The uniform margin compared against (the shipped 40°).
+    rule : {"mean", "worst"}
+        How the inner folds' false-flag rates are combined (:func:`choose_margins`).
     """
     base = replace(
         settings,
@@ -211,7 +215,7 @@ def nested_margins(
             for other in rigs
             if other != family
         ]
-        chosen = choose_margins(inner, target)
+        chosen = choose_margins(inner, target, rule)
         counts = count_margins(_map(rigs, {family}, base), rigs[family], seed)
         flags, _ = counts.false_flags(chosen)
         hits, total = counts.recall(chosen)

@@ -47,17 +47,21 @@ def bench_limits(
             "leave-one-rig-out (docs/limits.md).",
         ),
     ] = False,
+    margin_rule: Annotated[
+        str,
+        typer.Option(help="--joint-margins: inner false flags averaged ('mean') or worst rig."),
+    ] = "mean",
 ) -> None:
     """Canonical model per rig and leave-one-rig-out; optionally the per-rig models."""
     if joint_margins:
-        _bench_joint_margins(corpus_dir, seed)
+        _bench_joint_margins(corpus_dir, seed, margin_rule)
         return
     _bench_canonical(corpus_dir, shipped, seed, min_offset_deg)
     if per_rig:
         _bench_per_rig(corpus_dir, rig, networks, min_offset_deg, seed, shipped)
 
 
-def _bench_joint_margins(corpus_dir: Path, seed: int) -> None:
+def _bench_joint_margins(corpus_dir: Path, seed: int, rule: str) -> None:
     from mocapqa.bench.limits import role_takes
     from mocapqa.bench.limits_margins import nested_margins
     from mocapqa.core.motion import Motion
@@ -66,8 +70,11 @@ def _bench_joint_margins(corpus_dir: Path, seed: int) -> None:
     grouped: dict[str, list[tuple[str, Motion]]] = {}
     for name, motion in role_takes(corpus_dir):
         grouped.setdefault(rig_family(motion.skeleton), []).append((name, motion))
-    results = nested_margins({family: tuple(takes) for family, takes in grouped.items()}, seed=seed)
-    table = Table(title="leave one rig out: per-joint twist margins (nested) vs 40° everywhere")
+    rigs = {family: tuple(takes) for family, takes in grouped.items()}
+    results = nested_margins(rigs, seed=seed, rule=rule)
+    table = Table(
+        title=f"leave one rig out: per-joint twist margins (nested, rule {rule}) vs 40° everywhere"
+    )
     for column in (
         "left-out rig", "false flags % (per joint / 40°)", "injected flagged % (per joint / 40°)",
         "margins chosen on the other rigs (°)",
