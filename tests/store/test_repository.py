@@ -35,7 +35,8 @@ def test_a_take_and_its_first_run_are_stored_together(repository: Repository) ->
     assert take["status"] == "queued"
     assert take["review_status"] == "unreviewed"
     assert run["input_sha256"] == "ab" * 32
-    assert run["options"] == {"checks": ["twist"]}
+    # the run records the limits model it uses: the default one, for a take outside a shoot
+    assert run["options"] == {"checks": ["twist"], "limits_model": "default"}
     assert run["version"] == __version__
 
 
