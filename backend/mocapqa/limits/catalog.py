@@ -226,9 +226,8 @@ class ModelCatalog:
         """
         check_model_name(name)
         if name == DEFAULT_MODEL or name in self._shipped():
-            raise OptionError(
-                "limits_model", f"Expected a name other than the shipped {self.names()[:5]}"
-            )
+            taken = [DEFAULT_MODEL, *self._shipped()]
+            raise OptionError("limits_model", f"Expected a name other than the shipped {taken}")
         if self.folder is None:
             raise OptionError("limits_model", "Expected a data folder to register models in")
         model = load_model(source)
