@@ -170,3 +170,17 @@ def test_register_list_and_check_by_name(
     bandai = next(p for p in default_model_paths() if p.name == "bandai.npz")
     assert main(["limits", "register", str(bandai), "studio-b"]) == 0
     assert main(["limits", "check", walk, "--model", "studio-b"]) == 6
+
+
+def test_build_tries_the_hidden_sizes_asked_for(corpus_dir: Path, tmp_path: Path) -> None:
+    """``--hidden`` sets the networks tried per joint (here one tiny size on a tiny set)."""
+    corpus = tmp_path / "corpus"
+    corpus.mkdir()
+    name = "dataset-1_kick_normal_001.bvh"
+    (corpus / name).symlink_to(corpus_dir / "bvh" / "bandai" / name)
+    model = tmp_path / "model.npz"
+    args = ["limits", "build", str(corpus), "-o", str(model), "--all-takes", "--n-valid", "40"]
+    assert main([*args, "--hidden", "3"]) == 0
+    sizes = {j.scores.hidden_size for j in load_model(model).joints if j.scores is not None}
+    assert sizes == {3}
+    assert main([*args, "--hidden", "0"]) == 3  # refused before any take is read

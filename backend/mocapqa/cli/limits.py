@@ -73,6 +73,13 @@ def limits_build(
     exclude: Annotated[
         list[str] | None, typer.Option(help="Take file names to leave out (repeatable).")
     ] = None,
+    hidden: Annotated[
+        list[int] | None,
+        typer.Option(
+            help="Hidden units of a network tried per joint (repeatable; default 32 and 16); "
+            "the best by validation is kept."
+        ),
+    ] = None,
 ) -> None:
     """Build a joint-limits model from a folder of BVH takes.
 
@@ -90,6 +97,9 @@ def limits_build(
     settings = _build_params(bin_deg, dilation, margin_deg, paper, networks)
     if n_valid is not None and settings.discriminator is not None:
         settings = replace(settings, discriminator=replace(settings.discriminator, n_valid=n_valid))
+    if hidden and settings.discriminator is not None:
+        networks_asked = replace(settings.discriminator, hidden_sizes=tuple(hidden))
+        settings = replace(settings, discriminator=networks_asked)
     left_out = set(exclude or ())
     if rig is None:
         takes = canonical_takes(corpus_dir, all_takes, left_out)
