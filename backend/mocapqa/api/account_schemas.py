@@ -6,6 +6,7 @@ from datetime import datetime
 
 from pydantic import BaseModel, Field, StrictBool
 
+from mocapqa.api.request_model import RequestModel
 from mocapqa.store.roles import Action, Role
 
 __all__ = [
@@ -23,7 +24,7 @@ __all__ = [
 ]
 
 
-class SignInIn(BaseModel):
+class SignInIn(RequestModel):
     """A browser sign-in."""
 
     name: str = Field(min_length=1, max_length=64)
@@ -55,7 +56,7 @@ USER_NAME = r"^[A-Za-z0-9][A-Za-z0-9._@-]{0,63}$"
 """What a user name may hold (the store checks the same)."""
 
 
-class UserIn(BaseModel):
+class UserIn(RequestModel):
     """A new user; without a password it signs in only with tokens."""
 
     name: str = Field(pattern=USER_NAME)
@@ -63,7 +64,7 @@ class UserIn(BaseModel):
     password: str | None = Field(None, min_length=8, max_length=1024)
 
 
-class UserPatchIn(BaseModel):
+class UserPatchIn(RequestModel):
     """Changes to a user."""
 
     role: Role | None = None
@@ -71,7 +72,7 @@ class UserPatchIn(BaseModel):
     password: str | None = Field(None, min_length=8, max_length=1024)
 
 
-class TokenIn(BaseModel):
+class TokenIn(RequestModel):
     """A new personal token."""
 
     name: str = Field("", max_length=255)

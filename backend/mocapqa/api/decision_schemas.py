@@ -7,12 +7,14 @@ from typing import Literal
 
 from pydantic import BaseModel, Field
 
+from mocapqa.api.request_model import RequestModel
+
 __all__ = ["DecisionIn", "DecisionOut", "DecisionsOut", "IntervalOut"]
 
 Decision = Literal["accept", "reject"]
 
 
-class DecisionIn(BaseModel):
+class DecisionIn(RequestModel):
     """A reviewer's decision on one twist interval."""
 
     decision: Decision

@@ -18,6 +18,9 @@ One ASGI middleware (:class:`RequestGuard`), so each check answers before the bo
   thread); an anonymous request to a server without users counts against its client address.
   An upload the routes would refuse with 401 (a credential that is not valid, or none while
   users exist) gets its 401 here, before its body is read too.
+* **Text no store can keep**: a NUL (``%00``) in the path or in a query parameter gets 422
+  naming ``path`` or ``query.NAME`` (PostgreSQL refuses NUL in text; JSON bodies get the same
+  check from :class:`~mocapqa.api.request_model.RequestModel`).
 * **Security headers** on every answer: a Content-Security-Policy the dashboard satisfies (no
   inline script; Plotly sets inline styles), ``frame-ancestors 'none'``, ``nosniff``,
   ``Referrer-Policy: same-origin``.
@@ -35,7 +38,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from urllib.parse import urlsplit
+from urllib.parse import parse_qsl, urlsplit
 
 from fastapi import FastAPI
 from starlette.concurrency import run_in_threadpool
@@ -47,6 +50,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from mocapqa.api.errors import error_body
 from mocapqa.api.host_check import HostCheck
+from mocapqa.api.request_model import unstorable_text
 from mocapqa.config import Settings
 
 __all__ = [
@@ -56,6 +60,7 @@ __all__ = [
     "RequestGuard",
     "install_http_guards",
     "origin_allowed",
+    "unstorable_location",
 ]
 
 CONTENT_SECURITY_POLICY = (
@@ -92,6 +97,20 @@ def origin_allowed(headers: Headers, cors_origins: list[str]) -> bool:
     if origin == "null":
         return False
     return urlsplit(origin).netloc.lower() == headers.get("host", "").lower()
+
+
+def unstorable_location(scope: Scope) -> tuple[str, str] | None:
+    """Where a request's path or query holds text no store can keep (``path`` or
+    ``query.NAME``) and why, or None (see :func:`~mocapqa.api.request_model.unstorable_text`)."""
+    problem = unstorable_text(scope["path"])
+    if problem is not None:
+        return "path", problem
+    query = scope.get("query_string", b"").decode("latin-1")
+    for name, value in parse_qsl(query, keep_blank_values=True):
+        problem = unstorable_text(name) or unstorable_text(value)
+        if problem is not None:
+            return f"query.{name}", problem
+    return None
 
 
 class RateWindow:
@@ -190,6 +209,13 @@ class RequestGuard:
                 f"Sec-Fetch-Site {headers.get('sec-fetch-site')!r}"
             )
             await _send_json(secured, 403, error_body("ForbiddenError", detail))
+            return
+        unstorable = unstorable_location(scope)
+        if unstorable is not None:
+            field, message = unstorable
+            entry = {"field": field, "message": message}
+            body = error_body("ValidationError", f"{field}: {message}", field=field, errors=[entry])
+            await _send_json(secured, 422, body)
             return
         if is_upload:
             key = await run_in_threadpool(self.quota_key, HTTPConnection(scope))

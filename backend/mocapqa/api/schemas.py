@@ -5,8 +5,9 @@ from __future__ import annotations
 from datetime import datetime
 from typing import Any, Literal
 
-from pydantic import BaseModel, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
+from mocapqa.api.request_model import RequestModel
 from mocapqa.errors import InputError
 from mocapqa.pipeline.options import CHECKS, MAX_POINTS_RANGE, Check, TwistMethod, check_mapping
 from mocapqa.store.repository import ReviewStatus, RunStatus
@@ -53,12 +54,12 @@ class HealthOut(BaseModel):
     database: str
 
 
-class AnalysisOptionsIn(BaseModel):
+class AnalysisOptionsIn(RequestModel):
     """Options of a new run; omitted fields take their defaults."""
 
-    model_config = {"extra": "forbid"}
+    model_config = ConfigDict(extra="forbid")
 
-    checks: list[Check] = list(CHECKS)
+    checks: list[Check] = Field(list(CHECKS))
     twist_method: TwistMethod = "robust"
     twist_apply: str = Field(
         "confident",
@@ -157,7 +158,7 @@ class TakePageOut(BaseModel):
     offset: int
 
 
-class ReviewIn(BaseModel):
+class ReviewIn(RequestModel):
     """A review decision."""
 
     status: ReviewStatus

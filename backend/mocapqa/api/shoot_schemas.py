@@ -5,8 +5,9 @@ from __future__ import annotations
 from datetime import datetime
 from typing import Literal
 
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, ConfigDict, Field
 
+from mocapqa.api.request_model import RequestModel
 from mocapqa.limits.catalog import MODEL_NAME_PATTERN
 from mocapqa.store.repository import ReviewStatus, RunStatus
 
@@ -24,10 +25,10 @@ __all__ = [
 ]
 
 
-class ShootIn(BaseModel):
+class ShootIn(RequestModel):
     """A shoot's name (create or rename)."""
 
-    model_config = {"extra": "forbid"}
+    model_config = ConfigDict(extra="forbid")
 
     name: str = Field(min_length=1, max_length=255)
 
@@ -132,10 +133,10 @@ class NextTakeOut(BaseModel):
     remaining: int
 
 
-class LimitsModelIn(BaseModel):
+class LimitsModelIn(RequestModel):
     """The limits model a shoot's runs use, by name."""
 
-    model_config = {"extra": "forbid"}
+    model_config = ConfigDict(extra="forbid")
 
     name: str = Field(
         min_length=1,

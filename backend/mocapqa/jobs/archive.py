@@ -71,17 +71,22 @@ def _copy(source: IO[bytes], target: Path, budget: list[int], limit: int) -> Non
             budget[0] += len(chunk)
             if budget[0] > limit:
                 raise TooLargeError(
-                    f"Expected an archive unpacking to at most {limit} bytes, got more"
+                    f"Expected an archive unpacking to at most {limit} bytes (setting "
+                    "archive_max_unpacked_mb), got more"
                 )
             out.write(chunk)
 
 
 def _check_totals(count: int, declared: int, max_members: int, max_bytes: int) -> None:
     if count > max_members:
-        raise TooLargeError(f"Expected an archive of at most {max_members} members, got {count}")
+        raise TooLargeError(
+            f"Expected an archive of at most {max_members} members (setting "
+            f"archive_max_members), got {count}"
+        )
     if declared > max_bytes:
         raise TooLargeError(
-            f"Expected an archive unpacking to at most {max_bytes} bytes, got {declared} declared"
+            f"Expected an archive unpacking to at most {max_bytes} bytes (setting "
+            f"archive_max_unpacked_mb), got {declared} declared"
         )
 
 

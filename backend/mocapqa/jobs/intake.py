@@ -62,6 +62,7 @@ def ingest_take(
     limits: ReadLimits | None = None,
     client: str = "local",
     shoot_id: str | None = None,
+    owner_id: int | None = None,
 ) -> tuple[str, str]:
     """Store an uploaded take and queue its analysis.
 
@@ -84,6 +85,9 @@ def ingest_take(
         Who uploads (for the runner's fair queue).
     shoot_id : str, optional
         Shoot the take joins.
+    owner_id : int, optional
+        The uploading user, stored with the take's row (none on a server without users), so
+        no take is ever stored without its owner.
 
     Returns
     -------
@@ -151,6 +155,7 @@ def ingest_take(
                     "n_joints": n_points,
                     "file_name": file_name,
                     "shoot_id": shoot_id,
+                    "owner_id": owner_id,
                 },
                 (options or AnalysisOptions()).to_json(),
             )

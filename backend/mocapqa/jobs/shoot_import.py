@@ -81,9 +81,11 @@ def import_uploads(
     runner: JobRunner,
     limits: ImportLimits,
     client: str = "local",
+    owner_id: int | None = None,
 ) -> ImportReport:
     """Import uploaded files (takes or archives of takes) into a shoot; analyses start, in
-    ``client``'s line of the runner's fair queue (and counted in its queued runs).
+    ``client``'s line of the runner's fair queue (and counted in its queued runs). Each take
+    is stored owned by ``owner_id``, so takes made before a limit stops the import keep theirs.
 
     Raises
     ------
@@ -106,6 +108,7 @@ def import_uploads(
                 limits=limits.read,
                 client=client,
                 shoot_id=shoot_id,
+                owner_id=owner_id,
             )
         except MocapQAError as e:
             report.failed.append({"name": label or name, "error": str(e)})

@@ -157,9 +157,9 @@ def import_takes(
         services.runner,
         limits,
         client,
+        principal.user_id,
     )
     for take in report.created:
-        services.repository.set_owner(take["take_id"], principal.user_id)
         audit(request, principal, "upload", take["take_id"], f"{take['name']} run {take['run_id']}")
     return ImportOut(created=report.created, skipped=report.skipped, failed=report.failed)
 

@@ -71,8 +71,8 @@ def upload_take(
         read=ReadOptions(fps, length_unit, root_translation),
         limits=services.settings.read_limits,
         client=client,
+        owner_id=principal.user_id,
     )
-    services.repository.set_owner(take_id, principal.user_id)
     audit(request, principal, "upload", take_id, f"{file.filename or 'take'} run {run_id}")
     row = services.repository.get_take(take_id)
     reading = reading_of(services.files, take_id)

@@ -1,0 +1,206 @@
+"""A hostile client's pass over the API, in process: text the database cannot store (NUL,
+unpaired surrogates) in paths, queries and JSON bodies, and a shoot import cut short by a
+limit. Each answer must be a 4xx naming the field, and nothing stored may become unreadable
+or ownerless. Runs on SQLite and (``scripts/with-postgres.sh``) on PostgreSQL, which refuses
+NUL in text."""
+
+from __future__ import annotations
+
+import io
+import zipfile
+from datetime import timedelta
+from pathlib import Path
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from mocapqa.store.roles import Role
+
+SMALL_BVH = b"""HIERARCHY
+ROOT Hips
+{
+  OFFSET 0 0 0
+  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+  JOINT Spine
+  {
+    OFFSET 0 10 0
+    CHANNELS 3 Zrotation Xrotation Yrotation
+    End Site
+    {
+      OFFSET 0 10 0
+    }
+  }
+}
+MOTION
+Frames: 3
+Frame Time: 0.033333
+0 0 0 0 0 0 0 0 0
+1 1 1 1 1 1 1 1 1
+2 2 2 2 2 2 2 2 2
+"""
+
+
+def bearer(client: TestClient, name: str, role: Role) -> tuple[int, dict[str, str]]:
+    """A new user of ``role`` and its Bearer header."""
+    accounts = client.app.state.accounts  # type: ignore[attr-defined]
+    user = accounts.add_user(name, role)
+    token = accounts.issue(user.id, "api", timedelta(days=1)).token
+    return user.id, {"Authorization": f"Bearer {token}"}
+
+
+def upload(client: TestClient, headers: dict[str, str]) -> dict[str, Any]:
+    response = client.post(
+        "/api/v1/takes", files={"file": ("small.bvh", SMALL_BVH)}, headers=headers
+    )
+    assert response.status_code == 201, response.text
+    body: dict[str, Any] = response.json()
+    return body
+
+
+@pytest.fixture
+def alice(client: TestClient) -> tuple[int, dict[str, str]]:
+    """A reviewer."""
+    return bearer(client, "alice", Role.REVIEWER)
+
+
+def assert_refused(response: Any, field: str) -> None:
+    assert response.status_code == 422, response.text
+    body = response.json()
+    assert body["error"] == "ValidationError"
+    assert body["field"] == field, body
+    assert "NUL" in body["detail"] or "surrogate" in body["detail"], body
+
+
+@pytest.mark.parametrize(
+    "path",
+    [
+        "/api/v1/takes/%00",
+        "/api/v1/runs/%00/result",
+        "/api/v1/shoots/a%00b/takes",
+        "/api/v1/takes/%00/reviews",
+        "/api/v1/runs/%00/decisions",
+    ],
+)
+def test_nul_in_the_path_is_422_before_the_database(
+    path: str, client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    """PostgreSQL refuses NUL in text: an id holding one used to be a 500 there."""
+    assert_refused(client.get(path, headers=alice[1]), "path")
+
+
+def test_nul_in_the_path_of_a_change_is_422(
+    client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    take = upload(client, alice[1])
+    assert_refused(client.delete("/api/v1/takes/%00", headers=alice[1]), "path")
+    assert_refused(client.post("/api/v1/takes/%00/runs", json={}, headers=alice[1]), "path")
+    assert_refused(client.delete("/api/v1/tokens/%00", headers=alice[1]), "path")
+    assert client.get(f"/api/v1/takes/{take['id']}", headers=alice[1]).status_code == 200
+
+
+def test_nul_in_a_query_is_422_naming_it(
+    client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    shoot = client.post("/api/v1/shoots", json={"name": "day one"}, headers=alice[1]).json()
+    for name in ("search", "rig"):
+        response = client.get(f"/api/v1/shoots/{shoot['id']}/takes?{name}=a%00", headers=alice[1])
+        assert_refused(response, f"query.{name}")
+    response = client.delete(f"/api/v1/shoots/{shoot['id']}?confirm=%00", headers=alice[1])
+    assert_refused(response, "query.confirm")
+    assert client.get(f"/api/v1/shoots/{shoot['id']}", headers=alice[1]).status_code == 200
+
+
+@pytest.mark.parametrize(
+    ("path", "body", "field"),
+    [
+        ("/api/v1/shoots", b'{"name": "day\\u0000one"}', "body.name"),
+        ("/api/v1/tokens", b'{"name": "laptop\\u0000"}', "body.name"),
+        ("/api/v1/auth/sign-in", b'{"name": "a\\u0000", "password": "x"}', "body.name"),
+        ("/api/v1/shoots", b'{"name": "day \\udfff"}', "body.name"),
+    ],
+)
+def test_nul_or_surrogate_in_a_body_is_422_naming_the_field(
+    path: str, body: bytes, field: str, client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    headers = {**alice[1], "Content-Type": "application/json"}
+    assert_refused(client.post(path, content=body, headers=headers), field)
+
+
+@pytest.mark.parametrize(
+    ("options", "field"),
+    [
+        (b'{"mapping": {"left_upper_arm": "Left\\udfffArm"}}', "body.mapping"),
+        (b'{"mapping": {"left_upper_arm": "Left\\u0000Arm"}}', "body.mapping"),
+        (b'{"filter_params": {"window_s": "\\ud800"}}', "body.filter_params"),
+        (b'{"twist_apply": "0,\\udfff"}', "body.twist_apply"),
+    ],
+)
+def test_unstorable_run_options_are_422_and_the_take_stays_readable(
+    options: bytes, field: str, client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    """An unpaired surrogate in a run option was stored with the run, then every answer that
+    listed the take's runs failed to encode it: the take's page was a 500 for everyone."""
+    take = upload(client, alice[1])
+    response = client.post(
+        f"/api/v1/takes/{take['id']}/runs",
+        content=options,
+        headers={**alice[1], "Content-Type": "application/json"},
+    )
+    assert_refused(response, field)
+    detail = client.get(f"/api/v1/takes/{take['id']}", headers=alice[1])
+    assert detail.status_code == 200, detail.text
+    assert len(detail.json()["runs"]) == 1
+
+
+def test_review_and_decision_text_with_nul_is_422(
+    client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    take = upload(client, alice[1])
+    headers = {**alice[1], "Content-Type": "application/json"}
+    response = client.post(
+        f"/api/v1/takes/{take['id']}/reviews",
+        content=b'{"status": "approved", "notes": "ok\\u0000"}',
+        headers=headers,
+    )
+    assert_refused(response, "body.notes")
+    assert client.get(f"/api/v1/takes/{take['id']}/reviews", headers=alice[1]).json() == []
+
+
+def deflated_zip(members: dict[str, bytes]) -> bytes:
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, data in members.items():
+            archive.writestr(name, data)
+    return buffer.getvalue()
+
+
+@pytest.fixture
+def small_archives(settings: Any) -> Any:
+    """Settings whose imported archives may unpack to 1 MB."""
+    return settings.model_copy(update={"archive_max_unpacked_mb": 1.0})
+
+
+def test_import_cut_short_by_a_limit_keeps_its_takes_owned(
+    small_archives: Any, tmp_path: Path
+) -> None:
+    """An import whose second file is an archive over the unpacked limit answers 413; the take
+    made from its first file stays, owned by the importer (who may delete it), not ownerless
+    (which only an admin could delete)."""
+    from mocapqa.api.app import create_app
+
+    with TestClient(create_app(small_archives)) as client:
+        user_id, headers = bearer(client, "alice", Role.REVIEWER)
+        shoot = client.post("/api/v1/shoots", json={"name": "day one"}, headers=headers).json()
+        bomb = deflated_zip({"big.bvh": b"0" * 3_000_000})
+        response = client.post(
+            f"/api/v1/shoots/{shoot['id']}/takes",
+            files=[("files", ("first.bvh", SMALL_BVH)), ("files", ("bomb.zip", bomb))],
+            headers=headers,
+        )
+        assert response.status_code == 413, response.text
+        assert "archive_max_unpacked_mb" in response.json()["detail"]
+        takes = client.get("/api/v1/takes", headers=headers).json()["items"]
+        assert [(t["name"], t["owner_id"]) for t in takes] == [("first.bvh", user_id)]
+        deleted = client.delete(f"/api/v1/takes/{takes[0]['id']}", headers=headers)
+        assert deleted.status_code == 204, deleted.text
