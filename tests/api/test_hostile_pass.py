@@ -204,3 +204,30 @@ def test_import_cut_short_by_a_limit_keeps_its_takes_owned(
         assert [(t["name"], t["owner_id"]) for t in takes] == [("first.bvh", user_id)]
         deleted = client.delete(f"/api/v1/takes/{takes[0]['id']}", headers=headers)
         assert deleted.status_code == 204, deleted.text
+
+
+def test_a_mapping_to_a_joint_the_take_lacks_is_422_before_queueing(
+    client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    """Run options are checked when the run is asked for: a mapping naming a joint the BVH
+    does not have used to queue a run that failed later ("Expected a joint of this
+    skeleton")."""
+    take = upload(client, alice[1])
+    response = client.post(
+        f"/api/v1/takes/{take['id']}/runs",
+        json={"mapping": {"left_upper_arm": "NoSuchJoint"}},
+        headers=alice[1],
+    )
+    assert response.status_code == 422, response.text
+    body = response.json()
+    assert body["error"] == "OptionError"
+    assert body["field"] == "mapping.left_upper_arm"
+    assert "NoSuchJoint" in body["detail"]
+    detail = client.get(f"/api/v1/takes/{take['id']}", headers=alice[1]).json()
+    assert len(detail["runs"]) == 1
+    accepted = client.post(
+        f"/api/v1/takes/{take['id']}/runs",
+        json={"mapping": {"left_upper_arm": "Spine"}},
+        headers=alice[1],
+    )
+    assert accepted.status_code == 201, accepted.text

@@ -27,7 +27,7 @@ from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository, new_id
 
-__all__ = ["CHUNK_BYTES", "ingest_take", "reading_of", "safe_file_name"]
+__all__ = ["CHUNK_BYTES", "ingest_take", "joints_of", "reading_of", "safe_file_name"]
 
 CHUNK_BYTES = 1 << 20
 """Bytes read from an upload at a time while streaming it to disk."""
@@ -41,6 +41,13 @@ def reading_of(files: FileStore, take_id: str) -> dict[str, Any] | None:
     except (OSError, ValueError):
         return None
     return data if isinstance(data, dict) else None
+
+
+def joints_of(files: FileStore, take_id: str) -> list[str] | None:
+    """A BVH take's joint names as recorded when it was read (None for keypoint takes and
+    takes stored before the names were recorded)."""
+    joints = (reading_of(files, take_id) or {}).get("joints")
+    return [str(j) for j in joints] if isinstance(joints, list) else None
 
 
 def safe_file_name(name: str) -> str:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal, get_args
 
@@ -190,6 +191,25 @@ class AnalysisOptions:
                 "filter_preset",
                 f"Expected no preset or 'default' for a motion take, got {self.filter_preset!r}",
             )
+
+    def check_joints(self, joints: Sequence[str] | None) -> None:
+        """Refuse a ``mapping`` naming a joint the take does not have (``joints``: the BVH's
+        joint names, None when not recorded: the run then finds out).
+
+        Raises
+        ------
+        OptionError
+            Naming the role, e.g. ``mapping.left_upper_arm``.
+        """
+        if joints is None:
+            return
+        known = set(joints)
+        for role, joint in self.mapping.items():
+            if joint not in known:
+                raise OptionError(
+                    f"mapping.{role}",
+                    f"Expected a joint of this take ({len(known)} joints), got {joint!r}",
+                )
 
     def to_json(self) -> dict[str, Any]:
         """The options as a JSON-ready dict."""

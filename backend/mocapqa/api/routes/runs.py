@@ -15,6 +15,7 @@ from mocapqa.api.errors import responses
 from mocapqa.api.schemas import AnalysisOptionsIn, RunOut
 from mocapqa.api.views import run_out
 from mocapqa.errors import InputError, NotFoundError
+from mocapqa.jobs.intake import joints_of
 from mocapqa.jobs.rendered import html_report
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.roles import Action
@@ -46,11 +47,12 @@ def start_run(
 ) -> RunOut:
     """Start another analysis of a take with these options; earlier runs are kept.
 
-    The options are checked here, against the filter registry and the take's kind (422
-    naming the field), not when the run executes.
+    The options are checked here, against the filter registry, the take's kind and (for a
+    ``mapping``) the take's joints (422 naming the field), not when the run executes.
     """
     parsed = AnalysisOptions.from_json((options or AnalysisOptionsIn()).model_dump())
     parsed.check_take_kind(str(take["kind"]))
+    parsed.check_joints(joints_of(services.files, str(take["id"])))
     require_run_slot(services, client)
     run_id = services.repository.add_run(str(take["id"]), parsed.to_json())
     services.runner.submit(run_id, client=client)
