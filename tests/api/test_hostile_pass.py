@@ -231,3 +231,19 @@ def test_a_mapping_to_a_joint_the_take_lacks_is_422_before_queueing(
         headers=alice[1],
     )
     assert accepted.status_code == 201, accepted.text
+
+
+def test_shoot_names_lose_invisible_characters_as_take_names_do(
+    client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    """A bidirectional override makes "gpj.exe" read as "exe.jpg"; take and reviewer names
+    were cleaned of such characters, shoot names were stored and echoed as sent."""
+    made = client.post("/api/v1/shoots", json={"name": "day\u202e one\u200b"}, headers=alice[1])
+    assert made.status_code == 201, made.text
+    assert made.json()["name"] == "day one"
+    renamed = client.patch(
+        f"/api/v1/shoots/{made.json()['id']}", json={"name": "\u2066day\ttwo"}, headers=alice[1]
+    )
+    assert renamed.json()["name"] == "day two"
+    invisible = client.post("/api/v1/shoots", json={"name": "\u202e\u200b"}, headers=alice[1])
+    assert invisible.status_code == 422, invisible.text

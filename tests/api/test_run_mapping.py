@@ -40,10 +40,11 @@ def test_a_mapping_without_role_keys_is_refused(
         response = client.post(f"/api/v1/takes/{created['id']}/runs", json={"mapping": mapping})
         assert response.status_code == 422, mapping
         assert "mapping" in response.text
-    # A joint the take does not have fails the run with the reason.
+    # A joint the take does not have is refused when the run is asked for, naming the role.
     response = client.post(
         f"/api/v1/takes/{created['id']}/runs", json={"mapping": {"left_hand": "NoSuchJoint"}}
     )
-    run = wait_for_run(client, response.json()["id"])
-    assert run["status"] == "failed"
-    assert "NoSuchJoint" in run["error"]
+    assert response.status_code == 422, response.text
+    assert response.json()["field"] == "mapping.left_hand"
+    assert "NoSuchJoint" in response.json()["detail"]
+    assert len(client.get(f"/api/v1/takes/{created['id']}").json()["runs"]) == 1

@@ -15,6 +15,7 @@ from sqlalchemy.exc import IntegrityError
 from sqlalchemy.sql.elements import ColumnElement
 
 from mocapqa import __version__
+from mocapqa.core.text import display_name
 from mocapqa.errors import ConflictError, InputError, NotFoundError
 from mocapqa.pipeline.summary import SUMMARY_FIELDS
 from mocapqa.store.qa import sync_take
@@ -509,7 +510,9 @@ class ShootStore:
 
 
 def _checked_name(name: str) -> str:
-    clean = " ".join(str(name).split())
+    """The name without control and format characters (as take names, ``display_name``),
+    its runs of white space made one space."""
+    clean = " ".join(display_name(str(name), max_length=len(str(name))).split())
     if not clean or len(clean) > 255:
         raise InputError(f"Expected a shoot name of 1–255 characters, got {name!r}")
     return clean
