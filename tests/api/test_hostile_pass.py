@@ -247,3 +247,25 @@ def test_shoot_names_lose_invisible_characters_as_take_names_do(
     assert renamed.json()["name"] == "day two"
     invisible = client.post("/api/v1/shoots", json={"name": "\u202e\u200b"}, headers=alice[1])
     assert invisible.status_code == 422, invisible.text
+
+
+@pytest.mark.parametrize(
+    ("body", "words"),
+    [
+        (b'{"name": "day \xff"}', "UTF-8"),
+        (b'{"name": ' + b"[" * 100_000 + b"]" * 100_000 + b"}", "nested"),
+    ],
+)
+def test_a_json_body_that_cannot_be_decoded_names_the_body(
+    body: bytes, words: str, client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    """Not UTF-8, or nested past the parser's depth: was a bare "There was an error parsing
+    the body" (400) that said neither where nor why."""
+    response = client.post(
+        "/api/v1/shoots", content=body, headers={**alice[1], "Content-Type": "application/json"}
+    )
+    assert response.status_code == 422, response.text
+    answer = response.json()
+    assert answer["error"] == "ValidationError"
+    assert answer["field"] == "body"
+    assert words in answer["detail"]

@@ -4,7 +4,8 @@ Every error answer has one shape, :class:`~mocapqa.api.schemas.ErrorOut`:
 ``{"detail": message, "error": class name}`` plus ``line``/``field`` for parse errors (so the
 UI can show the file's line) and ``field``/``errors`` for request validation. FastAPI's own
 validation errors and HTTP exceptions (unknown route, 405, 413 of the body limit) are turned
-into the same shape. :func:`responses` gives a route's OpenAPI ``responses=`` from the same
+into the same shape; a JSON body FastAPI could not decode (not UTF-8, nested too deep) is a 422
+naming ``body`` and why. :func:`responses` gives a route's OpenAPI ``responses=`` from the same
 table, so the documented statuses are the ones the handlers answer.
 """
 
@@ -133,9 +134,26 @@ def _allowed_methods(request: Request) -> list[str]:
     return sorted(methods)
 
 
+def _undecodable_body(error: HTTPException) -> str | None:
+    """Why FastAPI could not decode a JSON body (its 400 names no reason), or None."""
+    cause = error.__cause__
+    if error.status_code != 400:
+        return None
+    if isinstance(cause, UnicodeDecodeError):
+        return f"Expected a UTF-8 JSON body, got an undecodable byte at offset {cause.start}"
+    if isinstance(cause, RecursionError):
+        return "Expected a JSON body nested a few levels deep, got one nested too deep to parse"
+    return None
+
+
 async def _handle_http(request: Request, error: Exception) -> JSONResponse:
     if not isinstance(error, HTTPException):  # pragma: no cover - registered for HTTPException
         raise error
+    undecodable = _undecodable_body(error)
+    if undecodable is not None:
+        entry = {"field": "body", "message": undecodable}
+        body = error_body("ValidationError", f"body: {undecodable}", field="body", errors=[entry])
+        return JSONResponse(body, status_code=422)
     body = error_body("HTTPError", str(error.detail))
     headers = dict(error.headers or {})
     if error.status_code == 405:
