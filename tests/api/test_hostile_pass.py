@@ -7,14 +7,20 @@ NUL in text."""
 from __future__ import annotations
 
 import io
+import socket
 import zipfile
 from datetime import timedelta
 from pathlib import Path
 from typing import Any
+from urllib.parse import urlsplit
 
+import httpx
 import pytest
 from fastapi.testclient import TestClient
+from tests.api.conftest import make_settings
+from tests.live_server import serve
 
+from mocapqa.api.app import create_app
 from mocapqa.store.roles import Role
 
 SMALL_BVH = b"""HIERARCHY
@@ -187,8 +193,6 @@ def test_import_cut_short_by_a_limit_keeps_its_takes_owned(
     """An import whose second file is an archive over the unpacked limit answers 413; the take
     made from its first file stays, owned by the importer (who may delete it), not ownerless
     (which only an admin could delete)."""
-    from mocapqa.api.app import create_app
-
     with TestClient(create_app(small_archives)) as client:
         user_id, headers = bearer(client, "alice", Role.REVIEWER)
         shoot = client.post("/api/v1/shoots", json={"name": "day one"}, headers=headers).json()
@@ -269,3 +273,43 @@ def test_a_json_body_that_cannot_be_decoded_names_the_body(
     assert answer["error"] == "ValidationError"
     assert answer["field"] == "body"
     assert words in answer["detail"]
+
+
+def raw_request(url: str, head: str, wait_s: float = 120.0) -> tuple[int, dict[str, Any]]:
+    """Send only a request's head on a socket and read the answer: a server waiting for the
+    body would never answer (the read then times out after ``wait_s``, a generous bound)."""
+    address = urlsplit(url)
+    with socket.create_connection((address.hostname, address.port), timeout=wait_s) as sock:
+        sock.sendall(head.encode())
+        data = b""
+        while b"\r\n\r\n" not in data or not data.rstrip().endswith(b"}"):
+            chunk = sock.recv(65536)
+            if not chunk:
+                break
+            data += chunk
+    start, _, rest = data.partition(b"\r\n\r\n")
+    status = int(start.split(b" ", 2)[1])
+    return status, httpx.Response(status, content=rest).json()
+
+
+@pytest.mark.parametrize("path", ["/api/v1/takes", "/api/v1/shoots/any/takes"])
+def test_a_viewer_upload_is_refused_before_its_body(path: str, tmp_path: Path) -> None:
+    """A viewer may not upload: the 403 used to come after the whole body (up to
+    ``max_upload_mb``, or ``archive_max_unpacked_mb`` for an import) was received and spooled
+    to disk. It now comes from the credential alone, as the 401 and the 429 do:
+    a 100 MB Content-Length (under both limits) with no body sent gets its answer."""
+    settings = make_settings("sqlite", tmp_path, allowed_hosts=["127.0.0.1"])
+    app = create_app(settings)
+    accounts = app.state.accounts
+    viewer = accounts.add_user("vic", Role.VIEWER)
+    token = accounts.issue(viewer.id, "api", timedelta(days=1)).token
+    with serve(app) as url:
+        head = f"POST {path} HTTP/1.1\r\nHost: {urlsplit(url).netloc}\r\n"
+        head += f"Authorization: Bearer {token}\r\n"
+        head += "Content-Type: multipart/form-data; boundary=b\r\n"
+        head += "Content-Length: 100000000\r\n\r\n"
+        status, body = raw_request(url, head)
+    assert status == 403, body
+    assert body["error"] == "ForbiddenError"
+    assert "upload" in body["detail"]
+    assert list((settings.data_dir / "incoming").iterdir()) == []

@@ -109,16 +109,30 @@ def quota_key(user_id: int | None, address: str) -> str:
 
 
 def quota_key_before_body(connection: HTTPConnection, accounts: Accounts) -> str | None:
-    """:func:`quota_key` from the credential alone, before the body is read, or None when
-    :func:`get_principal` would refuse the request (401): a credential that is not valid, or
-    none while users exist. A token or session is looked up by a hash and one query by
-    primary key, with no write (``last_used_at`` is the route's to set)."""
+    """An upload's :func:`quota_key` from the credential alone, before the body is read, or
+    None when :func:`get_principal` would refuse the request (401): a credential that is not
+    valid, or none while users exist. A token or session is looked up by a hash and one query
+    by primary key, with no write (``last_used_at`` is the route's to set).
+
+    Raises
+    ------
+    ForbiddenError
+        The credential's user has a role that may not upload (403, as :func:`require` would
+        answer after the body).
+    """
     credential = _credential(connection)
     if credential is None:
         return None if accounts.has_users() else client_address(connection)
     kind, token = credential
-    user_id = accounts.user_id_of(token, kind) if token else None
-    return None if user_id is None else quota_key(user_id, client_address(connection))
+    holder = accounts.holder_of(token, kind) if token else None
+    if holder is None:
+        return None
+    user_id, role = holder
+    if not allows(role, Action.UPLOAD):
+        raise ForbiddenError(
+            f"Expected a role allowed to upload, got {role.value} (refused before the body)"
+        )
+    return quota_key(user_id, client_address(connection))
 
 
 def get_principal(connection: HTTPConnection, accounts: AccountsDep) -> Principal:

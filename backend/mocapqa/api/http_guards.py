@@ -17,7 +17,8 @@ One ASGI middleware (:class:`RequestGuard`), so each check answers before the bo
   request's token or session cookie alone (a hash and one query by primary key, on a worker
   thread); an anonymous request to a server without users counts against its client address.
   An upload the routes would refuse with 401 (a credential that is not valid, or none while
-  users exist) gets its 401 here, before its body is read too.
+  users exist) gets its 401 here, before its body is read too, and one from a user whose role
+  may not upload (a viewer) its 403.
 * **Text no store can keep**: a NUL (``%00``) in the path or in a query parameter gets 422
   naming ``path`` or ``query.NAME`` (PostgreSQL refuses NUL in text; JSON bodies get the same
   check from :class:`~mocapqa.api.request_model.RequestModel`).
@@ -52,6 +53,7 @@ from mocapqa.api.errors import error_body
 from mocapqa.api.host_check import HostCheck
 from mocapqa.api.request_model import unstorable_text
 from mocapqa.config import Settings
+from mocapqa.errors import ForbiddenError
 
 __all__ = [
     "CONTENT_SECURITY_POLICY",
@@ -218,7 +220,11 @@ class RequestGuard:
             await _send_json(secured, 422, body)
             return
         if is_upload:
-            key = await run_in_threadpool(self.quota_key, HTTPConnection(scope))
+            try:
+                key = await run_in_threadpool(self.quota_key, HTTPConnection(scope))
+            except ForbiddenError as e:
+                await _send_json(secured, 403, error_body("ForbiddenError", str(e)))
+                return
             if key is None:
                 detail = "Expected a signed-in user (a valid session cookie or 'Authorization: "
                 detail += "Bearer TOKEN') to upload, got none or an invalid one"
@@ -298,7 +304,9 @@ def install_http_guards(
     order that makes the Host check run first. ``pending_runs`` counts a quota key's queued
     runs, ``quota_key`` names a request's key from its headers, None for a request to refuse
     with 401 (a blocking call: it runs on a worker thread); ``import_paths`` matches the
-    routes that take many files in one request (uploads with the import body limit)."""
+    routes that take many files in one request (uploads with the import body limit).
+    ``quota_key`` raises :class:`~mocapqa.errors.ForbiddenError` for a user whose role may not
+    upload (answered 403)."""
     app.add_middleware(
         RequestGuard,
         settings=settings,

@@ -308,10 +308,16 @@ class Accounts:
         return user, row.csrf
 
     def user_id_of(self, token: str, kind: str) -> int | None:
-        """The id of the user a valid credential of ``kind`` names, else None; reads only.
+        """The id of the user a valid credential of ``kind`` names, else None; reads only."""
+        holder = self.holder_of(token, kind)
+        return None if holder is None else holder[0]
 
-        The cheap lookup for a quota before a request's body is read (a hash and one query
-        by primary key); :meth:`verify` is the full check a route makes.
+    def holder_of(self, token: str, kind: str) -> tuple[int, Role] | None:
+        """The id and role of the user a valid credential of ``kind`` names, else None;
+        reads only.
+
+        The cheap lookup for a quota and a role before a request's body is read (a hash and
+        one query by primary key); :meth:`verify` is the full check a route makes.
         """
         match = _TOKEN.match(token)
         if match is None:
@@ -319,11 +325,13 @@ class Accounts:
         token_id, secret = match.groups()
         with self.engine.connect() as conn:
             row = conn.execute(
-                select(tokens, users.c.disabled)
+                select(tokens, users.c.disabled, users.c.role)
                 .join(users, users.c.id == tokens.c.user_id)
                 .where(tokens.c.id == token_id)
             ).first()
-        return None if row is None or not _usable(row, kind, secret) else int(row.user_id)
+        if row is None or not _usable(row, kind, secret):
+            return None
+        return int(row.user_id), Role(row.role)
 
     def list_tokens(self, user_id: int | None = None) -> list[dict[str, Any]]:
         """Personal tokens (never their secrets), newest first; of one user or of all."""
