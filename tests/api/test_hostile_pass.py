@@ -313,3 +313,36 @@ def test_a_viewer_upload_is_refused_before_its_body(path: str, tmp_path: Path) -
     assert body["error"] == "ForbiddenError"
     assert "upload" in body["detail"]
     assert list((settings.data_dir / "incoming").iterdir()) == []
+
+
+OPEN_OPERATIONS = {("get", "/api/v1/health"), ("post", "/api/v1/auth/sign-in")}
+"""The only operations an anonymous client may call on a server with users."""
+VIEWER_CHANGES = {
+    ("post", "/api/v1/auth/sign-out"),
+    ("post", "/api/v1/tokens"),
+    ("delete", "/api/v1/tokens/{token_id}"),
+}
+"""The only state-changing operations a viewer may call (its own session and tokens)."""
+
+
+def test_every_operation_names_who_may_call_it(
+    client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    """Every documented operation, called with ids that do not exist: anonymous gets 401
+    (before a 404 could tell whether the id exists), a viewer 403 on anything that changes
+    state, except the stated open operations and a viewer's own session and tokens. A new
+    route without its ``require`` fails here."""
+    _, viewer = bearer(client, "vic", Role.VIEWER)
+    spec = client.get("/openapi.json").json()
+    operations = [(m, p) for p, ops in spec["paths"].items() for m in ops]
+    assert len(operations) > 30
+    for method, path in operations:
+        url = path.replace("{kind}", "csv")
+        for name in ("take_id", "run_id", "shoot_id", "token_id", "name", "interval_id"):
+            url = url.replace("{" + name + "}", "0")
+        if (method, path) not in OPEN_OPERATIONS:
+            anonymous = client.request(method.upper(), url, json={})
+            assert anonymous.status_code == 401, (method, path, anonymous.text)
+        if method != "get" and (method, path) not in VIEWER_CHANGES | OPEN_OPERATIONS:
+            refused = client.request(method.upper(), url, json={}, headers=viewer)
+            assert refused.status_code == 403, (method, path, refused.text)
