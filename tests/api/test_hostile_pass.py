@@ -346,3 +346,18 @@ def test_every_operation_names_who_may_call_it(
         if method != "get" and (method, path) not in VIEWER_CHANGES | OPEN_OPERATIONS:
             refused = client.request(method.upper(), url, json={}, headers=viewer)
             assert refused.status_code == 403, (method, path, refused.text)
+
+
+def test_a_json_list_of_numbers_names_the_frame_at_fault(
+    client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    """A JSON list of numbers is read as MediaPipe frames: it was a 422 reading "TypeError:
+    object of type 'int' has no len()", naming no field."""
+    response = client.post(
+        "/api/v1/takes", files={"file": ("frames.json", b"[[], 1, 2]")}, headers=alice[1]
+    )
+    assert response.status_code == 422, response.text
+    body = response.json()
+    assert body["error"] == "ParseError"
+    assert body["field"] == "frames[1]"
+    assert "TypeError" not in body["detail"]

@@ -186,6 +186,13 @@ def _landmark_value(item: dict[str, Any], key: str, path: str, field: str) -> fl
 
 def _frames_of(document: Any, path: str) -> tuple[list[Any], Any]:
     if isinstance(document, list):
+        for i, frame in enumerate(document):
+            if frame is not None and not isinstance(frame, list):
+                raise ParseError(
+                    f"Expected a list of landmarks, got {type(frame).__name__}",
+                    path,
+                    field=f"frames[{i}]",
+                )
         return document, None
     if isinstance(document, dict) and isinstance(document.get("frames"), list):
         frames = []
