@@ -361,3 +361,17 @@ def test_a_json_list_of_numbers_names_the_frame_at_fault(
     assert body["error"] == "ParseError"
     assert body["field"] == "frames[1]"
     assert "TypeError" not in body["detail"]
+
+
+def test_a_frame_time_too_small_for_a_frame_rate_names_its_line(
+    client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    """``Frame Time: 5e-324`` is > 0 but its frame rate is infinite: the 422 came from the
+    motion's own check ("Expected `fps` > 0, got inf") without the file's line."""
+    data = SMALL_BVH.replace(b"Frame Time: 0.033333", b"Frame Time: 5e-324")
+    response = client.post("/api/v1/takes", files={"file": ("tiny.bvh", data)}, headers=alice[1])
+    assert response.status_code == 422, response.text
+    body = response.json()
+    assert body["error"] == "ParseError"
+    assert body["line"] == 18
+    assert "5e-324" in body["detail"]

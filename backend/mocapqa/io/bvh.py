@@ -336,6 +336,12 @@ def parse_bvh(
         ) from None
     if not (math.isfinite(frame_time) and frame_time > 0):
         raise ParseError(f"Expected a frame time > 0 s, got {time_text!r}", path, cursor.number + 1)
+    if not math.isfinite(1.0 / frame_time):
+        raise ParseError(
+            f"Expected a frame time whose frame rate is finite, got {time_text!r}",
+            path,
+            cursor.number + 1,
+        )
     n_channels = sum(len(c) for c in parser.channels)
     block = text[cursor.position :]
     if number_reader == "auto":
