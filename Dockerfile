@@ -3,13 +3,16 @@
 # workers of the compose file's "dask" profile all run from it, so every process has the same
 # Python, numpy, dask and distributed versions.
 
-# three.js (the dashboard's 3D views) comes from the npm registry, pinned by package-lock.json.
+# three.js (the dashboard's 3D views) and Plotly's cartesian bundle (its charts) come from the npm
+# registry, pinned by package-lock.json.
 FROM node:20.18.0-bookworm-slim AS three
 WORKDIR /js
 COPY package.json package-lock.json ./
 RUN npm ci --omit=dev --no-audit --no-fund && mkdir -p vendor/three \
  && cp node_modules/three/build/three.module.min.js node_modules/three/build/three.core.min.js \
-       node_modules/three/LICENSE vendor/three/
+       node_modules/three/LICENSE vendor/three/ \
+ && mkdir -p vendor/plotly && cp node_modules/plotly.js-cartesian-dist-min/plotly-cartesian.min.js \
+       node_modules/plotly.js-cartesian-dist-min/LICENSE vendor/plotly/
 
 FROM python:3.11.9-slim-bookworm
 
@@ -37,6 +40,7 @@ COPY pyproject.toml README.md ./
 COPY backend ./backend
 COPY frontend ./frontend
 COPY --from=three /js/vendor/three ./frontend/vendor/three
+COPY --from=three /js/vendor/plotly ./frontend/vendor/plotly
 # The package with its PostgreSQL driver; dask[distributed] is a dependency of the package.
 # Versions of the package's own dependencies are bounded in pyproject.toml; the ones the image
 # serves with are pinned here so that app, scheduler and workers match.

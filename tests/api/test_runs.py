@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -22,6 +23,9 @@ from mocapqa.render.service import RenderService
 
 Waiter = Callable[[TestClient, str], dict[str, Any]]
 Uploader = Callable[[TestClient, Path], dict[str, Any]]
+TRC_TAKE = (
+    "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d/S00_P00_T01_BalancingTrial_0-100.trc"
+)
 
 
 @pytest.fixture
@@ -89,6 +93,68 @@ def test_frames_come_in_windows_matching_forward_kinematics(
     assert overview["step"] == 11
     bad = client.get(f"/api/v1/runs/{run_id}/frames?start=600")
     assert bad.status_code == 422
+
+
+def unpack_frames(body: bytes) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """Read ``/frames.f32``: a uint32 length, a JSON header, then float32 arrays."""
+    length = int(np.frombuffer(body[:4], "<u4")[0])
+    header = json.loads(body[4 : 4 + length])
+    assert (4 + length) % 4 == 0
+    offset, arrays = 4 + length, {}
+    for name, components in header["arrays"]:
+        shape = (header["count"], header["points"], components)
+        size = int(np.prod(shape))
+        arrays[name] = np.frombuffer(body, "<f4", size, offset).reshape(shape)
+        offset += 4 * size
+    assert offset == len(body)
+    return header, arrays
+
+
+def test_packed_frames_hold_the_same_window_as_json(
+    client: TestClient, analysed: dict[str, Any]
+) -> None:
+    run_id = analysed["run_id"]
+    for query in ("start=100&stop=110", "max_frames=50", "start=7&step=3&stop=40"):
+        window = client.get(f"/api/v1/runs/{run_id}/frames?{query}").json()
+        packed = client.get(f"/api/v1/runs/{run_id}/frames.f32?{query}")
+        assert packed.status_code == 200
+        assert packed.headers["content-type"] == "application/octet-stream"
+        header, arrays = unpack_frames(packed.content)
+        frames = [header["start"] + k * header["step"] for k in range(header["count"])]
+        assert frames == window["frames"]
+        assert header["n_frames"] == window["n_frames"]
+        assert [name for name, _ in header["arrays"]] == [
+            "raw",
+            "corrected",
+            "raw_rotations",
+            "corrected_rotations",
+        ]
+        for name, values in arrays.items():
+            np.testing.assert_allclose(values, np.asarray(window[name]), atol=6e-4)
+    # Bad windows are refused as for JSON, naming the problem.
+    bad = client.get(f"/api/v1/runs/{run_id}/frames.f32?start=600")
+    assert bad.status_code == 422
+    assert "start" in bad.json()["detail"]
+    assert client.get(f"/api/v1/runs/{run_id}/frames.f32?step=0").status_code == 422
+    assert client.get("/api/v1/runs/0123456789abcdef0123456789abcdef/frames.f32").status_code == 404
+
+
+def test_packed_frames_of_a_keypoint_take_carry_confidence(
+    client: TestClient, corpus_dir: Path, upload: Uploader, wait_for_run: Waiter
+) -> None:
+    created = upload(client, corpus_dir / TRC_TAKE)
+    run = wait_for_run(client, created["run_id"])
+    assert run["status"] == "done"
+    window = client.get(f"/api/v1/runs/{run['id']}/frames?max_frames=40").json()
+    _, arrays = unpack_frames(
+        client.get(f"/api/v1/runs/{run['id']}/frames.f32?max_frames=40").content
+    )
+    assert "confidence" in arrays
+    for name, values in arrays.items():
+        expected = np.array(window[name], dtype=float)  # JSON null -> NaN
+        values = values.reshape(expected.shape)  # per-point marks: one component
+        np.testing.assert_array_equal(np.isnan(values), np.isnan(expected))
+        np.testing.assert_allclose(values, expected, atol=6e-3, equal_nan=True)
 
 
 def test_unfinished_runs_answer_409(client: TestClient, analysed: dict[str, Any]) -> None:
