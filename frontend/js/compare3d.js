@@ -34,7 +34,7 @@ export async function compareViews(container, a, b, labels, onTeardown = () => {
     return null;
   }
   const [framesA, framesB, { createViews }] = await Promise.all([
-    api.getFrames(a.run.id, { maxFrames: 800 }), api.getFrames(b.run.id, { maxFrames: 800 }), import("./scene3d.js")]);
+    api.getFramesPacked(a.run.id, { maxFrames: 800 }), api.getFramesPacked(b.run.id, { maxFrames: 800 }), import("./scene3d.js")]);
   const fpsA = a.result.summary.fps, fpsB = b.result.summary.fps;
   const nA = a.result.summary.n_frames, nB = b.result.summary.n_frames;
   const oriented = Array.isArray(framesA.corrected_rotations) && Array.isArray(framesB.corrected_rotations);

@@ -25,3 +25,10 @@ export function activatable(el, action) {
   });
   return el;
 }
+
+/** Fetch these modules now, all at once, rather than one level of imports after another. */
+export function preloadModules(urls) {
+  for (const href of urls) {
+    if (!document.head.querySelector(`link[rel="modulepreload"][href="${href}"]`)) document.head.append(h("link", { rel: "modulepreload", href }));
+  }
+}

@@ -2,7 +2,8 @@
 // Data arrive Y-up in file units; the views are Plotly scenes (Z-up), so every drawn point goes
 // through `toScene` (x, y, z) -> (x, -z, y), a rotation (not a mirror) about the x axis.
 
-export const present = (p) => p != null && p[0] != null && p[1] != null && p[2] != null;
+/** A point that was seen: null (JSON) and NaN (packed windows) mark a missing one. */
+export const present = (p) => p != null && Number.isFinite(p[0]) && Number.isFinite(p[1]) && Number.isFinite(p[2]);
 export const toScene = (p) => [p[0], -p[2], p[1]];
 /** Data coordinates unchanged (three.js scenes are Y-up like the data). */
 export const identity = (p) => p;
@@ -86,6 +87,62 @@ export function boneVertices(points, rotations, bones, sides, map = toScene) {
   });
   return { x, y, z };
 }
+
+/**
+ * The octahedral bones of one frame written straight into `out` as triangle soup (8 faces × 3
+ * vertices × xyz per bone, data coordinates): the same vertices as boneVertices followed by
+ * triangleSoup, without allocating anything, for the 3D views' per-frame update.
+ *
+ * @param out Float32Array of at least bones.length * 72 values
+ * @returns out
+ */
+export function boneSoup(points, rotations, bones, sides, out) {
+  const v = SCRATCH; // 6 vertices × xyz of the bone being written
+  let o = 0;
+  for (let b = 0; b < bones.length; b++) {
+    const [p, c] = bones[b];
+    const head = points[p], tail = points[c];
+    const headOk = present(head);
+    if (!headOk || !present(tail)) {
+      const at = headOk ? head : ORIGIN;
+      for (let k = 0; k < 6; k++) { v[3 * k] = at[0]; v[3 * k + 1] = at[1]; v[3 * k + 2] = at[2]; }
+    } else {
+      const dx = tail[0] - head[0], dy = tail[1] - head[1], dz = tail[2] - head[2];
+      const length = Math.hypot(dx, dy, dz);
+      if (!(length > 1e-9)) {
+        for (let k = 0; k < 6; k++) { v[3 * k] = head[0]; v[3 * k + 1] = head[1]; v[3 * k + 2] = head[2]; }
+      } else {
+        const ax = dx / length, ay = dy / length, az = dz / length;
+        // u: the marked side turned by the parent's rotation, made perpendicular to the bone.
+        const q = rotations[p], s0 = sides[b];
+        const tx = 2 * (q[1] * s0[2] - q[2] * s0[1]), ty = 2 * (q[2] * s0[0] - q[0] * s0[2]), tz = 2 * (q[0] * s0[1] - q[1] * s0[0]);
+        let ux = s0[0] + q[3] * tx + (q[1] * tz - q[2] * ty);
+        let uy = s0[1] + q[3] * ty + (q[2] * tx - q[0] * tz);
+        let uz = s0[2] + q[3] * tz + (q[0] * ty - q[1] * tx);
+        const along = ux * ax + uy * ay + uz * az;
+        ux -= along * ax; uy -= along * ay; uz -= along * az;
+        const n = Math.hypot(ux, uy, uz);
+        if (n > 1e-9) { ux /= n; uy /= n; uz /= n; } else { ux = 0; uy = 0; uz = 0; }
+        const vx = ay * uz - az * uy, vy = az * ux - ax * uz, vz = ax * uy - ay * ux;
+        const mx = head[0] + dx * WIDEST, my = head[1] + dy * WIDEST, mz = head[2] + dz * WIDEST;
+        const w = WIDTH * length;
+        v[0] = head[0]; v[1] = head[1]; v[2] = head[2];
+        v[3] = mx + ux * w; v[4] = my + uy * w; v[5] = mz + uz * w;
+        v[6] = mx + vx * w; v[7] = my + vy * w; v[8] = mz + vz * w;
+        v[9] = mx - ux * w; v[10] = my - uy * w; v[11] = mz - uz * w;
+        v[12] = mx - vx * w; v[13] = my - vy * w; v[14] = mz - vz * w;
+        v[15] = tail[0]; v[16] = tail[1]; v[17] = tail[2];
+      }
+    }
+    for (let f = 0; f < 8; f++) {
+      const face = BONE_FACES[f];
+      for (let k = 0; k < 3; k++) { const i = 3 * face[k]; out[o++] = v[i]; out[o++] = v[i + 1]; out[o++] = v[i + 2]; }
+    }
+  }
+  return out;
+}
+const SCRATCH = new Float64Array(18);
+const ORIGIN = [0, 0, 0];
 
 /** Face index arrays (i, j, k) of `count` bones, 6 vertices and 8 faces each. */
 export function boneFaces(count) {

@@ -124,25 +124,31 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   const requestRender = () => { if (!scheduled) scheduled = requestAnimationFrame(render); };
   new ResizeObserver(requestRender).observe(divs.raw.parentNode.parentNode);
 
-  const soupScratch = new Float32Array(bones.length * 24 * 3);
+  // Per frame, vertex buffers are rewritten in place: nothing is allocated, and the bones'
+  // colours are rewritten only when the highlighted joints change. Flat shading takes each
+  // face's normal from the screen-space derivatives, so no normals are computed.
+  const colorCache = new Map();
+  const colorFrom = (css) => { let c = colorCache.get(css); if (!c) { c = new THREE.Color(css); colorCache.set(css, c); } return c; };
   const write = (view, points, rotations, flagged, selected, confidence = null, bridged = null) => {
-    const colorOf = (j) => (j === selected ? SELECTED : flagged.has(j) ? new THREE.Color(flagged.get(j)) : null);
+    const colorOf = (j) => (j === selected ? SELECTED : flagged.has(j) ? colorFrom(flagged.get(j)) : null);
     if (oriented) {
-      const vertices = geo.boneVertices(points, rotations, bones, sides, geo.identity);
       const position = view.bones.geometry.attributes.position;
-      position.array.set(geo.triangleSoup(vertices, bones.length, soupScratch));
+      geo.boneSoup(points, rotations, bones, sides, position.array);
       position.needsUpdate = true;
-      const color = view.bones.geometry.attributes.color;
-      let o = 0;
-      bones.forEach(([p]) => {
-        const own = colorOf(p) || BODY;
-        for (let f = 0; f < 8; f++) {
-          const c = geo.MARKED_FACES.has(f) ? MARKED : own;
-          for (let v = 0; v < 3; v++) { color.array[o++] = c.r; color.array[o++] = c.g; color.array[o++] = c.b; }
+      const key = `${selected}|${[...flagged].join()}`;
+      if (view.colored !== key) {
+        view.colored = key;
+        const color = view.bones.geometry.attributes.color;
+        let o = 0;
+        for (const [p] of bones) {
+          const own = colorOf(p) || BODY;
+          for (let f = 0; f < 8; f++) {
+            const c = geo.MARKED_FACES.has(f) ? MARKED : own;
+            for (let v = 0; v < 3; v++) { color.array[o++] = c.r; color.array[o++] = c.g; color.array[o++] = c.b; }
+          }
         }
-      });
-      color.needsUpdate = true;
-      view.bones.geometry.computeVertexNormals();
+        color.needsUpdate = true;
+      }
     } else {
       writeLines(view.bones.geometry.attributes.position, points, bones);
     }

@@ -1,7 +1,7 @@
 // The take view: two 3D views with one camera, the player, findings, charts, review, re-run.
 import * as api from "./api.js";
 import * as charts from "./charts.js";
-import { badge, h } from "./dom.js";
+import { badge, h, preloadModules } from "./dom.js";
 import { fmt, nextStop, seconds, stepsRan } from "./format.js";
 import { findingAt, loopOfFinding } from "./findings.js";
 import { findingsList } from "./findings-list.js";
@@ -22,8 +22,12 @@ const LOOP_MARGIN_S = 0.5; // "loop this finding": seconds shown before and afte
 
 export async function takeView(main, takeId, params, onTeardown) {
   const runParam = params.get("run");
-  const plotly = loadPlotly(); // in parallel: the 3D views do not need it
-  const scene = import("./scene3d.js"); // three.js: only the take view loads it
+  // A link names its run: its report and first frames are asked for with the take, not after.
+  const early = runParam ? { result: api.getResult(runParam), first: firstFrames(runParam) } : null;
+  if (early) Object.values(early).forEach((p) => p.catch(() => {})); // a run not done: asked again below
+  // three.js: only the take view loads it, its three modules together.
+  preloadModules(["/static/js/geometry.js", "/static/vendor/three/three.module.min.js", "/static/vendor/three/three.core.min.js"]);
+  const scene = import("./scene3d.js");
   const take = await api.getTake(takeId);
   performance.mark("take-fetched");
   const runs = take.runs;
@@ -39,11 +43,14 @@ export async function takeView(main, takeId, params, onTeardown) {
     if (final.status === "failed") { main.append(h("p", { class: "error" }, final.error)); return; }
     window.dispatchEvent(new HashChangeEvent("hashchange")); return;
   }
-  const [result, filters, described, first] = await Promise.all([
-    api.getResult(run.id).then((r) => { performance.mark("result-fetched"); return r; }), api.listFilters(), api.getRunOptions(),
-    api.getFrames(run.id, { maxFrames: FIRST_FRAMES }).then((f) => { performance.mark("frames-fetched"); return f; })]);
+  const asked = early && run.id === runParam ? early : { result: api.getResult(run.id), first: firstFrames(run.id) };
+  const [result, first] = await Promise.all([
+    asked.result.then((r) => { performance.mark("result-fetched"); return r; }),
+    asked.first.then((f) => { performance.mark("frames-fetched"); return f; })]);
+  // The re-run form's lists wait for nothing on screen.
+  const formLists = Promise.all([api.listFilters(), api.getRunOptions()]);
   let overview = first;
-  const fuller = first.step > 1 ? api.getFrames(run.id, { maxFrames: OVERVIEW_FRAMES }) : Promise.resolve(first);
+  const fuller = first.step > 1 ? api.getFramesPacked(run.id, { maxFrames: OVERVIEW_FRAMES }) : Promise.resolve(first);
   const fps = result.summary.fps;
   const nFrames = result.summary.n_frames;
   const names = result.points.names;
@@ -101,8 +108,9 @@ export async function takeView(main, takeId, params, onTeardown) {
   document.getElementById("player").append(timebar.el);
   const bridgedRuns = result.series.filter && result.series.filter.bridged_runs;
   if (bridgedRuns) timebar.setGaps(bridgedRuns);
-  main.append(help, list.panel,
-    timelines, review, stepsPanel(result), downloadsPanel(run, result), rerunPanel(take, run, filters, described));
+  const rerunSlot = h("div", {});
+  main.append(help, list.panel, timelines, review, stepsPanel(result), downloadsPanel(run, result), rerunSlot);
+  formLists.then(([filters, described]) => rerunSlot.replaceWith(rerunPanel(take, run, filters, described)));
 
   // Frames: the overview (whole take, decimated) or, when paused, a full-rate window around.
   const pick = (source, f) => {
@@ -161,7 +169,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   const loadDetail = async () => {
     if (overview.step === 1) return;
     const f = store.state.frame;
-    const part = await api.getFrames(run.id, { start: Math.max(0, f - 200), stop: Math.min(nFrames, f + 200), maxFrames: 401 });
+    const part = await api.getFramesPacked(run.id, { start: Math.max(0, f - 200), stop: Math.min(nFrames, f + 200), maxFrames: 401 });
     detail = part;
     if (!player.playing) render();
   };
@@ -271,8 +279,13 @@ export async function takeView(main, takeId, params, onTeardown) {
   render();
   views.renderNow();
   fuller.then((more) => { overview = more; if (!player.playing) render(); });
-  Plotly = await plotly;
+  // The charting library (a long script to evaluate) only once the skeletons are on screen.
+  await new Promise((r) => requestAnimationFrame(() => setTimeout(r, 0)));
+  Plotly = await loadPlotly();
   timeline = createTimeline(Plotly, timelines, (f) => jump(f));
+  // Each chart in a task of its own: a key press or a drag waits for one chart, not all.
+  const breathe = () => new Promise((r) => setTimeout(r, 0));
+  await breathe();
 
   const series = result.series;
   if (series.twist) {
@@ -283,6 +296,7 @@ export async function takeView(main, takeId, params, onTeardown) {
         return inside ? inside.start_frame : p.x;
       });
   }
+  await breathe();
   if (series.limits) {
     // A heat-map cell selects its joint as well as its frame.
     await timeline.add("chart-limits", "Joint-limit violations (joint × frame, degrees outside the limits)", charts.limitsFigure(series.limits),
@@ -296,8 +310,10 @@ export async function takeView(main, takeId, params, onTeardown) {
     const k = () => Number(choice.value);
     overview = await fuller;
     const trajectory = () => charts.trajectoryFigure(overview.frames, overview.raw.map((p) => p[k()]), overview.corrected.map((p) => p[k()]), result.summary.length_unit);
+    await breathe();
     await timeline.add("chart-trajectory", "Raw vs filtered trajectory (one panel per axis)", trajectory(), (p) => p.x);
     const weights = series.filter && Object.keys(series.filter.weights).length ? series.filter.weights : null;
+    await breathe();
     if (weights) await timeline.add("chart-weights", "Filter weights (stacked: Kalman / One Euro / EMA)", charts.weightsFigure(series.frames, weights, k()), (p) => p.x);
     choice.addEventListener("change", () => {
       const t = trajectory(); Plotly.react("chart-trajectory", t.data, t.layout);
@@ -307,9 +323,13 @@ export async function takeView(main, takeId, params, onTeardown) {
   timeline.setFrame(store.state.frame);
   focusCharts();
   if (store.state.frame) loadDetail();
+  await formLists;
   await fuller; // "ready" once the full overview replaced the light one (tests compare pixels)
   main.dataset.ready = "1";
 }
+
+/** The first, light overview: the skeletons do not wait for the full one. */
+const firstFrames = (runId) => api.getFramesPacked(runId, { maxFrames: FIRST_FRAMES });
 
 function runPicker(take, run) {
   const select = h("select", { id: "run-pick", "aria-label": "run", onchange: (e) => { location.hash = api.takeLink(take.id, e.target.value); } },

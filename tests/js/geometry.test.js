@@ -77,3 +77,20 @@ test("frameTake holds every frame and keeps the floor at the lowest point", () =
   const { ranges } = geo.frameTake([[[[0, 0, 0], [1, 2, 3]]]], 0);
   assert.deepEqual(ranges, [[0, 1], [-3, 0], [0, 2]]);
 });
+
+test("boneSoup writes the triangles of boneVertices + triangleSoup, missing points included", () => {
+  const points = [[0, 0, 0], [0, 1, 0], [0.2, 1.8, 0.1], [NaN, NaN, NaN], [0, 1, 0]];
+  const rotations = [quarterAboutY, [0.1, 0.2, 0.3, 0.927], [0, 0, 0, 1], [0, 0, 0, 1], [0, 0, 0, 1]];
+  const bones = [[0, 1], [1, 2], [1, 3], [3, 4], [1, 4]]; // a missing tail, a missing head, a zero-length bone
+  const sides = geo.boneSides(points, rotations, bones);
+  const expected = geo.triangleSoup(geo.boneVertices(points, rotations, bones, sides, geo.identity), bones.length, new Float32Array(bones.length * 72));
+  const soup = geo.boneSoup(points, rotations, bones, sides, new Float32Array(bones.length * 72));
+  close([...soup], [...expected], 1e-6);
+  assert.ok(soup.every(Number.isFinite));
+});
+
+test("a NaN point (packed windows) is missing, as a null one (JSON) is", () => {
+  assert.equal(geo.present([NaN, NaN, NaN]), false);
+  assert.equal(geo.present([null, null, null]), false);
+  assert.equal(geo.present(new Float32Array([0, 1, 2])), true);
+});

@@ -180,7 +180,7 @@ def create_app(
 
     plotly_path = plotly_js_path()
     digest = hashlib.sha256(plotly_path.read_bytes()).hexdigest()[:12]
-    plotly_name = f"plotly-{plotly_path.stem.removesuffix('.min')}-{digest}.min.js"
+    plotly_name = f"{plotly_path.stem.removesuffix('.min')}-{digest}.min.js"
 
     compressed: list[bytes] = []
 
