@@ -22,9 +22,6 @@ const LOOP_MARGIN_S = 0.5; // "loop this finding": seconds shown before and afte
 
 export async function takeView(main, takeId, params, onTeardown) {
   const runParam = params.get("run");
-  // A link names its run: its report and first frames are asked for with the take, not after.
-  const early = runParam ? { result: api.getResult(runParam), first: firstFrames(runParam) } : null;
-  if (early) Object.values(early).forEach((p) => p.catch(() => {})); // a run not done: asked again below
   // three.js: only the take view loads it, its three modules together.
   preloadModules(["/static/js/geometry.js", "/static/vendor/three/three.module.min.js", "/static/vendor/three/three.core.min.js"]);
   const scene = import("./scene3d.js");
@@ -43,10 +40,9 @@ export async function takeView(main, takeId, params, onTeardown) {
     if (final.status === "failed") { main.append(h("p", { class: "error" }, final.error)); return; }
     window.dispatchEvent(new HashChangeEvent("hashchange")); return;
   }
-  const asked = early && run.id === runParam ? early : { result: api.getResult(run.id), first: firstFrames(run.id) };
   const [result, first] = await Promise.all([
-    asked.result.then((r) => { performance.mark("result-fetched"); return r; }),
-    asked.first.then((f) => { performance.mark("frames-fetched"); return f; })]);
+    api.getResult(run.id).then((r) => { performance.mark("result-fetched"); return r; }),
+    firstFrames(run.id).then((f) => { performance.mark("frames-fetched"); return f; })]);
   // The re-run form's lists wait for nothing on screen.
   const formLists = Promise.all([api.listFilters(), api.getRunOptions()]);
   let overview = first;
@@ -242,7 +238,8 @@ export async function takeView(main, takeId, params, onTeardown) {
     const target = e.target;
     const typing = target instanceof HTMLElement && (target.matches("input, textarea, select, [contenteditable]") || target.isContentEditable);
     if (typing || e.ctrlKey || e.metaKey || e.altKey) return;
-    if (e.key === " " && !target.matches("button, a, [tabindex]")) { e.preventDefault(); togglePlay(); }
+    // Space plays or pauses on its key-down (a focused play button would wait for the key-up).
+    if (e.key === " " && (target === playButton || !target.matches("button, a, [tabindex]"))) { e.preventDefault(); if (!e.repeat) togglePlay(); }
     else if (e.key === "ArrowRight" || e.key === "ArrowLeft") {
       e.preventDefault();
       if (player.playing) togglePlay();

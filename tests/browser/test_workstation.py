@@ -169,6 +169,13 @@ def test_playback_keeps_the_true_rate_and_pauses_at_once(
     page.page.click("#play")
     started = time.monotonic()
     time.sleep(3.0)
+    # In the page: from the key's arrival (the event's time stamp) to the end of the first frame
+    # drawn after it, the time the reviewer waits to see "paused".
+    page.page.evaluate(
+        """() => document.addEventListener('keydown', (e) => requestAnimationFrame(() =>
+          setTimeout(() => { window.pausedAfterMs = performance.now() - e.timeStamp; })),
+          { capture: true, once: true })"""
+    )
     clicked = time.monotonic()
     # Space on the focused play button: a real key press through the browser's input queue.
     page.page.keyboard.press("Space")
@@ -177,6 +184,8 @@ def test_playback_keeps_the_true_rate_and_pauses_at_once(
         timeout=ANSWER_S * 4000,
     )
     pause_s = time.monotonic() - clicked
+    page.page.wait_for_function("() => window.pausedAfterMs !== undefined")
+    paused_in_page_s = page.page.evaluate("() => window.pausedAfterMs") / 1000
     played_s = time.monotonic() - started
     stopped = page.frame()
     stats = page.page.evaluate(
@@ -187,6 +196,7 @@ def test_playback_keeps_the_true_rate_and_pauses_at_once(
     assert page.frame() == stopped  # paused means paused
     assert page.page.inner_text("#play").endswith("play")
     assert pause_s < ANSWER_S
+    assert paused_in_page_s < ANSWER_S
     advanced = stopped - before
     # Time runs at the take's rate (frames are dropped, never slowed): at least half of it.
     assert advanced >= 0.5 * fps * 3.0, (advanced, fps)
@@ -199,6 +209,7 @@ def test_playback_keeps_the_true_rate_and_pauses_at_once(
         "frames_drawn_per_s": round(stats["drawn"] / played_s, 1),
         "renders_per_s": round(stats["renders"] / played_s, 1),
         "pause_click_s": round(pause_s, 3),
+        "pause_key_to_painted_s": round(paused_in_page_s, 3),
     }
 
 
