@@ -142,6 +142,43 @@ export function boneSoup(points, rotations, bones, sides, out) {
   return out;
 }
 const SCRATCH = new Float64Array(18);
+
+/**
+ * Flat shading baked into vertex colours, so the bones need no lit material (a CPU rasteriser
+ * draws an unlit one faster, and compiles it sooner): every face of `count` bones of triangle
+ * soup (boneSoup) takes `colorOf(bone, face)` ([r, g, b], linear) × (ambient + direct ×
+ * max(0, n · light)) / π, as a Lambert material lit by an ambient and a directional light of
+ * those intensities would show it. n is the face's normal turned away from its bone's centre.
+ *
+ * @param light unit vector toward the directional light
+ * @returns out (Float32Array, 72 values per bone)
+ */
+export function shadeSoup(soup, count, colorOf, light, ambient, direct, out) {
+  for (let b = 0; b < count; b++) {
+    const base = 72 * b;
+    let cx = 0, cy = 0, cz = 0;
+    for (let k = 0; k < 24; k++) { cx += soup[base + 3 * k]; cy += soup[base + 3 * k + 1]; cz += soup[base + 3 * k + 2]; }
+    cx /= 24; cy /= 24; cz /= 24;
+    for (let f = 0; f < 8; f++) {
+      const o = base + 9 * f;
+      const ax = soup[o + 3] - soup[o], ay = soup[o + 4] - soup[o + 1], az = soup[o + 5] - soup[o + 2];
+      const bx = soup[o + 6] - soup[o], by = soup[o + 7] - soup[o + 1], bz = soup[o + 8] - soup[o + 2];
+      let nx = ay * bz - az * by, ny = az * bx - ax * bz, nz = ax * by - ay * bx;
+      const n = Math.hypot(nx, ny, nz);
+      let lit = 0;
+      if (n > 0) {
+        nx /= n; ny /= n; nz /= n;
+        const outward = nx * ((soup[o] + soup[o + 3] + soup[o + 6]) / 3 - cx) + ny * ((soup[o + 1] + soup[o + 4] + soup[o + 7]) / 3 - cy) + nz * ((soup[o + 2] + soup[o + 5] + soup[o + 8]) / 3 - cz);
+        const facing = (nx * light[0] + ny * light[1] + nz * light[2]) * (outward < 0 ? -1 : 1);
+        lit = Math.max(0, facing);
+      }
+      const k = (ambient + direct * lit) / Math.PI;
+      const c = colorOf(b, f);
+      for (let v = 0; v < 3; v++) { out[o + 3 * v] = c[0] * k; out[o + 3 * v + 1] = c[1] * k; out[o + 3 * v + 2] = c[2] * k; }
+    }
+  }
+  return out;
+}
 const ORIGIN = [0, 0, 0];
 
 /** Face index arrays (i, j, k) of `count` bones, 6 vertices and 8 faces each. */

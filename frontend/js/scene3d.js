@@ -11,18 +11,17 @@ const SELECTED = new THREE.Color("#f1c40f");
 const BRIDGED = new THREE.Color("#8e44ad"); // a keypoint the filter bridged (no valid input)
 const AXES = ["#d62728", "#2ca02c", "#1f77b4"].map((c) => new THREE.Color(c));
 
+const LIGHT_AMBIENT = 1.6, LIGHT_DIRECT = 1.6; // intensities of a white ambient and directional light
+const LIGHT = [1, 2, 3].map((v) => v / Math.hypot(1, 2, 3)); // toward the directional light
+
 function viewScene(bonesCount, nPoints, nJoints, oriented) {
   const scene = new THREE.Scene();
   scene.background = new THREE.Color("#ffffff");
-  scene.add(new THREE.AmbientLight(0xffffff, 1.6));
-  const light = new THREE.DirectionalLight(0xffffff, 1.6);
-  light.position.set(1, 2, 3);
-  scene.add(light);
   const soup = new THREE.BufferGeometry();
   soup.setAttribute("position", new THREE.BufferAttribute(new Float32Array(bonesCount * 24 * 3), 3));
   soup.setAttribute("color", new THREE.BufferAttribute(new Float32Array(bonesCount * 24 * 3), 3));
   const bones = oriented
-    ? new THREE.Mesh(soup, new THREE.MeshLambertMaterial({ vertexColors: true, flatShading: true, side: THREE.DoubleSide }))
+    ? new THREE.Mesh(soup, new THREE.MeshBasicMaterial({ vertexColors: true, side: THREE.DoubleSide })) // lit in shadeSoup
     : new THREE.LineSegments(lineGeometry(bonesCount * 2), new THREE.LineBasicMaterial({ color: BODY }));
   const jointsGeometry = new THREE.BufferGeometry();
   jointsGeometry.setAttribute("position", new THREE.BufferAttribute(new Float32Array(nPoints * 3), 3));
@@ -124,31 +123,24 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   const requestRender = () => { if (!scheduled) scheduled = requestAnimationFrame(render); };
   new ResizeObserver(requestRender).observe(divs.raw.parentNode.parentNode);
 
-  // Per frame, vertex buffers are rewritten in place: nothing is allocated, and the bones'
-  // colours are rewritten only when the highlighted joints change. Flat shading takes each
-  // face's normal from the screen-space derivatives, so no normals are computed.
+  // Per frame, vertex buffers are rewritten in place and nothing is allocated. The bones' light
+  // (the scene's ambient and directional light, as a Lambert material would show it) is baked
+  // into their vertex colours by shadeSoup: an unlit material draws and compiles faster on a
+  // CPU rasteriser.
   const colorCache = new Map();
   const colorFrom = (css) => { let c = colorCache.get(css); if (!c) { c = new THREE.Color(css); colorCache.set(css, c); } return c; };
+  const rgb = (c) => [c.r, c.g, c.b];
+  const [markedRgb, bodyRgb, selectedRgb] = [MARKED, BODY, SELECTED].map(rgb);
   const write = (view, points, rotations, flagged, selected, confidence = null, bridged = null) => {
     const colorOf = (j) => (j === selected ? SELECTED : flagged.has(j) ? colorFrom(flagged.get(j)) : null);
     if (oriented) {
       const position = view.bones.geometry.attributes.position;
       geo.boneSoup(points, rotations, bones, sides, position.array);
       position.needsUpdate = true;
-      const key = `${selected}|${[...flagged].join()}`;
-      if (view.colored !== key) {
-        view.colored = key;
-        const color = view.bones.geometry.attributes.color;
-        let o = 0;
-        for (const [p] of bones) {
-          const own = colorOf(p) || BODY;
-          for (let f = 0; f < 8; f++) {
-            const c = geo.MARKED_FACES.has(f) ? MARKED : own;
-            for (let v = 0; v < 3; v++) { color.array[o++] = c.r; color.array[o++] = c.g; color.array[o++] = c.b; }
-          }
-        }
-        color.needsUpdate = true;
-      }
+      const own = bones.map(([p]) => (p === selected ? selectedRgb : flagged.has(p) ? rgb(colorFrom(flagged.get(p))) : bodyRgb));
+      const color = view.bones.geometry.attributes.color;
+      geo.shadeSoup(position.array, bones.length, (b, f) => (geo.MARKED_FACES.has(f) ? markedRgb : own[b]), LIGHT, LIGHT_AMBIENT, LIGHT_DIRECT, color.array);
+      color.needsUpdate = true;
     } else {
       writeLines(view.bones.geometry.attributes.position, points, bones);
     }

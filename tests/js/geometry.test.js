@@ -94,3 +94,24 @@ test("a NaN point (packed windows) is missing, as a null one (JSON) is", () => {
   assert.equal(geo.present([null, null, null]), false);
   assert.equal(geo.present(new Float32Array([0, 1, 2])), true);
 });
+
+test("shadeSoup lights each face by its outward normal, whatever the winding", () => {
+  const points = [[0, 0, 0], [0, 1, 0]];
+  const rotations = [[0, 0, 0, 1], [0, 0, 0, 1]];
+  const bones = [[0, 1]];
+  const soup = geo.boneSoup(points, rotations, bones, geo.boneSides(points, rotations, bones), new Float32Array(72));
+  const white = () => [1, 1, 1];
+  const light = [1, 0, 0];
+  const shaded = geo.shadeSoup(soup, 1, white, light, 1, 2, new Float32Array(72));
+  const values = [...shaded];
+  assert.ok(values.every((v) => v >= 1 / Math.PI - 1e-6 && v <= 3 / Math.PI + 1e-6));
+  assert.ok(values.some((v) => v > 1.5 / Math.PI)); // faces toward +x are lit
+  assert.ok(values.some((v) => Math.abs(v - 1 / Math.PI) < 1e-6)); // faces away: ambient only
+  // The same triangles wound the other way round are lit the same.
+  const flipped = soup.slice();
+  for (let t = 0; t < 8; t++) for (let a = 0; a < 3; a++) [flipped[9 * t + 3 + a], flipped[9 * t + 6 + a]] = [soup[9 * t + 6 + a], soup[9 * t + 3 + a]];
+  close([...geo.shadeSoup(flipped, 1, white, light, 1, 2, new Float32Array(72))], values, 1e-6);
+  // The colour of a face scales its light.
+  const red = geo.shadeSoup(soup, 1, () => [1, 0, 0], light, 1, 2, new Float32Array(72));
+  close([red[0], red[1], red[2]], [values[0], 0, 0], 1e-6);
+});
