@@ -3,7 +3,7 @@
 // findings the filters keep, across groups; the one reached is marked and its group opened.
 import { activatable, h } from "./dom.js";
 import { findingStops, fmt, sortFindings } from "./format.js";
-import { filterFindings, groupByJoint, jointsOf, kindsOf, listOrder } from "./findings.js";
+import { filterFindings, filterParams, groupByJoint, jointsOf, kindsOf, listOrder } from "./findings.js";
 
 const COLUMNS = [["kind", "kind"], ["joint", "joint"], ["start_frame", "frames"], ["duration", "frames long"], ["value", "offset / outside"], ["confidence", "confidence"]];
 const UNITS = { deg: "°" };
@@ -13,32 +13,36 @@ const unitOf = (f) => UNITS[f.unit] ?? f.unit ?? "";
  * @param findings  the run's findings
  * @param decided   the interval decisions (cells of twist rows, footer)
  * @param onOpen    called with a finding opened by a click or Enter
+ * @param initial   the filter to start with ({kinds, joint, minValue, text}, as filterFromParams)
+ * @param onFilter  called with the filter's link parameters (filterParams) when it changes
  */
-export function findingsList(findings, decided, onOpen) {
+export function findingsList(findings, decided, onOpen, initial = null, onFilter = () => {}) {
   let key = "start_frame", dir = 1, grouped = true, current = null;
   const collapsed = new Set();
-  const filter = { kinds: new Set(), joint: "", minValue: null, text: "" };
+  const filter = { kinds: new Set(), joint: "", minValue: null, text: "", ...initial };
+  const allKinds = kindsOf(findings);
   let shown = findings;
   const table = h("table", { id: "findings" });
   const title = h("h2", {}, "");
   const units = [...new Set(findings.map(unitOf))].filter(Boolean).join(" / ");
 
-  const kindBoxes = kindsOf(findings).map((k) => {
-    const box = h("input", { type: "checkbox", id: `filter-kind-${k}`, value: k, checked: true });
+  const refilter = () => { render(); onFilter(filterParams(filter, allKinds)); };
+  const kindBoxes = allKinds.map((k) => {
+    const box = h("input", { type: "checkbox", id: `filter-kind-${k}`, value: k, checked: !filter.kinds.size || filter.kinds.has(k) });
     box.addEventListener("change", () => {
       filter.kinds = new Set(kindBoxes.filter((b) => b.checked).map((b) => b.value));
       if (!filter.kinds.size) filter.kinds = new Set(["none"]); // nothing ticked shows nothing
-      render();
+      refilter();
     });
     return box;
   });
   const joint = h("select", { id: "filter-joint", "aria-label": "joint filter" }, h("option", { value: "" }, "all joints"),
-    jointsOf(findings).map((j) => h("option", { value: j }, j)));
-  joint.addEventListener("change", () => { filter.joint = joint.value; render(); });
-  const least = h("input", { type: "number", id: "filter-min", min: 0, step: "any", size: 5, "aria-label": `smallest offset or distance outside (${units})` });
-  least.addEventListener("input", () => { filter.minValue = least.value === "" ? null : Number(least.value); render(); });
-  const text = h("input", { type: "search", id: "filter-text", placeholder: "search joint, kind, frames…", "aria-label": "search findings" });
-  text.addEventListener("input", () => { filter.text = text.value; render(); });
+    jointsOf(findings).map((j) => h("option", { value: j, selected: j === filter.joint }, j)));
+  joint.addEventListener("change", () => { filter.joint = joint.value; refilter(); });
+  const least = h("input", { type: "number", id: "filter-min", min: 0, step: "any", size: 5, value: filter.minValue ?? "", "aria-label": `smallest offset or distance outside (${units})` });
+  least.addEventListener("input", () => { filter.minValue = least.value === "" ? null : Number(least.value); refilter(); });
+  const text = h("input", { type: "search", id: "filter-text", value: filter.text, placeholder: "search joint, kind, frames…", "aria-label": "search findings" });
+  text.addEventListener("input", () => { filter.text = text.value; refilter(); });
   const groupBox = h("input", { type: "checkbox", id: "group-joints", checked: true });
   groupBox.addEventListener("change", () => { grouped = groupBox.checked; render(); });
 

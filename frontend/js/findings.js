@@ -64,3 +64,33 @@ export const kindsOf = (findings) => [...new Set(findings.map((f) => f.kind))];
 
 /** Joint names with findings, sorted by name. */
 export const jointsOf = (findings) => [...new Set(findings.map((f) => f.joint))].sort();
+
+/**
+ * A filter as link parameters, only those that narrow the list: `kinds` (comma-separated, when
+ * not every kind of `allKinds` is kept), `only` (one joint), `atleast` (smallest |value|), `q`
+ * (words).
+ */
+export function filterParams(filter, allKinds) {
+  const out = {};
+  if (filter.kinds && filter.kinds.size && !allKinds.every((k) => filter.kinds.has(k))) out.kinds = [...filter.kinds].join(",");
+  if (filter.joint) out.only = filter.joint;
+  if (filter.minValue != null && Number.isFinite(Number(filter.minValue))) out.atleast = String(filter.minValue);
+  if (filter.text) out.q = filter.text;
+  return out;
+}
+
+/**
+ * The filter a link's parameters (URLSearchParams) describe (filterParams' inverse): unknown
+ * kinds and joints and a minimum that is not a number are left out.
+ */
+export function filterFromParams(params, allKinds, allJoints) {
+  const kinds = (params.get("kinds") || "").split(",").filter((k) => allKinds.includes(k) || k === "none");
+  const joint = params.get("only") || "";
+  const least = params.get("atleast");
+  return {
+    kinds: new Set(kinds),
+    joint: allJoints.includes(joint) ? joint : "",
+    minValue: least != null && least !== "" && Number.isFinite(Number(least)) ? Number(least) : null,
+    text: params.get("q") || "",
+  };
+}

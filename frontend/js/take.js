@@ -3,7 +3,7 @@ import * as api from "./api.js";
 import * as charts from "./charts.js";
 import { badge, h, preloadModules } from "./dom.js";
 import { fmt, nextStop, seconds, stepsRan } from "./format.js";
-import { findingAt, loopOfFinding } from "./findings.js";
+import { filterFromParams, filterParams, findingAt, jointsOf, kindsOf, loopOfFinding } from "./findings.js";
 import { findingsList } from "./findings-list.js";
 import { createTimebar, parseRange, withIn, withOut } from "./timebar.js";
 import { createPlayer } from "./player.js";
@@ -96,7 +96,11 @@ export async function takeView(main, takeId, params, onTeardown) {
   const timelines = h("div", {});
   const review = reviewPanel(take);
   const decided = intervalDecisions(run, result);
-  const list = findingsList(result.findings, decided, (f) => { decided.opened(f); store.set({ joint: f.joint }); focusCharts(); jump(f.start_frame); viewsRow.scrollIntoView({ block: "start" }); });
+  // The findings filter travels in the link too (kinds, only, atleast, q).
+  const linkedFilter = filterFromParams(params, kindsOf(result.findings), jointsOf(result.findings));
+  let filterQuery = filterParams(linkedFilter, kindsOf(result.findings));
+  const list = findingsList(result.findings, decided, (f) => { decided.opened(f); store.set({ joint: f.joint }); focusCharts(); jump(f.start_frame); viewsRow.scrollIntoView({ block: "start" }); },
+    linkedFilter, (query) => { filterQuery = query; remember(); });
   const timebar = createTimebar({
     nFrames, marks: result.findings.map((f) => ({ start: f.start_frame, end: f.end_frame, color: findingColor(f), label: `${f.kind} · ${f.joint} · ${f.start_frame}–${f.end_frame}` })),
     onJump: (f) => { if (player.playing) togglePlay(); jump(f); }, onRange: (r) => setRange(r),
@@ -160,6 +164,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     const query = new URLSearchParams({ run: run.id, frame: store.state.frame });
     if (store.state.joint) query.set("joint", store.state.joint);
     if (store.state.loop) query.set("loop", store.state.loop.join("-"));
+    for (const [name, value] of Object.entries(filterQuery)) query.set(name, value);
     history.replaceState(null, "", `#/take/${take.id}?${query}`);
   };
   const loadDetail = async () => {

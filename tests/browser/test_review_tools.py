@@ -139,6 +139,20 @@ def test_findings_grouped_by_joint_filtered_and_walked(
     )
     assert cursor == pytest.approx((start + 0.5) / knees["result"]["summary"]["n_frames"], abs=0.01)
 
+    # The filters travel in the link: whoever opens it sees the same list.
+    p.fill("#filter-min", "20")
+    link = p.evaluate("() => location.hash")
+    assert "kinds=twist" in link
+    assert "atleast=20" in link
+    kept = [(r["start"], r["joint"]) for r in rows(page)]
+    assert kept
+    p.goto("about:blank")
+    p.goto(f"{live_server}/{link}")
+    p.wait_for_selector("main[data-ready='1']", timeout=60_000)
+    assert not p.is_checked("#filter-kind-limits")
+    assert p.input_value("#filter-min") == "20"
+    assert [(r["start"], r["joint"]) for r in rows(page)] == kept
+
 
 def loop_range(page: Page) -> list[int] | None:
     value: list[int] | None = page.page.evaluate("() => window.mocapqaPlayer.loop")

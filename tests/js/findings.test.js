@@ -138,3 +138,17 @@ test("a link's loop range is read back only when it fits the take", async () => 
   assert.equal(parseRange("x-1", 458), null);
   assert.equal(parseRange(null, 458), null);
 });
+
+test("a findings filter goes into link parameters and comes back the same", () => {
+  const kinds = ["twist", "limits"], joints = ["L_Calf", "R_Calf"];
+  const filter = { kinds: new Set(["twist"]), joint: "R_Calf", minValue: 20, text: "calf 12" };
+  const query = findings.filterParams(filter, kinds);
+  assert.deepEqual(query, { kinds: "twist", only: "R_Calf", atleast: "20", q: "calf 12" });
+  const back = findings.filterFromParams(new URLSearchParams(query), kinds, joints);
+  assert.deepEqual(back, filter);
+  // Every kind kept, no joint, no minimum, no words: nothing in the link.
+  assert.deepEqual(findings.filterParams({ kinds: new Set(kinds), joint: "", minValue: null, text: "" }, kinds), {});
+  // Unknown kinds and joints and a minimum that is not a number are left out.
+  const odd = findings.filterFromParams(new URLSearchParams("kinds=twist,bogus&only=Nobody&atleast=abc"), kinds, joints);
+  assert.deepEqual(odd, { kinds: new Set(["twist"]), joint: "", minValue: null, text: "" });
+});
