@@ -178,7 +178,9 @@ export async function takeView(main, takeId, params, onTeardown) {
     store.set({ frame: Math.max(0, Math.min(nFrames - 1, Math.round(f))) });
     render(); remember(); loadDetail();
   };
-  const player = createPlayer({ fps, nFrames, getFrame: () => store.state.frame, onFrame: (f) => { store.state.frame = f; render(); } });
+  // Playback draws in the animation frame that picked the frame (not one later): nothing is left
+  // pending for the frame after a pause, which then shows "paused" at once.
+  const player = createPlayer({ fps, nFrames, getFrame: () => store.state.frame, onFrame: (f) => { store.state.frame = f; render(); views.renderNow(); } });
   const togglePlay = () => {
     if (player.playing) { player.pause(); remember(); loadDetail(); } else { detail = null; player.play(); }
     playButton.textContent = player.playing ? "❚❚ pause" : "▶ play";
