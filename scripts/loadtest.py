@@ -154,7 +154,9 @@ def big_take(base: str, corpus: Path, folder: Path, paint: bool = False) -> None
             f"/api/v1/takes/{created['id']}",
             f"/api/v1/runs/{created['run_id']}/result",
             "/api/v1/filters",
-            f"/api/v1/runs/{created['run_id']}/frames?start=0&step=1&max_frames=800",
+            "/api/v1/run-options",
+            f"/api/v1/runs/{created['run_id']}/frames.f32?start=0&step=1&max_frames=100",
+            f"/api/v1/runs/{created['run_id']}/frames.f32?start=0&step=1&max_frames=800",
         ]
         sent = 0
         for url in urls:
