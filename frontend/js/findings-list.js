@@ -56,7 +56,7 @@ export function findingsList(findings, decided, onOpen, initial = null, onFilter
   const span = COLUMNS.length + (decided.enabled ? 1 : 0);
 
   const row = (f) => activatable(h("tr", {
-    class: `clickable finding${f === current ? " current" : ""}`, "data-start": f.start_frame, "data-joint": f.joint,
+    class: `clickable finding${f === current ? " current" : ""}`, "data-start": f.start_frame, "data-joint": f.joint, "data-kind": f.kind,
     "data-interval": f.kind === "twist" ? f.id : null, "aria-current": f === current ? "true" : null,
   },
   h("td", {}, f.kind), h("td", {}, f.joint), h("td", {}, `${f.start_frame}–${f.end_frame}`), h("td", {}, f.end_frame - f.start_frame + 1),
@@ -91,7 +91,8 @@ export function findingsList(findings, decided, onOpen, initial = null, onFilter
     current = f;
     if (f && collapsed.delete(f.joint)) render();
     for (const tr of table.querySelectorAll("tr.finding")) {
-      const on = tr.dataset.start === String(f?.start_frame) && tr.dataset.joint === f?.joint;
+      // A twist and a limits finding may share joint and start: the kind tells them apart.
+      const on = tr.dataset.start === String(f?.start_frame) && tr.dataset.joint === f?.joint && tr.dataset.kind === f?.kind;
       tr.classList.toggle("current", on);
       if (on) tr.setAttribute("aria-current", "true"); else tr.removeAttribute("aria-current");
     }

@@ -239,6 +239,7 @@ def test_loop_a_range_and_loop_the_finding(
     twist = next(f for f in knees["result"]["findings"] if f["kind"] == "twist")
     p.locator(
         f"#findings tr.finding[data-start='{twist['start_frame']}'][data-joint='{twist['joint']}']"
+        "[data-kind='twist']"
     ).click()
     p.evaluate("() => document.activeElement.blur()")
     p.keyboard.press("Shift+L")
@@ -274,6 +275,7 @@ def test_close_in_on_a_joint_and_follow_the_root(
     page.open_take(live_server, knees)
     p.locator(
         f"#findings tr.finding[data-start='{knee['start_frame']}'][data-joint='{knee['joint']}']"
+        f"[data-kind='{knee['kind']}']"
     ).click()
     page.settle()
     before = p.evaluate("() => window.mocapqaViews.orbit")
