@@ -14,7 +14,7 @@ from mocapqa.api.errors import responses
 from mocapqa.api.frame_windows import read_window, window_json, window_packed
 from mocapqa.api.schemas import AnalysisOptionsIn, RunOut
 from mocapqa.api.views import run_out
-from mocapqa.errors import InputError, NotFoundError
+from mocapqa.errors import NotFoundError
 from mocapqa.jobs.intake import joints_of
 from mocapqa.jobs.rendered import html_report
 from mocapqa.pipeline.options import AnalysisOptions
