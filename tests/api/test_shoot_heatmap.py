@@ -97,3 +97,74 @@ def test_heatmap_pages_through_more_than_200_takes(
         answer = client.get(f"{API}/shoots/{sid}/heatmap", params=bad)
         assert answer.status_code == 422, bad
     assert client.get(f"{API}/shoots/nope/heatmap").status_code == 404
+
+
+def _table_ids(client: TestClient, sid: str, params: dict[str, Any]) -> tuple[list[str], int]:
+    found: list[str] = []
+    total = 0
+    for offset in (0, 500):
+        page = client.get(
+            f"{API}/shoots/{sid}/takes", params={**params, "limit": 500, "offset": offset}
+        )
+        assert page.status_code == 200, page.text
+        found += [row["take_id"] for row in page.json()["items"]]
+        total = page.json()["total"]
+    return found, total
+
+
+def test_heatmap_follows_the_tables_filters_and_sort(
+    client: TestClient, settings: Settings, corpus_dir: Path
+) -> None:
+    sid = client.post(f"{API}/shoots", json={"name": "filtered"}).json()["id"]
+    _fill(settings, sid, corpus_dir)
+    everything, _ = _table_ids(client, sid, {"sort": "name"})
+    rows = client.get(f"{API}/shoots/{sid}/takes", params={"limit": 500}).json()["items"]
+    rigs = sorted({row["rig"] for row in rows if row["rig"]})
+    scores = sorted({row["score"] for row in rows if row["score"] is not None})
+    assert rigs and len(scores) >= 2, (rigs, scores)
+    cases: list[dict[str, Any]] = [
+        {"sort": "name", "order": "desc"},
+        {"sort": "n_frames", "search": "_1"},
+        {"sort": "score", "order": "desc", "has_findings": "true"},
+        {"sort": "name", "has_findings": "false"},
+        {"sort": "violation_share", "rig": rigs[0]},
+        {"sort": "score", "min_score": scores[1], "max_score": 100},
+        {"sort": "duration_s", "order": "desc", "max_score": scores[0], "status": "done"},
+        {"sort": "name", "status": "failed"},
+    ]
+    for params in cases:
+        ids, total = _table_ids(client, sid, params)
+        if params.get("status") != "failed":
+            assert 0 < total < N_TAKES or params == cases[0], (params, total)
+        for limit, offset in ((1000, 0), (7, 3)):
+            heat = client.get(
+                f"{API}/shoots/{sid}/heatmap", params={**params, "limit": limit, "offset": offset}
+            )
+            assert heat.status_code == 200, heat.text
+            body = heat.json()
+            assert body["total"] == total, params
+            assert [t["take_id"] for t in body["takes"]] == ids[offset : offset + limit], params
+            # Only the page's takes decide its joints.
+            shown = {str(t["take_id"]) for t in body["takes"]}
+            by_id = {row["take_id"]: row for row in rows}
+            violated = {
+                joint
+                for take_id in shown
+                for joint, share in (by_id[take_id]["joint_violations"] or {}).items()
+                if share > 0
+            }
+            assert set(body["joints"]) <= {
+                j for take_id in shown for j in (by_id[take_id]["joint_violations"] or {})
+            }
+            assert violated <= set(body["joints"]), params
+    assert len(everything) == N_TAKES
+    for bad in (
+        {"min_score": 101},
+        {"max_score": -1},
+        {"status": "sideways"},
+        {"review_status": "maybe"},
+        {"has_findings": "perhaps"},
+        {"search": "x" * 256},
+    ):
+        answer = client.get(f"{API}/shoots/{sid}/heatmap", params=bad)
+        assert answer.status_code == 422, bad

@@ -121,7 +121,7 @@ class HeatmapOut(BaseModel):
         description="joints × takes shares of frames outside the limits, in [0, 1]; null where "
         "the limits check did not run"
     )
-    total: int = Field(description="Takes in the shoot")
+    total: int = Field(description="Takes in the shoot that pass the filters")
     limit: int = Field(description="Takes per page asked for")
     offset: int = Field(description="Takes before this page")
 

@@ -325,9 +325,10 @@ class ShootStore:
         offset: int = 0,
         sort: str = "score",
         descending: bool = False,
+        filters: TakeFilter | None = None,
     ) -> dict[str, Any]:
         """Joint × take share of frames outside the limits, for a page of the shoot's takes
-        (in the order of :meth:`page`).
+        (in the order and with the filters of :meth:`page`).
 
         Returns
         -------
@@ -335,9 +336,9 @@ class ShootStore:
             ``joints`` (those with any violation on the page, most violated first), ``takes``
             (``{"take_id", "name", "score"}`` in table order) and ``values`` (``joints × takes``
             shares in [0, 1]; 0 where none, None where the limits check did not run) and
-            ``total`` (takes in the shoot).
+            ``total`` (takes in the shoot that pass ``filters``).
         """
-        page, total = self.page(shoot_id, limit, offset, sort=sort, descending=descending)
+        page, total = self.page(shoot_id, limit, offset, sort, descending, filters)
         totals: dict[str, float] = {}
         for row in page:
             for joint, share in (row["joint_violations"] or {}).items():

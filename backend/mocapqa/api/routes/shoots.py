@@ -32,7 +32,7 @@ from mocapqa.store.repository import ReviewStatus, RunStatus
 from mocapqa.store.roles import Action
 from mocapqa.store.shoots import SORT_COLUMNS, ShootStore, TakeFilter
 
-__all__ = ["EXPORT_COLUMNS", "HEATMAP_MAX_TAKES", "MAX_OFFSET", "router"]
+__all__ = ["EXPORT_COLUMNS", "HEATMAP_MAX_TAKES", "MAX_OFFSET", "router", "take_filter"]
 
 # A shoot's maker (its owner) renames and deletes it, as a take's uploader deletes the take;
 # admins may do both to any shoot, and are the only ones for shoots without an owner.
@@ -164,14 +164,7 @@ def import_takes(
     return ImportOut(created=report.created, skipped=report.skipped, failed=report.failed)
 
 
-@router.get("/{shoot_id}/takes", responses=responses(401, 404))
-def list_shoot_takes(
-    shoot_id: str,
-    services: ServicesDep,
-    limit: Annotated[int, Query(ge=1, le=500)] = 50,
-    offset: Annotated[int, Query(ge=0, le=MAX_OFFSET)] = 0,
-    sort: ShootSort = "score",
-    order: Literal["asc", "desc"] = "asc",
+def take_filter(
     status: RunStatus | None = None,
     review_status: ReviewStatus | None = None,
     rig: str | None = None,
@@ -179,9 +172,25 @@ def list_shoot_takes(
     max_score: Annotated[float | None, Query(ge=0, le=100)] = None,
     has_findings: bool | None = None,
     search: Annotated[str | None, Query(max_length=255)] = None,
+) -> TakeFilter:
+    """The take table's filters from the query (the take table and the heat map share them)."""
+    return TakeFilter(status, review_status, rig, min_score, max_score, has_findings, search)
+
+
+Filters = Annotated[TakeFilter, Depends(take_filter)]
+
+
+@router.get("/{shoot_id}/takes", responses=responses(401, 404))
+def list_shoot_takes(
+    shoot_id: str,
+    services: ServicesDep,
+    filters: Filters,
+    limit: Annotated[int, Query(ge=1, le=500)] = 50,
+    offset: Annotated[int, Query(ge=0, le=MAX_OFFSET)] = 0,
+    sort: ShootSort = "score",
+    order: Literal["asc", "desc"] = "asc",
 ) -> ShootTakePageOut:
     """A page of the shoot's take table, sorted and filtered on the server."""
-    filters = TakeFilter(status, review_status, rig, min_score, max_score, has_findings, search)
     rows, total = _store(services).page(shoot_id, limit, offset, sort, order == "desc", filters)
     return ShootTakePageOut(
         items=[ShootTakeOut(**r) for r in rows], total=total, limit=limit, offset=offset
@@ -198,15 +207,17 @@ def shoot_progress(shoot_id: str, services: ServicesDep) -> ProgressOut:
 def shoot_heatmap(
     shoot_id: str,
     services: ServicesDep,
+    filters: Filters,
     limit: Annotated[int, Query(ge=1, le=HEATMAP_MAX_TAKES, description="Takes per page")] = 200,
     offset: Annotated[int, Query(ge=0, le=MAX_OFFSET, description="Takes before the page")] = 0,
     sort: ShootSort = "score",
     order: Literal["asc", "desc"] = "asc",
 ) -> HeatmapOut:
     """Joint × take share of frames outside the joint limits, for a page of takes in the
-    table's order (``sort``, ``order``); ``total`` takes in all, so a client pages through a
-    shoot of any size ``limit`` takes at a time."""
-    heat = _store(services).heatmap(shoot_id, limit, offset, sort, order == "desc")
+    take table's order (``sort``, ``order``) and filters (the same parameters as the table);
+    ``total`` takes match the filters, so a client pages through a shoot of any size
+    ``limit`` takes at a time."""
+    heat = _store(services).heatmap(shoot_id, limit, offset, sort, order == "desc", filters)
     return HeatmapOut(**heat, limit=limit, offset=offset)
 
 
