@@ -8,6 +8,9 @@ export const TABLE_DEFAULTS = {
   status: "", review_status: "", rig: "", min_score: "", max_score: "", has_findings: "", search: "",
 };
 
+/** The take table's filters (the keys of TABLE_DEFAULTS that narrow the takes). */
+export const TABLE_FILTERS = ["status", "review_status", "rig", "min_score", "max_score", "has_findings", "search"];
+
 /** The table's state from the view's URL parameters (unknown keys ignored, numbers parsed). */
 export function tableState(params) {
   const out = { ...TABLE_DEFAULTS };
@@ -166,10 +169,22 @@ export function heatmapPage(offset, limit, total = null) {
   return { offset: start, limit: size };
 }
 
-/** The query string of GET /shoots/{id}/heatmap for a page, in the take table's sort. */
-export function heatmapQuery(page, sort = "score", order = "asc") {
+/** The query string of GET /shoots/{id}/heatmap for a page: the take table's sort, order and
+ * filters (`state`, as tableState gives it), the heat map's own page. */
+export function heatmapQuery(page, state = TABLE_DEFAULTS) {
   const safe = heatmapPage(page.offset, page.limit);
-  return new URLSearchParams({ limit: String(safe.limit), offset: String(safe.offset), sort, order }).toString();
+  return takesQuery({ ...TABLE_DEFAULTS, ...state, limit: safe.limit, offset: safe.offset });
+}
+
+/** Whether the table's state filters the takes (so an empty heat map says why). */
+export function isFiltered(state) {
+  return TABLE_FILTERS.some((key) => state[key] !== "" && state[key] != null);
+}
+
+/** Whether going from one table state to the next changes which takes the heat map shows
+ * (filters, sort or order; not the table's own page). */
+export function heatmapChanged(before, after) {
+  return ["sort", "order", ...TABLE_FILTERS].some((key) => String(before[key] ?? "") !== String(after[key] ?? ""));
 }
 
 /** What the pager shows: "takes 201–230 of 230" and the offsets of the pages before and

@@ -8,8 +8,8 @@ import { loadPlotly, untabbableModebar } from "./plotly.js";
 import { fmt } from "./format.js";
 import { limitsModelPanel } from "./shoot-limits.js";
 import {
-  decisionForKey, deleteConfirmed, formatCell, HEATMAP_SIZES, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
-  importLines, nextSort, pageInfo, progressSummary, scoreColor, shootControls, TAKE_COLUMNS, tableState, takesQuery, viewQuery,
+  decisionForKey, deleteConfirmed, formatCell, HEATMAP_SIZES, heatmapChanged, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
+  importLines, isFiltered, nextSort, pageInfo, progressSummary, scoreColor, shootControls, TAKE_COLUMNS, tableState, takesQuery, viewQuery,
 } from "./shoot-format.js";
 
 const POLL_MS = 1000;
@@ -226,27 +226,38 @@ export async function shootView(main, shootId, params, onTeardown) {
   };
   function apply(patch) {
     const resetsPage = !("offset" in patch);
+    const before = state;
     state = { ...state, ...patch, ...(resetsPage ? { offset: 0 } : {}) };
     history.replaceState(null, "", api.shootLink(shootId, viewQuery(state)));
     drawTable().catch(showError);
+    if (heatmapChanged(before, state)) { // the heat map shows the table's takes, from its first page
+      heat = heatmapPage(0, heat.limit);
+      drawHeatmap().catch(showHeatmapError);
+    }
   }
   const showError = (e) => tableArea.prepend(h("p", { class: "error" }, e.message));
 
-  // The heat map pages through the shoot (lowest score first) `heat.limit` takes at a time;
-  // the chart scrolls inside its box, and the pager keeps its place across redraws.
+  // The heat map shows the take table's takes (its filters, sort and order) `heat.limit` at a
+  // time; the chart scrolls inside its box, and the pager keeps its place across polls. A
+  // redraw started later wins over one still waiting for its answer (typing in the search).
   let heat = heatmapPage(0, 200);
+  let heatDrawn = 0;
   const drawHeatmap = async () => {
-    const [Plotly, first] = await Promise.all([loadPlotly(), api.shootHeatmap(shootId, heatmapQuery(heat))]);
+    const ticket = ++heatDrawn;
+    const shown = state;
+    const [Plotly, first] = await Promise.all([loadPlotly(), api.shootHeatmap(shootId, heatmapQuery(heat, shown))]);
     let data = first;
     const safe = heatmapPage(heat.offset, heat.limit, data.total);
     if (safe.offset !== heat.offset) { // the shoot shrank under the page: show its last page
       heat = safe;
-      data = await api.shootHeatmap(shootId, heatmapQuery(heat));
+      data = await api.shootHeatmap(shootId, heatmapQuery(heat, shown));
     }
-    if (!alive) return;
-    const title = h("h2", {}, "Share of frames outside the joint limits (joint × take)");
+    if (!alive || ticket !== heatDrawn) return;
+    heatmap.dataset.query = heatmapQuery(heat, shown);
+    const title = h("h2", {}, "Share of frames outside the joint limits (joint × take, in the table's order and filters)");
     if (!data.total) {
-      heatmap.replaceChildren(h("h2", {}, "Joint limits"), h("p", { class: "muted", id: "heatmap-empty" }, "No joint-limit results yet."));
+      const why = isFiltered(shown) ? "No take matches the table's filters." : "No joint-limit results yet.";
+      heatmap.replaceChildren(h("h2", {}, "Joint limits"), h("p", { class: "muted", id: "heatmap-empty" }, why));
       return;
     }
     const pager = heatmapPager(heat, data.total);

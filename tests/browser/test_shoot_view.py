@@ -223,6 +223,51 @@ def test_import_progress_sort_review_export(
     assert all(v == 0 for v in by_name["cmu_12_01_walk.bvh"])
     p.screenshot(path=str(ARTIFACTS / "shoot-heatmap.png"), full_page=True)
 
+    # The heat map follows the table: its sort and order, then its filters, from the first page.
+    p.click("#shoot-takes th[data-sort='score']")  # ascending already: now descending
+    p.wait_for_selector("#shoot-takes th[data-sort='score'][aria-sort='descending']")
+    p.wait_for_function(
+        "() => { const d = document.getElementById('heatmap-chart')?.data?.[0];"
+        " return !!d && d.y.length === 4"
+        " && d.y[3].endsWith('cmu_12_01_walk_twist_errors.bvh'); }",
+        timeout=60_000,
+    )
+    assert "order=desc" in (p.get_attribute("#shoot-heatmap", "data-query") or "")
+    down = p.evaluate("() => document.getElementById('heatmap-chart').data[0].y")
+    table_names = p.locator("#shoot-takes tbody td.name").all_inner_texts()
+    assert [label.split(". ", 1)[1] for label in down] == table_names
+    assert table_names[-1] == "cmu_12_01_walk_twist_errors.bvh"
+    p.fill("#shoot-search", "walk")
+    p.wait_for_function(
+        "() => document.getElementById('heatmap-page')?.innerText === 'takes 1–2 of 2'"
+        " && document.getElementById('heatmap-chart')?.data?.[0]?.y?.length === 2",
+        timeout=60_000,
+    )
+    walks = p.evaluate("() => document.getElementById('heatmap-chart').data[0].y")
+    assert [label.split(". ", 1)[1] for label in walks] == [
+        "cmu_12_01_walk.bvh",
+        "cmu_12_01_walk_twist_errors.bvh",
+    ]
+    query = p.get_attribute("#shoot-heatmap", "data-query") or ""
+    assert "search=walk" in query
+    assert "order=desc" in query
+    p.select_option("#shoot-has_findings", "true")
+    p.wait_for_function(
+        "() => document.getElementById('heatmap-page')?.innerText === 'takes 1–1 of 1'",
+        timeout=60_000,
+    )
+    p.fill("#shoot-search", "no such take")
+    p.wait_for_selector("#heatmap-empty", timeout=60_000)
+    assert p.inner_text("#heatmap-empty") == "No take matches the table's filters."
+    # The filters live in the view's URL: a fresh load draws the heat map with them.
+    page.open(f"{live_server}/#/shoot/{shoot_id}?search=walk&sort=name")
+    p.wait_for_function(
+        "() => document.getElementById('heatmap-chart')?.data?.[0]?.y?.length === 2",
+        timeout=60_000,
+    )
+    assert p.inner_text("#heatmap-page") == "takes 1–2 of 2"
+    p.screenshot(path=str(ARTIFACTS / "shoot-heatmap-filtered.png"), full_page=True)
+
     # The shoots list counts the takes per run status.
     page.open(f"{live_server}/#/shoots")
     row = p.locator(f"#shoot-list tr[data-shoot='{shoot_id}'] td").all_inner_texts()

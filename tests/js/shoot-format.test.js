@@ -1,8 +1,8 @@
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import {
-  decisionForKey, deleteConfirmed, formatCell, HEATMAP_MAX_TAKES, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
-  heatmapRows, importLines, nextSort, pageInfo, progressSummary, scoreColor, shootControls, tableState, takesQuery, viewQuery,
+  decisionForKey, deleteConfirmed, formatCell, HEATMAP_MAX_TAKES, heatmapChanged, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
+  heatmapRows, importLines, isFiltered, nextSort, pageInfo, progressSummary, scoreColor, shootControls, tableState, takesQuery, viewQuery,
   TABLE_DEFAULTS,
 } from "../../frontend/js/shoot-format.js";
 
@@ -149,7 +149,33 @@ test("heatmapQuery asks the API for one bounded page in the table's order", () =
   assert.equal(q.get("sort"), "score");
   assert.equal(q.get("order"), "asc");
   assert.equal(new URLSearchParams(heatmapQuery({ offset: 0, limit: 99999 })).get("limit"), String(HEATMAP_MAX_TAKES));
-  assert.equal(new URLSearchParams(heatmapQuery({ offset: 0, limit: 100 }, "name", "desc")).get("order"), "desc");
+  const sorted = new URLSearchParams(heatmapQuery({ offset: 0, limit: 100 }, { ...TABLE_DEFAULTS, sort: "name", order: "desc" }));
+  assert.equal(sorted.get("sort"), "name");
+  assert.equal(sorted.get("order"), "desc");
+});
+
+test("heatmapQuery carries the table's filters, with the heat map's own page", () => {
+  const state = tableState(new URLSearchParams("sort=rig&order=desc&limit=25&offset=75&status=done&rig=cmu&min_score=40&max_score=90&has_findings=true&search=walk&review_status=approved"));
+  const q = new URLSearchParams(heatmapQuery({ offset: 200, limit: 200 }, state));
+  assert.deepEqual(Object.fromEntries(q), {
+    sort: "rig", order: "desc", limit: "200", offset: "200", status: "done", review_status: "approved", rig: "cmu",
+    min_score: "40", max_score: "90", has_findings: "true", search: "walk",
+  });
+  // Empty filters are left out, as for the table.
+  assert.equal(heatmapQuery({ offset: 0, limit: 200 }, TABLE_DEFAULTS), "sort=score&order=asc&limit=200&offset=0");
+  assert.equal(isFiltered(TABLE_DEFAULTS), false);
+  assert.equal(isFiltered(state), true);
+  assert.equal(isFiltered({ ...TABLE_DEFAULTS, has_findings: "false" }), true);
+});
+
+test("heatmapChanged: filters, sort and order move the heat map; the table's page does not", () => {
+  const base = tableState(new URLSearchParams(""));
+  assert.equal(heatmapChanged(base, { ...base, offset: 25 }), false);
+  assert.equal(heatmapChanged(base, { ...base, limit: 100 }), false);
+  assert.equal(heatmapChanged(base, { ...base, sort: "name" }), true);
+  assert.equal(heatmapChanged(base, { ...base, order: "desc" }), true);
+  assert.equal(heatmapChanged(base, { ...base, search: "walk" }), true);
+  assert.equal(heatmapChanged({ ...base, min_score: 40 }, { ...base, min_score: "40" }), false);
 });
 
 test("heatmapPager pages through more than 200 takes", () => {
