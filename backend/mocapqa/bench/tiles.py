@@ -3,11 +3,13 @@
 Each tile is a real take's header with a seeded window of its frames: a random start and a
 random length around the mean, read forwards then backwards (ping-pong) when the take is
 shorter, so every frame is a recorded pose and consecutive frames stay continuous. Tiles differ
-in content (source, start, length), so none is skipped as a duplicate.
+in content: a draw that repeats an earlier tile's bytes (the same source, start and length —
+2 of the 2,000 default tiles did, and the batch skipped them as duplicates) is drawn again.
 """
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -57,15 +59,21 @@ def tile_corpus(
     parsed = [_split(p.read_text()) for p in sources]
     folder.mkdir(parents=True, exist_ok=True)
     total_frames = total_bytes = 0
+    written: set[bytes] = set()
     for index in range(n_takes):
-        which = int(rng.integers(len(parsed)))
-        head, frame_time, frames = parsed[which]
-        length = int(rng.integers(mean_frames // 2, mean_frames * 3 // 2 + 1))
-        start = int(rng.integers(len(frames)))
-        cycle = frames + frames[-2:0:-1] if len(frames) > 2 else frames
-        picked = [cycle[(start + i) % len(cycle)] for i in range(length)]
-        body = f"{head}Frames: {length}\n{frame_time}\n" + "\n".join(picked) + "\n"
-        data = body.encode()
+        while True:  # a tile equal to an earlier one is drawn again (a batch would skip it)
+            which = int(rng.integers(len(parsed)))
+            head, frame_time, frames = parsed[which]
+            length = int(rng.integers(mean_frames // 2, mean_frames * 3 // 2 + 1))
+            start = int(rng.integers(len(frames)))
+            cycle = frames + frames[-2:0:-1] if len(frames) > 2 else frames
+            picked = [cycle[(start + i) % len(cycle)] for i in range(length)]
+            body = f"{head}Frames: {length}\n{frame_time}\n" + "\n".join(picked) + "\n"
+            data = body.encode()
+            digest = hashlib.sha256(data).digest()
+            if digest not in written:
+                written.add(digest)
+                break
         name = f"tile_{index:05d}_{sources[which].stem}.bvh"
         (folder / name).write_bytes(data)
         total_frames += length

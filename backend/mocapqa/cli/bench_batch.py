@@ -268,7 +268,7 @@ def bench_batch(
         return watched
 
     def rate_row(label: str, wall: float, cpu: float, client: float, worker: str) -> None:
-        table.add_row(
+        cells = (
             label,
             f"{wall:.1f}",
             f"{cpu:.1f}",
@@ -277,8 +277,11 @@ def bench_batch(
             f"{client:.0f}",
             worker,
         )
+        table.add_row(*cells)
+        # Each run as it ends too: a run cut short keeps the figures measured before it.
+        console.print(" | ".join(cells), highlight=False)
 
-    for workers in (1, 2):
+    for workers in (2, 1):
         # Start-up: imports, the local cluster, and one take on cold workers (numba's kernels
         # compiled or loaded, each rig's limits model read): the same command on one tile.
         started = batch(f"start{workers}", one, workers)
@@ -290,6 +293,10 @@ def bench_batch(
         figures[f"start{workers}_s"], figures[f"start{workers}_cpu"] = started.wall_s, started.cpu_s
         figures[f"dask{workers}_s"] = run.wall_s - started.wall_s
         figures[f"dask{workers}_cpu"] = run.cpu_s - started.cpu_s
+        console.print(
+            f"start-up, one tile: {started.wall_s:.1f} s wall, {started.cpu_s:.1f} CPU s",
+            highlight=False,
+        )
         label = f"`mocapqa batch --workers {workers}`"
         rate_row(label, run.wall_s, run.cpu_s, run.peak_mb, f"{run.children_peak_mb:.0f}")
         if workers == 2:
@@ -302,6 +309,11 @@ def bench_batch(
             figures["resume_s"] = time.perf_counter() - clock
             if counts.skipped != takes:
                 raise RuntimeError(f"resume re-ran takes: {counts}")
+            console.print(
+                f"resume: `mocapqa batch` {again.wall_s:.2f} s wall, {again.cpu_s:.2f} CPU s, "
+                f"peak {again.peak_mb:.0f} MB; run_batch alone {figures['resume_s']:.2f} s",
+                highlight=False,
+            )
             rows = _stored_rows(repository)
         repository.close()
         shutil.rmtree(root / f"dask{workers}" / "data", ignore_errors=True)  # GBs of outputs
