@@ -15,7 +15,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import signal
 
 from mocapqa.core.arrays import BoolArray, FloatArray, check_shape
 from mocapqa.errors import InputError
@@ -54,6 +53,10 @@ def _lowpass(values: FloatArray, fps: float, params: ButterworthParams) -> Float
             f"Expected `cutoff_hz` below the Nyquist frequency {nyquist:g} Hz, got "
             f"{params.cutoff_hz:g}"
         )
+    # Imported here: scipy.signal costs about 2 CPU s to import, which every process reading
+    # the filter registry (a batch client, a resume that analyses nothing) would pay.
+    from scipy import signal
+
     b, a = signal.butter(params.order, params.cutoff_hz / nyquist)
     n = values.shape[0]
     if n < 2:

@@ -18,16 +18,16 @@ import time
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from mocapqa.errors import InputError, MocapQAError
 from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.take_task import analyse_path, content_sha256
-from mocapqa.limits.catalog import DEFAULT_MODEL
-from mocapqa.pipeline.loading import detect_take_format as detect_format
-from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.repository import new_id
 from mocapqa.store.shoots import ShootStore
+
+if TYPE_CHECKING:
+    from mocapqa.pipeline.options import AnalysisOptions
 
 __all__ = ["MOTION_SUFFIXES", "BatchCounts", "discover", "run_batch"]
 
@@ -60,8 +60,10 @@ class BatchCounts:
 def _is_frame_folder(folder: Path, names: list[str]) -> bool:
     if sum(n.lower().endswith(".json") for n in names) < 2:
         return False
+    from mocapqa.pipeline.loading import detect_take_format
+
     try:
-        return detect_format(folder) == "openpose"
+        return detect_take_format(folder) == "openpose"
     except MocapQAError:
         return False
 
@@ -164,6 +166,8 @@ def run_batch(
         When the Dask scheduler cannot be reached or is lost mid-batch; the takes finished
         before are stored and have their rows, the others have neither.
     """
+    from mocapqa.limits.catalog import DEFAULT_MODEL
+
     counts = BatchCounts()
     if options.limits_model is None:  # the shoot's model, as for the server's runs
         chosen = shoots.limits_model(shoot_id) if shoot_id else DEFAULT_MODEL

@@ -3,6 +3,11 @@
 The task reads the take itself (the client never holds the corpus), analyses it, writes the
 run's files and a copy of the take into the data folder (shared by the workers), and returns
 only the small things the client stores: the take's row values and the run summary.
+
+The analysis stack (the pipeline, scipy, numba) is imported inside the tasks, not by this
+module: the batch client imports it to name the task and hash files, and never analyses, so it
+does not pay that stack's import time (about 2 CPU s, most of a finished batch's resume) or its
+memory (docs/batch.md).
 """
 
 from __future__ import annotations
@@ -14,20 +19,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from mocapqa.core.motion import Motion
 from mocapqa.errors import MocapQAError, ParseError
-from mocapqa.jobs.runner import read_options, run_summary, write_outputs
-from mocapqa.limits.catalog import ModelCatalog
-from mocapqa.pipeline.analyze import analyze
-from mocapqa.pipeline.loading import (
-    READING_FILE,
-    ReadOptions,
-    detect_take_format,
-    read_take_file,
-    reading_facts,
-)
-from mocapqa.pipeline.options import AnalysisOptions
-from mocapqa.store.files import FileStore
 
 __all__ = ["analyse_path", "analyse_stored", "content_sha256", "stored_name"]
 
@@ -79,6 +71,20 @@ def analyse_path(
         ``{"status": "done", "take": row values, "summary": run summary, "time_s"}`` or
         ``{"status": "failed", "error": message}`` for a file the readers reject.
     """
+    from mocapqa.core.motion import Motion
+    from mocapqa.jobs.runner import run_summary, write_outputs
+    from mocapqa.limits.catalog import ModelCatalog
+    from mocapqa.pipeline.analyze import analyze
+    from mocapqa.pipeline.loading import (
+        READING_FILE,
+        ReadOptions,
+        detect_take_format,
+        read_take_file,
+        reading_facts,
+    )
+    from mocapqa.pipeline.options import AnalysisOptions
+    from mocapqa.store.files import FileStore
+
     started = time.perf_counter()
     source = Path(path)
     try:
@@ -147,6 +153,13 @@ def analyse_stored(
         The run summary (as :func:`mocapqa.jobs.runner.run_summary`). Errors the readers or
         the analysis raise on purpose travel back as themselves.
     """
+    from mocapqa.jobs.runner import read_options, run_summary, write_outputs
+    from mocapqa.limits.catalog import ModelCatalog
+    from mocapqa.pipeline.analyze import analyze
+    from mocapqa.pipeline.loading import read_take_file
+    from mocapqa.pipeline.options import AnalysisOptions
+    from mocapqa.store.files import FileStore
+
     stored = Path(path)
     take = read_take_file(stored, format_name, name, read_options(stored.parent))
     catalog = ModelCatalog.of_data_folder(data_dir)
