@@ -18,12 +18,14 @@ Checks that did not run leave their fields None; they then cost the score nothin
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from mocapqa.limits.rig import rig_family
-from mocapqa.pipeline.analyze import AnalysisResult
+
+if TYPE_CHECKING:  # the store reads SUMMARY_FIELDS without loading the analysis stack
+    from mocapqa.pipeline.analyze import AnalysisResult
 
 __all__ = ["MM_PER_UNIT", "SCORE_TERMS", "SUMMARY_FIELDS", "qa_score", "qa_summary"]
 
