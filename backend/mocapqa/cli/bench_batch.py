@@ -192,6 +192,41 @@ def _fill(database_url: str, rows: list[dict[str, Any]], n_takes: int) -> str:
     return str(shoot["id"])
 
 
+def api_latency(
+    rows: list[dict[str, Any]], n_takes: int, targets: list[tuple[str, str]], data_dir: Path
+) -> Any:
+    """The shoot view's requests on a shoot of ``n_takes`` takes repeating ``rows`` (stored
+    take values and summaries), through the app, on each ``(label, database URL)``: a table
+    of p50 / p95 ms over 40 requests after 3 warm-ups."""
+    from fastapi.testclient import TestClient
+    from rich.table import Table
+
+    from mocapqa.api.app import create_app
+    from mocapqa.config import Settings
+
+    latency = Table("database", "request", "p50 ms", "p95 ms")
+    for label, url in targets:
+        shoot_id = _fill(url, rows, n_takes)
+        settings = Settings(data_dir=data_dir, database_url=url, allowed_hosts=["testserver"])
+        with TestClient(create_app(settings)) as client:
+            base = f"/api/v1/shoots/{shoot_id}"
+            filtered = {"sort": "violation_share", "order": "desc", "min_score": 50}
+            requests: tuple[tuple[str, str, dict[str, Any]], ...] = (
+                ("list page (50, by created_at)", f"{base}/takes", {"sort": "created_at"}),
+                ("sort by score", f"{base}/takes", {"sort": "score", "offset": 5000}),
+                ("filter + search", f"{base}/takes", {**filtered, "search": "take_01"}),
+                ("heat map (200 takes)", f"{base}/heatmap", {}),
+                ("heat map, filtered and sorted", f"{base}/heatmap", filtered),
+                ("next for review", f"{base}/next", {}),
+                ("shoot list", "/api/v1/shoots", {}),
+            )
+            for name, path, params in requests:
+                _latency(client, path, params, 3)
+                p50, p95 = _latency(client, path, params, 40)
+                latency.add_row(label, name, f"{p50:.1f}", f"{p95:.1f}")
+    return latency
+
+
 @bench_app.command("batch")
 def bench_batch(
     takes: Annotated[int, typer.Option(help="Tiled takes in the corpus.")] = 2000,
@@ -212,15 +247,12 @@ def bench_batch(
     shoot-table API latency (list, sort by score, heat map) at ``--api-takes`` takes."""
     import os
 
-    from fastapi.testclient import TestClient
     from rich.console import Console
     from rich.table import Table
 
-    from mocapqa.api.app import create_app
     from mocapqa.bench.corpus import require_corpus
     from mocapqa.bench.tiles import tile_corpus
     from mocapqa.bench.watch import Watched, run_watched
-    from mocapqa.config import Settings
     from mocapqa.jobs.batch import run_batch
     from mocapqa.jobs.engine import Engine
     from mocapqa.pipeline.options import AnalysisOptions
@@ -371,38 +403,9 @@ def bench_batch(
         f"{figures['single_thread_s'] * 1000:.0f} ms, as a task on a warm Dask worker "
         f"{figures['single_dask_s'] * 1000:.0f} ms"
     )
-    latency = Table("database", "request", "p50 ms", "p95 ms")
     targets = [("SQLite", f"sqlite:///{root / 'api.sqlite3'}")]
     if postgres_url or os.environ.get("MOCAPQA_TEST_POSTGRES_URL"):
         targets.append(("PostgreSQL", str(postgres_url or os.environ["MOCAPQA_TEST_POSTGRES_URL"])))
-    for label, url in targets:
-        shoot_id = _fill(url, rows, api_takes)
-        settings = Settings(
-            data_dir=root / "api-data", database_url=url, allowed_hosts=["testserver"]
-        )
-        with TestClient(create_app(settings)) as client:
-            base = f"/api/v1/shoots/{shoot_id}"
-            requests: tuple[tuple[str, str, dict[str, Any]], ...] = (
-                ("list page (50, by created_at)", f"{base}/takes", {"sort": "created_at"}),
-                ("sort by score", f"{base}/takes", {"sort": "score", "offset": 5000}),
-                (
-                    "filter + search",
-                    f"{base}/takes",
-                    {
-                        "sort": "violation_share",
-                        "order": "desc",
-                        "min_score": 50,
-                        "search": "take_01",
-                    },
-                ),
-                ("heat map (200 takes)", f"{base}/heatmap", {}),
-                ("next for review", f"{base}/next", {}),
-                ("shoot list", "/api/v1/shoots", {}),
-            )
-            for name, path, params in requests:
-                _latency(client, path, params, 3)
-                p50, p95 = _latency(client, path, params, 40)
-                latency.add_row(label, name, f"{p50:.1f}", f"{p95:.1f}")
-    console.print(latency)
+    console.print(api_latency(rows, api_takes, targets, root / "api-data"))
     if scratch is None:
         shutil.rmtree(root, ignore_errors=True)
