@@ -27,6 +27,7 @@ from mocapqa.jobs.batch import run_batch
 from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.runner import write_outputs
 from mocapqa.jobs.take_task import analyse_path
+from mocapqa.limits.catalog import DEFAULT_MODEL
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.loading import read_take_file
 from mocapqa.pipeline.options import AnalysisOptions
@@ -101,7 +102,8 @@ def test_batch_equals_single_take_analysis(
     for relative in TAKES:
         row = by_name[Path(relative).name]
         take = read_take_file(corpus_copy / Path(relative).name, "")
-        alone = analyze(take, AnalysisOptions())
+        # A batch records the limits model it used: the default one, outside a chosen shoot.
+        alone = analyze(take, AnalysisOptions(limits_model=DEFAULT_MODEL))
         expected = qa_summary(alone)
         assert {k: row[k] for k in expected if k != "joint_violations"} == {
             k: v for k, v in expected.items() if k != "joint_violations"

@@ -28,7 +28,6 @@ from sqlalchemy.engine import Connection
 from mocapqa import __version__
 from mocapqa.core.text import display_name
 from mocapqa.errors import ConflictError, InputError, NotFoundError
-from mocapqa.limits.catalog import DEFAULT_MODEL
 from mocapqa.store.qa import lock_take, sync_take
 from mocapqa.store.tables import reviews, runs, shoots, take_qa, takes
 from mocapqa.store.upgrade import upgrade_database
@@ -245,6 +244,10 @@ class Repository:
         self, conn: Connection, take_id: str, sha256: str, options: dict[str, Any]
     ) -> str:
         if options.get("limits_model") is None:
+            # Imported here: the catalog loads the limits stack, which the batch client
+            # (it records runs through this store) never needs otherwise.
+            from mocapqa.limits.catalog import DEFAULT_MODEL
+
             # A run of a take in a shoot checks limits with the shoot's model; the name is
             # recorded with the run, so its options say which model it used.
             query = (
