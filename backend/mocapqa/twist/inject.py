@@ -95,6 +95,28 @@ class InjectionTruth:
     error_mask: BoolArray
     offsets_rad: FloatArray
 
+    @classmethod
+    def of_chains(
+        cls,
+        clean_quats: FloatArray,
+        geometries: list[ChainGeometry],
+        intervals: list[InjectedInterval],
+        error_mask: BoolArray,
+        offsets_rad: FloatArray,
+    ) -> InjectionTruth:
+        """The truth of an injection into the target chains ``geometries`` (their parent
+        joints are the targets); the other arguments as the fields."""
+        return cls(
+            clean_quats=clean_quats,
+            targets=tuple(g.chain.parent for g in geometries),
+            children=tuple(g.chain.child for g in geometries),
+            sides=tuple(g.chain.side for g in geometries),
+            segments=tuple(g.chain.segment for g in geometries),
+            intervals=tuple(intervals),
+            error_mask=error_mask,
+            offsets_rad=offsets_rad,
+        )
+
 
 def _place_intervals(
     rng: np.random.Generator, n_frames: int, count: int, max_length: int
@@ -261,14 +283,7 @@ def inject_twist_errors(
                 geometry.axis, -mismatch[rows, c] * chain_offsets[rows, c]
             )
             corrupted_quats[rows, first] = multiply(extra, corrupted_quats[rows, first])
-    truth = InjectionTruth(
-        clean_quats=motion.quats.copy(),
-        targets=tuple(g.chain.parent for g in geometries),
-        children=tuple(g.chain.child for g in geometries),
-        sides=tuple(g.chain.side for g in geometries),
-        segments=tuple(g.chain.segment for g in geometries),
-        intervals=tuple(intervals),
-        error_mask=error_mask,
-        offsets_rad=offsets_rad,
+    truth = InjectionTruth.of_chains(
+        motion.quats.copy(), geometries, intervals, error_mask, offsets_rad
     )
     return replace(motion, quats=corrupted_quats), truth

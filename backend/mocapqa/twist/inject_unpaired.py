@@ -204,14 +204,5 @@ def inject_unpaired_bursts(
         extra = quats_from_axis_angle(geometry.axis, -mismatch[rows, c] * offsets[rows, c])
         first = _first_child(geometry)
         corrupted[rows, first] = multiply(extra, corrupted[rows, first])
-    truth = InjectionTruth(
-        clean_quats=clean,
-        targets=tuple(g.chain.parent for g in geometries),
-        children=tuple(g.chain.child for g in geometries),
-        sides=tuple(g.chain.side for g in geometries),
-        segments=tuple(g.chain.segment for g in geometries),
-        intervals=tuple(intervals),
-        error_mask=error_mask,
-        offsets_rad=offsets_rad,
-    )
+    truth = InjectionTruth.of_chains(clean, geometries, intervals, error_mask, offsets_rad)
     return replace(motion, quats=corrupted), truth
