@@ -315,6 +315,30 @@ def test_a_viewer_upload_is_refused_before_its_body(path: str, tmp_path: Path) -
     assert list((settings.data_dir / "incoming").iterdir()) == []
 
 
+def test_an_import_into_a_missing_shoot_is_refused_before_its_body(tmp_path: Path) -> None:
+    """The 404 of an import into a shoot that does not exist used to come after the whole
+    body (up to ``archive_max_unpacked_mb``) was received; it now comes from the path alone,
+    after the credential is checked."""
+    settings = make_settings("sqlite", tmp_path, allowed_hosts=["127.0.0.1"])
+    app = create_app(settings)
+    accounts = app.state.accounts
+    reviewer = accounts.add_user("rita", Role.REVIEWER)
+    token = accounts.issue(reviewer.id, "api", timedelta(days=1)).token
+    with serve(app) as url:
+        head = f"POST /api/v1/shoots/{'0' * 32}/takes HTTP/1.1\r\n"
+        head += f"Host: {urlsplit(url).netloc}\r\nAuthorization: Bearer {token}\r\n"
+        head += "Content-Type: multipart/form-data; boundary=b\r\n"
+        head += "Content-Length: 100000000\r\n\r\n"
+        status, body = raw_request(url, head)
+        anonymous = head.replace(f"Authorization: Bearer {token}\r\n", "")
+        anonymous_status, _ = raw_request(url, anonymous)
+    assert status == 404, body
+    assert body["error"] == "NotFoundError"
+    assert "0" * 32 in body["detail"]
+    assert anonymous_status == 401  # no word about shoots to a stranger
+    assert list((settings.data_dir / "incoming").iterdir()) == []
+
+
 OPEN_OPERATIONS = {("get", "/api/v1/health"), ("post", "/api/v1/auth/sign-in")}
 """The only operations an anonymous client may call on a server with users."""
 VIEWER_CHANGES = {

@@ -52,6 +52,7 @@ from mocapqa.store.accounts import Accounts
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
 from mocapqa.store.roles import Action
+from mocapqa.store.shoots import ShootStore
 
 __all__ = ["API_PREFIX", "create_app", "frontend_dir", "plotly_js_path"]
 
@@ -172,7 +173,8 @@ def create_app(
         f"{API_PREFIX}/takes",
         runner.pending,
         lambda connection: quota_key_before_body(connection, accounts),
-        re.compile(rf"{API_PREFIX}/shoots/[^/]+/takes"),
+        re.compile(rf"{API_PREFIX}/shoots/([^/]+)/takes"),
+        ShootStore(repository.engine).require,
     )
     install_error_handlers(app)
     for router, dependencies in ROUTERS:

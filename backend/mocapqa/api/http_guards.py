@@ -18,7 +18,8 @@ One ASGI middleware (:class:`RequestGuard`), so each check answers before the bo
   thread); an anonymous request to a server without users counts against its client address.
   An upload the routes would refuse with 401 (a credential that is not valid, or none while
   users exist) gets its 401 here, before its body is read too, and one from a user whose role
-  may not upload (a viewer) its 403.
+  may not upload (a viewer) its 403. An import into a shoot that does not exist gets its 404
+  here as well (after the 401/403, so the answer says nothing of shoots to a stranger).
 * **Text no store can keep**: a NUL (``%00``) in the path or in a query parameter gets 422
   naming ``path`` or ``query.NAME`` (PostgreSQL refuses NUL in text; JSON bodies get the same
   check from :class:`~mocapqa.api.request_model.RequestModel`).
@@ -53,7 +54,7 @@ from mocapqa.api.errors import error_body
 from mocapqa.api.host_check import HostCheck
 from mocapqa.api.request_model import unstorable_text
 from mocapqa.config import Settings
-from mocapqa.errors import ForbiddenError
+from mocapqa.errors import ForbiddenError, NotFoundError
 
 __all__ = [
     "CONTENT_SECURITY_POLICY",
@@ -180,8 +181,10 @@ class RequestGuard:
         pending_runs: Callable[[str], int],
         quota_key: Callable[[HTTPConnection], str | None],
         import_paths: re.Pattern[str] | None = None,
+        import_target: Callable[[str], None] | None = None,
     ) -> None:
         self.app = app
+        self.import_target = import_target
         self.quota_key = quota_key
         self.settings = settings
         self.upload_path = upload_path
@@ -198,11 +201,12 @@ class RequestGuard:
             return
         headers = Headers(scope=scope)
         method = scope["method"]
-        is_import = (
-            method == "POST"
-            and self.import_paths is not None
-            and self.import_paths.fullmatch(scope["path"]) is not None
+        imported = (
+            self.import_paths.fullmatch(scope["path"])
+            if method == "POST" and self.import_paths is not None
+            else None
         )
+        is_import = imported is not None
         is_upload = (method == "POST" and scope["path"] == self.upload_path) or is_import
         secured = self._with_headers(send, scope["path"].startswith(_DOCS_PATHS), is_upload)
         if method in _STATE_CHANGING and not origin_allowed(headers, self.settings.cors_origins):
@@ -231,6 +235,12 @@ class RequestGuard:
                 body = error_body("AuthenticationError", detail)
                 await _send_json(secured, 401, body, extra=[(b"www-authenticate", b"Bearer")])
                 return
+            if imported is not None and imported.groups() and self.import_target is not None:
+                try:
+                    await run_in_threadpool(self.import_target, imported.group(1))
+                except NotFoundError as e:
+                    await _send_json(secured, 404, error_body("NotFoundError", str(e)))
+                    return
             refused = self._upload_refusal(key)
             if refused is not None:
                 await _send_json(secured, 429, refused[0], refused[1])
@@ -299,12 +309,15 @@ def install_http_guards(
     pending_runs: Callable[[str], int],
     quota_key: Callable[[HTTPConnection], str | None],
     import_paths: re.Pattern[str] | None = None,
+    import_target: Callable[[str], None] | None = None,
 ) -> None:
     """Add the request guard, CORS (when ``cors_origins`` is set) and the Host check, in the
     order that makes the Host check run first. ``pending_runs`` counts a quota key's queued
     runs, ``quota_key`` names a request's key from its headers, None for a request to refuse
     with 401 (a blocking call: it runs on a worker thread); ``import_paths`` matches the
-    routes that take many files in one request (uploads with the import body limit).
+    routes that take many files in one request (uploads with the import body limit), its
+    first group the target's id, which ``import_target`` (blocking) checks, raising
+    :class:`~mocapqa.errors.NotFoundError` (answered 404) when it does not exist.
     ``quota_key`` raises :class:`~mocapqa.errors.ForbiddenError` for a user whose role may not
     upload (answered 403)."""
     app.add_middleware(
@@ -314,6 +327,7 @@ def install_http_guards(
         pending_runs=pending_runs,
         quota_key=quota_key,
         import_paths=import_paths,
+        import_target=import_target,
     )
     if settings.cors_origins:
         app.add_middleware(
