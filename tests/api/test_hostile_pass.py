@@ -292,6 +292,16 @@ def raw_request(url: str, head: str, wait_s: float = 120.0) -> tuple[int, dict[s
     return status, httpx.Response(status, content=rest).json()
 
 
+def bodiless_upload_head(url: str, path: str, token: str | None) -> str:
+    """The head of a multipart POST to ``path`` announcing 100 MB (under both body limits)
+    whose body is never sent: only an answer given before the body can come back."""
+    head = f"POST {path} HTTP/1.1\r\nHost: {urlsplit(url).netloc}\r\n"
+    if token is not None:
+        head += f"Authorization: Bearer {token}\r\n"
+    head += "Content-Type: multipart/form-data; boundary=b\r\n"
+    return head + "Content-Length: 100000000\r\n\r\n"
+
+
 @pytest.mark.parametrize("path", ["/api/v1/takes", "/api/v1/shoots/any/takes"])
 def test_a_viewer_upload_is_refused_before_its_body(path: str, tmp_path: Path) -> None:
     """A viewer may not upload: the 403 used to come after the whole body (up to
@@ -304,11 +314,7 @@ def test_a_viewer_upload_is_refused_before_its_body(path: str, tmp_path: Path) -
     viewer = accounts.add_user("vic", Role.VIEWER)
     token = accounts.issue(viewer.id, "api", timedelta(days=1)).token
     with serve(app) as url:
-        head = f"POST {path} HTTP/1.1\r\nHost: {urlsplit(url).netloc}\r\n"
-        head += f"Authorization: Bearer {token}\r\n"
-        head += "Content-Type: multipart/form-data; boundary=b\r\n"
-        head += "Content-Length: 100000000\r\n\r\n"
-        status, body = raw_request(url, head)
+        status, body = raw_request(url, bodiless_upload_head(url, path, token))
     assert status == 403, body
     assert body["error"] == "ForbiddenError"
     assert "upload" in body["detail"]
@@ -324,14 +330,10 @@ def test_an_import_into_a_missing_shoot_is_refused_before_its_body(tmp_path: Pat
     accounts = app.state.accounts
     reviewer = accounts.add_user("rita", Role.REVIEWER)
     token = accounts.issue(reviewer.id, "api", timedelta(days=1)).token
+    path = f"/api/v1/shoots/{'0' * 32}/takes"
     with serve(app) as url:
-        head = f"POST /api/v1/shoots/{'0' * 32}/takes HTTP/1.1\r\n"
-        head += f"Host: {urlsplit(url).netloc}\r\nAuthorization: Bearer {token}\r\n"
-        head += "Content-Type: multipart/form-data; boundary=b\r\n"
-        head += "Content-Length: 100000000\r\n\r\n"
-        status, body = raw_request(url, head)
-        anonymous = head.replace(f"Authorization: Bearer {token}\r\n", "")
-        anonymous_status, _ = raw_request(url, anonymous)
+        status, body = raw_request(url, bodiless_upload_head(url, path, token))
+        anonymous_status, _ = raw_request(url, bodiless_upload_head(url, path, None))
     assert status == 404, body
     assert body["error"] == "NotFoundError"
     assert "0" * 32 in body["detail"]
