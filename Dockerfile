@@ -41,6 +41,8 @@ COPY backend ./backend
 COPY frontend ./frontend
 COPY --from=three /js/vendor/three ./frontend/vendor/three
 COPY --from=three /js/vendor/plotly ./frontend/vendor/plotly
+# Dask settings of the workers (and the scheduler): read from /etc/dask by every dask process.
+COPY backend/mocapqa/data/dask/mocapqa.yaml /etc/dask/mocapqa.yaml
 # The package with its PostgreSQL driver; dask[distributed] is a dependency of the package.
 # Versions of the package's own dependencies are bounded in pyproject.toml; the ones the image
 # serves with are pinned here so that app, scheduler and workers match.

@@ -24,7 +24,7 @@ from fastapi.testclient import TestClient
 from mocapqa.api.app import create_app
 from mocapqa.config import Settings
 from mocapqa.jobs.batch import run_batch
-from mocapqa.jobs.engine import Engine
+from mocapqa.jobs.engine import WORKER_CONFIG, Engine
 from mocapqa.jobs.runner import write_outputs
 from mocapqa.jobs.take_task import analyse_path
 from mocapqa.limits.catalog import DEFAULT_MODEL
@@ -67,6 +67,22 @@ def corpus_copy(corpus_dir: Path, tmp_path: Path) -> Path:
     )
     (folder / "notes.txt").write_text("not a take")
     return folder
+
+
+def _worker_settings() -> tuple[str | None, bool]:
+    """What a worker runs with: Dask's malloc trim variable, and whether it profiles."""
+    import dask
+
+    return os.environ.get("MALLOC_TRIM_THRESHOLD_"), bool(
+        dask.config.get("distributed.worker.profile.enabled")
+    )
+
+
+def test_local_workers_run_with_the_shipped_settings(engine: Engine) -> None:
+    """No malloc trim threshold (it costs +40 % CPU a take) and no profiler (+15 %)."""
+    found = engine.client().run(_worker_settings)
+    assert len(found) == 2
+    assert set(found.values()) == {(None, False)}
 
 
 def _store(tmp_path: Path) -> tuple[Repository, ShootStore]:
@@ -247,7 +263,11 @@ def _free_port() -> int:
 def test_batch_on_separate_scheduler_and_worker(corpus_copy: Path, tmp_path: Path) -> None:
     port = _free_port()
     address = f"tcp://127.0.0.1:{port}"
-    env = _environment(tmp_path)
+    # The settings file as the image installs it for the compose file's workers (/etc/dask).
+    env = {
+        **_environment(tmp_path),
+        "DASK_CONFIG": str(ROOT / "backend" / "mocapqa" / WORKER_CONFIG),
+    }
     dask = str(Path(sys.executable).with_name("dask"))
     scheduler = subprocess.Popen(
         [dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
@@ -262,6 +282,7 @@ def test_batch_on_separate_scheduler_and_worker(corpus_copy: Path, tmp_path: Pat
         rows: list[dict[str, Any]] = []
         with Engine(scheduler=address) as remote:
             remote.client().wait_for_workers(1, timeout=120)
+            assert set(remote.client().run(_worker_settings).values()) == {(None, False)}
             counts = run_batch(
                 [corpus_copy], shoots, AnalysisOptions(), rows.append, remote, tmp_path / "d"
             )

@@ -30,13 +30,35 @@ from typing import Any
 
 from mocapqa.errors import ClusterError
 
-__all__ = ["ALLOWED_FAILURES", "SCHEDULER_LOST", "Engine", "default_workers"]
+__all__ = [
+    "ALLOWED_FAILURES",
+    "SCHEDULER_LOST",
+    "WORKER_CONFIG",
+    "Engine",
+    "default_workers",
+    "worker_settings",
+]
 
 ALLOWED_FAILURES = 1
 """Worker deaths a task may cause on the local cluster before it is failed (Dask: 3)."""
 SCHEDULER_LOST = "scheduler-connection-lost"
 """Dask's reason for the tasks it cancels when the client loses its scheduler."""
+WORKER_CONFIG = "data/dask/mocapqa.yaml"
+"""Dask settings for the workers (within the package): the local cluster's, and the image's
+``/etc/dask/mocapqa.yaml`` for the compose file's workers."""
 log = logging.getLogger(__name__)
+
+
+def worker_settings() -> dict[str, Any]:
+    """The nested Dask settings of :data:`WORKER_CONFIG`."""
+    from importlib import resources
+
+    import yaml
+
+    loaded: dict[str, Any] = yaml.safe_load(
+        (resources.files("mocapqa") / WORKER_CONFIG).read_text(encoding="utf-8")
+    )
+    return loaded
 
 
 def default_workers() -> int:
@@ -117,6 +139,7 @@ class Engine:
                             "distributed.worker.daemon": False,
                         }
                     )
+                    dask.config.update(dask.config.config, worker_settings(), priority="new")
                     self._cluster = LocalCluster(  # type: ignore[no-untyped-call]
                         n_workers=self.workers,
                         threads_per_worker=1,
