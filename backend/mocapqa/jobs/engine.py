@@ -53,12 +53,11 @@ def worker_settings() -> dict[str, Any]:
     """The nested Dask settings of :data:`WORKER_CONFIG`."""
     from importlib import resources
 
-    import yaml
+    import dask.config
 
-    loaded: dict[str, Any] = yaml.safe_load(
-        (resources.files("mocapqa") / WORKER_CONFIG).read_text(encoding="utf-8")
-    )
-    return loaded
+    with resources.as_file(resources.files("mocapqa") / WORKER_CONFIG) as path:
+        (loaded,) = dask.config.collect_yaml([str(path)])
+    return dict(loaded)
 
 
 def default_workers() -> int:
