@@ -27,6 +27,19 @@ DASK_LOGGERS = ("distributed", "distributed.client")
 """Dask's client-side loggers (each has its own level and handler)."""
 
 
+def _quiet_dask_logging() -> None:
+    """Dask's client-side loggers at WARNING. Set in Dask's configuration, which distributed
+    reads when it is first imported — only once a take is sent to a cluster, so that a batch
+    with nothing left to analyse does not import it (0.8 CPU s of a resume, docs/batch.md) —
+    and on the loggers themselves for a process that imported it already."""
+    import dask.config
+
+    levels = {name: "warning" for name in DASK_LOGGERS}
+    dask.config.update(dask.config.config, {"logging": levels}, priority="new")
+    for name in DASK_LOGGERS:
+        logging.getLogger(name).setLevel(logging.WARNING)
+
+
 def _options(text: str | None) -> Any:
     from mocapqa.errors import InputError
     from mocapqa.pipeline.options import AnalysisOptions
@@ -66,7 +79,6 @@ def batch(
     an interrupted batch finishes when run again. Exit code 0 when no take failed, 2 when
     some did, 8 when the Dask scheduler cannot be reached or is lost.
     """
-    import distributed  # noqa: F401  - sets its loggers up; then quiet them below warnings
     from rich.console import Console
     from rich.progress import (
         BarColumn,
@@ -87,8 +99,7 @@ def batch(
     from mocapqa.store.repository import Repository
     from mocapqa.store.shoots import ShootStore
 
-    for name in DASK_LOGGERS:
-        logging.getLogger(name).setLevel(logging.WARNING)
+    _quiet_dask_logging()
     run_options = _options(options)
     settings = get_settings()
     if run_options.limits_model is not None:  # refused before any take is read

@@ -35,7 +35,6 @@ from mocapqa.core.arrays import BoolArray, FloatArray, check_shape
 from mocapqa.errors import InputError
 from mocapqa.filters.ema import EmaFilter, EmaParams
 from mocapqa.filters.kalman import KalmanFilter, KalmanParams
-from mocapqa.filters.kernels import adaptive_batch
 from mocapqa.filters.motion_state import MotionStateTracker
 from mocapqa.filters.one_euro import OneEuroFilter, OneEuroParams
 
@@ -257,6 +256,8 @@ class AdaptiveFilter:
             out = np.empty((1, 3 * k))
             weights = np.empty((1, k, 3))
             flags = np.empty((1, k), dtype=bool)
+            from mocapqa.filters.kernels import adaptive_batch  # numba, on first use
+
             adaptive_batch(
                 z[None], conf[None], self.settings, *self.kernel_state, out, weights, flags
             )
@@ -316,6 +317,8 @@ def adaptive_filter(
         out_flat = np.empty((n, 3 * k))
         w = np.empty((n, k, 3))
         bridged = np.empty((n, k), dtype=bool)
+        from mocapqa.filters.kernels import adaptive_batch  # numba, on first use
+
         adaptive_batch(
             flat, np.ascontiguousarray(conf), f.settings, *f.kernel_state, out_flat, w, bridged
         )

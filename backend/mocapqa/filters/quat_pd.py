@@ -36,7 +36,6 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray, check_shape
 from mocapqa.errors import InputError
-from mocapqa.filters.kernels import quat_pd_batch
 from mocapqa.kinematics.quaternion import unwrap
 
 __all__ = [
@@ -169,6 +168,8 @@ class QuatPDFilter:
         # The batch loop over one frame: the same compiled code as :meth:`run`, so the
         # streaming output is bit-identical to the batch output.
         out = np.empty((1, self.n_joints, 4))
+        from mocapqa.filters.kernels import quat_pd_batch  # numba, on first use
+
         quat_pd_batch(
             ref[None],
             self.settings,
@@ -190,6 +191,8 @@ class QuatPDFilter:
         if not self.started:
             out[0] = self._start(refs[0])
             start = 1
+        from mocapqa.filters.kernels import quat_pd_batch  # numba, on first use
+
         quat_pd_batch(
             refs[start:],
             self.settings,

@@ -19,12 +19,17 @@ import shutil
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from mocapqa.core.motion import Skeleton
 from mocapqa.errors import ConflictError, LimitsFileError, OptionError
-from mocapqa.limits.model import LimitsModel, check_rig
-from mocapqa.limits.storage import default_model_paths, load_default_model, load_model
+
+if TYPE_CHECKING:
+    from mocapqa.core.motion import Skeleton
+    from mocapqa.limits.model import LimitsModel
+
+# The models (and scipy under them) are imported when one is read, not with the catalog: the
+# run options check a model's name through it, and a resumed batch that analyses nothing
+# should not pay for them (docs/batch.md).
 
 __all__ = [
     "DEFAULT_MODEL",
@@ -97,6 +102,8 @@ def check_model_name(name: object) -> str:
 def _load_file(path: str, mtime_ns: int, size: int) -> LimitsModel:
     # Keyed by modification time and size, so a model registered again under the same name
     # is read anew; the shipped files never change while the process runs.
+    from mocapqa.limits.storage import load_model
+
     del mtime_ns, size
     return load_model(path)
 
@@ -136,6 +143,8 @@ class ModelCatalog:
         return cls(None if data_dir is None else Path(data_dir) / MODELS_FOLDER)
 
     def _shipped(self) -> dict[str, Path]:
+        from mocapqa.limits.storage import default_model_paths
+
         return {path.stem: path for path in default_model_paths()}
 
     def _registered(self) -> dict[str, Path]:
@@ -200,6 +209,9 @@ class ModelCatalog:
             The model does not cover this skeleton (a per-rig model of another rig, a skeleton
             without limb roles), or its file is corrupt.
         """
+        from mocapqa.limits.model import check_rig
+        from mocapqa.limits.storage import load_default_model
+
         self.require(name)
         if name == DEFAULT_MODEL:
             return load_default_model(skeleton)
@@ -230,6 +242,8 @@ class ModelCatalog:
             raise OptionError("limits_model", f"Expected a name other than the shipped {taken}")
         if self.folder is None:
             raise OptionError("limits_model", "Expected a data folder to register models in")
+        from mocapqa.limits.storage import load_model
+
         model = load_model(source)
         target = self.folder / f"{name}.npz"
         if target.exists() and not replace:
