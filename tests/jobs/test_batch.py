@@ -23,7 +23,7 @@ from fastapi.testclient import TestClient
 
 from mocapqa.api.app import create_app
 from mocapqa.config import Settings
-from mocapqa.jobs.batch import run_batch
+from mocapqa.jobs.batch import CHUNK_TAKES, chunk_size, run_batch
 from mocapqa.jobs.engine import WORKER_CONFIG, Engine
 from mocapqa.jobs.runner import write_outputs
 from mocapqa.jobs.take_task import analyse_path
@@ -200,8 +200,45 @@ def test_take_crashing_two_workers_fails_alone(
     assert set(failed) == {"cmu_12_01_walk.bvh", "broken.bvh"}
     assert "KilledWorker" in failed["cmu_12_01_walk.bvh"]
     assert counts.done == 3
-    engine.client().wait_for_workers(2, timeout=120)
+    engine.client().wait_for_workers(2, timeout=600)
     repository.close()
+
+
+def _dies_on_walk_raises_on_sad(
+    path: str, options: dict[str, Any], take_id: str, run_id: str, data: str | None
+) -> dict[str, Any]:
+    if path.endswith("bow_sad_001.bvh"):
+        raise ValueError("a bug in one take")
+    return _dies_on_walk(path, options, take_id, run_id, data)
+
+
+def test_chunked_tasks_fail_only_the_take_at_fault(
+    engine: Engine, corpus_copy: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Several takes to a task: a take whose task raises fails alone, and a take that kills
+    its worker has its chunk sent again one take per task, so only it fails."""
+    monkeypatch.setattr("mocapqa.jobs.batch.chunk_size", lambda n_pending, in_flight: 3)
+    repository, shoots = _store(tmp_path)
+    rows: list[dict[str, Any]] = []
+    counts = run_batch(
+        [corpus_copy], shoots, AnalysisOptions(), rows.append, engine, None,
+        task=_dies_on_walk_raises_on_sad,
+    )  # fmt: skip
+    failed = {Path(r["source"]).name: r["error"] for r in rows if r["status"] == "failed"}
+    assert set(failed) == {"cmu_12_01_walk.bvh", "broken.bvh", "dataset-1_bow_sad_001.bvh"}
+    assert "KilledWorker" in failed["cmu_12_01_walk.bvh"]
+    assert failed["dataset-1_bow_sad_001.bvh"] == "internal error: ValueError: a bug in one take"
+    assert counts.done == 2
+    assert repository.list_takes()[1] == 2
+    engine.client().wait_for_workers(2, timeout=600)
+    repository.close()
+
+
+def test_chunk_size_keeps_small_batches_one_take_per_task() -> None:
+    assert [chunk_size(n, 8) for n in (0, 1, 15, 16, 31, 32, 48, 64, 2000)] == [
+        1, 1, 1, 1, 1, 2, 3, 4, 4,
+    ]  # fmt: skip
+    assert chunk_size(2000, 8) == CHUNK_TAKES
 
 
 def _environment(tmp_path: Path) -> dict[str, str]:

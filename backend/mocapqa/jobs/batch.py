@@ -29,10 +29,15 @@ from mocapqa.store.shoots import ShootStore
 if TYPE_CHECKING:
     from mocapqa.pipeline.options import AnalysisOptions
 
-__all__ = ["MOTION_SUFFIXES", "BatchCounts", "discover", "run_batch"]
+__all__ = ["CHUNK_TAKES", "MOTION_SUFFIXES", "BatchCounts", "chunk_size", "discover", "run_batch"]
 
 MOTION_SUFFIXES = (".bvh", ".trc", ".csv", ".json", ".npy", ".npz", ".pbtxt")
 """File suffixes a batch analyses; other files under a folder are ignored."""
+
+CHUNK_TAKES = 4
+"""Takes per Dask task in a large batch. A task costs the client, scheduler and worker about
+9 ms of CPU beyond the take's own work (about 95 ms): one take per task made the Dask path
+about 10 % dearer than a loop, four per task make it about 2 % (docs/batch.md)."""
 
 Row = dict[str, Any]
 Task = Callable[[str, dict[str, Any], str, str, str | None], dict[str, Any]]
@@ -273,6 +278,26 @@ def _run_on_dask(
         raise lost from e
 
 
+def _analyse_chunk(task: Task, items: list[tuple[Any, ...]]) -> list[tuple[bool, Any]]:
+    """Run ``task`` on each argument tuple of ``items`` (one Dask task for several takes):
+    ``(True, outcome)``, or ``(False, "Name: message")`` for a take whose task raised, so that
+    one take's bug fails that take only."""
+    results: list[tuple[bool, Any]] = []
+    for arguments in items:
+        try:
+            results.append((True, task(*arguments)))
+        except Exception as e:  # reported per take, as a single-take task's would be
+            results.append((False, f"{type(e).__name__}: {e}"))
+    return results
+
+
+def chunk_size(n_pending: int, in_flight: int) -> int:
+    """Takes per Dask task: :data:`CHUNK_TAKES` when there are enough takes to keep every
+    slot in flight busy with whole chunks, fewer for a small batch (one take per task below
+    ``2 · in_flight`` takes), so that small batches still spread over every worker."""
+    return max(1, min(CHUNK_TAKES, n_pending // (2 * in_flight)))
+
+
 def _submit_and_collect(
     engine: Engine,
     pending: list[tuple[Path, str]],
@@ -282,52 +307,69 @@ def _submit_and_collect(
     finish: Callable[[Path, str, str, str, dict[str, Any]], None],
     emit: Callable[[Row], None],
 ) -> None:
+    from collections import deque
+
     from distributed import as_completed
 
     client = engine.client()
     in_flight = max(8, 4 * max(1, engine.n_workers()))
-    queue = iter(pending)
-    meta: dict[str, tuple[Path, str, str, str]] = {}
+    size = chunk_size(len(pending), in_flight)
+    units: deque[list[tuple[Path, str]]] = deque(
+        pending[start : start + size] for start in range(0, len(pending), size)
+    )
+    meta: dict[str, list[tuple[Path, str, str, str]]] = {}
 
     def submit() -> Any:
-        item = next(queue, None)
-        if item is None:
+        if not units:
             return None
-        path, sha = item
-        take_id, run_id = new_id(), new_id()
+        unit = [(path, sha, new_id(), new_id()) for path, sha in units.popleft()]
+        items = [
+            (str(path), options_json, take_id, run_id, folder) for path, _, take_id, run_id in unit
+        ]
+        _, sha, _, run_id = unit[0]
         future = client.submit(
+            _analyse_chunk,
             task,
-            str(path),
-            options_json,
-            take_id,
-            run_id,
-            folder,
-            key=f"analyse-{sha[:16]}-{run_id[:8]}",
+            items,
+            key=f"analyse-{len(unit)}-{sha[:16]}-{run_id[:8]}",
             pure=False,
         )
-        meta[future.key] = (path, sha, take_id, run_id)
+        meta[future.key] = unit
         return future
 
     first = [f for f in (submit() for _ in range(in_flight)) if f is not None]
     waiting = as_completed(first)  # type: ignore[no-untyped-call]
     for future in waiting:
-        path, sha, take_id, run_id = meta.pop(future.key)
+        unit = meta.pop(future.key)
         try:
-            outcome = future.result()
-        except Exception as e:  # a crashed worker (KilledWorker) or a bug in one take
+            results = future.result()
+        except Exception as e:  # a crashed worker (KilledWorker) or a lost scheduler
             lost = engine.lost_after_settling(e)
             if lost is not None:  # every task in flight is cancelled: stop, store nothing
                 raise lost from e
             name = type(e).__name__
-            reason = (
-                f"worker died while analysing this take ({name}: {e})"
-                if name == "KilledWorker"
-                else f"internal error: {name}: {e}"
-            )
-            emit({"source": str(path), "status": "failed", "error": reason})
+            if name == "KilledWorker" and len(unit) > 1:
+                # Which take killed the workers is not known: each is sent again alone, so
+                # only the one that kills two more fails (ALLOWED_FAILURES).
+                units.extendleft([(path, sha)] for path, sha, _, _ in reversed(unit))
+            else:
+                reason = (
+                    f"worker died while analysing this take ({name}: {e})"
+                    if name == "KilledWorker"
+                    else f"internal error: {name}: {e}"
+                )
+                for path, _, _, _ in unit:
+                    emit({"source": str(path), "status": "failed", "error": reason})
         else:
-            finish(path, sha, take_id, run_id, outcome)
+            for (path, sha, take_id, run_id), (ran, outcome) in zip(unit, results, strict=True):
+                if ran:
+                    finish(path, sha, take_id, run_id, outcome)
+                else:
+                    error = f"internal error: {outcome}"
+                    emit({"source": str(path), "status": "failed", "error": error})
         future.release()
-        following = submit()
-        if following is not None:
+        while len(meta) < in_flight:
+            following = submit()
+            if following is None:
+                break
             waiting.add(following)  # type: ignore[no-untyped-call]
