@@ -131,8 +131,8 @@ def fit_on_fit_takes(records: Sequence[IntervalRecord], path: Path | None = None
     takes = len({(r.rig, r.take) for r in fit})
     description = (
         f"{len(fit)} intervals ({sum(r.right for r in fit)} right) on {takes} fit takes "
-        f"({', '.join(rigs)}), injected with level shifts (the paper's protocol) and with "
-        "bursts of flips, and their clean versions"
+        f"({', '.join(rigs)}), injected with level shifts (the paper's protocol), bursts of "
+        "flips and unpaired bursts after a natural roll step, and their clean versions"
     )
     return fit_calibration(
         np.array([r.features for r in fit]), [r.right for r in fit], description, path,

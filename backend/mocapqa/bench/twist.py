@@ -57,6 +57,7 @@ __all__ = [
     "MethodResult",
     "TwistBenchResult",
     "find_bench_files",
+    "interval_records",
     "rig_of",
     "run_twist_bench",
     "speed_frames_per_s",
@@ -308,12 +309,14 @@ def speed_frames_per_s(
     return n / best_wall, n / max(best_cpu, 1e-9), n / best_full
 
 
-def _interval_records(
+def interval_records(
     analysis: TwistAnalysis,
     truth_offsets: FloatArray | None,
     bench_file: BenchFile,
 ) -> list[IntervalRecord]:
-    """Each interval of ``analysis`` labelled right or wrong against the injected offsets."""
+    """Each interval of ``analysis`` labelled right or wrong against the injected offsets
+    (parent joint columns of ``truth_offsets``, shape (F, J), radians; None: a clean take, where
+    every interval is wrong)."""
     out = []
     for interval, found in zip(analysis.intervals, analysis.found, strict=True):
         if not found.features:
@@ -390,7 +393,7 @@ def run_twist_bench(
             for corrupted, truth in injected:
                 analysis = analyze_twist(corrupted, method, params=params, apply=apply)
                 refined = analysis.refined
-                result.records += _interval_records(analysis, truth.offsets_rad, bench_file)
+                result.records += interval_records(analysis, truth.offsets_rad, bench_file)
                 for k, target in enumerate(truth.targets):
                     rows = truth.error_mask[:, target]
                     key = (bench_file.rig, bench_file.held_out, truth.sides[k], truth.segments[k])
@@ -410,7 +413,7 @@ def run_twist_bench(
             start = time.perf_counter()
             analysis = analyze_twist(motion, method, params=params, apply=apply)
             elapsed = time.perf_counter() - start
-            result.records += _interval_records(analysis, None, bench_file)
+            result.records += interval_records(analysis, None, bench_file)
             result.seconds[bench_file.rig] = result.seconds.get(bench_file.rig, 0.0) + elapsed
             result.frames[bench_file.rig] = result.frames.get(bench_file.rig, 0) + motion.n_frames
             mask = np.broadcast_to(has_rotation, motion.quats.shape[:2])

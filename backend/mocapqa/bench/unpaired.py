@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mocapqa.bench.natural import natural_error_figures
-from mocapqa.bench.twist import RIGS, BenchFile
+from mocapqa.bench.twist import RIGS, BenchFile, IntervalRecord, interval_records
 from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.twist.analysis import analyze_twist
@@ -65,6 +65,7 @@ def run_unpaired_bench(
     repeats: int = 2,
     apply: str = "confident",
     on_file: Callable[[BenchFile], None] | None = None,
+    records: list[IntervalRecord] | None = None,
 ) -> dict[Key, UnpairedTotals]:
     """Inject unpaired bursts into every take, refine with the robust method and measure.
 
@@ -81,6 +82,9 @@ def run_unpaired_bench(
         The apply choice of the refinement.
     on_file : callable, optional
         Called after each take (progress).
+    records : list of IntervalRecord, optional
+        When given, every interval found is appended to it, labelled right or wrong against
+        the injected burst like the other injections' intervals (for the calibration).
 
     Returns
     -------
@@ -95,10 +99,12 @@ def run_unpaired_bench(
         for repeat in range(repeats):
             rng = np.random.default_rng((seed, name_key, repeat))
             try:
-                corrupted, _ = inject_unpaired_bursts(motion, rng)
+                corrupted, truth = inject_unpaired_bursts(motion, rng)
             except InputError:
                 continue
             analysis = analyze_twist(corrupted, "robust", params=params, apply=apply)
+            if records is not None:
+                records += interval_records(analysis, truth.offsets_rad, bench_file)
             f = natural_error_figures(corrupted, analysis)
             key = (bench_file.rig, bench_file.held_out, bench_file.path.name, repeat)
             out[key] = UnpairedTotals(1, f.n_jumps, f.n_removed, f.n_far_frames, f.n_far_moved,

@@ -339,7 +339,9 @@ def bench_twist(
         unpaired_table,
     )
     from mocapqa.io.bvh import read_bvh
+    from mocapqa.twist.intervals import FEATURES
 
+    split = FEATURES.index("split")
     methods_chosen = method or ["robust", "paper"]
     for m in methods_chosen:
         _check_method(m)
@@ -354,6 +356,7 @@ def bench_twist(
             for r in _run(fit_files, {"robust": ("robust", None)}, seed, repeats, console, "all",
                           kind).methods["robust"].records
         ]  # fmt: skip
+        run_unpaired_bench(fit_files, seed=seed, repeats=repeats, apply="all", records=records)
         calibration = fit_on_fit_takes(records, fit_calibration)
         console.print(f"calibration written to {fit_calibration}: {calibration.fitted_on}")
         probabilities = calibration.probability(np.array([r.features for r in records]))
@@ -396,13 +399,29 @@ def bench_twist(
                 disagreement_loro([*main_methods["robust"].records, *bursts["robust"].records])
             )
         )
+        unpaired_records: list[Any] = []
         with Progress(console=console, transient=True) as progress:
             task = progress.add_task("unpaired bursts", total=len(bench_files))
             unpaired = run_unpaired_bench(
                 bench_files, seed=seed, repeats=repeats,
                 on_file=lambda f: progress.update(task, advance=1, description=f.path.name),
+                records=unpaired_records,
             )  # fmt: skip
         console.print(unpaired_table(unpaired))
+        for title, records in (
+            ("unpaired bursts", unpaired_records),
+            ("bursts split off a group", [
+                r for r in [*main_methods["robust"].records, *bursts["robust"].records,
+                            *unpaired_records] if r.features and r.features[split] > 0
+            ]),
+        ):  # fmt: skip
+            held = [r for r in records if r.held_out]
+            console.print(
+                calibration_table(
+                    f"Calibration on the held-out takes, {title} ({len(held)} intervals)",
+                    reliability([r.confidence for r in held], [r.right for r in held]),
+                )
+            )
     if ablation:
         console.print(_ablation_table(result.methods))
     if loro:

@@ -49,12 +49,17 @@ FEATURES = (
     "disagreement",
     "log_length_s",
     "log_level_deg",
+    "split",
+    "unreturned",
 )
 """Names of the confidence features of an interval, in :attr:`IntervalEstimate.features` order:
 log of the smaller end jump over the chain's natural roll scale per frame; largest
 counter-rotation mismatch ratio of its events (0 = exact); net jump over largest jump (0 = the
 ends agree); largest disagreement between the outside and the accumulated level, relative;
-log of the duration in seconds; log of the largest level in degrees."""
+log of the duration in seconds; log of the largest level in degrees; 1 for a burst split off
+a group by the mirror check, else 0; the part of the roll's net change across the interval
+that the child counter-rotates (a twist offset that has not returned to the natural level,
+measured from outside, not from the jumps) over its largest jump."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -162,6 +167,30 @@ def _spread(values: FloatArray) -> float:
     return float(1.4826 * np.median(np.abs(wrap_angle(values - centre))))
 
 
+def _unreturned(
+    parent: tuple[FloatArray, FloatArray],
+    child: tuple[FloatArray, FloatArray] | None,
+    before: int,
+    after: int,
+) -> float:
+    """The counter-rotated part of the net roll change between two anchors, radians (≥ 0).
+
+    Each roll's change from ``before`` to ``after`` beyond its natural velocities; a twist
+    offset left at ``after`` moves the parent and the child oppositely, a natural step moves
+    one of them (or both alike): the common opposite part, ``min(|P|, |C|)`` when the signs
+    differ, else 0. ``parent`` and ``child`` are each (integrated roll, natural increments);
+    without the child, 0.
+    """
+    if child is None:
+        return 0.0
+    travel = slice(before + 1, after + 1)
+    p_net, c_net = (
+        float(wrap_angle(np.array(r[after] - r[before] - np.sum(n[travel]))))
+        for r, n in (parent, child)
+    )
+    return min(abs(p_net), abs(c_net)) if p_net * c_net < 0 else 0.0
+
+
 def chain_intervals(
     frames: IntArray,
     jumps: FloatArray,
@@ -255,13 +284,16 @@ def chain_intervals(
     tail_frames = max(0, round(tail_s * fps)) if small_steps is not None else 0
     roll = np.cumsum(increments)
     groups = _groups(frames, jumps, threshold, closure_fraction, burst_gap, max_frames, sigma)
-    if mirror > 0 and child is not None:
-        rolls = (roll, np.cumsum(child[0]))
-        groups = split_unmirrored(frames, groups, rolls, (natural, child[1]), burst_gap, mirror)
+    split = [False] * len(groups)
+    child_roll = None if child is None else (np.cumsum(child[0]), child[1])
+    if mirror > 0 and child_roll is not None:
+        groups, split = split_unmirrored(
+            frames, groups, (roll, child_roll[0]), (natural, child_roll[1]), burst_gap, mirror
+        )
     # Anchors must sit where the roll is at its natural level: outside every interval and
     # away from events that belong to none.
     forbidden = forbidden_frames(frames, groups, n_frames, burst_gap)
-    for group in groups:
+    for group, is_split in zip(groups, split, strict=True):
         events = frames[group]
         first, last = int(events[0]), int(events[-1])
         steps = jumps[group]
@@ -311,6 +343,7 @@ def chain_intervals(
             continue
         applied = applied[nonzero[0] : nonzero[-1] + 1]
         ends = min(abs(float(steps[0])), abs(float(steps[-1])))
+        unreturned = _unreturned((roll, natural), child_roll, before, after)
         features = (
             float(np.log(ends / scale)),
             float(np.max(mismatch[group])),
@@ -318,6 +351,8 @@ def chain_intervals(
             float(min(disagreement, 2.0)),
             float(np.log((last - first) / fps)),
             float(np.log(np.rad2deg(np.max(np.abs(applied))))),
+            float(is_split),
+            unreturned / float(np.max(np.abs(steps))),
         )
         level_mean = float(np.angle(np.mean(np.exp(1j * applied))))
         start, end = first + int(nonzero[0]), first + int(nonzero[-1])

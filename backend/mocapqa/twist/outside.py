@@ -113,7 +113,7 @@ def split_unmirrored(
     naturals: tuple[FloatArray, FloatArray],
     burst_gap: int,
     mirror: float,
-) -> list[list[int]]:
+) -> tuple[list[list[int]], list[bool]]:
     """Groups that pair a burst with events far from it, split where the child does not mirror.
 
     A group whose events form two or more clusters (events within ``burst_gap``), one of them
@@ -139,18 +139,23 @@ def split_unmirrored(
 
     Returns
     -------
-    list of list of int
+    groups : list of list of int
         The groups kept and the bursts of those split.
+    split : list of bool
+        For each group, whether it is a burst split off a group (its ends need not agree:
+        the rest of its group's net was paired with it).
     """
     n_frames = len(rolls[0])
     forbidden = forbidden_frames(frames, groups, n_frames, burst_gap)
     out: list[list[int]] = []
+    split: list[bool] = []
     for group in groups:
         events = frames[group]
         cuts = np.flatnonzero(np.diff(events) > burst_gap) + 1
         clusters = [list(c) for c in np.split(np.array(group), cuts)]
         if len(clusters) < 2 or max(len(c) for c in clusters) < 2:
             out.append(group)
+            split.append(False)
             continue
         before, _ = anchors(forbidden, int(events[0]), int(events[-1]))
         stop = int(events[-1]) + 1
@@ -173,6 +178,9 @@ def split_unmirrored(
             mirrored &= gap <= mirror * min(abs(p_level), abs(c_level))
         if mirrored:
             out.append(group)
+            split.append(False)
         else:
-            out += [c for c in clusters if len(c) >= 2]
-    return out
+            bursts = [c for c in clusters if len(c) >= 2]
+            out += bursts
+            split += [True] * len(bursts)
+    return out, split
