@@ -3,19 +3,24 @@
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from mocapqa.bench.natural import natural_error_figures
+from mocapqa.bench.twist import IntervalRecord, find_bench_files
+from mocapqa.bench.unpaired import run_unpaired_bench
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.errors import InputError
 from mocapqa.kinematics.quaternion import conjugate, multiply
 from mocapqa.twist.analysis import analyze_twist
 from mocapqa.twist.angles import chain_geometry, wrap_angle
+from mocapqa.twist.confidence import default_calibration
 from mocapqa.twist.detect import RobustParams, detect_robust
 from mocapqa.twist.inject_unpaired import UnpairedShape, inject_unpaired_bursts
+from mocapqa.twist.intervals import FEATURES
 
 FPS = 60.0
 
@@ -141,3 +146,50 @@ def test_the_shape_is_checked(takes: dict[str, Motion]) -> None:
                     euler_hint_deg=None)  # fmt: skip
     with pytest.raises(InputError, match="at least"):
         inject_unpaired_bursts(short, np.random.default_rng(0))
+
+
+def _burst_features(child_burst: dict[int, float]) -> tuple[float, ...]:
+    """The features of the one interval of a two-flip burst at frames 130–131 (quiet rolls)."""
+    dp, dc = _increments({130: 30.0, 131: -38.0}, child_burst)
+    (interval,) = detect_robust(dp, dc, FPS, RobustParams()).intervals
+    assert interval.start_frame == 130
+    return interval.features
+
+
+def test_unreturned_is_the_net_the_child_counter_rotates() -> None:
+    # The parent's net of −8° is natural when the child does not counter-rotate it (the burst
+    # returned), a twist offset left over when the child counter-rotates it too.
+    index = FEATURES.index("unreturned")
+    returned = _burst_features({130: -30.0, 131: 30.0})
+    kept = _burst_features({130: -30.0, 131: 38.0})
+    assert returned[index] < 0.02
+    assert kept[index] == pytest.approx(8.0 / 38.0, abs=0.02)
+    # Both read the same net from their jumps; only the new feature tells them apart.
+    closure = FEATURES.index("closure")
+    assert abs(returned[closure] - kept[closure]) < 0.15
+    # The shipped calibration rates the burst that left an offset lower, all else equal.
+    calibration = default_calibration()
+    probability = calibration.probability(np.array([returned, [*returned[:index], kept[index]]]))
+    assert probability[0] > probability[1]
+
+
+def test_a_burst_the_mirror_check_splits_off_is_flagged() -> None:
+    dp, dc = _increments({**STEP[0], **BURST[0]}, {**STEP[1], **BURST[1]})
+    split = FEATURES.index("split")
+    checked = detect_robust(dp, dc, FPS, RobustParams()).intervals
+    assert [i.features[split] for i in checked if i.start_frame >= 130] == [1.0]
+    assert all(i.features[split] == 0.0 for i in checked if i.start_frame < 130)
+    unchecked = detect_robust(dp, dc, FPS, replace(RobustParams(), mirror=0.0)).intervals
+    assert unchecked
+    assert all(i.features[split] == 0.0 for i in unchecked)
+
+
+def test_the_unpaired_bench_labels_its_intervals(corpus_dir: Path) -> None:
+    files = [f for f in find_bench_files(corpus_dir / "bvh") if f.rig == "iclone"][:1]
+    records: list[IntervalRecord] = []
+    figures = run_unpaired_bench(files, repeats=2, records=records)
+    assert records
+    assert {r.take for r in records} == {files[0].path.name}
+    assert any(r.right for r in records)
+    # The records are those of the refined takes the figures describe.
+    assert sum(v.n_injected for v in figures.values()) == 2
