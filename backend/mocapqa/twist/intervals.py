@@ -27,7 +27,9 @@ Conventions
   jittering by more than the level cannot contradict it). Where the jumps do not cancel (a
   burst whose ends disagree), the outside level is used.
 * A group that pairs a burst with events far from it is kept only where the child's roll
-  mirrors the parent's between them (:func:`mocapqa.twist.outside.split_unmirrored`).
+  mirrors the parent's between them (:func:`mocapqa.twist.outside.split_unmirrored`); the
+  bursts of a group split there are marked (feature ``split``), and every interval's
+  ``unreturned`` feature reads, from the rolls outside it, how much twist offset its end leaves.
 """
 
 from __future__ import annotations
