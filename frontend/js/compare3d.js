@@ -47,7 +47,7 @@ export async function compareViews(container, a, b, labels, onTeardown = () => {
   const presets = ["front", "side", "top"].map((name) => h("button", { class: "small", "data-preset": name }, name));
   container.append(h("h2", {}, "Side by side in 3D (each run's corrected take, one camera)"),
     h("div", { class: "controls" }, "camera ", presets),
-    h("div", { class: "row", id: "compare-3d" }, h("div", { class: "col panel" }, titleA, divA), h("div", { class: "col panel" }, titleB, divB)),
+    h("div", { class: "row view-row", id: "compare-3d" }, h("div", { class: "col panel" }, titleA, divA), h("div", { class: "col panel" }, titleB, divB)),
     h("div", { class: "controls panel" }, play, scrubber, h("label", {}, "B offset ", offset, " frames of B")));
   // Both views draw "corrected" points: A's in the first view, B's in the second.
   const overview = {

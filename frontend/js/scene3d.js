@@ -1,8 +1,12 @@
 // The two 3D views drawn with three.js: one camera (one orbit state, one THREE camera) renders
-// both views, so they cannot drift apart nor re-trigger each other. A frame update rewrites
-// vertex buffers and asks for one render on the next animation frame; nothing queues.
+// both views, so they cannot drift apart nor re-trigger each other. One WebGL canvas, laid over
+// both panels, draws them in two scissored viewports: the browser's compositor reads a WebGL
+// canvas back once per frame, and with two canvases those reads were most of a frame's cost.
+// A frame update rewrites vertex buffers and asks for one render on the next animation frame;
+// nothing queues.
 import * as THREE from "/static/vendor/three/three.module.min.js";
 import * as geo from "./geometry.js";
+import { canvasLayout, sameLayout } from "./viewports.js";
 
 const BODY = new THREE.Color("#5b84b1");
 const MARKED = new THREE.Color("#f39c12");
@@ -70,19 +74,27 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   const size = 2 * box.half;
   const orbit = { ...geo.PRESETS.front, distance: size * 1.5, target: [0, floorY + size * 0.4, 0] };
   const camera = new THREE.PerspectiveCamera(35, 1, size / 100, size * 200);
+  // The one canvas: absolutely placed in the row that holds both panels, over the union of the
+  // shown views; it takes no pointer events (each view's own element does) and is transparent
+  // between the views, where the panels' borders and gap show through.
+  const row = divs.raw.parentNode.parentNode;
+  const canvas = document.createElement("canvas");
+  canvas.className = "view-canvas";
+  canvas.setAttribute("aria-hidden", "true");
+  row.append(canvas);
+  // No multisampling: on a CPU rasteriser (SwiftShader, headless) it cost 40 % of the frame
+  // rate (15.6 → 25.7 frames/s in playback); the pixel ratio still smooths HiDPI screens.
+  // A transparent canvas: between the views, the panels' borders and the page show through (an
+  // opaque one, which would have to paint them, measured no faster).
+  const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, alpha: true });
+  renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
+  // No depth sorting of objects: it needs bounding spheres, which a missing keypoint (NaN, not
+  // drawn) would spoil; opaque parts go before the transparent ghost all the same.
+  renderer.sortObjects = false;
   const views = {};
   for (const [name, div] of Object.entries(divs)) {
-    const canvas = document.createElement("canvas");
-    canvas.className = "view-canvas";
-    canvas.setAttribute("aria-label", `${name} skeleton, drag to orbit, wheel to zoom`);
-    div.append(canvas);
-    // No multisampling: on a CPU rasteriser (SwiftShader, headless) it cost 40 % of the frame
-    // rate (15.6 → 25.7 frames/s in playback); the pixel ratio still smooths HiDPI screens.
-    const renderer = new THREE.WebGLRenderer({ canvas, antialias: false });
-    renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
-    // No depth sorting of objects: it needs bounding spheres, which a missing keypoint (NaN, not
-    // drawn) would spoil; opaque parts go before the transparent ghost all the same.
-    renderer.sortObjects = false;
+    div.setAttribute("role", "img");
+    div.setAttribute("aria-label", `${name} skeleton, drag to orbit, wheel to zoom`);
     const parts = viewScene(bones.length, names.length, nJoints, oriented);
     const grid = new THREE.GridHelper(size * 3, 12, 0xc0c7cf, 0xe3e7ec);
     grid.position.y = floorY;
@@ -93,7 +105,7 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
         new THREE.LineBasicMaterial({ color: 0x95a5a6 }));
       parts.scene.add(line);
     }
-    views[name] = { div, canvas, renderer, ...parts };
+    views[name] = { div, ...parts };
   }
   const tooltip = document.createElement("div");
   tooltip.className = "joint-tooltip";
@@ -104,24 +116,50 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   let focus = "body";
   let frame = null, triadsOn = false, overlayOn = false, renders = 0, drawn = 0, scheduled = 0, marked = false;
   const sizeOf = (view) => [view.div.clientWidth, view.div.clientHeight];
+  // The shown views' rectangles (inside their borders, from the row's padding edge, where the
+  // absolutely placed canvas is measured from) → the canvas box and the viewports.
+  let layout = null;
+  const place = () => {
+    const r0 = row.getBoundingClientRect();
+    const originLeft = r0.left + row.clientLeft, originTop = r0.top + row.clientTop;
+    const shown = Object.values(views).map((view) => {
+      if (view.div.offsetParent === null) return null;
+      const r = view.div.getBoundingClientRect();
+      return { left: r.left + view.div.clientLeft - originLeft, top: r.top + view.div.clientTop - originTop, width: view.div.clientWidth, height: view.div.clientHeight };
+    });
+    const next = canvasLayout(shown);
+    if (!sameLayout(layout, next)) {
+      Object.assign(canvas.style, { left: `${next.box.left}px`, top: `${next.box.top}px` });
+      renderer.setSize(next.box.width, next.box.height, true);
+      layout = next;
+    }
+    return layout;
+  };
   const render = () => {
     scheduled = 0;
     camera.position.set(...geo.orbitPosition(orbit.target, orbit.azimuth, orbit.elevation, orbit.distance));
     camera.up.set(0, 1, 0);
     camera.lookAt(...orbit.target);
-    for (const view of Object.values(views)) {
-      if (view.div.offsetParent === null) continue;
-      const [w, h] = sizeOf(view);
-      if (view.canvas.width !== Math.round(w * view.renderer.getPixelRatio()) || view.canvas.height !== Math.round(h * view.renderer.getPixelRatio())) view.renderer.setSize(w, h, true);
-      camera.aspect = w / Math.max(1, h);
+    const { viewports } = place();
+    // Each view's viewport is cleared to its scene's white and drawn; the rest of the canvas stays
+    // transparent: WebGL clears the drawing buffer after each composite (preserveDrawingBuffer
+    // is false), so no clear of the whole canvas is needed.
+    renderer.setScissorTest(true);
+    Object.values(views).forEach((view, k) => {
+      const v = viewports[k];
+      if (!v) return;
+      renderer.setViewport(v.x, v.y, v.width, v.height);
+      renderer.setScissor(v.x, v.y, v.width, v.height);
+      camera.aspect = v.width / Math.max(1, v.height);
       camera.updateProjectionMatrix();
-      view.renderer.render(view.scene, camera);
-    }
+      renderer.render(view.scene, camera);
+    });
     if (frame && !marked) { marked = true; performance.mark("skeletons-drawn"); }
     renders += 1;
   };
   const requestRender = () => { if (!scheduled) scheduled = requestAnimationFrame(render); };
-  new ResizeObserver(requestRender).observe(divs.raw.parentNode.parentNode);
+  const resized = new ResizeObserver(requestRender);
+  for (const element of [row, ...Object.values(divs)]) resized.observe(element);
 
   // Per frame, vertex buffers are rewritten in place and nothing is allocated. The bones' light
   // (the scene's ambient and directional light, as a Lambert material would show it) is baked
@@ -181,15 +219,18 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   };
 
   // Orbit: drag to turn, wheel to zoom; both views move the one camera.
+  // Each view's element (under the canvas, which lets the pointer through) takes its own events,
+  // so a click picks among the joints of the view it landed in.
   for (const view of Object.values(views)) {
+    const target = view.div;
     let last = null, travelled = 0;
-    view.canvas.addEventListener("pointerdown", (e) => { last = [e.clientX, e.clientY]; travelled = 0; view.canvas.setPointerCapture(e.pointerId); });
-    view.canvas.addEventListener("pointerup", (e) => {
+    target.addEventListener("pointerdown", (e) => { last = [e.clientX, e.clientY]; travelled = 0; target.setPointerCapture(e.pointerId); });
+    target.addEventListener("pointerup", (e) => {
       last = null;
-      view.canvas.releasePointerCapture(e.pointerId);
+      target.releasePointerCapture(e.pointerId);
       if (travelled < 4) { const j = nearest(view, e); if (j != null) onSelect(j); } // a click, not a drag
     });
-    view.canvas.addEventListener("pointermove", (e) => {
+    target.addEventListener("pointermove", (e) => {
       if (last) {
         travelled += Math.abs(e.clientX - last[0]) + Math.abs(e.clientY - last[1]);
         orbit.azimuth -= (e.clientX - last[0]) * 0.01;
@@ -198,8 +239,8 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
         requestRender();
       } else hover(view, e);
     });
-    view.canvas.addEventListener("pointerleave", () => { tooltip.hidden = true; });
-    view.canvas.addEventListener("wheel", (e) => {
+    target.addEventListener("pointerleave", () => { tooltip.hidden = true; });
+    target.addEventListener("wheel", (e) => {
       e.preventDefault();
       orbit.distance = Math.max(size * 0.3, Math.min(size * 8, orbit.distance * Math.exp(e.deltaY * 0.001)));
       requestRender();
@@ -208,8 +249,9 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   // Hover: the joint nearest the pointer (within 10 px) names itself.
   const project = (view, point) => {
     const v = new THREE.Vector3(point[0], point[1], point[2]).project(camera);
-    const rect = view.canvas.getBoundingClientRect();
-    return [rect.left + ((v.x + 1) / 2) * rect.width, rect.top + ((1 - v.y) / 2) * rect.height];
+    const rect = view.div.getBoundingClientRect();
+    const left = rect.left + view.div.clientLeft, top = rect.top + view.div.clientTop;
+    return [left + ((v.x + 1) / 2) * view.div.clientWidth, top + ((1 - v.y) / 2) * view.div.clientHeight];
   };
   const aspectFor = (view) => { const [w, h] = sizeOf(view); camera.aspect = w / Math.max(1, h); camera.updateProjectionMatrix(); };
   const nearest = (view, e) => {
@@ -269,6 +311,8 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
     setCamera(name) { Object.assign(orbit, geo.PRESETS[name]); requestRender(); },
     setTriads(on) { triadsOn = on && oriented; for (const v of Object.values(views)) v.axes.visible = triadsOn; if (frame) show(frame); },
     setOverlay(on) { overlayOn = on; views.corrected.ghost.visible = on; if (frame) show(frame); },
-    dispose() { tooltip.remove(); for (const v of Object.values(views)) v.renderer.dispose(); },
+    /** The canvas's box and each view's viewport (CSS pixels, y from the bottom), as last drawn. */
+    get layout() { return layout && { box: { ...layout.box }, viewports: layout.viewports.map((v) => v && { ...v }) }; },
+    dispose() { resized.disconnect(); tooltip.remove(); renderer.dispose(); canvas.remove(); },
   };
 }

@@ -22,8 +22,8 @@ const LOOP_MARGIN_S = 0.5; // "loop this finding": seconds shown before and afte
 
 export async function takeView(main, takeId, params, onTeardown) {
   const runParam = params.get("run");
-  // three.js: only the take view loads it, its three modules together.
-  preloadModules(["/static/js/geometry.js", "/static/vendor/three/three.module.min.js", "/static/vendor/three/three.core.min.js"]);
+  // three.js: only the take view loads it, its modules together.
+  preloadModules(["/static/js/geometry.js", "/static/js/viewports.js", "/static/vendor/three/three.module.min.js", "/static/vendor/three/three.core.min.js"]);
   const scene = import("./scene3d.js");
   const take = await api.getTake(takeId);
   performance.mark("take-fetched");
@@ -79,7 +79,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   const loopLabel = h("span", { id: "loop-label", class: "muted" }, "in/out: none (I / O or drag on the bar)");
   const triadsBox = h("input", { type: "checkbox", id: "show-axes", disabled: !oriented });
   const overlayBox = h("input", { type: "checkbox", id: "overlay" });
-  const viewsRow = h("div", { class: "row", id: "views" }, rawPanel, h("div", { class: "col panel" }, corrTitle, corrDiv));
+  const viewsRow = h("div", { class: "row view-row", id: "views" }, rawPanel, h("div", { class: "col panel" }, corrTitle, corrDiv));
   main.append(
     runPicker(take, run),
     h("div", { class: "controls view-options" }, "camera ", presets, closeButton, followButton,

@@ -235,6 +235,16 @@ def test_a_knee_twist_error_shows_in_the_oriented_bones(
     for f in result["findings"]:
         busy.update(range(f["start_frame"] - 5, f["end_frame"] + 6))
     clean = next(k for k in range(20, result["summary"]["n_frames"]) if k not in busy)
+    # One canvas draws both views: the two regions compared below are its two viewports.
+    canvas = page.page.locator("#views canvas")
+    assert canvas.count() == 1
+    box = canvas.bounding_box()
+    for view in ("#view-raw", "#view-corrected"):
+        region = page.page.locator(view).bounding_box()
+        assert box["x"] <= region["x"]
+        assert region["x"] + region["width"] <= box["x"] + box["width"]
+        assert box["y"] <= region["y"]
+        assert region["y"] + region["height"] <= box["y"] + box["height"]
     differences = {}
     for axes in (False, True):
         if axes:
@@ -453,16 +463,35 @@ def test_timings_overlay_and_upload_progress(
         " [n, performance.getEntriesByName(n)[0].startTime]))"
     )
     marks["fcp"], marks["skeletons"] = marks["first-contentful-paint"], marks["skeletons-drawn"]
-    # Scrubbing: 60 scrubber moves, each drawn before the next.
-    scrub_s = fresh.page.evaluate(
+    # Scrubbing, measured two ways. "paced": 60 scrubber moves, each waited for two animation
+    # frames (drawn, then painted), so at most half the display's rate (30/s at 60 Hz).
+    # "per frame": a move in every animation frame, as a drag on the scrubber delivers them, for
+    # 120 frames: the updates the views drew per second. The idle page's animation frames per
+    # second are the display's rate, the ceiling of the second figure.
+    scrub = fresh.page.evaluate(
         """async () => {
           const s = document.getElementById('scrubber');
-          const t0 = performance.now();
+          const views = window.mocapqaViews;
+          const frame = () => new Promise((r) => requestAnimationFrame(r));
+          await frame();
+          let t0 = performance.now();
           for (let k = 0; k < 60; k++) {
             s.value = 1000 + 37 * k; s.dispatchEvent(new Event('input'));
-            await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+            await frame(); await frame();
           }
-          return (performance.now() - t0) / 1000; }"""
+          const paced = (performance.now() - t0) / 1000;
+          t0 = performance.now();
+          for (let k = 0; k < 30; k++) await frame();
+          const idle = (performance.now() - t0) / 1000;
+          const renders = views.renders;
+          t0 = performance.now();
+          for (let k = 0; k < 120; k++) {
+            s.value = 3000 + 37 * k; s.dispatchEvent(new Event('input'));
+            await frame();
+          }
+          const perFrame = (performance.now() - t0) / 1000;
+          return { paced, idle, perFrame, drawn: views.renders - renders,
+                   canvases: document.querySelectorAll('#views canvas').length }; }"""
     )
     fresh.close()
     TIMINGS["big_take"] = {
@@ -470,10 +499,15 @@ def test_timings_overlay_and_upload_progress(
         "joints": 31,
         "first_contentful_paint_s": round(marks["fcp"] / 1000, 3),
         "skeletons_after_first_paint_s": round((marks["skeletons"] - marks["fcp"]) / 1000, 3),
-        "scrub_frames_per_s": round(60 / scrub_s, 1),
+        "scrub_frames_per_s": round(60 / scrub["paced"], 1),
+        "scrub_updates_per_s": round(scrub["drawn"] / scrub["perFrame"], 1),
+        "animation_frames_per_s": round(30 / scrub["idle"], 1),
         "marks_s": {k: round(v / 1000, 3) for k, v in marks.items()},
     }
     assert marks["skeletons"] > marks["fcp"]
+    # One canvas draws both views; every move of the scrubber was drawn.
+    assert scrub["canvases"] == 1
+    assert scrub["drawn"] >= 120, scrub
 
     # Overlay: one view, corrected solid and raw as a ghost, at a flagged knee frame.
     overlay = Page(chromium)
@@ -527,6 +561,7 @@ def test_compare_matches_findings_and_diffs_options(
     assert "only in A" in matches
     assert p.evaluate("() => document.getElementById('compare-twist').data.length") == 4
     # Both runs side by side in 3D, one camera: a drag in A's view turns B's too.
+    assert p.locator("#compare-3d canvas").count() == 1  # one canvas draws both runs
     views = p.evaluate("() => window.mocapqaCompareViews.points")
     assert views == len(knees["result"]["points"]["names"])
     before = p.evaluate("() => window.mocapqaCompareViews.orbit.azimuth")
@@ -539,12 +574,13 @@ def test_compare_matches_findings_and_diffs_options(
         p.mouse.move(x + 10 * step, y)
     p.mouse.up()
     assert p.evaluate("() => window.mocapqaCompareViews.orbit.azimuth") != pytest.approx(before)
-    # The scrubber moves both; an offset moves B only (same fps: B = A + offset).
+    # The scrubber moves both; an offset moves B only (same fps: B = A + offset). The row's last
+    # child is the canvas, hence "of-type": the columns are its only divs.
     p.locator("#compare-scrubber").fill("200")
-    assert "frame 200" in p.inner_text("#compare-3d .col:first-child .view-title")
-    assert "frame 200" in p.inner_text("#compare-3d .col:last-child .view-title")
+    assert "frame 200" in p.inner_text("#compare-3d .col:first-of-type .view-title")
+    assert "frame 200" in p.inner_text("#compare-3d .col:last-of-type .view-title")
     p.fill("#compare-offset", "-10")
-    assert "frame 190" in p.inner_text("#compare-3d .col:last-child .view-title")
+    assert "frame 190" in p.inner_text("#compare-3d .col:last-of-type .view-title")
     p.locator("#compare-3d").scroll_into_view_if_needed()
     p.screenshot(path=str(ARTIFACTS / "workstation-compare-3d.png"))
     # At 900 px the two views stay side by side, with no sideways scroll.
