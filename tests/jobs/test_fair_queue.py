@@ -39,3 +39,35 @@ def test_close_wakes_waiting_workers() -> None:
     queue.close()
     worker.join(timeout=60)
     assert got == [None]
+
+
+def test_runs_beyond_the_per_client_limit_are_held_until_one_is_done() -> None:
+    """A client's import puts ``per_client`` runs in line; the rest are held, in order, and
+    line up one by one as its runs are done, without delaying another client."""
+    queue = FairQueue(per_client=2)
+    assert [queue.put("import", f"i{n}") for n in range(5)] == [True, True, False, False, False]
+    assert queue.put("other", "o0")
+    assert (queue.in_line("import"), queue.held("import")) == (2, 3)
+    assert [queue.get() for _ in range(3)] == ["i0", "o0", "i1"]
+    assert queue.waiting("import") == 0
+    assert queue.in_line("import") == 2  # taken, not done
+    queue.done("i0")
+    assert (queue.in_line("import"), queue.held("import")) == (2, 2)
+    assert queue.get() == "i2"
+    queue.done("o0")
+    assert queue.held("import") == 2  # another client's run frees no place of this one
+
+
+def test_removing_a_held_or_queued_run_keeps_the_limit() -> None:
+    queue = FairQueue(per_client=1)
+    for run in ("a", "b", "c"):
+        queue.put("x", run)
+    assert queue.remove("b")  # held
+    assert (queue.in_line("x"), queue.held("x")) == (1, 1)
+    assert queue.remove("a")  # queued: the next held run takes its place
+    assert (queue.in_line("x"), queue.held("x")) == (1, 0)
+    assert queue.get() == "c"
+    assert not queue.remove("c")  # running: done() frees its place
+    queue.done("c")
+    queue.done("c")
+    assert queue.in_line("x") == 0

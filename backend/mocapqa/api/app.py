@@ -134,6 +134,7 @@ def create_app(
         max_attempts=settings.max_run_attempts,
         read_limits=settings.read_limits,
         engine=engine,
+        max_in_line=settings.max_queued_runs_per_user,
     )
     services = Services(settings, repository, files, runner, render_service)
     accounts = Accounts(repository.engine)

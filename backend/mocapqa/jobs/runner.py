@@ -145,6 +145,10 @@ class JobRunner:
         folder) while the thread here waits, records progress and renders the thumbnail.
         Without one, the analysis runs on this thread (faster for one take, see
         ``docs/batch.md``).
+    max_in_line : int, optional
+        Most runs of one client in the workers' line (waiting or running): more are held,
+        as ids, and line up as the client's runs finish (:class:`FairQueue`'s
+        ``per_client``; the server passes ``max_queued_runs_per_user``). None: no limit.
     """
 
     def __init__(
@@ -156,6 +160,7 @@ class JobRunner:
         max_attempts: int = 2,
         read_limits: ReadLimits | None = None,
         engine: Engine | None = None,
+        max_in_line: int | None = None,
     ) -> None:
         self.engine = engine
         self.repository = repository
@@ -165,7 +170,7 @@ class JobRunner:
         self.read_limits = read_limits
         self._workers = max(1, workers)
         self._threads: list[threading.Thread] = []
-        self._queue = FairQueue()
+        self._queue = FairQueue(max_in_line)
         self._futures: dict[str, Future[None]] = {}
         self._clients: dict[str, str] = {}
         self._cancelled: set[str] = set()
@@ -188,19 +193,27 @@ class JobRunner:
         """Queue a run (already recorded as queued) for a worker, in ``client``'s line.
 
         ``take`` is the take as already read by the upload, which spares the worker a second
-        parse of the same bytes.
+        parse of the same bytes; a run held back (``client`` has ``max_in_line`` runs in
+        line) does not keep it, so a large import holds ids, not parsed takes.
         """
         with self._lock:
             if take is not None:
                 self._preloaded[run_id] = take
             self._futures[run_id] = Future()
             self._clients[run_id] = client
-        self._queue.put(client, run_id)
+        if not self._queue.put(client, run_id):
+            with self._lock:
+                self._preloaded.pop(run_id, None)
 
     def pending(self, client: str) -> int:
-        """Runs of ``client`` queued or running."""
+        """Runs of ``client`` queued (held back included) or running."""
         with self._lock:
             return sum(1 for c in self._clients.values() if c == client)
+
+    def in_line(self, client: str) -> int:
+        """Runs of ``client`` in the workers' line: waiting for a worker or running (at most
+        ``max_in_line``; :meth:`pending` also counts the runs held back)."""
+        return self._queue.in_line(client)
 
     def cancel(self, run_ids: list[str]) -> None:
         """Stop these runs (their take is being deleted): queued ones never start, running
@@ -228,6 +241,7 @@ class JobRunner:
             thread.join()
 
     def _settle(self, run_id: str) -> None:
+        self._queue.done(run_id)  # the client's next held run lines up
         with self._lock:
             future = self._futures.pop(run_id, None)
             self._clients.pop(run_id, None)

@@ -100,8 +100,9 @@ def delete_shoot(
     services: ServicesDep,
     confirm: Annotated[str, Query(description="The shoot's exact name, to confirm")] = "",
 ) -> Response:
-    """Delete a shoot **with all its takes**, their runs, reviews and files: its owner or an
-    admin (403 otherwise), whoever uploaded the takes.
+    """Delete a shoot **with all its takes**, their runs (a queued or running one is
+    stopped), reviews and files: its owner or an admin (403 otherwise), whoever uploaded the
+    takes.
 
     ``confirm`` must repeat the shoot's name (422 otherwise, nothing deleted).
     """
@@ -114,9 +115,9 @@ def delete_shoot(
             f"{shoot['n_takes']} take(s), got {confirm!r}"
         )
     take_ids, run_ids = store.delete(shoot_id)
+    services.runner.cancel(run_ids)  # queued and held runs never start; outputs removed
     for take_id in take_ids:
         services.files.remove_take(take_id, [])
-    services.files.remove_runs(run_ids)
     audit(request, principal, "shoot_delete", shoot_id, f"{shoot['name']}: {len(take_ids)} take(s)")
     return Response(status_code=204)
 
