@@ -29,6 +29,7 @@ from mocapqa import __version__
 from mocapqa.api.auth import quota_key_before_body, require
 from mocapqa.api.deps import Services
 from mocapqa.api.errors import install_error_handlers
+from mocapqa.api.form_parts import check_form_parts
 from mocapqa.api.http_guards import install_http_guards
 from mocapqa.api.routes import (
     decisions,
@@ -164,6 +165,8 @@ def create_app(
         version=__version__,
         description="Motion-capture QA: twist errors, joint limits and keypoint filtering.",
         lifespan=lifespan,
+        # Every route: a form route refuses the parts it would not read (api/form_parts.py).
+        dependencies=[Depends(check_form_parts)],
     )
     app.state.services = services
     app.state.accounts = accounts

@@ -5,8 +5,10 @@ Every error answer has one shape, :class:`~mocapqa.api.schemas.ErrorOut`:
 UI can show the file's line) and ``field``/``errors`` for request validation. FastAPI's own
 validation errors and HTTP exceptions (unknown route, 405, 413 of the body limit) are turned
 into the same shape; a JSON body FastAPI could not decode (not UTF-8, nested too deep) is a 422
-naming ``body`` and why. :func:`responses` gives a route's OpenAPI ``responses=`` from the same
-table, so the documented statuses are the ones the handlers answer.
+naming ``body`` and why, a multipart body the parser refused (Starlette's bare 400) or a form
+sent where JSON is read a 422 naming the field (:mod:`mocapqa.api.form_parts`).
+:func:`responses` gives a route's OpenAPI ``responses=`` from the same table, so the
+documented statuses are the ones the handlers answer.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException
 from starlette.routing import compile_path
 
+from mocapqa.api.form_parts import form_sent_for_json, multipart_refusal
 from mocapqa.api.schemas import ErrorOut
 from mocapqa.errors import (
     AuthenticationError,
@@ -146,14 +149,27 @@ def _undecodable_body(error: HTTPException) -> str | None:
     return None
 
 
+def _invalid(entries: list[dict[str, str]]) -> JSONResponse:
+    """The 422 of request validation: the first entry's field and message, every entry."""
+    first = entries[0] if entries else {"field": "", "message": "invalid request"}
+    body = error_body(
+        "ValidationError",
+        f"{first['field']}: {first['message']}",
+        field=first["field"],
+        errors=entries[:20],
+    )
+    return JSONResponse(body, status_code=422)
+
+
 async def _handle_http(request: Request, error: Exception) -> JSONResponse:
     if not isinstance(error, HTTPException):  # pragma: no cover - registered for HTTPException
         raise error
     undecodable = _undecodable_body(error)
     if undecodable is not None:
-        entry = {"field": "body", "message": undecodable}
-        body = error_body("ValidationError", f"body: {undecodable}", field="body", errors=[entry])
-        return JSONResponse(body, status_code=422)
+        return _invalid([{"field": "body", "message": undecodable}])
+    refused = multipart_refusal(error, request.scope.get("route"))
+    if refused is not None:
+        return _invalid([{"field": refused[0], "message": refused[1]}])
     body = error_body("HTTPError", str(error.detail))
     headers = dict(error.headers or {})
     if error.status_code == 405:
@@ -166,20 +182,16 @@ def _location(entry: dict[str, Any]) -> str:
 
 
 async def _handle_validation(request: Request, error: Exception) -> JSONResponse:
-    del request
     if not isinstance(error, RequestValidationError):  # pragma: no cover - registered for it
         raise error
     entries = [
         {"field": _location(e), "message": str(e.get("msg", ""))} for e in error.errors()[:20]
     ]
-    first = entries[0] if entries else {"field": "", "message": "invalid request"}
-    body = error_body(
-        "ValidationError",
-        f"{first['field']}: {first['message']}",
-        field=first["field"],
-        errors=entries,
-    )
-    return JSONResponse(body, status_code=422)
+    if any(entry["field"] == "body" for entry in entries):
+        form = await form_sent_for_json(request)
+        if form:
+            return _invalid([{"field": field, "message": message} for field, message in form])
+    return _invalid(entries)
 
 
 def install_error_handlers(app: FastAPI) -> None:

@@ -100,8 +100,8 @@ class FairQueue:
             client = self._owner.get(run_id)
             if client is None:
                 return False
-            held = self._held.get(client, {})
-            if run_id in held:
+            held = self._held.get(client)
+            if held is not None and run_id in held:
                 del held[run_id]
                 if not held:
                     del self._held[client]

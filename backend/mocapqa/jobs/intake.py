@@ -27,10 +27,29 @@ from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository, new_id
 
-__all__ = ["CHUNK_BYTES", "ingest_take", "joints_of", "reading_of", "safe_file_name"]
+__all__ = [
+    "CHUNK_BYTES",
+    "MAX_NAME_CHARS",
+    "ingest_take",
+    "joints_of",
+    "name_too_long",
+    "reading_of",
+    "safe_file_name",
+]
 
 CHUNK_BYTES = 1 << 20
 """Bytes read from an upload at a time while streaming it to disk."""
+MAX_NAME_CHARS = 255
+"""Longest file name of a take, in characters: what file systems keep (255 bytes on Linux,
+255 UTF-16 units on Windows and macOS), and the size of the take name column. A longer name
+comes from no file system: it is refused, not cut."""
+
+
+def name_too_long(name: str) -> str | None:
+    """Why a take's file name is refused (an "Expected …, got …" message), or None."""
+    if len(name) <= MAX_NAME_CHARS:
+        return None
+    return f"Expected a file name of at most {MAX_NAME_CHARS} characters, got {len(name)}"
 
 
 def reading_of(files: FileStore, take_id: str) -> dict[str, Any] | None:
@@ -51,9 +70,13 @@ def joints_of(files: FileStore, take_id: str) -> list[str] | None:
 
 
 def safe_file_name(name: str) -> str:
-    """A file name safe to store: the base name, with unusual characters replaced."""
+    """A file name safe to store: the base name, with unusual characters replaced, at most
+    200 characters, its extension kept (readers and downloads go by it)."""
     base = Path(name.replace("\\", "/")).name.strip() or "take"
-    cleaned = re.sub(r"[^A-Za-z0-9._-]+", "_", base)[:200].lstrip(".")
+    cleaned = re.sub(r"[^A-Za-z0-9._-]+", "_", base).lstrip(".")
+    suffix = Path(cleaned).suffix[:20]
+    if len(cleaned) > 200:
+        cleaned = cleaned[: 200 - len(suffix)] + suffix
     return cleaned or "take"
 
 
@@ -103,7 +126,11 @@ def ingest_take(
     Raises
     ------
     TooLargeError, FormatError, ParseError, InputError
+        ``InputError`` too for a name over :data:`MAX_NAME_CHARS`.
     """
+    too_long = name_too_long(name)
+    if too_long is not None:
+        raise InputError(too_long)
     file_name = safe_file_name(name)
     incoming = files.incoming_path(Path(file_name).suffix.lower())
     digest = hashlib.sha256()

@@ -17,7 +17,7 @@ from typing import Any, BinaryIO
 from mocapqa.errors import MocapQAError, TooLargeError
 from mocapqa.jobs.archive import archive_kind, unpack
 from mocapqa.jobs.batch import MOTION_SUFFIXES
-from mocapqa.jobs.intake import CHUNK_BYTES, ingest_take
+from mocapqa.jobs.intake import CHUNK_BYTES, MAX_NAME_CHARS, ingest_take
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.pipeline.loading import ReadLimits
 from mocapqa.store.files import FileStore
@@ -67,6 +67,14 @@ def _receive(source: BinaryIO, target: Path, name: str, max_bytes: int) -> None:
                     f"Expected an upload of at most {max_bytes} bytes, got more ({name!r})"
                 )
             out.write(chunk)
+
+
+def _label(archive: str, member: str) -> str:
+    """How a member is named in the report: ``archive:member``, a name longer than any file
+    system keeps cut (a zip member's name may hold 65,535 bytes, echoed per member)."""
+    label = f"{archive}:{member}"
+    limit = 2 * MAX_NAME_CHARS
+    return label if len(label) <= limit else f"{label[: limit - 1]}…"
 
 
 def _is_motion_name(name: str) -> bool:
@@ -128,7 +136,7 @@ def import_uploads(
             for member in unpack(
                 received, name, members, limits.max_members, limits.max_unpacked_bytes
             ):
-                label = f"{name}:{member.name}"
+                label = _label(name, member.name)
                 if member.path is None:
                     report.failed.append({"name": label, "error": str(member.problem)})
                 elif not _is_motion_name(member.name):

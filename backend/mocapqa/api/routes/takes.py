@@ -11,6 +11,7 @@ from mocapqa.api.deps import ClientDep, ServicesDep, TakeDep, require_run_slot
 from mocapqa.api.errors import responses
 from mocapqa.api.schemas import TakeCreatedOut, TakeDetailOut, TakeOut, TakePageOut
 from mocapqa.api.views import review_out, run_out, take_fields
+from mocapqa.core.keypoints import LENGTH_UNITS
 from mocapqa.jobs.intake import ingest_take, reading_of
 from mocapqa.jobs.rendered import THUMBNAIL_PNG
 from mocapqa.jobs.thumbnails import thumbnail_svg
@@ -24,6 +25,8 @@ router = APIRouter(prefix="/takes", tags=["takes"])
 """Routes of this resource, included under ``/api/v1``."""
 MAX_OFFSET = 2**31 - 1
 """Largest page offset (the schema refuses more with 422)."""
+LengthUnit = Literal[LENGTH_UNITS]  # type: ignore[valid-type]
+"""A keypoint length unit: another is a 422 naming ``body.length_unit``."""
 
 
 @router.post("", status_code=201, responses=responses(401, 403, 413, 415, 429))
@@ -38,7 +41,7 @@ def upload_take(
         Form(gt=0, le=100_000, description="Frame rate, for formats that do not store one."),
     ] = None,
     length_unit: Annotated[
-        str | None,
+        LengthUnit | None,
         Form(
             description="Unit of keypoint coordinates (m, cm, mm, in, px, normalized), for "
             "formats that do not store one."
