@@ -150,7 +150,7 @@ def test_a_second_file_part_is_422_naming_it(signed_in: TestClient) -> None:
         "/api/v1/takes",
         files=[("file", ("a.bvh", SMALL_BVH)), ("file", ("b.bvh", SMALL_BVH))],
     )
-    assert_names(response, "body.file", "one", "2")
+    assert_names(response, "body.file", "one 'file' part", "2")
     no_takes(signed_in)
 
 
@@ -257,3 +257,20 @@ def test_run_options_sent_as_form_fields_name_the_field(name: str, signed_in: Te
         assert_names(response, f"body.{name}", "JSON")
     runs = signed_in.get(f"/api/v1/takes/{take['id']}").json()["runs"]
     assert len(runs) == 1
+
+
+@pytest.mark.parametrize(
+    ("content_type", "words"),
+    [
+        ("multipart/form-data; boundary=x", "Invalid multipart data"),
+        ("multipart/form-data", "boundary"),
+    ],
+)
+@pytest.mark.parametrize("path", ["/api/v1/takes", "/api/v1/shoots"])
+def test_a_multipart_body_the_parser_refuses_is_422_naming_the_body(
+    content_type: str, words: str, path: str, signed_in: TestClient
+) -> None:
+    """Was Starlette's bare 400 ("Invalid multipart data."), on an upload route and on a
+    route that reads JSON alike."""
+    response = signed_in.post(path, content=b"garbage", headers={"Content-Type": content_type})
+    assert_names(response, "body", words)

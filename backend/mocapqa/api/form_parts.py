@@ -96,7 +96,7 @@ def _form_problems(form: FormData, declared: dict[str, bool]) -> list[tuple[str,
                 (_shown(name), f"Expected only the form fields {expected}, got {_shown(name)!r}")
             )
         elif count > 1 and not declared[name]:
-            problems.append((name, f"Expected one {name!r} part (one file), got {count}"))
+            problems.append((name, f"Expected one {name!r} part, got {count}"))
     for name, value in form.multi_items():
         if name in declared and isinstance(value, UploadFile) and value.filename:
             too_long = name_too_long(value.filename)
@@ -134,7 +134,9 @@ async def form_sent_for_json(request: Request) -> list[tuple[str, str]]:
     kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
     if kind not in FORM_TYPES or _reads_form(request.scope.get("route")) is not False:
         return []
-    form = await request.form()  # the body FastAPI already read, parsed as a form
+    # The body FastAPI already read, parsed as a form; a multipart body the parser refuses
+    # raises its 400 here, which the outer handler answers as multipart_refusal says.
+    form = await request.form()
     message = "Expected it in a JSON body (Content-Type: application/json), got a form field"
     return [(f"body.{_shown(name)}", message) for name in dict.fromkeys(form.keys())]
 
