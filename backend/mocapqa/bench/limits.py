@@ -16,13 +16,13 @@ child is flagged; and check speed in joint-frames per second for the map and the
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from mocapqa.core.motion import Motion
+from mocapqa.core.motion import Motion, Skeleton
 from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.limits.analysis import check_limits, limit_params
@@ -38,9 +38,12 @@ __all__ = [
     "RigTakes",
     "bench_rig",
     "canonical_takes",
+    "corpus_files",
     "corpus_rigs",
     "held_back",
+    "held_back_names",
     "role_takes",
+    "split_group",
 ]
 
 
@@ -129,14 +132,12 @@ def corpus_rigs(corpus_dir: Path, families: tuple[str, ...] | None = None) -> li
     list of RigTakes
         Groups of two or more takes, sorted by family label.
     """
-    root = corpus_dir / "bvh" if (corpus_dir / "bvh").is_dir() else corpus_dir
     groups: dict[tuple[object, ...], list[tuple[str, Motion]]] = {}
-    for path in sorted(root.rglob("*.bvh"), key=lambda p: p.name):
+    for path in corpus_files(corpus_dir):
         motion = read_bvh(path)
-        family = rig_family(motion.skeleton)
-        if family == "other" or (families is not None and family not in families):
+        key = split_group(motion.skeleton)
+        if key is None or (families is not None and key[0] not in families):
             continue
-        key: tuple[object, ...] = (family, *sorted(rig_fingerprint(motion.skeleton).items()))
         groups.setdefault(key, []).append((path.name, motion))
     rigs = []
     for key, takes in groups.items():
@@ -148,6 +149,35 @@ def corpus_rigs(corpus_dir: Path, families: tuple[str, ...] | None = None) -> li
     return sorted(rigs, key=lambda r: r.family)
 
 
+def corpus_files(corpus_dir: Path) -> list[Path]:
+    """The BVH files of a corpus in the order every split and build reads them: under its
+    ``bvh`` subfolder when it has one, sorted by file name."""
+    root = corpus_dir / "bvh" if (corpus_dir / "bvh").is_dir() else corpus_dir
+    return sorted(root.rglob("*.bvh"), key=lambda p: p.name)
+
+
+def split_group(skeleton: Skeleton) -> tuple[object, ...] | None:
+    """The group a take is split in (family label and rig fingerprint), None for a rig of
+    the family "other" (never split)."""
+    family = rig_family(skeleton)
+    if family == "other":
+        return None
+    return (family, *sorted(rig_fingerprint(skeleton).items()))
+
+
+def held_back_names(groups: Sequence[tuple[str, tuple[object, ...] | None]]) -> set[str]:
+    """Names of the takes the fixed split holds back, from ``(name, split_group)`` of every
+    take in :func:`corpus_files` order (:func:`corpus_rigs` without reading the takes)."""
+    members: dict[tuple[object, ...], list[str]] = {}
+    for name, key in groups:
+        if key is not None:
+            members.setdefault(key, []).append(name)
+    return {
+        name for names in members.values() if len(names) >= 2
+        for i, name in enumerate(names) if held_back(i)
+    }  # fmt: skip
+
+
 def role_takes(corpus_dir: Path) -> list[tuple[str, Motion]]:
     """Every BVH take under ``corpus_dir`` whose skeleton has limb roles, sorted by file name.
 
@@ -156,9 +186,8 @@ def role_takes(corpus_dir: Path) -> list[tuple[str, Motion]]:
     InputError
         If a file cannot be read (naming it).
     """
-    root = corpus_dir / "bvh" if (corpus_dir / "bvh").is_dir() else corpus_dir
     takes = []
-    for path in sorted(root.rglob("*.bvh"), key=lambda p: p.name):
+    for path in corpus_files(corpus_dir):
         motion = read_bvh(path)
         if rig_fingerprint(motion.skeleton):
             takes.append((path.name, motion))
@@ -174,11 +203,12 @@ def canonical_takes(
     takes, unless ``all_takes``); single takes of other rigs are all used. Names in
     ``exclude`` are left out.
     """
-    held = set()
-    if not all_takes:
-        for rig in corpus_rigs(corpus_dir):
-            held |= {n for n, _ in rig.held_back}
-    return tuple((n, m) for n, m in role_takes(corpus_dir) if n not in held and n not in exclude)
+    read = [(path.name, read_bvh(path)) for path in corpus_files(corpus_dir)]
+    held = set() if all_takes else held_back_names([(n, split_group(m.skeleton)) for n, m in read])
+    return tuple(
+        (n, m) for n, m in read
+        if rig_fingerprint(m.skeleton) and n not in held and n not in exclude
+    )  # fmt: skip
 
 
 def _speed(model: LimitsModel, motion: Motion, method: str, repeats: int) -> float:

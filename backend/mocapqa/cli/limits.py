@@ -80,11 +80,27 @@ def limits_build(
             "the best by validation is kept."
         ),
     ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            help="Read and chart the takes as tasks of this Dask scheduler (tcp://host:8786); "
+            "the maps and networks are trained here."
+        ),
+    ] = None,
+    workers: Annotated[
+        int,
+        typer.Option(
+            help="Read and chart the takes on a local Dask cluster of N worker processes "
+            "(0: in this process, the default)."
+        ),
+    ] = 0,
 ) -> None:
     """Build a joint-limits model from a folder of BVH takes.
 
     Without --rig: one rig-independent (canonical) model per role from the takes of every rig
-    with roles. With --rig: a model in that rig's own joint frames.
+    with roles. With --rig: a model in that rig's own joint frames. --scheduler or --workers
+    runs the per-take part of a canonical build on Dask (same model; worth it for folders of
+    hundreds of takes, docs/limits.md).
     """
     from dataclasses import replace
 
@@ -92,7 +108,6 @@ def limits_build(
 
     from mocapqa.bench.limits import canonical_takes, corpus_rigs
     from mocapqa.limits.build import build_canonical_model, build_model
-    from mocapqa.limits.storage import save_model
 
     settings = _build_params(bin_deg, dilation, margin_deg, paper, networks)
     if n_valid is not None and settings.discriminator is not None:
@@ -101,6 +116,15 @@ def limits_build(
         networks_asked = replace(settings.discriminator, hidden_sizes=tuple(hidden))
         settings = replace(settings, discriminator=networks_asked)
     left_out = set(exclude or ())
+    if scheduler or workers > 0:
+        if rig is not None:
+            raise InputError(
+                "Expected no --rig with --scheduler/--workers: only the canonical build runs on "
+                "Dask"
+            )
+        model = _build_on_dask(corpus_dir, settings, all_takes, left_out, scheduler, workers)
+        _write_model(model, output)
+        return
     if rig is None:
         takes = canonical_takes(corpus_dir, all_takes, left_out)
         builder = build_canonical_model
@@ -123,12 +147,62 @@ def limits_build(
             progress.update(task, completed=n_done[0], description=f"built {name}")
 
         model = builder([m for _, m in takes], [n for n, _ in takes], settings, advance)
+    _write_model(model, output)
+
+
+def _write_model(model: LimitsModel, output: Path) -> None:
+    from mocapqa.limits.storage import save_model
+
     output.parent.mkdir(parents=True, exist_ok=True)
     save_model(model, output)
     console.print(
         f"wrote {output}: rig {model.rig_family}, {len(model.joints)} joints, "
-        f"{len(takes)} takes, {model.n_frames} frames, {output.stat().st_size / 1024:.0f} KiB"
+        f"{len(model.takes)} takes, {model.n_frames} frames, "
+        f"{output.stat().st_size / 1024:.0f} KiB"
     )
+
+
+def _build_on_dask(
+    corpus_dir: Path, settings: BuildParams, all_takes: bool, left_out: set[str],
+    scheduler: str | None, workers: int,
+) -> LimitsModel:  # fmt: skip
+    """A canonical build whose per-take part runs on Dask, with a progress bar."""
+    import logging
+
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+    )
+
+    from mocapqa.cli.batch import DASK_LOGGERS
+    from mocapqa.jobs.engine import Engine
+    from mocapqa.jobs.limits_build import build_canonical_on_engine
+
+    for name in DASK_LOGGERS:
+        logging.getLogger(name).setLevel(logging.WARNING)
+    progress = Progress(
+        TextColumn("[bold]limits build"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("{task.description}"),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+    )
+    task = progress.add_task("starting", total=None)
+    with progress, Engine(scheduler, workers or None) as engine:
+        return build_canonical_on_engine(
+            engine,
+            corpus_dir,
+            settings,
+            all_takes,
+            left_out,
+            on_total=lambda total: progress.update(task, total=total),
+            step=lambda what: progress.update(task, advance=1, description=what),
+        )
 
 
 @limits_app.command("check")

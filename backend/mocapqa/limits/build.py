@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from mocapqa.core.arrays import FloatArray
-from mocapqa.core.motion import Motion
+from mocapqa.core.motion import Motion, Skeleton
 from mocapqa.core.rig import SIDES, role_key
 from mocapqa.errors import InputError
 from mocapqa.limits.canonical import CANONICAL_AXIS, CanonicalFrames, rig_frames, rig_key
@@ -39,7 +39,9 @@ __all__ = [
     "BuildParams",
     "build_canonical_model",
     "build_model",
+    "canonical_model_from_rotations",
     "mean_rotation",
+    "stored_frames",
     "with_rig_frames",
 ]
 
@@ -208,13 +210,52 @@ def build_canonical_model(
             f"{len(take_names)} names"
         )
     known, stored = _frames_by_rig(motions, take_names)
+    rotations = [canonical_quats(m, known=known[rig_key(m)]) for m in motions]
+    return canonical_model_from_rotations(
+        take_names,
+        [(frames.roles, quats) for frames, quats in rotations],
+        stored,
+        int(sum(m.n_frames for m in motions)),
+        settings,
+        progress,
+    )
+
+
+def canonical_model_from_rotations(
+    take_names: Sequence[str],
+    rotations: Sequence[tuple[tuple[str, ...], FloatArray]],
+    stored: dict[str, StoredFrames],
+    n_frames: int,
+    settings: BuildParams = DEFAULT_BUILD,
+    progress: Callable[[str], None] | None = None,
+) -> LimitsModel:
+    """The corpus-wide half of :func:`build_canonical_model`: maps and networks per role from
+    every take's canonical rotations (the per-take half may run elsewhere, e.g. on Dask).
+
+    Parameters
+    ----------
+    take_names : sequence of str
+    rotations : sequence of (tuple of str, ndarray)
+        Per take, in the order of ``take_names``: its role keys and canonical rotations
+        ``(F, R, 4)`` in its rig's frames (:func:`mocapqa.limits.charting.canonical_quats`).
+    stored : dict
+        :func:`mocapqa.limits.canonical.rig_key` → the frames of every rig among the takes.
+    n_frames : int
+        Frames of all the takes.
+    settings : BuildParams
+    progress : callable, optional
+        Called with a role key after each role is built.
+
+    Returns
+    -------
+    LimitsModel
+    """
     samples: dict[str, list[FloatArray]] = {}
     digest = hashlib.sha256()
-    for motion, name in zip(motions, take_names, strict=True):
-        frames, quats = canonical_quats(motion, known=known[rig_key(motion)])
+    for name, (roles_of_take, quats) in zip(take_names, rotations, strict=True):
         digest.update(name.encode("utf-8"))
         digest.update(np.ascontiguousarray(quats).tobytes())
-        for k, role in enumerate(frames.roles):
+        for k, role in enumerate(roles_of_take):
             samples.setdefault(role, []).append(quats[:, k])
     order = [role_key(s, r) for s in SIDES for r in MODELLED_ROLES]
     roles = [r for r in order if r in samples]
@@ -253,9 +294,22 @@ def build_canonical_model(
         reference=settings.reference,
         corpus_hash=digest.hexdigest(),
         takes=tuple(take_names),
-        n_frames=int(sum(m.n_frames for m in motions)),
+        n_frames=n_frames,
         frame="canonical",
         rig_frames=stored,
+    )
+
+
+def stored_frames(skeleton: Skeleton, frames: CanonicalFrames) -> StoredFrames:
+    """``frames`` of the rig of ``skeleton`` as a model stores them (joints by name)."""
+    names = skeleton.names
+    return StoredFrames(
+        family=rig_family(skeleton),
+        roles=frames.roles,
+        joints=tuple(names[j] for j in frames.joints),
+        parents=tuple(names[j] for j in frames.parents),
+        frames=frames.frames,
+        parent_frames=frames.parent_frames,
     )
 
 
@@ -274,16 +328,8 @@ def _frames_by_rig(
             frames = rig_frames([motions[i] for i in members])
         except InputError as e:
             raise InputError(f"{take_names[members[0]]}: {e}") from e
-        names = motions[members[0]].skeleton.names
         known[key] = frames
-        stored[key] = StoredFrames(
-            family=rig_family(motions[members[0]].skeleton),
-            roles=frames.roles,
-            joints=tuple(names[j] for j in frames.joints),
-            parents=tuple(names[j] for j in frames.parents),
-            frames=frames.frames,
-            parent_frames=frames.parent_frames,
-        )
+        stored[key] = stored_frames(motions[members[0]].skeleton, frames)
     return known, stored
 
 

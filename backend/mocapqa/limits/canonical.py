@@ -58,6 +58,7 @@ __all__ = [
     "CANONICAL_AXIS",
     "CanonicalFrames",
     "canonical_frames",
+    "pose_sample",
     "rig_frames",
     "rig_key",
     "role_parent",
@@ -86,6 +87,14 @@ _DISTAL_ROLE = {
 _MIN_BEND_SIN2 = float(np.sin(np.deg2rad(10.0)) ** 2)
 _MEDIAN_FRAMES = 4000
 _ARM_ROLES = ("clavicle", "upper_arm", "forearm", "hand")
+
+
+def pose_sample(n_frames: int) -> np.ndarray | None:
+    """Frames a frame estimate uses out of ``n_frames``: at most 4,000 evenly spaced (the
+    medians are as stable and the cost stays bounded), or None for all of them."""
+    if n_frames <= _MEDIAN_FRAMES:
+        return None
+    return np.linspace(0, n_frames - 1, _MEDIAN_FRAMES).astype(np.intp)
 
 
 def role_parent(role: str) -> str | None:
@@ -213,7 +222,7 @@ def _body_axes(rig: RigMap, positions: FloatArray, arms: bool) -> tuple[FloatArr
 
 
 def canonical_frames(
-    motion: Motion,
+    motion: Motion | Skeleton,
     rig: RigMap | None = None,
     world: tuple[FloatArray, FloatArray] | None = None,
 ) -> CanonicalFrames:
@@ -221,12 +230,14 @@ def canonical_frames(
 
     Parameters
     ----------
-    motion : Motion
-        Any rig whose roles are found by :func:`mocapqa.core.rig.find_roles`.
+    motion : Motion or Skeleton
+        Any rig whose roles are found by :func:`mocapqa.core.rig.find_roles`; a skeleton
+        alone when ``world`` is given.
     rig : RigMap, optional
         Roles to use instead of the automatic ones.
     world : (ndarray, ndarray), optional
-        The take's world rotations ``(F, J, 4)`` and positions ``(F, J, 3)``, when computed.
+        The take's world rotations ``(F, J, 4)`` and positions ``(F, J, 3)``, when computed;
+        only the frames :func:`pose_sample` keeps are used.
 
     Returns
     -------
@@ -238,17 +249,20 @@ def canonical_frames(
         If the skeleton has no modelled role, or lacks the hips and shoulders that give the
         body's axes.
     """
-    skeleton = motion.skeleton
+    skeleton = motion if isinstance(motion, Skeleton) else motion.skeleton
     rig = find_roles(skeleton) if rig is None else rig
     keys = [(s, r) for s in SIDES for r in MODELLED_ROLES if rig.joint(s, r) is not None]
     if not keys:
         raise InputError(
             f"Expected a skeleton with limb roles, got none among {skeleton.names[:8]}"
         )
-    quats, positions = forward_kinematics(motion) if world is None else world
-    if quats.shape[0] > _MEDIAN_FRAMES:
-        # Evenly spaced frames: the medians are as stable and the cost stays bounded.
-        keep = np.linspace(0, quats.shape[0] - 1, _MEDIAN_FRAMES).astype(np.intp)
+    if world is None:
+        if isinstance(motion, Skeleton):
+            raise InputError("Expected a take's world poses with a skeleton alone, got none")
+        world = forward_kinematics(motion)
+    quats, positions = world
+    keep = pose_sample(quats.shape[0])
+    if keep is not None:
         quats, positions = quats[keep], positions[keep]
     body = {arms: _body_axes(rig, positions, arms) for arms in (True, False)}
     roles, joints, parents, frames, parent_frames = [], [], [], [], []
@@ -347,8 +361,8 @@ def take_frames(
     if known is not None:
         return known
     sample = motion
-    if motion.n_frames > _MEDIAN_FRAMES:
-        keep = np.linspace(0, motion.n_frames - 1, _MEDIAN_FRAMES).astype(np.intp)
+    keep = pose_sample(motion.n_frames)
+    if keep is not None:
         sample = Motion(motion.skeleton, motion.quats[keep], motion.translations[keep], motion.fps)
     return canonical_frames(sample, rig)
 

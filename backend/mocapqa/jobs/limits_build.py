@@ -1,0 +1,234 @@
+"""``mocapqa limits build`` on the Dask engine: the per-take half as tasks, training here.
+
+A canonical build (:func:`mocapqa.limits.build.build_canonical_model`) has a part that grows
+with the corpus — reading every take, its world poses, its canonical rotations — and a part
+that does not — one map and one network per role. The first runs here as Dask tasks that read
+their own files (paths on storage the workers share), in three rounds, each returning small
+results:
+
+1. :func:`take_summary` per BVH file: its split group, whether it has roles, its rig key,
+   frame count and skeleton, from which the client picks the build takes (the fixed split,
+   :func:`mocapqa.bench.limits.held_back_names`);
+2. :func:`world_sample` per build take: its world poses at the frames the frame estimate of
+   its rig keeps (:func:`mocapqa.limits.canonical.pose_sample` over the rig's pooled frames,
+   at most 4,000 per rig), from which the client frames every rig as
+   :func:`mocapqa.limits.canonical.rig_frames` does;
+3. :func:`take_rotations` per build take: its canonical rotations in its rig's frames.
+
+The maps and networks are then built in the client
+(:func:`mocapqa.limits.build.canonical_model_from_rotations`) from the same arrays in the same
+order as in one process, so the model is the same (tested on a local cluster).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mocapqa.bench.limits import corpus_files, held_back_names, split_group
+from mocapqa.core.arrays import FloatArray
+from mocapqa.core.motion import Skeleton
+from mocapqa.core.rig import SIDES
+from mocapqa.errors import InputError
+from mocapqa.io.bvh import read_bvh
+from mocapqa.jobs.engine import Engine
+from mocapqa.kinematics.forward import forward_kinematics
+from mocapqa.limits.build import BuildParams, canonical_model_from_rotations, stored_frames
+from mocapqa.limits.canonical import CanonicalFrames, canonical_frames, pose_sample, rig_key
+from mocapqa.limits.charting import canonical_rotations
+from mocapqa.limits.model import LimitsModel, StoredFrames
+from mocapqa.limits.rig import MODELLED_ROLES, rig_fingerprint
+
+__all__ = [
+    "TakeSummary",
+    "build_canonical_on_engine",
+    "take_rotations",
+    "take_summary",
+    "world_sample",
+]
+
+Step = Callable[[str], None]
+
+
+@dataclass(frozen=True, slots=True)
+class TakeSummary:
+    """What the client needs of one BVH file to split the corpus and frame its rigs.
+
+    Parameters
+    ----------
+    path : str
+    group : tuple or None
+        :func:`mocapqa.bench.limits.split_group`.
+    has_roles : bool
+        Whether the skeleton has limb roles (a rig fingerprint).
+    rig : str
+        :func:`mocapqa.limits.canonical.rig_key`.
+    n_frames : int
+    skeleton : Skeleton
+    """
+
+    path: str
+    group: tuple[object, ...] | None
+    has_roles: bool
+    rig: str
+    n_frames: int
+    skeleton: Skeleton
+
+    @property
+    def name(self) -> str:
+        """The take's file name (what a model stores and ``--exclude`` names)."""
+        return Path(self.path).name
+
+
+def take_summary(path: str) -> TakeSummary:
+    """Task: read one BVH file and summarise it (round 1)."""
+    motion = read_bvh(path)
+    return TakeSummary(
+        path=path,
+        group=split_group(motion.skeleton),
+        has_roles=bool(rig_fingerprint(motion.skeleton)),
+        rig=rig_key(motion),
+        n_frames=motion.n_frames,
+        skeleton=motion.skeleton,
+    )
+
+
+def world_sample(path: str, frames: np.ndarray) -> tuple[FloatArray, FloatArray]:
+    """Task: world rotations ``(K, J, 4)`` and positions ``(K, J, 3)`` of the take at
+    ``frames`` (indices, shape (K,)) (round 2)."""
+    quats, positions = forward_kinematics(read_bvh(path))
+    return quats[frames], positions[frames]
+
+
+def take_rotations(path: str, frames: CanonicalFrames) -> FloatArray:
+    """Task: canonical rotations ``(F, R, 4)`` of the take in its rig's ``frames`` (round 3)."""
+    return canonical_rotations(read_bvh(path), frames)
+
+
+def _gather(
+    engine: Engine, calls: Sequence[tuple[Callable[..., Any], tuple[Any, ...]]], step: Step,
+    label: str,
+) -> list[Any]:  # fmt: skip
+    """Run ``calls`` as Dask tasks; their results in the order of ``calls``. ``step`` is
+    called with ``label`` as each finishes."""
+    from distributed import as_completed
+
+    client = engine.client()
+    futures = [client.submit(f, *args, pure=False) for f, args in calls]
+    index = {future.key: i for i, future in enumerate(futures)}
+    results: list[Any] = [None] * len(futures)
+    for future in as_completed(futures):  # type: ignore[no-untyped-call]
+        try:
+            results[index[future.key]] = future.result()
+        except InputError:
+            raise
+        except Exception as e:
+            lost = engine.lost_after_settling(e)
+            if lost is not None:
+                raise lost from e
+            raise
+        future.release()
+        step(label)
+    return results
+
+
+def _rig_frames(
+    engine: Engine, takes: Sequence[TakeSummary], step: Step
+) -> tuple[dict[str, CanonicalFrames], dict[str, StoredFrames]]:
+    """Frames of every rig among ``takes`` (round 2), each estimated over all its takes as
+    :func:`mocapqa.limits.canonical.rig_frames` does, keyed by rig key."""
+    members: dict[str, list[TakeSummary]] = {}
+    for take in takes:
+        members.setdefault(take.rig, []).append(take)
+    calls = []
+    for group in members.values():
+        counts = np.array([t.n_frames for t in group])
+        starts = np.concatenate(([0], np.cumsum(counts)))
+        keep = pose_sample(int(starts[-1]))
+        for t, take in enumerate(group):
+            local = np.arange(take.n_frames) if keep is None else keep - starts[t]
+            if keep is not None:
+                local = local[(local >= 0) & (local < take.n_frames)]
+            calls.append((world_sample, (take.path, local)))
+    samples = iter(_gather(engine, calls, step, "framing rigs"))
+    known: dict[str, CanonicalFrames] = {}
+    stored: dict[str, StoredFrames] = {}
+    for key, group in members.items():
+        worlds = [next(samples) for _ in group]
+        pooled = (np.concatenate([w[0] for w in worlds]), np.concatenate([w[1] for w in worlds]))
+        try:
+            frames = canonical_frames(group[0].skeleton, world=pooled)
+        except InputError as e:
+            raise InputError(f"{group[0].name}: {e}") from e
+        known[key] = frames
+        stored[key] = stored_frames(group[0].skeleton, frames)
+    return known, stored
+
+
+def build_canonical_on_engine(
+    engine: Engine,
+    corpus_dir: Path,
+    settings: BuildParams,
+    all_takes: bool = False,
+    exclude: frozenset[str] | set[str] = frozenset(),
+    on_total: Callable[[int], None] | None = None,
+    step: Step | None = None,
+) -> LimitsModel:
+    """The canonical model of :func:`mocapqa.limits.build.build_canonical_model` over
+    :func:`mocapqa.bench.limits.canonical_takes`, with the per-take work on ``engine``.
+
+    Parameters
+    ----------
+    engine : Engine
+    corpus_dir : Path
+        Folder of BVH takes (its ``bvh`` subfolder when it has one), read by the workers.
+    settings : BuildParams
+    all_takes : bool
+        Every take, not only the build split.
+    exclude : set of str
+        Take file names to leave out.
+    on_total : callable, optional
+        Called with the number of steps to come once it is known (after round 1), and first
+        with the files' count.
+    step : callable, optional
+        Called with a description after each step (a task done, a role built).
+
+    Raises
+    ------
+    InputError
+        When no take has roles, or a file cannot be read (naming it).
+    ClusterError
+        When the Dask scheduler cannot be reached or is lost.
+    """
+    tick: Step = step or (lambda _: None)
+    paths = [str(p) for p in corpus_files(corpus_dir)]
+    if on_total is not None:
+        on_total(len(paths))
+    summaries: list[TakeSummary] = _gather(
+        engine, [(take_summary, (p,)) for p in paths], tick, "reading takes"
+    )
+    held = set() if all_takes else held_back_names([(s.name, s.group) for s in summaries])
+    takes = [s for s in summaries if s.has_roles and s.name not in held and s.name not in exclude]
+    if not takes:
+        raise InputError(f"Expected BVH takes with limb roles in {corpus_dir}, got none")
+    if on_total is not None:
+        on_total(len(paths) + 2 * len(takes) + len(SIDES) * len(MODELLED_ROLES))
+    known, stored = _rig_frames(engine, takes, tick)
+    rotations = _gather(
+        engine,
+        [(take_rotations, (t.path, known[t.rig])) for t in takes],
+        tick,
+        "charting takes",
+    )
+    return canonical_model_from_rotations(
+        [t.name for t in takes],
+        [(known[t.rig].roles, q) for t, q in zip(takes, rotations, strict=True)],
+        stored,
+        sum(t.n_frames for t in takes),
+        settings,
+        lambda role: tick(f"built {role}"),
+    )
