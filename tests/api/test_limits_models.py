@@ -147,3 +147,73 @@ def test_runs_of_a_shoot_use_its_model(team: Team, cmu_walk: Path) -> None:
     alone = _poll(client, single.json()["run_id"], admin)
     assert alone["options"]["limits_model"] == "default"
     assert alone["summary"]["steps"]["limits"] == "done"
+
+
+def test_takes_run_with_an_older_model_are_counted_and_run_again(
+    settings: Settings, renderer: RenderService, corpus_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # One queued run per user at a time, so the re-runs come in two requests.
+    settings = settings.model_copy(update={"job_workers": 1, "max_queued_runs_per_user": 1})
+    with TestClient(create_app(settings, renderer=renderer)) as client:
+        accounts: Accounts = client.app.state.accounts  # type: ignore[attr-defined]
+        headers: dict[str, dict[str, str]] = {"anonymous": {}}
+        for name, role in ROLES.items():
+            user = accounts.add_user(name, role, "correct horse battery")
+            token = accounts.issue(user.id, "api", timedelta(days=1))
+            headers[name] = {"Authorization": f"Bearer {token.token}"}
+        admin = headers["admin"]
+        shoot = client.post(f"{API}/shoots", json={"name": "day2"}, headers=admin).json()["id"]
+        bandai = corpus_dir / "bvh" / "bandai"
+        takes = {}
+        for name in ("dataset-1_dash_normal_001.bvh", "dataset-2_wave-left-hand_active_011.bvh"):
+            take, run = _import(client, shoot, bandai / name, admin)
+            assert _poll(client, run, admin)["options"]["limits_model"] == "default"
+            takes[take] = run
+        assert client.get(f"{API}/shoots/{shoot}", headers=admin).json()["limits_stale_takes"] == 0
+        reruns = f"{API}/shoots/{shoot}/limits-reruns"
+        nothing = client.post(reruns, headers=admin)
+        assert nothing.status_code == 200
+        assert nothing.json() == {"limits_model": "default", "queued": [], "remaining": 0}
+
+        chosen = client.put(
+            f"{API}/shoots/{shoot}/limits-model", json={"name": "bandai"}, headers=admin
+        )
+        assert chosen.json()["limits_stale_takes"] == 2
+        listed = client.get(f"{API}/shoots", headers=headers["viewer"]).json()
+        assert [s["limits_stale_takes"] for s in listed if s["id"] == shoot] == [2]
+        for who, status in (("anonymous", 401), ("viewer", 403), ("rev", 403)):
+            assert client.post(reruns, headers=headers[who]).status_code == status, who
+        assert client.post(f"{API}/shoots/0000/limits-reruns", headers=admin).status_code == 404
+        runner = client.app.state.services.runner  # type: ignore[attr-defined]
+        with monkeypatch.context() as patch:  # the caller's line is full: nothing is queued
+            patch.setattr(runner, "pending", lambda _client: 1)
+            full = client.post(reruns, headers=admin)
+            assert full.status_code == 429, full.text
+        assert client.get(f"{API}/shoots/{shoot}", headers=admin).json()["limits_stale_takes"] == 2
+
+        new_runs = []
+        for remaining in (1, 0):  # one free place per request
+            answer = client.post(reruns, headers=admin)
+            assert answer.status_code == 200, answer.text
+            body = answer.json()
+            assert body["limits_model"] == "bandai"
+            assert body["remaining"] == remaining
+            (entry,) = body["queued"]
+            assert entry["take_id"] in takes
+            done = _poll(client, entry["run_id"], admin)
+            assert done["status"] == "done", done
+            assert done["options"]["limits_model"] == "bandai"
+            assert done["summary"]["steps"]["limits"] == "done"
+            old = client.get(f"{API}/runs/{takes[entry['take_id']]}", headers=admin).json()
+            assert {**old["options"], "limits_model": "bandai"} == done["options"]
+            new_runs.append(entry["take_id"])
+        assert sorted(new_runs) == sorted(takes)
+        seen = client.get(f"{API}/shoots/{shoot}", headers=headers["viewer"]).json()
+        assert seen["limits_stale_takes"] == 0
+        log = client.get(f"{API}/audit?limit=50", headers=admin).json()["items"]
+        details = sorted(e["detail"] for e in log if e["action"] == "shoot_limits_reruns")
+        assert details == [
+            "0 run(s) with default, 0 left",
+            "1 run(s) with bandai, 0 left",
+            "1 run(s) with bandai, 1 left",
+        ]

@@ -16,6 +16,7 @@ __all__ = [
     "ImportOut",
     "LimitsModelIn",
     "LimitsModelOut",
+    "LimitsRerunsOut",
     "NextTakeOut",
     "ProgressOut",
     "ShootIn",
@@ -52,6 +53,12 @@ class ShootOut(BaseModel):
         "default",
         description="The joint-limits model the runs of its takes use (`GET /limits-models`); "
         "an admin chooses it",
+    )
+    limits_stale_takes: int = Field(
+        0,
+        description="Motion takes whose latest run checked joint limits with another model "
+        "than `limits_model` (made before the shoot's model was changed); an admin runs them "
+        "again with `POST /shoots/{id}/limits-reruns`",
     )
 
 
@@ -144,6 +151,19 @@ class LimitsModelIn(RequestModel):
         pattern=MODEL_NAME_PATTERN,
         description="A name from `GET /limits-models`",
         examples=["default", "canonical"],
+    )
+
+
+class LimitsRerunsOut(BaseModel):
+    """What `POST /shoots/{id}/limits-reruns` queued."""
+
+    limits_model: str = Field(description="The shoot's model, which the new runs use")
+    queued: list[dict[str, str]] = Field(
+        description="One entry per new run: `take_id`, `run_id` (oldest take first)"
+    )
+    remaining: int = Field(
+        description="Takes still to run again: beyond the caller's free places in the run "
+        "queue (`max_queued_runs_per_user`); the same request queues them once runs finish"
     )
 
 

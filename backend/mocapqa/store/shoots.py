@@ -18,6 +18,7 @@ from mocapqa import __version__
 from mocapqa.core.text import display_name
 from mocapqa.errors import ConflictError, InputError, NotFoundError
 from mocapqa.pipeline.summary import SUMMARY_FIELDS
+from mocapqa.store.limits_runs import stale_limits_counts
 from mocapqa.store.qa import sync_take
 from mocapqa.store.repository import RUN_STATUSES, new_id, utc_now
 from mocapqa.store.tables import reviews, runs, shoots, source_hashes, take_qa, takes
@@ -205,7 +206,9 @@ class ShootStore:
             rows = [_plain(r) for r in conn.execute(query).mappings()]
             tallies = list(conn.execute(counts).mappings())
         by_id = {row["id"]: row for row in rows}
+        stale = stale_limits_counts(self.engine, shoot_id)
         for row in rows:
+            row["limits_stale_takes"] = stale.get(str(row["id"]), 0)
             row["n_takes"] = 0
             row["n_frames"] = 0
             row["status_counts"] = {s: 0 for s in RUN_STATUSES}
