@@ -51,12 +51,27 @@ def bench_limits(
         str,
         typer.Option(help="--joint-margins: inner false flags averaged ('mean') or worst rig."),
     ] = "mean",
+    model_path: Annotated[
+        Path | None,
+        typer.Option(
+            "--model",
+            help="Measure this canonical model file instead of the shipped one (built on the "
+            "same build takes, e.g. by `mocapqa limits build CORPUS --exclude 005_05.bvh`).",
+        ),
+    ] = None,
+    leave_one_out: Annotated[
+        bool,
+        typer.Option(
+            help="Also the leave-one-rig-out tables (maps built without each rig: they do not "
+            "depend on the model measured)."
+        ),
+    ] = True,
 ) -> None:
     """Canonical model per rig and leave-one-rig-out; optionally the per-rig models."""
     if joint_margins:
         _bench_joint_margins(corpus_dir, seed, margin_rule)
         return
-    _bench_canonical(corpus_dir, shipped, seed, min_offset_deg)
+    _bench_canonical(corpus_dir, shipped, seed, min_offset_deg, model_path, leave_one_out)
     if per_rig:
         _bench_per_rig(corpus_dir, rig, networks, min_offset_deg, seed, shipped)
 
@@ -98,7 +113,10 @@ def _bench_joint_margins(corpus_dir: Path, seed: int, rule: str) -> None:
     )
 
 
-def _bench_canonical(corpus_dir: Path, shipped: bool, seed: int, min_offset_deg: float) -> None:
+def _bench_canonical(
+    corpus_dir: Path, shipped: bool, seed: int, min_offset_deg: float,
+    model_path: Path | None = None, leave_one_out: bool = True,
+) -> None:  # fmt: skip
     from dataclasses import replace
 
     from mocapqa.bench.limits import canonical_takes, corpus_rigs, role_takes
@@ -110,6 +128,7 @@ def _bench_canonical(corpus_dir: Path, shipped: bool, seed: int, min_offset_deg:
         leave_one_rig_out,
     )
     from mocapqa.core.motion import Motion
+    from mocapqa.errors import InputError
     from mocapqa.limits.build import DEFAULT_BUILD, build_canonical_model, build_model
     from mocapqa.limits.rig import rig_family
     from mocapqa.limits.storage import default_model_paths, load_model
@@ -117,7 +136,15 @@ def _bench_canonical(corpus_dir: Path, shipped: bool, seed: int, min_offset_deg:
     build_takes = canonical_takes(corpus_dir, exclude=EVALUATION_ONLY)
     names = tuple(n for n, _ in build_takes)
     model = None
-    if shipped:
+    if model_path is not None:
+        model = load_model(model_path)
+        if model.frame != "canonical" or model.takes != names:
+            raise InputError(
+                f"Expected a canonical model built on the {len(names)} build takes of "
+                f"{corpus_dir}, got a {model.frame} model of {len(model.takes)} takes in "
+                f"{model_path}"
+            )
+    elif shipped:
         for path in default_model_paths():
             candidate = load_model(path)
             if candidate.frame == "canonical" and candidate.takes == names:
@@ -126,6 +153,8 @@ def _bench_canonical(corpus_dir: Path, shipped: bool, seed: int, min_offset_deg:
     if model is None:
         console.print("canonical model: built now (map only)")
         model = build_canonical_model([m for _, m in build_takes], list(names), map_only)
+    elif model_path is not None:
+        console.print(f"canonical model: {model_path} (same build takes)")
     else:
         console.print("canonical model: the shipped one (same build takes)")
     occ = model.occupancy_params
@@ -180,7 +209,7 @@ def _bench_canonical(corpus_dir: Path, shipped: bool, seed: int, min_offset_deg:
     for name, motion in role_takes(corpus_dir):
         grouped.setdefault(rig_family(motion.skeleton), []).append((name, motion))
     groups = {family: tuple(takes) for family, takes in grouped.items()}
-    for framed_once in (False, True):
+    for framed_once in (False, True) if leave_one_out else ():
         loro = leave_one_rig_out(groups, DEFAULT_BUILD, seed, min_offset_deg, framed_once)
         how = "framed once from all its clean takes" if framed_once else "each take framed alone"
         table = Table(title=f"leave one rig out: canonical map built without the rig ({how})")
@@ -224,10 +253,12 @@ def _bench_canonical(corpus_dir: Path, shipped: bool, seed: int, min_offset_deg:
     for rig_takes in rigs:
         longest = max((m for _, m in rig_takes.held_back), key=lambda m: m.n_frames)
         speed = canonical_speed(model, longest)
+        networks = all(j.network is not None for j in model.joints)
+        by_network = canonical_speed(model, longest, 2, "network") if networks else math.nan
         console.print(
             f"speed {rig_takes.family} ({longest.skeleton.n_joints} joints): "
             f"{speed / 1e6:.2f} M joint-frames per CPU second (map check, canonical frames "
-            "included)"
+            f"included); network check (--network) {by_network / 1e6:.2f} M"
         )
 
 
