@@ -106,6 +106,7 @@ export const shootProgress = (id) => request("GET", `/shoots/${id}/progress`);
 export const shootHeatmap = (id, query) => request("GET", `/shoots/${id}/heatmap?${query}`);
 export const limitsModels = () => request("GET", "/limits-models");
 export const setShootLimitsModel = (id, name) => request("PUT", `/shoots/${id}/limits-model`, { name });
+export const rerunStaleLimits = (id) => request("POST", `/shoots/${id}/limits-reruns`);
 export const nextForReview = (id, after) => request("GET", `/shoots/${id}/next${after ? `?after=${after}` : ""}`);
 export const summaryUrl = (id, kind) => `${BASE}/shoots/${id}/summary.${kind}`;
 export const shootLink = (id, query = "") => `#/shoot/${id}${query ? `?${query}` : ""}`;

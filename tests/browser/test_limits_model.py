@@ -1,6 +1,6 @@
 """Choosing a shoot's joint-limits model in Debian's Chromium: a viewer sees the model's name,
-an admin picks another from the models the server offers (a registered one here), and the
-next run of the shoot's take uses it."""
+an admin picks another from the models the server offers (a registered one here), sees that
+the take's latest run used the old one and runs it again with the new one from the panel."""
 
 from __future__ import annotations
 
@@ -94,15 +94,28 @@ def test_admin_picks_the_model_a_shoot_uses(studio: dict[str, Any], chromium: An
     shoot = httpx.get(f"{url}/api/v1/shoots/{shoot_id}", headers=bearer).json()
     assert shoot["limits_model"] == "walks"
 
-    # The take's next run uses it; the first one keeps the model it ran with.
+    # The take's latest run used the old model: the panel says so, and the admin runs it
+    # again from there; the new run uses the shoot's model, the first keeps the one it ran with.
+    assert page.inner_text("#limits-model-stale") == (
+        "1 take's latest run checked joint limits with another model than walks"
+    )
     first = _poll(url, studio["take"]["run_id"], bearer)
     assert first["options"]["limits_model"] == "default"
+    page.click("#limits-rerun")
+    page.wait_for_selector("#limits-model-message:has-text('queued')", timeout=60_000)
+    assert page.inner_text("#limits-model-message") == "1 run queued with walks"
+    assert page.inner_text("#limits-model-stale") == ""
+    assert page.locator("#limits-rerun").is_hidden()
     take_id = studio["take"]["take_id"]
-    again = httpx.post(f"{url}/api/v1/takes/{take_id}/runs", headers=bearer, timeout=60)
-    assert again.status_code == 201, again.text
-    second = _poll(url, again.json()["id"], bearer)
+    runs = httpx.get(f"{url}/api/v1/takes/{take_id}", headers=bearer).json()["runs"]
+    (again,) = [r for r in runs if r["id"] != first["id"]]
+    second = _poll(url, again["id"], bearer)
     assert second["status"] == "done", second
     assert second["options"]["limits_model"] == "walks"
+    assert (
+        httpx.get(f"{url}/api/v1/shoots/{shoot_id}", headers=bearer).json()["limits_stale_takes"]
+        == 0
+    )
 
     # After a reload the picker shows the saved choice.
     open_shoot(page, url, shoot_id)
