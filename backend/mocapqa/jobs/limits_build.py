@@ -46,12 +46,15 @@ from mocapqa.limits.rig import MODELLED_ROLES, rig_fingerprint
 __all__ = [
     "TakeSummary",
     "build_canonical_on_engine",
+    "run_calls",
     "take_rotations",
     "take_summary",
     "world_sample",
 ]
 
 Step = Callable[[str], None]
+CHUNK = 16
+"""Most per-take calls sent to a worker in one task."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -109,18 +112,27 @@ def take_rotations(path: str, frames: CanonicalFrames) -> FloatArray:
     return canonical_rotations(read_bvh(path), frames)
 
 
+def run_calls(calls: Sequence[tuple[Callable[..., Any], tuple[Any, ...]]]) -> list[Any]:
+    """Task: several per-take calls in one task (each Dask task costs the client tens of
+    milliseconds; a take's work is about as short)."""
+    return [f(*args) for f, args in calls]
+
+
 def _gather(
     engine: Engine, calls: Sequence[tuple[Callable[..., Any], tuple[Any, ...]]], step: Step,
     label: str,
 ) -> list[Any]:  # fmt: skip
-    """Run ``calls`` as Dask tasks; their results in the order of ``calls``. ``step`` is
-    called with ``label`` as each finishes."""
+    """Run ``calls`` on the engine, in chunks of consecutive calls (about four per worker, at
+    most :data:`CHUNK` calls each); their results in the order of ``calls``. ``step`` is
+    called with ``label`` once per call as each chunk finishes."""
     from distributed import as_completed
 
     client = engine.client()
-    futures = [client.submit(f, *args, pure=False) for f, args in calls]
+    size = max(1, min(CHUNK, -(-len(calls) // (4 * max(1, engine.n_workers())))))
+    chunks = [list(calls[i : i + size]) for i in range(0, len(calls), size)]
+    futures = [client.submit(run_calls, chunk, pure=False) for chunk in chunks]
     index = {future.key: i for i, future in enumerate(futures)}
-    results: list[Any] = [None] * len(futures)
+    results: list[list[Any]] = [[] for _ in futures]
     for future in as_completed(futures):  # type: ignore[no-untyped-call]
         try:
             results[index[future.key]] = future.result()
@@ -132,8 +144,9 @@ def _gather(
                 raise lost from e
             raise
         future.release()
-        step(label)
-    return results
+        for _ in results[index[future.key]]:
+            step(label)
+    return [result for chunk in results for result in chunk]
 
 
 def _rig_frames(
