@@ -145,9 +145,19 @@ def limits_build(
         def advance(name: str) -> None:
             n_done[0] += 1
             progress.update(task, completed=n_done[0], description=f"built {name}")
+            _log_role(f"built {name}")
 
         model = builder([m for _, m in takes], [n for n, _ in takes], settings, advance)
     _write_model(model, output)
+
+
+def _log_role(line: str) -> None:
+    """A line per built role when the output is not a terminal (a log file of a long build
+    shows no progress bar)."""
+    if not console.is_terminal:
+        import time
+
+        console.print(f"{time.strftime('%H:%M:%S')} {line}")
 
 
 def _write_model(model: LimitsModel, output: Path) -> None:
@@ -193,6 +203,12 @@ def _build_on_dask(
         transient=True,
     )
     task = progress.add_task("starting", total=None)
+
+    def step(what: str) -> None:
+        progress.update(task, advance=1, description=what)
+        if what.startswith("built "):
+            _log_role(what)
+
     with progress, Engine(scheduler, workers or None) as engine:
         return build_canonical_on_engine(
             engine,
@@ -201,7 +217,7 @@ def _build_on_dask(
             all_takes,
             left_out,
             on_total=lambda total: progress.update(task, total=total),
-            step=lambda what: progress.update(task, advance=1, description=what),
+            step=step,
         )
 
 
