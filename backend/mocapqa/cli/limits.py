@@ -177,8 +177,6 @@ def _build_on_dask(
     scheduler: str | None, workers: int,
 ) -> LimitsModel:  # fmt: skip
     """A canonical build whose per-take part runs on Dask, with a progress bar."""
-    import logging
-
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -187,12 +185,11 @@ def _build_on_dask(
         TimeElapsedColumn,
     )
 
-    from mocapqa.cli.batch import DASK_LOGGERS
+    from mocapqa.cli.batch import _quiet_dask_logging
     from mocapqa.jobs.engine import Engine
     from mocapqa.jobs.limits_build import build_canonical_on_engine
 
-    for name in DASK_LOGGERS:
-        logging.getLogger(name).setLevel(logging.WARNING)
+    _quiet_dask_logging()
     progress = Progress(
         TextColumn("[bold]limits build"),
         BarColumn(),
