@@ -287,6 +287,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   await new Promise((r) => requestAnimationFrame(() => setTimeout(r, 0)));
   Plotly = await loadPlotly();
   timeline = createTimeline(Plotly, timelines, (f) => jump(f));
+  window.mocapqaCharts = timeline; // the browser tests compare the drawn charts with their full data
   // Each chart in a task of its own: a key press or a drag waits for one chart, not all.
   const breathe = () => new Promise((r) => setTimeout(r, 0));
   await breathe();
@@ -320,8 +321,8 @@ export async function takeView(main, takeId, params, onTeardown) {
     await breathe();
     if (weights) await timeline.add("chart-weights", "Filter weights (stacked: Kalman / One Euro / EMA)", charts.weightsFigure(series.frames, weights, k()), (p) => p.x);
     choice.addEventListener("change", () => {
-      const t = trajectory(); Plotly.react("chart-trajectory", t.data, t.layout);
-      if (weights) { const w = charts.weightsFigure(series.frames, weights, k()); Plotly.react("chart-weights", w.data, w.layout); }
+      timeline.replace("chart-trajectory", trajectory());
+      if (weights) timeline.replace("chart-weights", charts.weightsFigure(series.frames, weights, k()));
     });
   }
   timeline.setFrame(store.state.frame);

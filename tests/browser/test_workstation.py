@@ -434,6 +434,59 @@ def chromium_cpu_s() -> float:
     return total
 
 
+def check_decimated_charts(page: Any) -> dict[str, list[Any]]:
+    """The big take's charts drawn from at most four points per pixel column look as the full
+    data would: the same y-ranges and bands as the full figure plotted in a box of the same size,
+    and a zoom into 100 frames draws every sample of the full series there. Returns the points
+    each chart was handed against its full data's."""
+    out = page.evaluate(
+        r"""async () => {
+          const same = [];
+          const drawn = {};
+          for (const chart of window.mocapqaCharts.charts) {
+            const div = chart.div;
+            const full = document.createElement('div');
+            full.style.width = `${div.clientWidth}px`; full.style.height = `${div.clientHeight}px`;
+            div.parentElement.append(full);
+            const { data, layout } = chart.figure;
+            await Plotly.newPlot(full, data, layout, { displaylogo: false });
+            const ranges = (d) => Object.keys(d._fullLayout).filter((k) => /^[xy]axis\d*$/.test(k))
+              .map((k) => [k, d._fullLayout[k].range.map((v) => Math.round(v * 1000) / 1000)]);
+            const bands = (d) => d.data.filter((t) => t.type === 'bar')
+              .map((t) => [t.x, t.width, t.base]);
+            same.push([div.id, JSON.stringify(ranges(div)), JSON.stringify(ranges(full)),
+              JSON.stringify(bands(div)) === JSON.stringify(bands(full))]);
+            const points = (d) => d.data.reduce((n, t) => n + (t.x ? t.x.length : 0), 0);
+            // At most four samples per pixel column of a line, one cell per column of a heat map.
+            const w = div._fullLayout._size.w;
+            const bounded = div.data.every((t) => t.type === 'heatmap' ? t.z[0].length <= w
+              : t.type !== 'scatter' || t.stackgroup || t.x.length <= 4 * w);
+            drawn[div.id] = [points(div), points(full), Math.round(w), bounded];
+            Plotly.purge(full); full.remove();
+          }
+          // Zoom into 100 frames: the shown lines hold every sample of the range.
+          const chart0 = (div) => window.mocapqaCharts.charts.find((c) => c.div === div);
+          await Plotly.relayout('chart-twist', { 'xaxis.range': [5000, 5100] });
+          const twist = document.getElementById('chart-twist');
+          const k = twist.data.findIndex((t) => t.type === 'scatter' && t.visible === true);
+          const within = (x) => x.filter((f) => f >= 5000 && f <= 5100);
+          const inside = [within(twist.data[k].x), within(chart0(twist).figure.data[k].x)];
+          await Plotly.relayout('chart-twist', { 'xaxis.autorange': true });
+          return { same, drawn, inside }; }"""
+    )
+    for chart_id, drawn, full, bands in out["same"]:
+        assert drawn == full, (chart_id, drawn, full)
+        assert bands, chart_id
+    for chart_id, (points, all_points, width, bounded) in out["drawn"].items():
+        assert bounded, (chart_id, width)
+        assert points <= all_points, (chart_id, points, all_points)
+    assert out["drawn"]["chart-limits"][0] < out["drawn"]["chart-limits"][1]
+    shown, full = out["inside"]
+    assert shown == full, (shown, full)
+    assert len(full) > 10, full
+    return out["drawn"]
+
+
 def tiled_walk(corpus_dir: Path, folder: Path, n_frames: int = 10_000) -> Path:
     """The CMU walk (31 joints) repeated to ``n_frames`` frames, as the load test does."""
     from dataclasses import replace
@@ -485,6 +538,10 @@ def test_timings_overlay_and_upload_progress(
         " [n, performance.getEntriesByName(n)[0].startTime]))"
     )
     marks["fcp"], marks["skeletons"] = marks["first-contentful-paint"], marks["skeletons-drawn"]
+    plot_ms = fresh.page.evaluate(
+        "() => performance.getEntriesByType('measure').filter((m) => m.name.startsWith('plot '))"
+        ".map((m) => [m.name.slice(5), Math.round(m.startTime) / 1000, Math.round(m.duration)])"
+    )
     # Scrubbing, measured two ways. "paced": 60 scrubber moves, each waited for two animation
     # frames (drawn, then painted), so at most half the display's rate (30/s at 60 Hz).
     # "per frame": a move in every animation frame, as a drag on the scrubber delivers them, for
@@ -523,6 +580,7 @@ def test_timings_overlay_and_upload_progress(
           return { perFrame: (performance.now() - t0) / 1000, drawn: views.renders - renders }; }"""
     )
     cpu_s = chromium_cpu_s() - cpu_before
+    charts = check_decimated_charts(fresh.page)
     fresh.close()
     TIMINGS["big_take"] = {
         "frames": 10_000,
@@ -534,6 +592,9 @@ def test_timings_overlay_and_upload_progress(
         "animation_frames_per_s": round(30 / scrub["idle"], 1),
         "scrub_cpu_ms_per_update": round(1000 * cpu_s / scrub["drawn"], 1),
         "marks_s": {k: round(v / 1000, 3) for k, v in marks.items()},
+        "chart_points_drawn": charts,
+        # Each chart's plotting (from the chart's box to Plotly's promise): [chart, start s, ms].
+        "chart_plot_ms": plot_ms,
         # Tasks over 100 ms once the skeletons were drawn, until the page was ready: [start, ms].
         "tasks_over_100ms_after_skeletons": [
             [round(start / 1000, 3), round(ms)]
