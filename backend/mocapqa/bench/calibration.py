@@ -30,6 +30,7 @@ from mocapqa.twist.confidence import APPLY_THRESHOLD, MIN_LEVEL_DEG, Calibration
 from mocapqa.twist.intervals import FEATURES
 
 __all__ = [
+    "CALIBRATION_KINDS",
     "DisagreementCheck",
     "ReliabilityBin",
     "disagreement_loro",
@@ -37,6 +38,12 @@ __all__ = [
     "real_interval_records",
     "reliability",
 ]
+
+
+CALIBRATION_KINDS = ("level", "burst")
+"""The injected kinds (besides unpaired bursts) whose intervals the calibration is fitted on.
+Clusters (``kind="cluster"``) are left out on purpose: the bench's cluster table then measures
+how the calibration carries over to an error layout it was not fitted on."""
 
 
 @dataclass(frozen=True, slots=True)

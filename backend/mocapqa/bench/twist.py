@@ -363,7 +363,7 @@ def run_twist_bench(
         Called after each take (progress).
     apply : str
         Which intervals the refinement applies (see :func:`mocapqa.twist.analysis.analyze_twist`).
-    kind : {"level", "burst"}
+    kind : {"level", "burst", "cluster"}
         The injected error shape (see :func:`mocapqa.twist.inject.inject_twist_errors`).
 
     Returns

@@ -327,7 +327,12 @@ def bench_twist(
     calibration and (optionally) leave-one-rig-out figures, and the speed."""
     import numpy as np
 
-    from mocapqa.bench.calibration import disagreement_loro, fit_on_fit_takes, reliability
+    from mocapqa.bench.calibration import (
+        CALIBRATION_KINDS,
+        disagreement_loro,
+        fit_on_fit_takes,
+        reliability,
+    )
     from mocapqa.bench.twist import find_bench_files, speed_frames_per_s
     from mocapqa.bench.unpaired import run_unpaired_bench
     from mocapqa.cli.twist_tables import (
@@ -352,7 +357,7 @@ def bench_twist(
         fit_files = [f for f in bench_files if not f.held_out]
         records = [
             r
-            for kind in ("level", "burst")
+            for kind in CALIBRATION_KINDS
             for r in _run(fit_files, {"robust": ("robust", None)}, seed, repeats, console, "all",
                           kind).methods["robust"].records
         ]  # fmt: skip
@@ -382,9 +387,14 @@ def bench_twist(
                       kind="burst").methods  # fmt: skip
         console.print("Bursts of alternating flips (injected, kind=burst):")
         console.print(rates_table(bursts))
+        clusters = _run(bench_files, {"robust": ("robust", None)}, seed, repeats, console,
+                        kind="cluster").methods  # fmt: skip
+        console.print("Clusters of separate flips and holds (injected, kind=cluster):")
+        console.print(rates_table(clusters))
         for title, records in (
             ("level shifts", main_methods["robust"].records),
             ("bursts", bursts["robust"].records),
+            ("clusters", clusters["robust"].records),
         ):
             held = [r for r in records if r.held_out]
             console.print(
@@ -412,7 +422,8 @@ def bench_twist(
             ("unpaired bursts", unpaired_records),
             ("bursts split off a group", [
                 r for r in [*main_methods["robust"].records, *bursts["robust"].records,
-                            *unpaired_records] if r.features and r.features[split] > 0
+                            *clusters["robust"].records, *unpaired_records]
+                if r.features and r.features[split] > 0
             ]),
         ):  # fmt: skip
             held = [r for r in records if r.held_out]

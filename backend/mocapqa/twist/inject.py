@@ -17,6 +17,13 @@ as described for the retargeted CMU knees): 1–4 *holds*, each held for 1 frame
 with its own offset of ±20–90° and alternating sign, then a tail of up to 0.1 s that decays
 linearly from 10–40 % of the last offset back to the natural level; the child counter-rotates
 by (1 + ε) δ with ε uniform in ±0.2 over the burst, since a real retarget rarely does it exactly.
+
+``kind="cluster"`` injects *clusters of separate errors*: inside a window of up to 0.6 s, 2–4
+pieces, each a single-frame flip (half of them) or a hold of 2 frames up to 0.15 s, with its own
+offset of ±20–90° (independent signs) and its own child mismatch ε in ±0.2, separated by 1 frame
+up to 0.3 s of natural roll. Each piece starts and ends at the natural level, so each is an
+error of its own; what the cluster adds is their crowding (the retargeted CMU knees show such
+groups: flips and short holds a few frames to a quarter of a second apart).
 """
 
 from __future__ import annotations
@@ -34,7 +41,10 @@ from mocapqa.kinematics.quaternion import multiply, quats_from_axis_angle
 from mocapqa.twist.angles import ChainGeometry, chain_geometry
 from mocapqa.twist.refine import refine_quats
 
-__all__ = ["InjectedInterval", "InjectionTruth", "choose_targets", "inject_twist_errors"]
+__all__ = ["KINDS", "InjectedInterval", "InjectionTruth", "choose_targets", "inject_twist_errors"]
+
+KINDS = ("level", "burst", "cluster")
+"""The injected error shapes (``kind`` of :func:`inject_twist_errors`)."""
 
 TARGET_SEGMENTS = ("clavicle", "upper_arm", "forearm", "upper_leg", "lower_leg")
 _LIMB = {"clavicle": "arm", "upper_arm": "arm", "forearm": "arm", "upper_leg": "leg",
@@ -161,6 +171,26 @@ def _burst_parts(
     return parts
 
 
+def _cluster_parts(
+    rng: np.random.Generator, start: int, end: int, fps: float
+) -> list[tuple[int, int, float]]:
+    """Separate flips and short holds of ±20–90° inside ``[start, end]``, 1 frame to 0.3 s
+    apart."""
+    longest_hold = max(2, round(0.15 * fps))
+    widest_gap = max(1, round(0.3 * fps))
+    parts: list[tuple[int, int, float]] = []
+    first = start
+    for _ in range(int(rng.integers(2, 5))):
+        if first > end:
+            break
+        length = 1 if rng.random() < 0.5 else int(rng.integers(2, longest_hold + 1))
+        last = min(end, first + length - 1)
+        sign = float(rng.choice((-1.0, 1.0)))
+        parts.append((first, last, sign * float(rng.uniform(20.0, 90.0))))
+        first = last + 1 + int(rng.integers(1, widest_gap + 1))
+    return parts
+
+
 def choose_targets(
     motion: Motion, rng: np.random.Generator, n_targets: int, mapping: dict[str, str] | None
 ) -> list[ChainGeometry]:
@@ -214,9 +244,10 @@ def inject_twist_errors(
         Range of the offset magnitude, degrees; the sign is random.
     mapping : dict, optional
         Role key → joint name overrides for :func:`mocapqa.core.rig.find_roles`.
-    kind : {"level", "burst"}
-        The paper's level shifts, or bursts of alternating flips (see the module notes; then
-        the interval count is per burst and the offsets and lengths are the burst's own).
+    kind : {"level", "burst", "cluster"}
+        The paper's level shifts, bursts of alternating flips, or clusters of separate flips
+        and holds (see the module notes; for the last two the interval count is per burst or
+        cluster and the offsets and lengths are their own).
 
     Returns
     -------
@@ -229,8 +260,8 @@ def inject_twist_errors(
     InputError
         If the parameters are inconsistent or the rig has too few separate limbs.
     """
-    if kind not in ("level", "burst"):
-        raise InputError(f"Expected kind 'level' or 'burst', got {kind!r}")
+    if kind not in KINDS:
+        raise InputError(f"Expected kind 'level', 'burst' or 'cluster', got {kind!r}")
     if not (0 < min_offset_deg <= max_offset_deg <= 180.0):
         raise InputError(
             "Expected 0 < min_offset_deg ≤ max_offset_deg ≤ 180, got "
@@ -253,13 +284,18 @@ def inject_twist_errors(
         count = int(rng.integers(min_intervals, max_intervals + 1))
         hold = max(1, round(0.05 * motion.fps))
         tail_max = round(0.1 * motion.fps)
-        longest = max_interval_frames if kind == "level" else 4 * hold + tail_max
+        longest = {"level": max_interval_frames, "burst": 4 * hold + tail_max,
+                   "cluster": max(3, round(0.6 * motion.fps))}[kind]  # fmt: skip
         parent = geometry.chain.parent
         for start, end in _place_intervals(rng, n_frames, count, longest):
             parts = [(start, end, 0.0)]
             if kind == "burst":
                 parts = _burst_parts(rng, start, end, hold, tail_max)
                 mismatch[start : end + 1, c] = rng.uniform(-0.2, 0.2)
+            elif kind == "cluster":
+                parts = _cluster_parts(rng, start, end, motion.fps)
+                for a, b, _ in parts:
+                    mismatch[a : b + 1, c] = rng.uniform(-0.2, 0.2)
             for a, b, value in parts:
                 if kind == "level":
                     magnitude = rng.uniform(min_offset_deg, max_offset_deg)
