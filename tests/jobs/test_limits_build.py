@@ -1,4 +1,5 @@
-"""``mocapqa limits build`` on Dask: the same model as in one process, on a real local cluster."""
+"""``mocapqa limits build`` on Dask, canonical and per-rig: the same model as in one process, on
+a real local cluster."""
 
 from __future__ import annotations
 
@@ -11,13 +12,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mocapqa.bench.limits import canonical_takes
+from mocapqa.bench.limits import canonical_takes, rig_takes
 from mocapqa.cli.main import main
 from mocapqa.errors import InputError
 from mocapqa.jobs.engine import Engine
-from mocapqa.jobs.limits_build import build_canonical_on_engine
+from mocapqa.jobs.limits_build import build_on_engine
 from mocapqa.limits import canonical
-from mocapqa.limits.build import DEFAULT_BUILD, build_canonical_model
+from mocapqa.limits.build import DEFAULT_BUILD, build_canonical_model, build_model
 from mocapqa.limits.discriminator import DiscriminatorParams
 from mocapqa.limits.model import LimitsModel
 from mocapqa.limits.storage import load_model, model_bytes
@@ -88,9 +89,7 @@ def test_build_on_two_workers_equals_the_build_in_one_process(
     here = build_canonical_model([m for _, m in takes], [n for n, _ in takes], SETTINGS)
     steps: list[str] = []
     totals: list[int] = []
-    there = build_canonical_on_engine(
-        engine, corpus, SETTINGS, on_total=totals.append, step=steps.append
-    )
+    there = build_on_engine(engine, corpus, SETTINGS, on_total=totals.append, step=steps.append)
     _assert_same(here, there)
     assert there.takes == (
         "002_03.bvh",
@@ -108,30 +107,106 @@ def test_build_on_two_workers_equals_the_build_in_one_process(
     assert totals[-1] >= len(steps)
 
 
-def test_cli_builds_on_a_local_cluster(corpus: Path, tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    ("build", "left_out", "n_takes"),
+    [([], "007_12.bvh", len(TAKES) - 1), (["--rig", "bandai"], "dataset-1_run_giant_001.bvh", 4)],
+    ids=["canonical", "per-rig"],
+)
+def test_cli_builds_on_a_local_cluster(
+    corpus: Path, tmp_path: Path, build: list[str], left_out: str, n_takes: int
+) -> None:
     on_dask = tmp_path / "dask.npz"
     here = tmp_path / "here.npz"
-    common = ["--no-networks", "--exclude", "007_12.bvh", "--all-takes"]
+    common = [*build, "--no-networks", "--exclude", left_out, "--all-takes"]
     assert (
         main(["limits", "build", str(corpus), "-o", str(on_dask), "--workers", "2", *common]) == 0
     )
     assert main(["limits", "build", str(corpus), "-o", str(here), *common]) == 0
     _assert_same(load_model(on_dask), load_model(here))
-    assert "007_12.bvh" not in load_model(on_dask).takes
-    assert len(load_model(on_dask).takes) == len(TAKES) - 1
+    assert left_out not in load_model(on_dask).takes
+    assert len(load_model(on_dask).takes) == n_takes
 
 
-def test_per_rig_build_on_dask_is_refused(corpus: Path, tmp_path: Path) -> None:
-    out = tmp_path / "m.npz"
-    code = main(
-        ["limits", "build", str(corpus), "-o", str(out), "--rig", "bandai", "--workers", "2"]
+@pytest.mark.parametrize(
+    ("all_takes", "exclude", "expected"),
+    [
+        # the fixed split holds back the second of the five Bandai clips
+        (False, frozenset(), ("dataset-1_dash_chimpira_001.bvh", "dataset-1_run_giant_001.bvh",
+                              "dataset-2_raise-up-left-hand_active_001.bvh",
+                              "dataset-2_wave-left-hand_active_011.bvh")),
+        # every take, the held-back one after the build takes, less the one excluded
+        (True, frozenset({"dataset-1_run_giant_001.bvh"}),
+         ("dataset-1_dash_chimpira_001.bvh", "dataset-2_raise-up-left-hand_active_001.bvh",
+          "dataset-2_wave-left-hand_active_011.bvh", "dataset-1_dash_normal_001.bvh")),
+    ],
+)  # fmt: skip
+def test_per_rig_build_on_two_workers_equals_the_build_in_one_process(
+    engine: Engine, corpus: Path, all_takes: bool, exclude: frozenset[str],
+    expected: tuple[str, ...],
+) -> None:  # fmt: skip
+    takes = rig_takes(corpus, "bandai", all_takes, exclude)
+    here = build_model([m for _, m in takes], [n for n, _ in takes], SETTINGS)
+    steps: list[str] = []
+    totals: list[int] = []
+    there = build_on_engine(
+        engine, corpus, SETTINGS, "bandai", all_takes, exclude, totals.append, steps.append
     )
-    assert code == 3  # InputError
+    _assert_same(here, there)
+    assert there.rig_family == "bandai"
+    assert there.frame != "canonical"
+    assert there.takes == expected
+    assert all(j.network is not None for j in there.joints)
+    assert len(there.joints) == 14
+    assert totals == [len(TAKES), len(TAKES) + len(expected) + len(there.joints)]
+    assert steps == (
+        ["reading takes"] * len(TAKES)
+        + ["charting takes"] * len(expected)
+        + [f"built {j.name}" for j in there.joints]
+    )
+
+
+@pytest.fixture
+def character_creator(corpus_dir: Path, tmp_path: Path) -> Path:
+    """A folder of two Character Creator takes (the second held back by the split)."""
+    folder = tmp_path / "character_creator"
+    folder.mkdir()
+    for name in ("002_03.bvh", "007_12.bvh"):
+        (folder / name).symlink_to(corpus_dir / "bvh" / "cmu" / "iclone" / name)
+    return folder
+
+
+@pytest.mark.parametrize("dask", [[], ["--workers", "2"]], ids=["in-process", "dask"])
+def test_per_rig_build_without_takes_of_the_rig_is_an_input_error(
+    character_creator: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str],
+    dask: list[str],
+) -> None:  # fmt: skip
+    out = tmp_path / "m.npz"
+    build = ["limits", "build", str(character_creator), "-o", str(out), "--no-networks", *dask]
+    capsys.readouterr()
+    assert main([*build, "--rig", "robot"]) == 3
+    assert "Expected a rig family among bandai, character_creator, cmu, got 'robot'" in (
+        capsys.readouterr().err
+    )
+    assert main([*build, "--rig", "bandai"]) == 3
+    assert f"Expected one bandai rig with two or more takes in {character_creator}, got 0" in (
+        capsys.readouterr().err
+    )
     assert not out.exists()
+
+
+def test_per_rig_build_with_every_take_left_out_is_an_input_error(
+    engine: Engine, character_creator: Path
+) -> None:
+    message = "Expected takes of the character_creator rig left to build from, got none"
+    left_out = {"002_03.bvh"}  # the one build take
+    with pytest.raises(InputError, match=message):
+        rig_takes(character_creator, "character_creator", exclude=left_out)
+    with pytest.raises(InputError, match=message):
+        build_on_engine(engine, character_creator, SETTINGS, "character_creator", exclude=left_out)
 
 
 def test_a_folder_without_takes_with_roles_is_an_input_error(
     engine: Engine, tmp_path: Path
 ) -> None:
     with pytest.raises(InputError, match="got none"):
-        build_canonical_on_engine(engine, tmp_path, SETTINGS)
+        build_on_engine(engine, tmp_path, SETTINGS)

@@ -29,7 +29,7 @@ from mocapqa.limits.analysis import check_limits, limit_params
 from mocapqa.limits.build import DEFAULT_BUILD, BuildParams, build_model
 from mocapqa.limits.model import LimitsModel
 from mocapqa.limits.occupancy import is_valid
-from mocapqa.limits.rig import rig_family, rig_fingerprint
+from mocapqa.limits.rig import RIG_FAMILIES, rig_family, rig_fingerprint
 from mocapqa.twist.inject import inject_twist_errors
 
 __all__ = [
@@ -38,12 +38,16 @@ __all__ = [
     "RigTakes",
     "bench_rig",
     "canonical_takes",
+    "check_rig_family",
     "corpus_files",
     "corpus_rigs",
     "held_back",
     "held_back_names",
+    "rig_positions",
+    "rig_takes",
     "role_takes",
     "split_group",
+    "split_positions",
 ]
 
 
@@ -132,21 +136,30 @@ def corpus_rigs(corpus_dir: Path, families: tuple[str, ...] | None = None) -> li
     list of RigTakes
         Groups of two or more takes, sorted by family label.
     """
-    groups: dict[tuple[object, ...], list[tuple[str, Motion]]] = {}
+    read = _split_takes(corpus_dir, families)
+    rigs = [
+        RigTakes(
+            str(key[0]),
+            tuple((read[i][0], read[i][2]) for i in build),
+            tuple((read[i][0], read[i][2]) for i in back),
+        )
+        for key, (build, back) in split_positions([key for _, key, _ in read]).items()
+    ]
+    return sorted(rigs, key=lambda r: r.family)
+
+
+def _split_takes(
+    corpus_dir: Path, families: tuple[str, ...] | None
+) -> list[tuple[str, tuple[object, ...], Motion]]:
+    """Name, split group and motion of every take of ``families`` (all families but
+    "other" when None), in :func:`corpus_files` order."""
+    read = []
     for path in corpus_files(corpus_dir):
         motion = read_bvh(path)
         key = split_group(motion.skeleton)
-        if key is None or (families is not None and key[0] not in families):
-            continue
-        groups.setdefault(key, []).append((path.name, motion))
-    rigs = []
-    for key, takes in groups.items():
-        if len(takes) < 2:
-            continue
-        build = tuple(t for i, t in enumerate(takes) if not held_back(i))
-        back = tuple(t for i, t in enumerate(takes) if held_back(i))
-        rigs.append(RigTakes(str(key[0]), build, back))
-    return sorted(rigs, key=lambda r: r.family)
+        if key is not None and (families is None or key[0] in families):
+            read.append((path.name, key, motion))
+    return read
 
 
 def corpus_files(corpus_dir: Path) -> list[Path]:
@@ -165,17 +178,97 @@ def split_group(skeleton: Skeleton) -> tuple[object, ...] | None:
     return (family, *sorted(rig_fingerprint(skeleton).items()))
 
 
+def split_positions(
+    groups: Sequence[tuple[object, ...] | None],
+) -> dict[tuple[object, ...], tuple[list[int], list[int]]]:
+    """The fixed split over takes in :func:`corpus_files` order, from the :func:`split_group`
+    of each: per group of two or more takes, the positions (in ``groups``) of its build takes
+    and of its held-back takes."""
+    members: dict[tuple[object, ...], list[int]] = {}
+    for i, key in enumerate(groups):
+        if key is not None:
+            members.setdefault(key, []).append(i)
+    return {
+        key: ([i for n, i in enumerate(m) if not held_back(n)],
+              [i for n, i in enumerate(m) if held_back(n)])
+        for key, m in members.items() if len(m) >= 2
+    }  # fmt: skip
+
+
 def held_back_names(groups: Sequence[tuple[str, tuple[object, ...] | None]]) -> set[str]:
     """Names of the takes the fixed split holds back, from ``(name, split_group)`` of every
     take in :func:`corpus_files` order (:func:`corpus_rigs` without reading the takes)."""
-    members: dict[tuple[object, ...], list[str]] = {}
-    for name, key in groups:
-        if key is not None:
-            members.setdefault(key, []).append(name)
-    return {
-        name for names in members.values() if len(names) >= 2
-        for i, name in enumerate(names) if held_back(i)
-    }  # fmt: skip
+    positions = split_positions([key for _, key in groups])
+    return {groups[i][0] for _, back in positions.values() for i in back}
+
+
+def check_rig_family(family: str) -> None:
+    """An InputError unless ``family`` is one of :data:`mocapqa.limits.rig.RIG_FAMILIES`."""
+    if family not in RIG_FAMILIES:
+        raise InputError(f"Expected a rig family among {', '.join(RIG_FAMILIES)}, got {family!r}")
+
+
+def rig_positions(
+    groups: Sequence[tuple[str, tuple[object, ...] | None]], family: str, corpus_dir: Path,
+    all_takes: bool = False, exclude: set[str] | frozenset[str] = frozenset(),
+) -> list[int]:  # fmt: skip
+    """The takes a per-rig model of ``family`` is built from: the build takes of the one rig
+    of that family (then its held-back takes, with ``all_takes``), less the names in
+    ``exclude``.
+
+    Parameters
+    ----------
+    groups : sequence of (str, tuple or None)
+        Name and :func:`split_group` of every take, in :func:`corpus_files` order.
+    family : str
+    corpus_dir : Path
+        For messages.
+    all_takes : bool
+    exclude : set of str
+
+    Returns
+    -------
+    list of int
+        Positions in ``groups``.
+
+    Raises
+    ------
+    InputError
+        If ``family`` is not a rig family, the folder has no rig of that family with two or
+        more takes or more than one such rig, or no take is left.
+    """
+    check_rig_family(family)
+    rigs = [
+        split for key, split in split_positions([key for _, key in groups]).items()
+        if key[0] == family
+    ]  # fmt: skip
+    if len(rigs) != 1:
+        raise InputError(
+            f"Expected one {family} rig with two or more takes in {corpus_dir}, got {len(rigs)}"
+        )
+    build, back = rigs[0]
+    chosen = [i for i in build + (back if all_takes else []) if groups[i][0] not in exclude]
+    if not chosen:
+        raise InputError(f"Expected takes of the {family} rig left to build from, got none")
+    return chosen
+
+
+def rig_takes(
+    corpus_dir: Path, family: str, all_takes: bool = False,
+    exclude: set[str] | frozenset[str] = frozenset(),
+) -> tuple[tuple[str, Motion], ...]:  # fmt: skip
+    """The takes (names and motions) a per-rig model of ``family`` is built from
+    (:func:`rig_positions`).
+
+    Raises
+    ------
+    InputError
+        As :func:`rig_positions`, or if a file cannot be read (naming it).
+    """
+    check_rig_family(family)
+    read = _split_takes(corpus_dir, (family,))
+    chosen = rig_positions([(n, key) for n, key, _ in read], family, corpus_dir, all_takes, exclude)
+    return tuple((read[i][0], read[i][2]) for i in chosen)
 
 
 def role_takes(corpus_dir: Path) -> list[tuple[str, Motion]]:

@@ -53,7 +53,10 @@ def limits_build(
     output: Annotated[Path, typer.Option("-o", "--output", help="Model file (.npz) to write.")],
     rig: Annotated[
         str | None,
-        typer.Option(help="Build a per-rig model of this family (cmu, character_creator, bandai)."),
+        typer.Option(
+            help="Build a per-rig model of this family (bandai, character_creator, cmu) from "
+            "the takes of its one rig in the folder (also with --scheduler/--workers)."
+        ),
     ] = None,
     all_takes: Annotated[
         bool, typer.Option("--all-takes", help="Build on every take, not only the build split.")
@@ -83,8 +86,8 @@ def limits_build(
     scheduler: Annotated[
         str | None,
         typer.Option(
-            help="Read and chart the takes as tasks of this Dask scheduler (tcp://host:8786); "
-            "the maps and networks are trained here."
+            help="Read and chart the takes as tasks of this Dask scheduler (tcp://host:8786), "
+            "with or without --rig; the maps and networks are trained here."
         ),
     ] = None,
     workers: Annotated[
@@ -99,14 +102,14 @@ def limits_build(
 
     Without --rig: one rig-independent (canonical) model per role from the takes of every rig
     with roles. With --rig: a model in that rig's own joint frames. --scheduler or --workers
-    runs the per-take part of a canonical build on Dask (same model; worth it for folders of
-    hundreds of takes, docs/limits.md).
+    runs the per-take part of either build on Dask, the training here (same model; worth it
+    for folders of hundreds of takes on workers with cores of their own, docs/limits.md).
     """
     from dataclasses import replace
 
     from rich.progress import Progress
 
-    from mocapqa.bench.limits import canonical_takes, corpus_rigs
+    from mocapqa.bench.limits import canonical_takes, rig_takes
     from mocapqa.limits.build import build_canonical_model, build_model
 
     settings = _build_params(bin_deg, dilation, margin_deg, paper, networks)
@@ -117,24 +120,14 @@ def limits_build(
         settings = replace(settings, discriminator=networks_asked)
     left_out = set(exclude or ())
     if scheduler or workers > 0:
-        if rig is not None:
-            raise InputError(
-                "Expected no --rig with --scheduler/--workers: only the canonical build runs on "
-                "Dask"
-            )
-        model = _build_on_dask(corpus_dir, settings, all_takes, left_out, scheduler, workers)
+        model = _build_on_dask(corpus_dir, rig, settings, all_takes, left_out, scheduler, workers)
         _write_model(model, output)
         return
     if rig is None:
         takes = canonical_takes(corpus_dir, all_takes, left_out)
         builder = build_canonical_model
     else:
-        rigs = corpus_rigs(corpus_dir, (rig,))
-        if len(rigs) != 1:
-            found = [r.family for r in rigs]
-            raise InputError(f"Expected takes of the rig {rig!r} in {corpus_dir}, got {found}")
-        takes = rigs[0].build + (rigs[0].held_back if all_takes else ())
-        takes = tuple(t for t in takes if t[0] not in left_out)
+        takes = rig_takes(corpus_dir, rig, all_takes, left_out)
         builder = build_model
     if not takes:
         raise InputError(f"Expected BVH takes with limb roles in {corpus_dir}, got none")
@@ -173,10 +166,12 @@ def _write_model(model: LimitsModel, output: Path) -> None:
 
 
 def _build_on_dask(
-    corpus_dir: Path, settings: BuildParams, all_takes: bool, left_out: set[str],
-    scheduler: str | None, workers: int,
+    corpus_dir: Path, rig: str | None, settings: BuildParams, all_takes: bool,
+    left_out: set[str], scheduler: str | None, workers: int,
 ) -> LimitsModel:  # fmt: skip
-    """A canonical build whose per-take part runs on Dask, with a progress bar."""
+    """A canonical (``rig`` None) or per-rig build whose per-take part runs on Dask, with a
+    progress bar."""
+
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -187,7 +182,7 @@ def _build_on_dask(
 
     from mocapqa.cli.batch import _quiet_dask_logging
     from mocapqa.jobs.engine import Engine
-    from mocapqa.jobs.limits_build import build_canonical_on_engine
+    from mocapqa.jobs.limits_build import build_on_engine
 
     _quiet_dask_logging()
     progress = Progress(
@@ -207,10 +202,11 @@ def _build_on_dask(
             _log_role(what)
 
     with progress, Engine(scheduler, workers or None) as engine:
-        return build_canonical_on_engine(
+        return build_on_engine(
             engine,
             corpus_dir,
             settings,
+            rig,
             all_takes,
             left_out,
             on_total=lambda total: progress.update(task, total=total),

@@ -1,14 +1,22 @@
 """``mocapqa limits build`` on the Dask engine: the per-take half as tasks, training here.
 
+Both builds start with one round of tasks, :func:`take_summary` per BVH file (its split group,
+whether it has roles, its rig key, frame count and skeleton), from which the client picks the
+build takes by the fixed split (:mod:`mocapqa.bench.limits`); :func:`build_on_engine` runs
+either build.
+
+A per-rig build (:func:`mocapqa.limits.build.build_model`) then needs one more round:
+:func:`take_role_rotations` per build take of the rig (its role joints' local rotations); the
+maps and networks are built in the client (:func:`mocapqa.limits.build.rig_model_from_rotations`).
+
 A canonical build (:func:`mocapqa.limits.build.build_canonical_model`) has a part that grows
 with the corpus — reading every take, its world poses, its canonical rotations — and a part
 that does not — one map and one network per role. The first runs here as Dask tasks that read
 their own files (paths on storage the workers share), in three rounds, each returning small
 results:
 
-1. :func:`take_summary` per BVH file: its split group, whether it has roles, its rig key,
-   frame count and skeleton, from which the client picks the build takes (the fixed split,
-   :func:`mocapqa.bench.limits.held_back_names`);
+1. :func:`take_summary` per BVH file, from which the client picks the build takes (every
+   take with roles; :func:`mocapqa.bench.limits.held_back_names`);
 2. :func:`world_sample` per build take: its world poses at the frames the frame estimate of
    its rig keeps (:func:`mocapqa.limits.canonical.pose_sample` over the rig's pooled frames,
    at most 4,000 per rig), from which the client frames every rig as
@@ -17,7 +25,7 @@ results:
 
 The maps and networks are then built in the client
 (:func:`mocapqa.limits.build.canonical_model_from_rotations`) from the same arrays in the same
-order as in one process, so the model is the same (tested on a local cluster).
+order as in one process, so the model is the same (both builds tested on a local cluster).
 """
 
 from __future__ import annotations
@@ -29,7 +37,13 @@ from typing import Any
 
 import numpy as np
 
-from mocapqa.bench.limits import corpus_files, held_back_names, split_group
+from mocapqa.bench.limits import (
+    check_rig_family,
+    corpus_files,
+    held_back_names,
+    rig_positions,
+    split_group,
+)
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Skeleton
 from mocapqa.core.rig import SIDES
@@ -37,7 +51,14 @@ from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.jobs.engine import Engine
 from mocapqa.kinematics.forward import forward_kinematics
-from mocapqa.limits.build import BuildParams, canonical_model_from_rotations, stored_frames
+from mocapqa.limits.build import (
+    BuildParams,
+    canonical_model_from_rotations,
+    rig_model_from_rotations,
+    rig_roles,
+    role_rotations,
+    stored_frames,
+)
 from mocapqa.limits.canonical import CanonicalFrames, canonical_frames, pose_sample, rig_key
 from mocapqa.limits.charting import canonical_rotations
 from mocapqa.limits.model import LimitsModel, StoredFrames
@@ -45,8 +66,9 @@ from mocapqa.limits.rig import MODELLED_ROLES, rig_fingerprint
 
 __all__ = [
     "TakeSummary",
-    "build_canonical_on_engine",
+    "build_on_engine",
     "run_calls",
+    "take_role_rotations",
     "take_rotations",
     "take_summary",
     "world_sample",
@@ -110,6 +132,12 @@ def world_sample(path: str, frames: np.ndarray) -> tuple[FloatArray, FloatArray]
 def take_rotations(path: str, frames: CanonicalFrames) -> FloatArray:
     """Task: canonical rotations ``(F, R, 4)`` of the take in its rig's ``frames`` (round 3)."""
     return canonical_rotations(read_bvh(path), frames)
+
+
+def take_role_rotations(path: str, fingerprint: dict[str, tuple[str, str]]) -> FloatArray:
+    """Task: local rotations ``(F, R, 4)`` of the take's joints of ``fingerprint`` (per-rig
+    build, round 2)."""
+    return role_rotations(read_bvh(path), fingerprint)
 
 
 def run_calls(calls: Sequence[tuple[Callable[..., Any], tuple[Any, ...]]]) -> list[Any]:
@@ -182,17 +210,20 @@ def _rig_frames(
     return known, stored
 
 
-def build_canonical_on_engine(
+def build_on_engine(
     engine: Engine,
     corpus_dir: Path,
     settings: BuildParams,
+    rig: str | None = None,
     all_takes: bool = False,
     exclude: frozenset[str] | set[str] = frozenset(),
     on_total: Callable[[int], None] | None = None,
     step: Step | None = None,
 ) -> LimitsModel:
-    """The canonical model of :func:`mocapqa.limits.build.build_canonical_model` over
-    :func:`mocapqa.bench.limits.canonical_takes`, with the per-take work on ``engine``.
+    """The model of ``mocapqa limits build``, with the per-take work on ``engine``: without
+    ``rig`` the canonical model of :func:`mocapqa.limits.build.build_canonical_model` over
+    :func:`mocapqa.bench.limits.canonical_takes`; with it, the per-rig model of
+    :func:`mocapqa.limits.build.build_model` over :func:`mocapqa.bench.limits.rig_takes`.
 
     Parameters
     ----------
@@ -200,6 +231,8 @@ def build_canonical_on_engine(
     corpus_dir : Path
         Folder of BVH takes (its ``bvh`` subfolder when it has one), read by the workers.
     settings : BuildParams
+    rig : str, optional
+        A family of :data:`mocapqa.limits.rig.RIG_FAMILIES`.
     all_takes : bool
         Every take, not only the build split.
     exclude : set of str
@@ -208,15 +241,19 @@ def build_canonical_on_engine(
         Called with the number of steps to come once it is known (after round 1), and first
         with the files' count.
     step : callable, optional
-        Called with a description after each step (a task done, a role built).
+        Called with a description after each step (a task done, a role or joint built).
 
     Raises
     ------
     InputError
-        When no take has roles, or a file cannot be read (naming it).
+        When ``rig`` is not a rig family (before any task); when no take has roles, or, with
+        ``rig``, the folder has no rig of that family with two or more takes or no take of it
+        is left; or a file cannot be read (naming it).
     ClusterError
         When the Dask scheduler cannot be reached or is lost.
     """
+    if rig is not None:
+        check_rig_family(rig)
     tick: Step = step or (lambda _: None)
     paths = [str(p) for p in corpus_files(corpus_dir)]
     if on_total is not None:
@@ -224,19 +261,41 @@ def build_canonical_on_engine(
     summaries: list[TakeSummary] = _gather(
         engine, [(take_summary, (p,)) for p in paths], tick, "reading takes"
     )
+
+    def total(n_more: int) -> None:
+        if on_total is not None:
+            on_total(len(paths) + n_more)
+
+    if rig is None:
+        takes = _canonical_takes(corpus_dir, summaries, all_takes, exclude)
+        return _canonical_model(engine, takes, settings, total, tick)
+    groups = [(s.name, s.group) for s in summaries]
+    takes = [summaries[i] for i in rig_positions(groups, rig, corpus_dir, all_takes, exclude)]
+    return _rig_model(engine, takes, settings, total, tick)
+
+
+def _canonical_takes(
+    corpus_dir: Path, summaries: Sequence[TakeSummary], all_takes: bool,
+    exclude: frozenset[str] | set[str],
+) -> list[TakeSummary]:  # fmt: skip
+    """The takes of :func:`mocapqa.bench.limits.canonical_takes` among ``summaries``."""
     held = set() if all_takes else held_back_names([(s.name, s.group) for s in summaries])
     takes = [s for s in summaries if s.has_roles and s.name not in held and s.name not in exclude]
     if not takes:
         raise InputError(f"Expected BVH takes with limb roles in {corpus_dir}, got none")
-    if on_total is not None:
-        on_total(len(paths) + 2 * len(takes) + len(SIDES) * len(MODELLED_ROLES))
+    return takes
+
+
+def _canonical_model(
+    engine: Engine, takes: Sequence[TakeSummary], settings: BuildParams,
+    total: Callable[[int], None], tick: Step,
+) -> LimitsModel:  # fmt: skip
+    """Rounds 2 and 3 of a canonical build of ``takes`` and its training; ``total`` is called
+    with the steps to come after round 1."""
+    total(2 * len(takes) + len(SIDES) * len(MODELLED_ROLES))
     known, stored = _rig_frames(engine, takes, tick)
-    rotations = _gather(
-        engine,
-        [(take_rotations, (t.path, known[t.rig])) for t in takes],
-        tick,
-        "charting takes",
-    )
+    calls = [(take_rotations, (t.path, known[t.rig])) for t in takes]
+    rotations = _gather(engine, calls, tick, "charting takes")
     return canonical_model_from_rotations(
         [t.name for t in takes],
         [(known[t.rig].roles, q) for t, q in zip(takes, rotations, strict=True)],
@@ -244,4 +303,23 @@ def build_canonical_on_engine(
         sum(t.n_frames for t in takes),
         settings,
         lambda role: tick(f"built {role}"),
+    )
+
+
+def _rig_model(
+    engine: Engine, takes: Sequence[TakeSummary], settings: BuildParams,
+    total: Callable[[int], None], tick: Step,
+) -> LimitsModel:  # fmt: skip
+    """Round 2 of a per-rig build of ``takes`` (the chosen takes of one rig) and its
+    training; ``total`` is called with the steps to come after round 1."""
+    fingerprint = rig_roles([t.skeleton for t in takes], [t.name for t in takes])
+    total(len(takes) + len(fingerprint))
+    calls = [(take_role_rotations, (t.path, fingerprint)) for t in takes]
+    rotations = _gather(engine, calls, tick, "charting takes")
+    return rig_model_from_rotations(
+        takes[0].skeleton,
+        [t.name for t in takes],
+        rotations,
+        settings,
+        lambda name: tick(f"built {name}"),
     )

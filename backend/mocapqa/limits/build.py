@@ -41,6 +41,9 @@ __all__ = [
     "build_model",
     "canonical_model_from_rotations",
     "mean_rotation",
+    "rig_model_from_rotations",
+    "rig_roles",
+    "role_rotations",
     "stored_frames",
     "with_rig_frames",
 ]
@@ -114,60 +117,82 @@ def build_model(
         If there are no takes, the names do not match the takes, a take is of another rig, or
         the rig has none of the modelled roles.
     """
-    if not motions or len(motions) != len(take_names):
-        raise InputError(
-            f"Expected one name per take and at least one take, got {len(motions)} takes and "
-            f"{len(take_names)} names"
-        )
-    skeleton = motions[0].skeleton
-    fingerprint = rig_fingerprint(skeleton)
+    fingerprint = rig_roles([m.skeleton for m in motions], take_names)
+    return rig_model_from_rotations(
+        motions[0].skeleton,
+        take_names,
+        [role_rotations(m, fingerprint) for m in motions],
+        settings,
+        progress,
+    )
+
+
+def rig_roles(
+    skeletons: Sequence[Skeleton], take_names: Sequence[str]
+) -> dict[str, tuple[str, str]]:
+    """The fingerprint (:func:`mocapqa.limits.rig.rig_fingerprint`) shared by takes of one rig.
+
+    Raises
+    ------
+    InputError
+        If there are no takes, the names do not match the takes, the first rig has none of the
+        modelled roles, or a take is of another rig.
+    """
+    _check_names(len(skeletons), take_names)
+    fingerprint = rig_fingerprint(skeletons[0])
     if not fingerprint:
         raise InputError(f"Expected a skeleton with limb roles, got none in {take_names[0]!r}")
-    for motion, name in zip(motions, take_names, strict=True):
-        problems = fingerprint_mismatches(fingerprint, motion.skeleton)
+    for skeleton, name in zip(skeletons, take_names, strict=True):
+        problems = fingerprint_mismatches(fingerprint, skeleton)
         if problems:
             raise InputError(f"Expected every take of one rig, got {name!r}: {problems[0]}")
+    return fingerprint
+
+
+def role_rotations(motion: Motion, fingerprint: dict[str, tuple[str, str]]) -> FloatArray:
+    """The per-take half of :func:`build_model`: local rotations ``(F, R, 4)`` of the
+    fingerprint's joints, in its order."""
+    return motion.quats[:, [motion.skeleton.index(name) for name, _ in fingerprint.values()]]
+
+
+def rig_model_from_rotations(
+    skeleton: Skeleton,
+    take_names: Sequence[str],
+    rotations: Sequence[FloatArray],
+    settings: BuildParams = DEFAULT_BUILD,
+    progress: Callable[[str], None] | None = None,
+) -> LimitsModel:
+    """The corpus-wide half of :func:`build_model`: a map (and network) per joint from every
+    take's :func:`role_rotations` (the per-take half may run elsewhere, e.g. on Dask).
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+        Of the rig (of the first take); :func:`rig_roles` of every take has checked it.
+    take_names : sequence of str
+    rotations : sequence of ndarray
+        Per take, in the order of ``take_names``: ``(F, R, 4)``.
+    settings, progress
+        As for :func:`build_model`.
+    """
+    fingerprint = rig_fingerprint(skeleton)
     roles = list(fingerprint)
-    per_take = [m.quats[:, [m.skeleton.index(fingerprint[r][0]) for r in roles]] for m in motions]
-    quats = np.concatenate(per_take, axis=0)
-    digest = hashlib.sha256()
-    for name, q in zip(take_names, per_take, strict=True):
-        digest.update(name.encode("utf-8"))
-        digest.update(np.ascontiguousarray(q).tobytes())
-    axes = np.stack([bone_axis(skeleton, skeleton.index(fingerprint[r][0])) for r in roles])
-    if settings.reference == "mean":
-        references = np.stack([mean_rotation(quats[:, j]) for j in range(len(roles))])
-    else:
-        references = np.tile([0.0, 0.0, 0.0, 1.0], (len(roles), 1))
-    params = limit_params_from_quats(quats, axes, references)
+    quats = np.concatenate(rotations, axis=0)
     rng = np.random.default_rng(settings.seed)
     joints = []
     for j, role in enumerate(roles):
-        occupancy = build_occupancy(params[:, j], settings.occupancy)
-        network, scores = None, None
-        if settings.discriminator is not None:
-            network, scores = train_discriminator(occupancy, settings.discriminator, rng)
-        joints.append(
-            JointLimits(
-                role=role,
-                name=fingerprint[role][0],
-                axis=axes[j],
-                reference=references[j],
-                occupancy=occupancy,
-                network=network,
-                scores=scores,
-                n_samples=int(quats.shape[0]),
-            )
-        )
+        name = fingerprint[role][0]
+        axis = bone_axis(skeleton, skeleton.index(name))
+        joints.append(_joint_limits(role, name, quats[:, j], axis, settings, rng))
         if progress is not None:
-            progress(fingerprint[role][0])
+            progress(name)
     return LimitsModel(
         rig_family=rig_family(skeleton),
         fingerprint=fingerprint,
         joints=tuple(joints),
         occupancy_params=settings.occupancy,
         reference=settings.reference,
-        corpus_hash=digest.hexdigest(),
+        corpus_hash=_corpus_hash(take_names, rotations),
         takes=tuple(take_names),
         n_frames=int(quats.shape[0]),
     )
@@ -204,11 +229,7 @@ def build_canonical_model(
     InputError
         If there are no takes, the names do not match, or a take has no limb roles.
     """
-    if not motions or len(motions) != len(take_names):
-        raise InputError(
-            f"Expected one name per take and at least one take, got {len(motions)} takes and "
-            f"{len(take_names)} names"
-        )
+    _check_names(len(motions), take_names)
     known, stored = _frames_by_rig(motions, take_names)
     rotations = [canonical_quats(m, known=known[rig_key(m)]) for m in motions]
     return canonical_model_from_rotations(
@@ -251,39 +272,15 @@ def canonical_model_from_rotations(
     LimitsModel
     """
     samples: dict[str, list[FloatArray]] = {}
-    digest = hashlib.sha256()
-    for name, (roles_of_take, quats) in zip(take_names, rotations, strict=True):
-        digest.update(name.encode("utf-8"))
-        digest.update(np.ascontiguousarray(quats).tobytes())
+    for roles_of_take, quats in rotations:
         for k, role in enumerate(roles_of_take):
             samples.setdefault(role, []).append(quats[:, k])
     order = [role_key(s, r) for s in SIDES for r in MODELLED_ROLES]
-    roles = [r for r in order if r in samples]
     rng = np.random.default_rng(settings.seed)
     joints = []
-    for role in roles:
+    for role in (r for r in order if r in samples):
         quats = np.concatenate(samples[role], axis=0)
-        if settings.reference == "mean":
-            reference = mean_rotation(quats)
-        else:
-            reference = np.array([0.0, 0.0, 0.0, 1.0])
-        params = limit_params_from_quats(quats[:, None], CANONICAL_AXIS[None], reference[None])
-        occupancy = build_occupancy(params[:, 0], settings.occupancy)
-        network, scores = None, None
-        if settings.discriminator is not None:
-            network, scores = train_discriminator(occupancy, settings.discriminator, rng)
-        joints.append(
-            JointLimits(
-                role=role,
-                name=role,
-                axis=CANONICAL_AXIS.copy(),
-                reference=reference,
-                occupancy=occupancy,
-                network=network,
-                scores=scores,
-                n_samples=int(quats.shape[0]),
-            )
-        )
+        joints.append(_joint_limits(role, role, quats, CANONICAL_AXIS, settings, rng))
         if progress is not None:
             progress(role)
     return LimitsModel(
@@ -292,12 +289,57 @@ def canonical_model_from_rotations(
         joints=tuple(joints),
         occupancy_params=settings.occupancy,
         reference=settings.reference,
-        corpus_hash=digest.hexdigest(),
+        corpus_hash=_corpus_hash(take_names, [quats for _, quats in rotations]),
         takes=tuple(take_names),
         n_frames=n_frames,
         frame="canonical",
         rig_frames=stored,
     )
+
+
+def _check_names(n_takes: int, take_names: Sequence[str]) -> None:
+    """One name per take and at least one take, or an InputError."""
+    if not n_takes or n_takes != len(take_names):
+        raise InputError(
+            f"Expected one name per take and at least one take, got {n_takes} takes and "
+            f"{len(take_names)} names"
+        )
+
+
+def _joint_limits(
+    role: str, name: str, quats: FloatArray, axis: FloatArray, settings: BuildParams,
+    rng: np.random.Generator,
+) -> JointLimits:  # fmt: skip
+    """One joint's map (and network) from its rotations ``quats`` (N, 4) about its bone
+    ``axis`` (3,); ``rng`` draws the network's synthetic set (shared by the joints in turn)."""
+    if settings.reference == "mean":
+        reference = mean_rotation(quats)
+    else:
+        reference = np.array([0.0, 0.0, 0.0, 1.0])
+    params = limit_params_from_quats(quats[:, None], axis[None], reference[None])
+    occupancy = build_occupancy(params[:, 0], settings.occupancy)
+    network, scores = None, None
+    if settings.discriminator is not None:
+        network, scores = train_discriminator(occupancy, settings.discriminator, rng)
+    return JointLimits(
+        role=role,
+        name=name,
+        axis=np.array(axis, dtype=np.float64),
+        reference=reference,
+        occupancy=occupancy,
+        network=network,
+        scores=scores,
+        n_samples=int(quats.shape[0]),
+    )
+
+
+def _corpus_hash(take_names: Sequence[str], rotations: Sequence[FloatArray]) -> str:
+    """SHA-256 of every take's name and rotations, in order (what a model was built from)."""
+    digest = hashlib.sha256()
+    for name, quats in zip(take_names, rotations, strict=True):
+        digest.update(name.encode("utf-8"))
+        digest.update(np.ascontiguousarray(quats).tobytes())
+    return digest.hexdigest()
 
 
 def stored_frames(skeleton: Skeleton, frames: CanonicalFrames) -> StoredFrames:

@@ -22,6 +22,7 @@ from mocapqa.core.rig import SIDES, find_roles, role_key
 
 __all__ = [
     "MODELLED_ROLES",
+    "RIG_FAMILIES",
     "axis_label",
     "bone_axis",
     "fingerprint_mismatches",
@@ -31,6 +32,9 @@ __all__ = [
 
 # The limb roles a limits model holds (toes are left out: most rigs end them in zero offsets).
 MODELLED_ROLES = ("clavicle", "upper_arm", "forearm", "hand", "upper_leg", "lower_leg", "foot")
+
+# The labels of :func:`rig_family` a per-rig model can be built for (all but "other").
+RIG_FAMILIES = ("bandai", "character_creator", "cmu")
 
 _ZERO_LENGTH = 1e-4
 
