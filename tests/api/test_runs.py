@@ -50,7 +50,7 @@ def test_rerun_with_other_options_keeps_earlier_runs(
     result = client.get(f"/api/v1/runs/{run['id']}/result").json()
     assert result["steps"]["filter"]["state"] == "done"
     assert result["steps"]["limits"]["state"] == "skipped"
-    assert len(result["series"]["frames"]) == 100
+    assert 50 < len(result["series"]["frames"]) <= 100
     detail = client.get(f"/api/v1/takes/{analysed['id']}").json()
     assert [r["id"] for r in detail["runs"]] == [analysed["run_id"], run["id"]]
     filtered = client.get(f"/api/v1/runs/{run['id']}/download/bvh").content

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from mocapqa.core.decimate import sample_frames
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
@@ -15,7 +16,7 @@ from mocapqa.jobs.demo import demo_paths
 from mocapqa.jobs.runner import write_outputs
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.pipeline.analyze import analyze
-from mocapqa.pipeline.frames import motion_points, motion_pose, sample_frames
+from mocapqa.pipeline.frames import motion_points, motion_pose
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.pipeline.steps import true_runs, violation_findings
 from mocapqa.store.files import FileStore
@@ -96,7 +97,8 @@ def test_analyze_motion_reports_steps_and_progress() -> None:
     limits = report["steps"]["limits"]
     if limits["state"] == "done":
         heat = np.asarray(report["series"]["limits"]["score_deg"])
-        assert heat.shape == (len(report["series"]["limits"]["joints"]), 200)
+        n_samples = len(report["series"]["frames"])
+        assert heat.shape == (len(report["series"]["limits"]["joints"]), n_samples)
         assert np.all(heat >= 0)
         # The heat map's hover text: a read-out exactly where a cell is flagged.
         readout = np.asarray(report["series"]["limits"]["readout"])
@@ -105,7 +107,11 @@ def test_analyze_motion_reports_steps_and_progress() -> None:
     else:
         assert limits["state"] == "no_model"
         assert "no model for this rig" in limits["message"]
-    assert len(report["series"]["frames"]) == 200
+    frames = report["series"]["frames"]
+    assert 100 < len(frames) <= 200 < motion.n_frames
+    assert report["series"]["twist"]["frames"] == frames
+    # Every finding's first frame is on the plotted axis.
+    assert {f["start_frame"] for f in report["findings"]} <= set(frames)
     assert result.corrected_motion is not None
     assert result.raw_points.shape == result.corrected_points.shape
     twist_joints = {f["joint"] for f in report["findings"] if f["kind"] == "twist"}

@@ -55,12 +55,18 @@ def test_to_json_decimates_long_takes_and_keeps_one_frame_intervals(
     analysis = analyze_twist(corrupted)
     full = analysis.to_json()
     short = analysis.to_json(max_points=100)
-    assert short["frame_step"] == 6
-    assert len(short["frames"]) <= 100
+    frames = np.asarray(short["frames"])
+    assert len(frames) <= 100
+    assert short["frame_step"] == np.diff(frames).max() > 1
+    # Every interval's first frame and every offset step are kept.
+    assert np.isin(analysis.step_frames(), frames).all()
     for a, b in zip(full["chains"], short["chains"], strict=True):
-        assert len(b["offset_deg"]) == len(short["frames"])
+        assert len(b["offset_deg"]) == len(b["theta_p_deg"]) == len(frames)
         assert (sum(a["flagged"]) > 0) == (sum(b["flagged"]) > 0)
-        assert max(map(abs, b["offset_deg"])) == pytest.approx(max(map(abs, a["offset_deg"])))
+        # Each series is its value at the kept frames, and keeps its extremes.
+        for key in ("theta_p_deg", "offset_deg"):
+            np.testing.assert_array_equal(np.asarray(a[key])[frames], b[key])
+            assert (min(b[key]), max(b[key])) == (min(a[key]), max(a[key]))
 
 
 def test_twist_accuracy_matches_hand_computed_values() -> None:

@@ -4,7 +4,8 @@
 and the downloads need into an :class:`AnalysisResult`:
 
 * ``report`` — JSON-ready: summary, per-step state, findings, and the plotted time series
-  (decimated to ``options.max_points`` samples);
+  on one frame axis of at most ``options.max_points`` frames that keeps every series' peaks
+  and every finding's first and last frame (:func:`series_json`);
 * the corrected motion (twist-refined, optionally filtered) or the filtered keypoints;
 * raw and corrected point positions ``(F, P, 3)`` for the 3D view (served in windows).
 
@@ -15,18 +16,21 @@ without a limits model, a keypoint take for twist) reports why, and the take pas
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from mocapqa import __version__
 from mocapqa.core.arrays import BoolArray, FloatArray
+from mocapqa.core.decimate import peak_frames
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles
 from mocapqa.errors import InputError
 from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
-from mocapqa.pipeline.frames import motion_pose, sample_frames
+from mocapqa.pipeline.frames import motion_pose
 from mocapqa.pipeline.loading import Take
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.pipeline.steps import (
@@ -37,7 +41,7 @@ from mocapqa.pipeline.steps import (
     run_twist,
 )
 
-__all__ = ["AnalysisResult", "ProgressCallback", "analyze"]
+__all__ = ["AnalysisResult", "ProgressCallback", "analyze", "series_json"]
 
 ProgressCallback = Callable[[int, str], None]
 """Called as ``progress(percent, step)`` with percent in 0–100."""
@@ -87,6 +91,38 @@ def _steps_json(outcomes: dict[str, StepOutcome]) -> dict[str, dict[str, str]]:
     return {name: {"state": o.state, "message": o.message} for name, o in outcomes.items()}
 
 
+def series_json(
+    outcomes: Mapping[str, StepOutcome], n_frames: int, fps: float, max_points: int
+) -> dict[str, Any]:
+    """The plotted series of a run's steps, sampled on one frame axis that keeps their peaks.
+
+    The axis is :func:`mocapqa.core.decimate.peak_frames` of every step's plotted series
+    together, keeping the steps' findings' frames first, in the steps' order (each twist
+    interval's first frame and offset steps, largest first; then the limits findings' first
+    frames and last frames, worst first): ``frames`` is shared by all series, as the page and
+    API clients read it.
+
+    Parameters
+    ----------
+    outcomes : mapping of str to StepOutcome
+        The steps that ran, by name; a step without a plot (no model) gives None.
+    n_frames : int
+        Frames of the take.
+    fps : float
+        Frame rate, frames per second.
+    max_points : int
+        Most frames kept.
+    """
+    plots = [o.plot for o in outcomes.values() if o.plot is not None]
+    signals = np.concatenate([np.empty((n_frames, 0))] + [p.signals for p in plots], axis=1)
+    keep = np.concatenate([np.empty(0, dtype=np.intp)] + [p.keep for p in plots])
+    frames = peak_frames(signals, max_points, keep)
+    series: dict[str, Any] = {"frames": frames.tolist(), "fps": fps}
+    for name, outcome in outcomes.items():
+        series[name] = None if outcome.plot is None else outcome.plot.at(frames)
+    return series
+
+
 def _analyze_motion(
     motion: Motion,
     options: AnalysisOptions,
@@ -94,10 +130,9 @@ def _analyze_motion(
     catalog: ModelCatalog | None,
 ) -> AnalysisResult:
     outcomes: dict[str, StepOutcome] = {}
-    series: dict[str, Any] = {}
+    plotted: dict[str, StepOutcome] = {}
     findings: list[dict[str, Any]] = []
     timings: dict[str, float] = {}
-    frames = sample_frames(motion.n_frames, options.max_points)
 
     rig = find_roles(motion.skeleton, options.mapping)  # a bad mapping fails the run here
     progress(10, "forward kinematics (raw)")
@@ -109,14 +144,11 @@ def _analyze_motion(
     if "twist" in options.checks:
         progress(25, "twist analysis")
         clock = time.perf_counter()
-        outcome = run_twist(
-            motion, options.twist_method, frames, options.mapping, options.twist_apply
-        )
+        outcome = run_twist(motion, options.twist_method, options.mapping, options.twist_apply)
         timings["twist_s"] = time.perf_counter() - clock
-        outcomes["twist"] = outcome
+        outcomes["twist"] = plotted["twist"] = outcome
         if outcome.motion is not None:
             corrected = outcome.motion
-        series["twist"] = outcome.series
         findings += outcome.findings
     else:
         outcomes["twist"] = StepOutcome("skipped", "not requested")
@@ -125,11 +157,10 @@ def _analyze_motion(
         progress(55, "joint-limit check")
         clock = time.perf_counter()
         outcome = run_limits(
-            motion, frames, options.mapping, options.limits_model or DEFAULT_MODEL, catalog
+            motion, options.mapping, options.limits_model or DEFAULT_MODEL, catalog
         )
         timings["limits_s"] = time.perf_counter() - clock
-        outcomes["limits"] = outcome
-        series["limits"] = outcome.series
+        outcomes["limits"] = plotted["limits"] = outcome
         findings += outcome.findings
     else:
         outcomes["limits"] = StepOutcome("skipped", "not requested")
@@ -149,6 +180,9 @@ def _analyze_motion(
     clock = time.perf_counter()
     _, _, corrected_points, corrected_rotations = motion_pose(corrected)
     timings["fk_corrected_s"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    series = series_json(plotted, motion.n_frames, motion.fps, options.max_points)
+    timings["series_s"] = time.perf_counter() - clock
     skeleton = motion.skeleton
     report = {
         "kind": "motion",
@@ -170,7 +204,7 @@ def _analyze_motion(
         "timings_s": {k: round(v, 4) for k, v in timings.items()},
         "findings": findings,
         "points": {"names": names, "parents": parents, "n_joints": skeleton.n_joints},
-        "series": {"frames": frames.tolist(), "fps": motion.fps, **series},
+        "series": series,
     }
     return AnalysisResult(
         report,
@@ -192,9 +226,8 @@ def _analyze_keypoints(
         "twist": StepOutcome("skipped", "keypoint takes have no joint rotations"),
         "limits": StepOutcome("skipped", "keypoint takes have no joint rotations"),
     }
-    frames = sample_frames(sequence.n_frames, options.max_points)
+    plotted: dict[str, StepOutcome] = {}
     filtered = sequence
-    series: dict[str, Any] = {}
     findings: list[dict[str, Any]] = []
     if "filter" in options.checks:
         progress(30, "filtering keypoints")
@@ -203,12 +236,10 @@ def _analyze_keypoints(
             options.filter_method or "adaptive",
             options.filter_preset,
             options.filter_params,
-            frames,
         )
-        outcomes["filter"] = outcome
+        outcomes["filter"] = plotted["filter"] = outcome
         if outcome.keypoints is not None:
             filtered = outcome.keypoints
-        series["filter"] = outcome.series
         findings += outcome.findings
     else:
         outcomes["filter"] = StepOutcome("skipped", "not requested")
@@ -238,7 +269,7 @@ def _analyze_keypoints(
             "parents": [-1] * sequence.n_keypoints,
             "n_joints": sequence.n_keypoints,
         },
-        "series": {"frames": frames.tolist(), "fps": sequence.fps, **series},
+        "series": series_json(plotted, sequence.n_frames, sequence.fps, options.max_points),
     }
     bridged = outcomes["filter"].bridged
     return AnalysisResult(

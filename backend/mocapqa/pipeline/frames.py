@@ -1,4 +1,4 @@
-"""Point positions for the 3D view and the sample grid of plotted series.
+"""Point positions for the 3D view.
 
 The 3D view draws joints and End Sites as points joined to their parents. Positions are
 ``(F, P, 3)`` in file units, with the P points in skeleton order followed by the End Sites.
@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from mocapqa.core.arrays import FloatArray, IntArray
+from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Motion
 from mocapqa.kinematics.forward import end_site_positions, forward_kinematics
 
-__all__ = ["motion_points", "motion_pose", "sample_frames"]
+__all__ = ["motion_points", "motion_pose"]
 
 
 def motion_points(motion: Motion) -> tuple[list[str], list[int], FloatArray]:
@@ -52,23 +52,3 @@ def motion_pose(motion: Motion) -> tuple[list[str], list[int], FloatArray, Float
     positions = np.concatenate([world_positions, ends], axis=1)
     rotations = np.concatenate([world_quats, world_quats[:, site_parents]], axis=1)
     return names, parents, positions, rotations
-
-
-def sample_frames(n_frames: int, max_points: int) -> IntArray:
-    """Evenly spaced frame indices, at most ``max_points`` of them, always the first and last.
-
-    Parameters
-    ----------
-    n_frames : int
-        Frames in the take.
-    max_points : int
-        Largest number of samples.
-
-    Returns
-    -------
-    ndarray, shape (S,)
-        Increasing frame indices.
-    """
-    if n_frames <= max_points:
-        return np.arange(n_frames, dtype=np.intp)
-    return np.unique(np.linspace(0, n_frames - 1, max_points).round().astype(np.intp))

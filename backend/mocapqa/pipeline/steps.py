@@ -9,7 +9,9 @@
 
 Every step returns a :class:`StepOutcome` whose ``findings`` share one shape
 (``kind, joint, start_frame, end_frame, value, unit, confidence``; frames inclusive) and whose
-``series`` is the JSON the UI plots, sampled at the run's frame grid. Angles are in degrees.
+``plot`` holds the series the UI plots on every frame, with the frames a plot must keep; the
+run samples every step's series on one frame axis chosen from all of them
+(:func:`mocapqa.core.decimate.peak_frames`). Angles are in degrees.
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ from mocapqa.pipeline.options import ParamValue
 from mocapqa.twist.analysis import analyze_twist
 
 __all__ = [
+    "Plot",
     "StepOutcome",
     "run_filter_keypoints",
     "run_filter_motion",
@@ -42,6 +45,25 @@ __all__ = [
     "true_runs",
     "violation_findings",
 ]
+
+
+@dataclass(frozen=True, slots=True)
+class Plot:
+    """A step's plotted series, before the run chooses the frames it samples.
+
+    Parameters
+    ----------
+    signals : ndarray, shape (F, S)
+        Every plotted series on every frame (degrees or shares; NaN where missing).
+    keep : ndarray of int, shape (K,)
+        Frames the plot must keep (its findings' edges), most important first.
+    at : callable
+        ``at(frames)`` → the JSON-ready series sampled at ``frames`` (increasing, shape (N,)).
+    """
+
+    signals: FloatArray
+    keep: IntArray
+    at: Callable[[IntArray], dict[str, Any]]
 
 
 @dataclass(frozen=True, slots=True)
@@ -56,8 +78,8 @@ class StepOutcome:
         One line for the UI.
     findings : list of dict
         Normalised findings.
-    series : dict, optional
-        Plotted series (JSON-ready).
+    plot : Plot, optional
+        Plotted series on every frame, sampled once the run's frames are chosen.
     motion : Motion, optional
         A corrected motion, when the step makes one.
     keypoints : KeypointSequence, optional
@@ -69,7 +91,7 @@ class StepOutcome:
     state: str
     message: str = ""
     findings: list[dict[str, Any]] = field(default_factory=list)
-    series: dict[str, Any] | None = None
+    plot: Plot | None = None
     motion: Motion | None = None
     keypoints: KeypointSequence | None = None
     bridged: BoolArray | None = None
@@ -92,10 +114,16 @@ def true_runs(flags: BoolArray) -> IntArray:
     return np.stack([starts, stops - 1], axis=1).astype(np.intp)
 
 
+def _finding_edges(findings: list[dict[str, Any]]) -> IntArray:
+    """Every finding's first frame, then every last frame, the largest ``value`` first."""
+    ordered = sorted(findings, key=lambda f: -abs(float(f["value"])))
+    starts = [int(f["start_frame"]) for f in ordered]
+    return np.asarray(starts + [int(f["end_frame"]) for f in ordered], dtype=np.intp)
+
+
 def run_twist(
     motion: Motion,
     method: str,
-    frames: IntArray,
     mapping: dict[str, str] | None = None,
     apply: str = "confident",
 ) -> StepOutcome:
@@ -122,14 +150,18 @@ def run_twist(
         }
         for interval in analysis.intervals
     ]
-    series = analysis.to_json(max_points=int(frames.size))
+    plot = Plot(
+        analysis.plotted_deg(),
+        analysis.step_frames(),
+        lambda frames: analysis.to_json(frames=frames),
+    )
     unchecked = f"; roles not found, not checked: {', '.join(missing)}" if missing else ""
     return StepOutcome(
         "done",
         f"{len(findings)} twist interval(s) on {len(analysis.chains)} chain(s), "
         f"{sum(i.applied for i in analysis.intervals)} applied ({analysis.apply}){unchecked}",
         findings,
-        series,
+        plot,
         analysis.refined,
     )
 
@@ -196,7 +228,6 @@ def _default_for_rig(key: RigKey) -> LimitsModel | str:
 
 def run_limits(
     motion: Motion,
-    frames: IntArray,
     mapping: dict[str, str] | None = None,
     model_name: str = DEFAULT_MODEL,
     catalog: ModelCatalog | None = None,
@@ -228,25 +259,27 @@ def run_limits(
     report = check_limits(motion, model, mapping=mapping)
     joints = list(report.joint_names)
     findings = violation_findings(report.valid, report.score_deg, joints, report.readout)
-    sampled = frames[frames < report.valid.shape[0]]
-    heat = np.where(report.valid[sampled].T, 0.0, np.round(report.score_deg[sampled].T, 2))
-    # Hover text of the heat map: the anatomical read-out of each flagged cell ("" if valid).
-    readouts = [[report.readout(int(f), j) for f in sampled] for j in range(len(joints))]
+    heat = np.where(report.valid, 0.0, report.score_deg)
     summary = report.to_json(max_points=1)
     for joint in summary["joints"]:
         joint.pop("frames", None)  # the heat map carries the per-frame values
+
+    def at(frames: IntArray) -> dict[str, Any]:
+        return {
+            "joints": joints,
+            "frames": frames.tolist(),
+            "score_deg": np.round(heat[frames].T, 2).tolist(),
+            # Hover text of the heat map: the anatomical read-out of each flagged cell.
+            "readout": [[report.readout(int(f), j) for f in frames] for j in range(len(joints))],
+            "summary": summary,
+        }
+
     return StepOutcome(
         "done",
         f"{len(findings)} violation interval(s), model {model_name} ({report.rig_family}); "
         f"{len(report.not_checked)} joint(s) not checked (listed in summary.not_checked)",
         findings,
-        {
-            "joints": joints,
-            "frames": sampled.tolist(),
-            "score_deg": heat.tolist(),
-            "readout": readouts,
-            "summary": summary,
-        },
+        Plot(heat, _finding_edges(findings), at),
     )
 
 
@@ -261,36 +294,47 @@ def run_filter_keypoints(
     method: str,
     preset: str | None,
     params: dict[str, ParamValue],
-    frames: IntArray,
 ) -> StepOutcome:
     """Filter keypoints; the series holds the filter weight timeline (mean over keypoints)."""
     result = filter_keypoints(sequence, method, preset or "default", dict(params))
-    weights: dict[str, Any] = {}
-    if result.weights is not None:
-        sampled = np.nan_to_num(result.weights[frames])
-        mean = sampled.mean(axis=1)
-        for i, name in enumerate(result.weight_names):
-            weights[name] = {
-                "mean": np.round(mean[:, i], 4).tolist(),
+    n_frames = sequence.n_frames
+    shares = np.zeros((n_frames, 0, 0)) if result.weights is None else result.weights
+    # Plotted: the mean of each weight over the keypoints, then each keypoint's weights.
+    mean = np.nan_to_num(shares).mean(axis=1)
+    signals = np.concatenate([mean, shares.reshape(n_frames, -1)], axis=1)
+
+    def at(frames: IntArray) -> dict[str, Any]:
+        sampled = np.nan_to_num(shares[frames])
+        return {
+            name: {
+                "mean": np.round(mean[frames, i], 4).tolist(),
                 "per_keypoint": np.round(sampled[:, :, i].T, 3).tolist(),
             }
+            for i, name in enumerate(result.weight_names)
+        }
+
     detail = result.to_json(max_points=1)
     for key in ("weights", "weights_mean", "timeline_frames"):
         detail.pop(key, None)
     bridged = int(result.bridged.sum())
+    # Frames where any keypoint was bridged (no valid input), as [first, last] runs.
+    runs = true_runs(np.any(result.bridged, axis=1))
+    series = {
+        "method": method,
+        "names": list(sequence.names),
+        "length_unit": sequence.length_unit,
+        "summary": detail,
+        "bridged_runs": runs.tolist(),
+    }
     return StepOutcome(
         "done",
         f"filtered with {method} ({bridged} bridged samples)",
         [],
-        {
-            "method": method,
-            "names": list(sequence.names),
-            "length_unit": sequence.length_unit,
-            "weights": weights,
-            "summary": detail,
-            # Frames where any keypoint was bridged (no valid input), as [first, last] runs.
-            "bridged_runs": true_runs(np.any(result.bridged, axis=1)).tolist(),
-        },
+        Plot(
+            signals,
+            runs.reshape(-1),
+            lambda frames: {**series, "weights": at(frames) if result.weights is not None else {}},
+        ),
         keypoints=result.sequence,
         bridged=result.bridged,
     )

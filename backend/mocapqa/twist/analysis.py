@@ -8,13 +8,13 @@ series (θP, offset, flagged frames) in the shape documented in ``docs/twist.md`
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 from typing import Any, Literal, get_args
 
 import numpy as np
 
-from mocapqa.core.arrays import BoolArray, FloatArray
+from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.core.decimate import peak_frames
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.errors import InputError
@@ -119,43 +119,79 @@ class TwistAnalysis:
             )
         return out
 
-    def to_json(self, max_points: int | None = None) -> dict[str, Any]:
+    def plotted_deg(self) -> FloatArray:
+        """The plotted series on every frame: θP per chain, then the removed offset per chain.
+
+        Returns
+        -------
+        ndarray, shape (F, 2 C)
+            Degrees; θP in (−180, 180], the offset wrapped to (−180, 180].
+        """
+        theta = np.rad2deg(self.parent_twist_rad)
+        offsets = np.rad2deg(wrap_angle(self.offsets_rad))
+        return np.concatenate([theta, offsets], axis=1)
+
+    def step_frames(self) -> IntArray:
+        """Where the intervals found start and where their offset steps, most important first.
+
+        The detected offset (applied or not) steps where θP jumps: on each level's first frame
+        and on the frame after each interval. A plot that keeps these frames shows every
+        interval's first frame and every jump at its frame.
+
+        Returns
+        -------
+        ndarray of int, shape (K,)
+            Each interval's first frame, in order, then the other frames where the offset of
+            some chain steps, by decreasing step (the largest over the chains); inside the take.
+        """
+        offsets = self.detected_offsets_rad
+        change = np.abs(wrap_angle(np.diff(offsets, axis=0, prepend=0.0)))
+        size = change.max(axis=1, initial=0.0)
+        steps = np.flatnonzero(size > 1e-9)
+        steps = steps[np.argsort(-size[steps], kind="stable")]
+        starts = np.asarray([i.start_frame for i in self.intervals], dtype=np.intp)
+        frames: IntArray = np.concatenate([starts, steps[~np.isin(steps, starts)]])
+        return frames.astype(np.intp)
+
+    def to_json(
+        self, max_points: int | None = None, frames: IntArray | None = None
+    ) -> dict[str, Any]:
         """Plot-ready time series per chain (shape documented in ``docs/twist.md``).
 
         Parameters
         ----------
         max_points : int, optional
-            Longest series returned. Longer takes are decimated in blocks of ``frame_step``
-            frames: θP takes the block's first value, the offset the value of largest magnitude
-            in the block and ``flagged`` whether any frame of the block is flagged, so that
-            one-frame intervals stay visible.
+            Most samples returned. Longer takes keep the frames of
+            :func:`mocapqa.core.decimate.peak_frames`: per bucket of frames the lowest and
+            highest θP and offset of every chain, and every interval's first frame and offset
+            step (:meth:`step_frames`), so a one-frame flip stays visible.
+        frames : ndarray of int, shape (N,), optional
+            The frames to sample instead (increasing), as the pipeline's shared axis.
 
         Returns
         -------
         dict
+            ``frame_step`` is the largest gap between consecutive samples (1 when every frame
+            is kept); every series holds its value at ``frames``.
         """
         n_frames = self.offsets_rad.shape[0]
-        step = 1
-        if max_points is not None:
-            if max_points < 1:
-                raise InputError(f"Expected max_points ≥ 1, got {max_points}")
-            step = max(1, math.ceil(n_frames / max_points))
-        frames = np.arange(0, n_frames, step)
-        pad = (-n_frames) % step
-        chains_json = []
-        flagged_all = np.zeros((n_frames, len(self.chains)), dtype=bool)
+        plotted = self.plotted_deg()
+        if frames is None:
+            if max_points is not None and max_points < 2:
+                raise InputError(f"Expected max_points ≥ 2, got {max_points}")
+            limit = n_frames if max_points is None else max_points
+            frames = peak_frames(plotted, limit, self.step_frames())
+        n_chains = len(self.chains)
+        flagged_all = np.zeros((n_frames, n_chains), dtype=bool)
         for interval in self.intervals:
             c = next(
                 k for k, g in enumerate(self.chains)
                 if self.joint_names[g.chain.parent] == interval.joint
             )  # fmt: skip
             flagged_all[interval.start_frame : interval.end_frame + 1, c] = True
+        sampled = np.round(plotted[frames], 3)
+        chains_json = []
         for c, geometry in enumerate(self.chains):
-            offsets = np.rad2deg(wrap_angle(self.offsets_rad[:, c]))
-            blocks = np.pad(offsets, (0, pad)).reshape(-1, step)
-            picked = blocks[np.arange(len(blocks)), np.argmax(np.abs(blocks), axis=1)]
-            flags = np.pad(flagged_all[:, c], (0, pad)).reshape(-1, step).any(axis=1)
-            theta = np.rad2deg(self.parent_twist_rad[frames, c])
             joint = self.joint_names[geometry.chain.parent]
             grand = geometry.chain.grandchild
             chains_json.append(
@@ -166,9 +202,9 @@ class TwistAnalysis:
                     "side": geometry.chain.side,
                     "segment": geometry.chain.segment,
                     "axis": [round(float(v), 6) for v in geometry.axis],
-                    "theta_p_deg": np.round(theta, 3).tolist(),
-                    "offset_deg": np.round(picked, 3).tolist(),
-                    "flagged": flags.astype(int).tolist(),
+                    "theta_p_deg": sampled[:, c].tolist(),
+                    "offset_deg": sampled[:, n_chains + c].tolist(),
+                    "flagged": flagged_all[frames, c].astype(int).tolist(),
                     "intervals": [i.to_json() for i in self.intervals if i.joint == joint],
                 }
             )
@@ -177,7 +213,7 @@ class TwistAnalysis:
             "apply": self.apply,
             "fps": self.fps,
             "n_frames": n_frames,
-            "frame_step": step,
+            "frame_step": int(np.diff(frames).max(initial=1)),
             "frames": frames.tolist(),
             "chains": chains_json,
             "intervals": [i.to_json() for i in self.intervals],
