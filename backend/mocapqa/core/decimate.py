@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mocapqa.core.arrays import FloatArray, IntArray, check_shape
+from mocapqa.core.arrays import BoolArray, FloatArray, IntArray, check_shape
 from mocapqa.errors import InputError
 
 __all__ = ["bucket_extremes", "peak_frames", "sample_frames"]
@@ -61,28 +61,34 @@ def bucket_extremes(signals: FloatArray, width: int) -> IntArray:
     check_shape(signals, "signals", ("F", "S"))
     if width < 1:
         raise InputError(f"Expected width ≥ 1, got {width}")
-    n_frames, n_series = signals.shape
-    n_buckets = -(-n_frames // width)
-    padded = np.full((n_buckets * width, n_series), np.nan)
-    padded[:n_frames] = signals
-    blocks = padded.reshape(n_buckets, width, n_series)
-    missing = np.isnan(blocks)
-    low = np.argmin(np.where(missing, np.inf, blocks), axis=1)
-    high = np.argmax(np.where(missing, -np.inf, blocks), axis=1)
-    real_gap = np.zeros(padded.shape, dtype=bool)  # the padding is no gap
-    real_gap[:n_frames] = np.isnan(signals)
-    real_gap = real_gap.reshape(blocks.shape)
-    gap = np.argmax(real_gap, axis=1)
-    starts = np.arange(n_buckets, dtype=np.intp) * width
-    frames = np.concatenate(
-        [
-            starts,
-            (starts[:, None] + low).ravel(),
-            (starts[:, None] + high).ravel(),
-            (starts[:, None] + gap)[real_gap.any(axis=1)],
+    return _extremes(*_prepared(signals), width)
+
+
+def _prepared(signals: FloatArray) -> tuple[FloatArray, FloatArray, BoolArray]:
+    gaps = np.isnan(signals)
+    return np.where(gaps, np.inf, signals), np.where(gaps, -np.inf, signals), gaps
+
+
+def _extremes(lowered: FloatArray, raised: FloatArray, gaps: BoolArray, width: int) -> IntArray:
+    # The full buckets are views of the arrays; the shorter last bucket is its own block.
+    n_frames, n_series = lowered.shape
+    full = n_frames // width * width
+    picks = [np.arange(0, n_frames, width, dtype=np.intp)]
+    for start, stop in ((0, full), (full, n_frames)):
+        size = width if start == 0 else stop - start
+        if stop <= start:
+            continue
+        n_blocks = (stop - start) // size
+        shape = (n_blocks, size, n_series)
+        base = start + size * np.arange(n_blocks, dtype=np.intp)[:, None]
+        holes = gaps[start:stop].reshape(shape)
+        picks += [
+            (base + lowered[start:stop].reshape(shape).argmin(axis=1)).ravel(),
+            (base + raised[start:stop].reshape(shape).argmax(axis=1)).ravel(),
+            (base + holes.argmax(axis=1))[holes.any(axis=1)],
         ]
-    )
-    return np.unique(frames[frames < n_frames]).astype(np.intp)
+    frames: IntArray = np.unique(np.concatenate(picks)).astype(np.intp)
+    return frames
 
 
 def _kept(n_frames: int, room: int, keep: IntArray) -> IntArray:
@@ -128,8 +134,10 @@ def peak_frames(signals: FloatArray, max_points: int, keep: IntArray | None = No
     required = _kept(n_frames, max_points, wanted)
     room = max_points - required.size
 
+    prepared = _prepared(signals)
+
     def kept(width: int) -> IntArray:
-        return np.union1d(required, bucket_extremes(signals, width)).astype(np.intp)
+        return np.union1d(required, _extremes(*prepared, width)).astype(np.intp)
 
     # Each bucket adds at most 1 + 3 S frames: this width always fits when room allows it.
     per_bucket = 1 + 3 * n_series
