@@ -298,10 +298,12 @@ def run_filter_keypoints(
     """Filter keypoints; the series holds the filter weight timeline (mean over keypoints)."""
     result = filter_keypoints(sequence, method, preset or "default", dict(params))
     n_frames = sequence.n_frames
-    shares = np.zeros((n_frames, 0, 0)) if result.weights is None else result.weights
+    n_keypoints = sequence.n_keypoints
+    shares = np.zeros((n_frames, n_keypoints, 0)) if result.weights is None else result.weights
     # Plotted: the mean of each weight over the keypoints, then each keypoint's weights.
     mean = np.nan_to_num(shares).mean(axis=1)
-    signals = np.concatenate([mean, shares.reshape(n_frames, -1)], axis=1)
+    per_keypoint = shares.reshape(n_frames, n_keypoints * shares.shape[2])
+    signals = np.concatenate([mean, per_keypoint], axis=1)
 
     def at(frames: IntArray) -> dict[str, Any]:
         sampled = np.nan_to_num(shares[frames])
