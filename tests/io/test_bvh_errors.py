@@ -62,7 +62,8 @@ def test_the_good_file_reads_with_any_line_endings() -> None:
     ("lines", "pattern"),
     [
         (GOOD_LINES[:19], r"line 20: Expected 2 frame lines \(Frames:\), got 1 \(truncated"),
-        (GOOD_LINES[:12], r"line 12: Expected a 'MOTION' section, got none"),
+        (GOOD_LINES[:12], r"line 12: Expected '}', got end of file \(truncated file\?\)"),
+        (GOOD_LINES[:15], r"line 15: Expected a 'MOTION' section, got end of file"),
         (replaced(19, "0 90 0 0 0 0 10 20"), r"line 19: Expected 9 values on a frame line, got 8"),
         (replaced(20, "1 91 0 1 2 3 11 abc 31"), r"line 20: Expected a number, got 'abc'"),
         (replaced(20, "1 91 0 1 2 3 11 1,5 31"), r"line 20: Expected a number, got '1,5'"),
@@ -72,7 +73,7 @@ def test_the_good_file_reads_with_any_line_endings() -> None:
             r"line 20: Expected finite numbers, got NaN or inf",
         ),
         (replaced(20, "1 91 0 1 2 3 11 21 1e999"), r"line 20: Expected finite numbers"),
-        (replaced(16, None), r"line 19: Expected a 'MOTION' section, got none"),
+        (replaced(16, None), r"line 16: Expected 'ROOT' or 'MOTION', got 'Frames:'"),
         (replaced(17, None), r"line 17: Expected 'Frames:', got 'Frame Time: 0.0333333'"),
         (replaced(17, "Frames: two"), r"line 17: Expected a frame count, got 'two'"),
         (replaced(17, "Frames: -1"), r"line 17: Expected a frame count >= 0, got -1"),

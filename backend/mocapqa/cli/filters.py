@@ -49,12 +49,13 @@ def filter_command(
     from mocapqa.filters.apply import filter_keypoints, filter_motion
     from mocapqa.filters.registry import FILTERS
     from mocapqa.io.bvh_write import write_bvh
-    from mocapqa.io.formats import read_take, write_keypoints
+    from mocapqa.io.formats import read_take, require_frames, write_keypoints
     from mocapqa.metrics.smoothness import lag_frames, mean_abs_jerk
 
     overrides = parse_overrides(param or [])
     roles = load_mapping(mapping)
     take = read_take(input_path, fps=fps)
+    require_frames(take, input_path)
     summary: dict[str, Any]
     if roles is not None and not isinstance(take, Motion):
         raise InputError("Expected --mapping only for BVH input, got a keypoint take")

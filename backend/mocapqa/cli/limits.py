@@ -245,10 +245,12 @@ def limits_check(
     are reported missing (the warning line and ``missing_roles`` in the JSON).
     """
     from mocapqa.io.bvh import read_bvh
+    from mocapqa.io.formats import require_frames
     from mocapqa.limits.analysis import check_limits
 
     roles = load_mapping(mapping)
     motion = read_bvh(path)
+    require_frames(motion, path)
     missing = missing_roles(motion.skeleton, roles)
     model = _chosen_model(model_path, motion) if model_path is not None else None
     if frame_from is not None:

@@ -51,10 +51,11 @@ def raw_run(
 ) -> TakeRun:
     """A take read without analysis: corrected is the raw take, no findings."""
     from mocapqa.core.motion import Motion
-    from mocapqa.io.formats import read_take
+    from mocapqa.io.formats import read_take, require_frames
     from mocapqa.render.scene import track_from_keypoints, track_from_motion
 
     take = read_take(path, root_translation=root_translation)
+    require_frames(take, path)
     summary: dict[str, object] = {"fps": 0.0}
     if isinstance(take, Motion):
         track = track_from_motion(take)

@@ -67,11 +67,13 @@ def refine(
     """
     from mocapqa.io.bvh import read_bvh
     from mocapqa.io.bvh_write import write_bvh
+    from mocapqa.io.formats import require_frames
     from mocapqa.twist.analysis import analyze_twist
 
     _check_method(method)
     roles = load_mapping(mapping)
     motion = read_bvh(input_path)
+    require_frames(motion, input_path)
     missing = missing_roles(motion.skeleton, roles)
     analysis = analyze_twist(motion, method, roles, apply=apply)
     write_bvh(output, analysis.refined)
@@ -97,11 +99,13 @@ def detect(
 ) -> None:
     """Report axial twist error intervals (and which refine would apply) without writing."""
     from mocapqa.io.bvh import read_bvh
+    from mocapqa.io.formats import require_frames
     from mocapqa.twist.analysis import analyze_twist
 
     _check_method(method)
     roles = load_mapping(mapping)
     motion = read_bvh(input_path)
+    require_frames(motion, input_path)
     missing = missing_roles(motion.skeleton, roles)
     analysis = analyze_twist(motion, method, roles, apply=apply)
     if as_json:

@@ -17,31 +17,28 @@ Conventions
 
 from __future__ import annotations
 
+import codecs
 import math
 import re
 import sys
-from collections.abc import Iterator
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
 import numpy as np
 
 from mocapqa.core.arrays import FloatArray
-from mocapqa.core.motion import (
-    POSITION_CHANNELS,
-    ROTATION_CHANNELS,
-    EndSite,
-    Motion,
-    Skeleton,
-)
+from mocapqa.core.motion import POSITION_CHANNELS, Motion, Skeleton
 from mocapqa.errors import ParseError
-from mocapqa.io.bvh_frames import frames_by_arrow, frames_by_line
+from mocapqa.io.bvh_frames import MAX_MAGNITUDE, frames_by_arrow, frames_by_line
+from mocapqa.io.bvh_hierarchy import MAX_JOINTS, Hierarchy, parse_hierarchy
 from mocapqa.kinematics.euler import quats_from_euler
 
 __all__ = [
     "AUTO_ARROW_BYTES",
+    "MAX_FRAME_TIME_S",
     "MAX_JOINTS",
+    "MAX_MAGNITUDE",
+    "MIN_FRAME_TIME_S",
     "BvhParseError",
     "NumberReader",
     "parse_bvh",
@@ -52,24 +49,27 @@ BvhParseError = ParseError
 """Alias of :class:`~mocapqa.errors.ParseError`, the error every malformed BVH raises."""
 NumberReader = Literal["arrow", "python", "auto"]
 """How the frame block's numbers are read (see :func:`parse_bvh`)."""
+MIN_FRAME_TIME_S = 1e-5
+"""Shortest Frame Time accepted: 100,000 fps, ten times the fastest motion-capture cameras."""
+MAX_FRAME_TIME_S = 10.0
+"""Longest Frame Time accepted (0.1 fps); a larger one is most often a frame rate."""
 AUTO_ARROW_BYTES = 1_000_000
 """Frame blocks from this size are read by Arrow under ``number_reader="auto"``.
 
 Below it, in a process that has not loaded pyarrow yet, importing it (~0.05 s) costs more than
 the line-by-line reader (~0.07 s per MB) takes for the whole block.
 """
-MAX_JOINTS = 1000
-"""Largest joint count accepted; more means a corrupt or hostile file."""
-_KNOWN_CHANNELS = set(POSITION_CHANNELS) | set(ROTATION_CHANNELS)
-
-
-@dataclass(slots=True)
-class _Token:
-    text: str
-    line: int
 
 
 def _decode(data: bytes, path: str) -> str:
+    if data[:2] in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE):
+        # Windows tools (PowerShell's redirection, Notepad's "Unicode") save UTF-16.
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError as e:
+            raise ParseError(
+                "Expected UTF-16 text after its byte order mark, got odd bytes", path
+            ) from e
     if b"\x00" in data[:65536]:
         raise ParseError("Expected a text file, got binary data (NUL bytes)", path, 1)
     try:
@@ -80,149 +80,9 @@ def _decode(data: bytes, path: str) -> str:
     return text
 
 
-def _tokens(lines: list[str], stop: int) -> Iterator[_Token]:
-    for number, line in enumerate(lines[:stop], start=1):
-        for text in line.split():
-            yield _Token(text, number)
-
-
-class _HierarchyParser:
-    def __init__(self, tokens: list[_Token], path: str) -> None:
-        self.tokens = tokens
-        self.pos = 0
-        self.path = path
-        self.names: list[str] = []
-        self.name_set: set[str] = set()
-        self.parents: list[int] = []
-        self.offsets: list[tuple[float, float, float]] = []
-        self.channels: list[tuple[str, ...]] = []
-        self.end_sites: list[EndSite] = []
-
-    def _fail(self, message: str, line: int | None = None) -> ParseError:
-        if line is None:
-            line = self.tokens[min(self.pos, len(self.tokens) - 1)].line if self.tokens else 1
-        return ParseError(message, self.path, line)
-
-    def _next(self, what: str) -> _Token:
-        if self.pos >= len(self.tokens):
-            last = self.tokens[-1].line if self.tokens else 1
-            raise self._fail(f"Expected {what}, got end of hierarchy (truncated file?)", last)
-        token = self.tokens[self.pos]
-        self.pos += 1
-        return token
-
-    def _expect(self, word: str) -> _Token:
-        token = self._next(repr(word))
-        if token.text != word:
-            raise self._fail(f"Expected {word!r}, got {token.text!r}", token.line)
-        return token
-
-    def _number(self, what: str) -> float:
-        token = self._next(what)
-        try:
-            value = float(token.text)
-        except ValueError:
-            raise self._fail(
-                f"Expected a number for {what}, got {token.text!r}", token.line
-            ) from None
-        if not math.isfinite(value):
-            raise self._fail(f"Expected a finite number for {what}, got {token.text!r}", token.line)
-        return value
-
-    def parse(self) -> None:
-        self._expect("HIERARCHY")
-        if self.pos < len(self.tokens) and self.tokens[self.pos].text == "ROOT":
-            while self.pos < len(self.tokens) and self.tokens[self.pos].text == "ROOT":
-                self.pos += 1
-                self._joint(parent=-1)
-        else:
-            token = self._next("'ROOT'")
-            raise self._fail(f"Expected 'ROOT', got {token.text!r}", token.line)
-        if self.pos < len(self.tokens):
-            token = self.tokens[self.pos]
-            raise self._fail(f"Expected 'ROOT' or 'MOTION', got {token.text!r}", token.line)
-
-    def _open_joint(self, parent: int) -> tuple[int, _Token]:
-        name_token = self._next("a joint name")
-        name = name_token.text
-        if name == "{":
-            raise self._fail("Expected a joint name, got '{'", name_token.line)
-        if name in self.name_set:
-            raise self._fail(f"Expected unique joint names, got {name!r} twice", name_token.line)
-        if len(self.names) >= MAX_JOINTS:
-            raise self._fail(f"Expected at most {MAX_JOINTS} joints, got more", name_token.line)
-        index = len(self.names)
-        self.names.append(name)
-        self.name_set.add(name)
-        self.parents.append(parent)
-        self.offsets.append((0.0, 0.0, 0.0))
-        self.channels.append(())
-        self._expect("{")
-        return index, name_token
-
-    def _joint(self, parent: int) -> None:
-        """Parse a joint and its descendants; iterative, so deep chains cannot overflow."""
-        stack: list[tuple[int, _Token, bool]] = [(*self._open_joint(parent), False)]
-        while stack:
-            index, name_token, seen_offset = stack[-1]
-            token = self._next("'OFFSET', 'CHANNELS', 'JOINT', 'End' or '}'")
-            if token.text == "OFFSET":
-                self.offsets[index] = (
-                    self._number("OFFSET x"),
-                    self._number("OFFSET y"),
-                    self._number("OFFSET z"),
-                )
-                stack[-1] = (index, name_token, True)
-            elif token.text == "CHANNELS":
-                count_token = self._next("a channel count")
-                try:
-                    count = int(count_token.text)
-                except ValueError:
-                    raise self._fail(
-                        f"Expected a channel count, got {count_token.text!r}", count_token.line
-                    ) from None
-                if not 0 <= count <= 6:
-                    raise self._fail(f"Expected 0 to 6 channels, got {count}", count_token.line)
-                names = tuple(self._next("a channel name").text for _ in range(count))
-                for channel in names:
-                    if channel not in _KNOWN_CHANNELS:
-                        raise self._fail(
-                            f"Expected a channel name like 'Xrotation', got {channel!r}",
-                            count_token.line,
-                        )
-                rot = [c for c in names if c in ROTATION_CHANNELS]
-                if len(set(names)) != len(names) or len(rot) not in (0, 3):
-                    raise self._fail(
-                        f"Expected 0 or 3 distinct rotation channels, got {' '.join(names)}",
-                        count_token.line,
-                    )
-                self.channels[index] = names
-            elif token.text == "JOINT":
-                stack.append((*self._open_joint(index), False))
-            elif token.text == "End":
-                self._expect("Site")
-                self._expect("{")
-                self._expect("OFFSET")
-                offset = (
-                    self._number("End Site x"),
-                    self._number("End Site y"),
-                    self._number("End Site z"),
-                )
-                self._expect("}")
-                self.end_sites.append(EndSite(index, offset))
-            elif token.text == "}":
-                if not seen_offset:
-                    name = self.names[index]
-                    raise self._fail(f"Expected an OFFSET for joint {name!r}", name_token.line)
-                stack.pop()
-            else:
-                raise self._fail(
-                    f"Expected 'OFFSET', 'CHANNELS', 'JOINT', 'End' or '}}', got {token.text!r}",
-                    token.line,
-                )
-
-
-_MOTION = re.compile(r"^[^\S\n]*MOTION[^\S\n]*$", re.MULTILINE)
+_MOTION = re.compile(r"^[^\S\n]*MOTION[^\S\n]*$", re.MULTILINE | re.IGNORECASE)
+_FRAMES = re.compile(r"\s*FRAMES\s*:(.*)", re.IGNORECASE | re.DOTALL)
+_FRAME_TIME = re.compile(r"\s*FRAME\s+TIME\s*:(.*)", re.IGNORECASE | re.DOTALL)
 
 
 class _LineCursor:
@@ -251,11 +111,29 @@ class _LineCursor:
         return line
 
 
-def _header_value(line: str, key: str, path: str, number: int) -> str:
-    stripped = line.strip()
-    if not stripped.startswith(key):
-        raise ParseError(f"Expected {key!r}, got {stripped[:40]!r}", path, number)
-    return stripped[len(key) :].strip()
+def _header_value(line: str, pattern: re.Pattern[str], key: str, path: str, number: int) -> str:
+    match = pattern.match(line)
+    if match is None:
+        raise ParseError(f"Expected {key!r}, got {line.strip()[:40]!r}", path, number)
+    return match.group(1).strip()
+
+
+def _check_frame_time(frame_time: float, text: str, path: str, line: int) -> None:
+    if not (math.isfinite(frame_time) and frame_time > 0):
+        raise ParseError(f"Expected a frame time > 0 s, got {text!r}", path, line)
+    if not MIN_FRAME_TIME_S <= frame_time <= MAX_FRAME_TIME_S:
+        hint = ""
+        if frame_time > MAX_FRAME_TIME_S and frame_time.is_integer():
+            hint = (
+                " (a frame rate? Frame Time is seconds per frame, "
+                f"{1 / frame_time:.7g} for {frame_time:g} fps)"
+            )
+        raise ParseError(
+            f"Expected a frame time from {MIN_FRAME_TIME_S:g} to {MAX_FRAME_TIME_S:g} s, "
+            f"got {text!r}{hint}",
+            path,
+            line,
+        )
 
 
 def parse_bvh(
@@ -302,20 +180,19 @@ def parse_bvh(
     # editors for LF, CRLF and mixed files.
     match = _MOTION.search(text)
     if match is None:
+        # The hierarchy read to the end names a truncation, or stray text where MOTION belongs.
+        parse_hierarchy(text.split("\n"), path, "end of file (truncated file?)")
         last_line = text.count("\n", 0, len(text.rstrip())) + 1
-        raise ParseError("Expected a 'MOTION' section, got none", path, last_line)
-    header_lines = text[: match.start()].split("\n")
-    motion_line = len(header_lines) - 1  # 0-based index of the MOTION line
-    tokens = list(_tokens(header_lines, motion_line))
-    if not tokens:
-        raise ParseError("Expected 'HIERARCHY', got an empty header", path, 1)
-    parser = _HierarchyParser(tokens, path)
-    parser.parse()
+        raise ParseError("Expected a 'MOTION' section, got end of file", path, last_line)
+    motion_line = text.count("\n", 0, match.start())  # 0-based index of the MOTION line
+    hierarchy = parse_hierarchy(
+        text[: match.start()].split("\n"), path, "end of hierarchy (truncated file?)"
+    )
     cursor = _LineCursor(text, match.end(), motion_line)
     line = cursor.next_nonblank()
     if line is None:
         raise ParseError("Expected 'Frames:', got end of file", path, cursor.number + 1)
-    frames_text = _header_value(line, "Frames:", path, cursor.number + 1)
+    frames_text = _header_value(line, _FRAMES, "Frames:", path, cursor.number + 1)
     try:
         n_frames = int(frames_text)
     except ValueError:
@@ -324,25 +201,18 @@ def parse_bvh(
         ) from None
     if n_frames < 0:
         raise ParseError(f"Expected a frame count >= 0, got {n_frames}", path, cursor.number + 1)
-    line = cursor.next_line()
+    line = cursor.next_nonblank()
     if line is None:
         raise ParseError("Expected 'Frame Time:', got end of file", path, cursor.number + 1)
-    time_text = _header_value(line, "Frame Time:", path, cursor.number + 1)
+    time_text = _header_value(line, _FRAME_TIME, "Frame Time:", path, cursor.number + 1)
     try:
         frame_time = float(time_text)
     except ValueError:
         raise ParseError(
             f"Expected a frame time in seconds, got {time_text!r}", path, cursor.number + 1
         ) from None
-    if not (math.isfinite(frame_time) and frame_time > 0):
-        raise ParseError(f"Expected a frame time > 0 s, got {time_text!r}", path, cursor.number + 1)
-    if not math.isfinite(1.0 / frame_time):
-        raise ParseError(
-            f"Expected a frame time whose frame rate is finite, got {time_text!r}",
-            path,
-            cursor.number + 1,
-        )
-    n_channels = sum(len(c) for c in parser.channels)
+    _check_frame_time(frame_time, time_text, path, cursor.number + 1)
+    n_channels = sum(len(c) for c in hierarchy.channels)
     block = text[cursor.position :]
     if number_reader == "auto":
         big = len(block) >= AUTO_ARROW_BYTES
@@ -352,24 +222,24 @@ def parse_bvh(
         values = frames_by_arrow(block, n_frames, n_channels)
     if values is None:
         values = frames_by_line(text.split("\n"), cursor.number + 1, n_frames, n_channels, path)
-    return _motion_from_channels(parser, values, 1.0 / frame_time, root_translation, length_unit)
+    return _motion_from_channels(hierarchy, values, 1.0 / frame_time, root_translation, length_unit)
 
 
 def _motion_from_channels(
-    parser: _HierarchyParser,
+    hierarchy: Hierarchy,
     values: FloatArray,
     fps: float,
     root_translation: Literal["auto", "replace", "add"],
     length_unit: str,
 ) -> Motion:
     n_frames = values.shape[0]
-    n_joints = len(parser.names)
+    n_joints = len(hierarchy.names)
     translations = np.zeros((n_frames, n_joints, 3))
     by_order: dict[str, list[tuple[int, list[int]]]] = {}
     # Position channels: (column, joint, axis), copied in one gather and one scatter.
     position_columns: list[tuple[int, int, int]] = []
     column = 0
-    for j, chans in enumerate(parser.channels):
+    for j, chans in enumerate(hierarchy.channels):
         rot_cols: list[int] = []
         order = ""
         for k, channel in enumerate(chans):
@@ -399,16 +269,16 @@ def _motion_from_channels(
             angles_deg = values[:, np.array([c for _, c in entries])]  # (F, n, 3)
             euler_deg[:, joints] = angles_deg
             quats[:, joints] = quats_from_euler(angles_deg, order, degrees=True)
-    offsets = np.array(parser.offsets, dtype=np.float64).reshape(n_joints, 3)
+    offsets = np.array(hierarchy.offsets, dtype=np.float64).reshape(n_joints, 3)
     mode = root_translation
     if mode == "auto":
-        mode = _detect_root_translation(parser, offsets, translations)
+        mode = _detect_root_translation(hierarchy, offsets, translations)
     skeleton = Skeleton(
-        names=tuple(parser.names),
-        parents=np.array(parser.parents, dtype=np.intp),
+        names=tuple(hierarchy.names),
+        parents=np.array(hierarchy.parents, dtype=np.intp),
         offsets=offsets,
-        channels=tuple(parser.channels),
-        end_sites=tuple(parser.end_sites),
+        channels=tuple(hierarchy.channels),
+        end_sites=tuple(hierarchy.end_sites),
         length_unit=length_unit,
         root_translation=mode,
     )
@@ -422,10 +292,10 @@ def _motion_from_channels(
 
 
 def _detect_root_translation(
-    parser: _HierarchyParser, offsets: FloatArray, translations: FloatArray
+    hierarchy: Hierarchy, offsets: FloatArray, translations: FloatArray
 ) -> Literal["replace", "add"]:
     root_offset = offsets[0]
-    has_pos = any(c in POSITION_CHANNELS for c in parser.channels[0])
+    has_pos = any(c in POSITION_CHANNELS for c in hierarchy.channels[0])
     if not has_pos or not np.any(root_offset) or translations.shape[0] == 0:
         return "replace"
     # Along the OFFSET's dominant axis (the height, for a hip root), deltas sit near zero while

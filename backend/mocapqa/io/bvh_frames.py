@@ -23,7 +23,15 @@ import numpy as np
 from mocapqa.core.arrays import FloatArray
 from mocapqa.errors import ParseError
 
-__all__ = ["frames_by_arrow", "frames_by_line"]
+__all__ = ["MAX_MAGNITUDE", "frames_by_arrow", "frames_by_line"]
+
+MAX_MAGNITUDE = 1e9
+"""Largest |value| of a channel or OFFSET, in file units or degrees.
+
+Far beyond any real take (a kilometre in micrometres, 2.8 million turns), and far enough
+below the float range that sums along a 1000-joint chain, squares and third differences at
+100,000 fps stay finite: a file with 1e308 in it is refused here, not turned into NaN later.
+"""
 
 _TOKEN_SHAPES = bytes(
     byte if byte == 10 else 32 if byte in b" \t\r" else ord("x") for byte in range(256)
@@ -95,7 +103,7 @@ def frames_by_arrow(block: str, n_frames: int, n_channels: int) -> FloatArray | 
         column = _float_column(table.column(0))
     except (arrow.ArrowException, ValueError):
         return None
-    if column is None or column.shape != (n_tokens,) or not np.all(np.isfinite(column)):
+    if column is None or column.shape != (n_tokens,) or not _in_range(column):
         return None
     return column.reshape(n_frames, n_channels)
 
@@ -143,9 +151,14 @@ def _frames_by_columns(
         values: FloatArray = blocks[0] if len(blocks) == 1 else np.concatenate(blocks)
     except (arrow.ArrowException, ValueError):
         return None
-    if values.shape != (n_frames, n_channels) or not np.all(np.isfinite(values)):
+    if values.shape != (n_frames, n_channels) or not _in_range(values):
         return None
     return values
+
+
+def _in_range(values: FloatArray) -> bool:
+    """Whether every value is finite and within :data:`MAX_MAGNITUDE` (NaN is not)."""
+    return bool(np.all(np.abs(values) <= MAX_MAGNITUDE))
 
 
 @functools.lru_cache(maxsize=64)
@@ -231,8 +244,8 @@ def frames_by_line(
     Raises
     ------
     ParseError
-        On a wrong value count, a non-number, NaN or infinity, or too few or too many lines,
-        with the 1-based line.
+        On a wrong value count, a non-number, NaN or infinity, a value beyond
+        :data:`MAX_MAGNITUDE`, or too few or too many lines, with the 1-based line.
     """
     # Rows are collected, not preallocated: a corrupt "Frames:" count must not allocate.
     rows: list[list[float]] = []
@@ -260,6 +273,11 @@ def frames_by_line(
             raise ParseError(f"Expected a number, got {bad!r}", path, number + 1) from None
         if not all(map(math.isfinite, parsed)):
             raise ParseError("Expected finite numbers, got NaN or infinity", path, number + 1)
+        if max(map(abs, parsed), default=0.0) > MAX_MAGNITUDE:
+            bad = next(t for t, v in zip(tokens, parsed, strict=True) if abs(v) > MAX_MAGNITUDE)
+            raise ParseError(
+                f"Expected values within ±{int(MAX_MAGNITUDE):,}, got {bad!r}", path, number + 1
+            )
         rows.append(parsed)
         row += 1
     if row != n_frames:

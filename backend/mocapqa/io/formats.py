@@ -42,6 +42,7 @@ __all__ = [
     "TAKE_FORMATS",
     "detect_format",
     "read_take",
+    "require_frames",
     "write_keypoints",
 ]
 
@@ -241,6 +242,22 @@ def read_take(
     else:
         check_take_size(take.n_frames, take.n_keypoints, Path(path).name, limits)
     return take
+
+
+def require_frames(take: Motion | KeypointSequence, path: str | Path) -> None:
+    """Refuse a take without frames (a BVH's ``Frames: 0``): nothing to analyse or draw.
+
+    Readers accept such a take, so ``mocapqa info`` and ``convert`` work on a rig-only BVH;
+    everything that analyses, filters or renders a take calls this first.
+
+    Raises
+    ------
+    ParseError
+        Naming the file (and the ``Frames`` field of a BVH).
+    """
+    if take.n_frames == 0:
+        field = "Frames" if isinstance(take, Motion) else None
+        raise ParseError("Expected at least one frame, got 0", path, field=field)
 
 
 def _read(

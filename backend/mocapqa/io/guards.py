@@ -49,7 +49,10 @@ JSON_FORMATS = frozenset({"json", "mediapipe-json", "openpose"})
 """Formats parsed as JSON documents (their nesting depth is limited)."""
 
 _CHUNK = 1 << 20
-_JOINT = re.compile(rb"^[ \t]*(?:ROOT|JOINT)[ \t]", re.MULTILINE)
+# Keywords in any case, as the reader takes them.
+_JOINT = re.compile(rb"^[ \t]*(?:ROOT|JOINT)[ \t]", re.MULTILINE | re.IGNORECASE)
+_MOTION = re.compile(rb"^[ \t]*MOTION[ \t\r]*$", re.MULTILINE | re.IGNORECASE)
+_FRAMES = re.compile(rb"\s*FRAMES[ \t]*:([^\n]*)", re.IGNORECASE)
 _TRC_LABEL = re.compile(r"^[XYZ]\d+$", re.IGNORECASE)
 _OPEN = np.zeros(256, dtype=np.int8)
 _OPEN[[ord("["), ord("{")]] = 1
@@ -196,8 +199,9 @@ def _check_arrays(path: Path, kind: str, limits: ReadLimits) -> None:
 
 def _check_bvh_header(path: Path, limits: ReadLimits) -> None:
     data = path.read_bytes()
-    motion = data.find(b"MOTION")
-    header_end = len(data) if motion < 0 else motion
+    motion_line = _MOTION.search(data)
+    motion = -1 if motion_line is None else motion_line.end()
+    header_end = len(data) if motion_line is None else motion_line.start()
     joints = sum(1 for _ in _JOINT.finditer(data, 0, header_end))
     if joints > limits.max_joints:
         raise TooLargeError(
@@ -206,12 +210,11 @@ def _check_bvh_header(path: Path, limits: ReadLimits) -> None:
         )
     if motion < 0:
         return
-    frames_at = data.find(b"Frames:", motion, motion + 200)
-    if frames_at < 0:
+    frames = _FRAMES.match(data, motion, motion + 200)
+    if frames is None:
         return
-    end = data.find(b"\n", frames_at)
     try:
-        n_frames = int(data[frames_at + 7 : end if end >= 0 else None].strip())
+        n_frames = int(frames.group(1).strip())
     except ValueError:
         return  # the reader names the malformed line
     if n_frames * max(joints, 1) > limits.max_frame_points:

@@ -14,6 +14,7 @@ from typing import Any, BinaryIO
 from mocapqa.core.motion import Motion
 from mocapqa.core.text import display_name
 from mocapqa.errors import InputError, MocapQAError, ParseError, TooLargeError
+from mocapqa.io.formats import require_frames
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.pipeline.loading import (
     READING_FILE,
@@ -165,8 +166,7 @@ def ingest_take(
             raise ParseError(
                 f"Expected a readable {format_name} file, got {type(e).__name__}: {e}", file_name
             ) from e
-        if take.n_frames == 0:
-            raise InputError(f"Expected at least one frame, got 0 ({name!r})")
+        require_frames(take, file_name)
         if isinstance(take, Motion):
             kind, n_points, fps = "motion", take.skeleton.n_joints, take.fps
         else:

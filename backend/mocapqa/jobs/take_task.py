@@ -72,6 +72,7 @@ def analyse_path(
         ``{"status": "failed", "error": message}`` for a file the readers reject.
     """
     from mocapqa.core.motion import Motion
+    from mocapqa.io.formats import require_frames
     from mocapqa.jobs.runner import run_summary, write_outputs
     from mocapqa.limits.catalog import ModelCatalog
     from mocapqa.pipeline.analyze import analyze
@@ -97,8 +98,7 @@ def analyse_path(
             raise ParseError(
                 f"Expected a readable {format_name} file, got {type(e).__name__}: {e}", source
             ) from e
-        if take.n_frames == 0:
-            raise ParseError("Expected at least one frame, got 0", source)
+        require_frames(take, source)
         catalog = ModelCatalog.of_data_folder(data_dir)
         result = analyze(take, AnalysisOptions.from_json(options), catalog=catalog)
     except MocapQAError as e:
