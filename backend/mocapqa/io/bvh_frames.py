@@ -261,8 +261,10 @@ def frames_by_line(
                 f"Expected {n_frames} frame lines (Frames:), got more", path, number + 1
             )
         if len(tokens) != n_channels:
+            cut = len(tokens) < n_channels and not any(map(str.strip, lines[number + 1 :]))
             raise ParseError(
-                f"Expected {n_channels} values on a frame line, got {len(tokens)}",
+                f"Expected {n_channels} values on a frame line, got {len(tokens)}"
+                + (" (truncated file?)" if cut else ""),
                 path,
                 number + 1,
             )
