@@ -6,9 +6,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from tests.io.bvh_variants import chain
 
 from mocapqa.errors import InputError, ParseError
-from mocapqa.io.bvh import MAX_JOINTS, parse_bvh, read_bvh
+from mocapqa.io.bvh import parse_bvh, read_bvh
+from mocapqa.io.bvh_hierarchy import MAX_JOINTS
 from mocapqa.io.bvh_write import channel_values
 
 # Line numbers are 1-based; the comments give them.
@@ -113,21 +115,10 @@ def test_error_names_the_file(tmp_path: Path) -> None:
 
 
 def test_more_than_max_joints_is_refused() -> None:
-    n = MAX_JOINTS + 1
-    lines = [
-        "HIERARCHY",
-        "ROOT J0",
-        "{",
-        "OFFSET 0 0 0",
-        "CHANNELS 3 Zrotation Xrotation Yrotation",
-    ]
-    for j in range(1, n):
-        lines += [f"JOINT J{j}", "{", "OFFSET 0 1 0", "CHANNELS 3 Zrotation Xrotation Yrotation"]
-    lines += ["}"] * n
-    lines += ["MOTION", "Frames: 1", "Frame Time: 0.01", " ".join(["0"] * (3 * n))]
+    data = chain(MAX_JOINTS + 1)
     # The 1001st joint's name is on line 2 + 4 * 1000 = 4002.
     with pytest.raises(ParseError, match=r"line 4002: Expected at most 1000 joints, got more"):
-        parse_bvh(bvh(lines))
+        parse_bvh(data)
 
 
 def test_binary_file_is_refused() -> None:

@@ -42,7 +42,8 @@ from mocapqa.cli.main import main
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles
 from mocapqa.errors import ParseError
-from mocapqa.io.bvh import MAX_JOINTS, NumberReader, parse_bvh
+from mocapqa.io.bvh import NumberReader, parse_bvh
+from mocapqa.io.bvh_hierarchy import MAX_JOINTS
 from mocapqa.io.bvh_write import format_bvh
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.render.scene import track_from_motion
@@ -282,26 +283,6 @@ MALFORMED: dict[str, Callable[[Take, int], tuple[bytes, str]]] = {
         replace(t, hierarchy=(*t.hierarchy[:3], "\tOFFSET 1e308 0 0", *t.hierarchy[4:])).data(),
         r"line 4: Expected OFFSET x within ±1,000,000,000, got '1e308'",
     ),
-    "Frame Time: 0": lambda t, h: (
-        frame_time(t, "0"),
-        rf"line {h + 3}: Expected a frame time > 0 s, got '0'",
-    ),
-    "Frame Time: -0.01": lambda t, h: (
-        frame_time(t, "-0.01"),
-        rf"line {h + 3}: Expected a frame time > 0 s, got '-0.01'",
-    ),
-    "Frame Time: 1e-6": lambda t, h: (
-        frame_time(t, "1e-6"),
-        rf"line {h + 3}: Expected a frame time from 1e-05 to 10 s, got '1e-6'$",
-    ),
-    "Frame Time: 1000": lambda t, h: (
-        frame_time(t, "1000"),
-        rf"line {h + 3}: .* got '1000' \(a frame rate\? .* 0.001 for 1000 fps\)",
-    ),
-    "Frame Time: 5e-324": lambda t, h: (
-        frame_time(t, "5e-324"),
-        rf"line {h + 3}: Expected a frame time from 1e-05 to 10 s, got '5e-324'",
-    ),
     "duplicate joint names": lambda t, h: (
         t.renamed({"LeftArm": "RightArm"}).data(),
         rf"line {hierarchy_line(t, 'RightArm')}: Expected unique joint names, got 'RightArm'",
@@ -359,6 +340,21 @@ MALFORMED: dict[str, Callable[[Take, int], tuple[bytes, str]]] = {
         rf"line {6 + 9 * (MAX_JOINTS - 1)}: Expected at most {MAX_JOINTS} joints, got more",
     ),
 }
+
+
+BAD_FRAME_TIMES = {
+    "0": r"Expected a frame time > 0 s, got '0'",
+    "-0.01": r"Expected a frame time > 0 s, got '-0.01'",
+    "1e-6": r"Expected a frame time from 1e-05 to 10 s, got '1e-6'$",
+    "5e-324": r"Expected a frame time from 1e-05 to 10 s, got '5e-324'",
+    "1000": r".* got '1000' \(a frame rate\? .* 0.001 for 1000 fps\)",
+}
+"""Frame Time texts and the message each gets on the Frame Time line."""
+for _text, _message in BAD_FRAME_TIMES.items():
+    MALFORMED[f"Frame Time: {_text}"] = lambda t, h, text=_text, message=_message: (
+        frame_time(t, text),
+        rf"line {h + 3}: {message}",
+    )
 
 
 @pytest.mark.parametrize("reader", READERS)

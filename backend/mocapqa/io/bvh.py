@@ -2,9 +2,14 @@
 
 Conventions
 -----------
-* Reads any hierarchy, 3- or 6-channel joints (position channels on non-root joints are kept
-  and used by forward kinematics), any rotation order per joint, End Sites, tabs or spaces,
-  CRLF/LF/mixed line endings, trailing spaces, exponents, ``-0`` and ``.0083333``.
+* Reads any hierarchy (:mod:`mocapqa.io.bvh_hierarchy`: keywords in any case, names with
+  spaces), 0-, 3- or 6-channel joints (position channels on non-root joints are kept and used
+  by forward kinematics), any rotation order per joint, End Sites, tabs or spaces,
+  CRLF/LF/CR/mixed line endings, UTF-8 or UTF-16 with a byte order mark, trailing spaces,
+  exponents, ``-0`` and ``.0083333``.
+* Refuses what no take holds: a Frame Time outside :data:`MIN_FRAME_TIME_S` to
+  :data:`MAX_FRAME_TIME_S`, values beyond :data:`~mocapqa.io.bvh_frames.MAX_MAGNITUDE`, more
+  than :data:`~mocapqa.io.bvh_hierarchy.MAX_JOINTS` joints.
 * Rotation channels are intrinsic in channel order (see :mod:`mocapqa.kinematics.euler`) and are
   converted to local quaternions ``(F, J, 4)``; the angles read are kept as the motion's
   ``euler_hint_deg`` so that writing an unchanged take reproduces its numbers.
@@ -29,15 +34,13 @@ import numpy as np
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import POSITION_CHANNELS, Motion, Skeleton
 from mocapqa.errors import ParseError
-from mocapqa.io.bvh_frames import MAX_MAGNITUDE, frames_by_arrow, frames_by_line
-from mocapqa.io.bvh_hierarchy import MAX_JOINTS, Hierarchy, parse_hierarchy
+from mocapqa.io.bvh_frames import frames_by_arrow, frames_by_line
+from mocapqa.io.bvh_hierarchy import Hierarchy, parse_hierarchy
 from mocapqa.kinematics.euler import quats_from_euler
 
 __all__ = [
     "AUTO_ARROW_BYTES",
     "MAX_FRAME_TIME_S",
-    "MAX_JOINTS",
-    "MAX_MAGNITUDE",
     "MIN_FRAME_TIME_S",
     "BvhParseError",
     "NumberReader",

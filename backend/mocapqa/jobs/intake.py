@@ -147,7 +147,7 @@ def ingest_take(
                 digest.update(chunk)
                 out.write(chunk)
         if size == 0:
-            raise InputError(f"Expected a non-empty file, got 0 bytes ({name!r})")
+            raise ParseError("Expected a non-empty file, got 0 bytes", file_name)
         format_name = detect_take_format(incoming)
         try:
             take = read_take_file(incoming, format_name, file_name, read, limits)
