@@ -223,6 +223,20 @@ def test_takes_of_zero_one_and_two_frames_read(takes: dict[str, Take], n_frames:
     assert positions(motion).shape == (n_frames, 31, 3)
 
 
+def test_two_roots_read_as_two_skeletons(takes: dict[str, Take]) -> None:
+    """Two characters in one file: a second ROOT, its channels after the first's."""
+    take = takes["walk"]
+    other = take.renamed({name: f"B {name}" for name in take.joint_names()})
+    rows = tuple(f"{a} {b}" for a, b in zip(take.rows, other.rows, strict=True))
+    both = Take((*take.hierarchy, *other.hierarchy[1:]), take.frame_time, rows)
+    motion = parse_bvh(both.data())
+    assert motion.skeleton.n_joints == 62
+    assert list(np.flatnonzero(motion.skeleton.parents < 0)) == [0, 31]
+    world = positions(motion)
+    np.testing.assert_array_equal(world[:, :31], world[:, 31:])
+    np.testing.assert_allclose(world[:, :31], positions(parse_bvh(take.data())), atol=1e-9)
+
+
 def test_the_deepest_and_widest_allowed_hierarchies_read() -> None:
     deep = parse_bvh(chain(MAX_JOINTS))
     np.testing.assert_allclose(positions(deep)[0, :, 1], np.arange(1, MAX_JOINTS + 1))
@@ -286,6 +300,15 @@ MALFORMED: dict[str, Callable[[Take, int], tuple[bytes, str]]] = {
     "duplicate joint names": lambda t, h: (
         t.renamed({"LeftArm": "RightArm"}).data(),
         rf"line {hierarchy_line(t, 'RightArm')}: Expected unique joint names, got 'RightArm'",
+    ),
+    "a 100,000-character joint name": lambda t, h: (
+        t.renamed({"LeftArm": "x" * 100_000}).data(),
+        rf"line {hierarchy_line(t, 'LeftArm')}: Expected a joint name of at most 255 characters, "
+        "got 100000",
+    ),
+    "a megabyte of letters in a frame": lambda t, h: (
+        value(t, 1, "z" * 1_000_000),
+        rf"line {h + 5}: Expected a number, got '{'z' * 40}'…$",
     ),
     "no MOTION section": lambda t, h: (
         "\n".join(t.hierarchy).encode(),

@@ -34,7 +34,7 @@ import numpy as np
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import POSITION_CHANNELS, Motion, Skeleton
 from mocapqa.errors import ParseError
-from mocapqa.io.bvh_frames import frames_by_arrow, frames_by_line
+from mocapqa.io.bvh_frames import frames_by_arrow, frames_by_line, quoted
 from mocapqa.io.bvh_hierarchy import Hierarchy, parse_hierarchy
 from mocapqa.kinematics.euler import quats_from_euler
 
@@ -117,13 +117,13 @@ class _LineCursor:
 def _header_value(line: str, pattern: re.Pattern[str], key: str, path: str, number: int) -> str:
     match = pattern.match(line)
     if match is None:
-        raise ParseError(f"Expected {key!r}, got {line.strip()[:40]!r}", path, number)
+        raise ParseError(f"Expected {key!r}, got {quoted(line.strip())}", path, number)
     return match.group(1).strip()
 
 
 def _check_frame_time(frame_time: float, text: str, path: str, line: int) -> None:
     if not (math.isfinite(frame_time) and frame_time > 0):
-        raise ParseError(f"Expected a frame time > 0 s, got {text!r}", path, line)
+        raise ParseError(f"Expected a frame time > 0 s, got {quoted(text)}", path, line)
     if not MIN_FRAME_TIME_S <= frame_time <= MAX_FRAME_TIME_S:
         hint = ""
         if frame_time > MAX_FRAME_TIME_S and frame_time.is_integer():
@@ -133,7 +133,7 @@ def _check_frame_time(frame_time: float, text: str, path: str, line: int) -> Non
             )
         raise ParseError(
             f"Expected a frame time from {MIN_FRAME_TIME_S:g} to {MAX_FRAME_TIME_S:g} s, "
-            f"got {text!r}{hint}",
+            f"got {quoted(text)}{hint}",
             path,
             line,
         )
@@ -200,7 +200,7 @@ def parse_bvh(
         n_frames = int(frames_text)
     except ValueError:
         raise ParseError(
-            f"Expected a frame count, got {frames_text!r}", path, cursor.number + 1
+            f"Expected a frame count, got {quoted(frames_text)}", path, cursor.number + 1
         ) from None
     if n_frames < 0:
         raise ParseError(f"Expected a frame count >= 0, got {n_frames}", path, cursor.number + 1)
@@ -212,7 +212,7 @@ def parse_bvh(
         frame_time = float(time_text)
     except ValueError:
         raise ParseError(
-            f"Expected a frame time in seconds, got {time_text!r}", path, cursor.number + 1
+            f"Expected a frame time in seconds, got {quoted(time_text)}", path, cursor.number + 1
         ) from None
     _check_frame_time(frame_time, time_text, path, cursor.number + 1)
     n_channels = sum(len(c) for c in hierarchy.channels)

@@ -23,7 +23,7 @@ import numpy as np
 from mocapqa.core.arrays import FloatArray
 from mocapqa.errors import ParseError
 
-__all__ = ["MAX_MAGNITUDE", "frames_by_arrow", "frames_by_line"]
+__all__ = ["MAX_MAGNITUDE", "frames_by_arrow", "frames_by_line", "quoted"]
 
 MAX_MAGNITUDE = 1e9
 """Largest |value| of a channel or OFFSET, in file units or degrees.
@@ -32,6 +32,17 @@ Far beyond any real take (a kilometre in micrometres, 2.8 million turns), and fa
 below the float range that sums along a 1000-joint chain, squares and third differences at
 100,000 fps stay finite: a file with 1e308 in it is refused here, not turned into NaN later.
 """
+
+_QUOTED_CHARS = 40
+
+
+def quoted(text: str) -> str:
+    """``text`` quoted for an error message, cut to 40 characters (a hostile file's token
+    may be megabytes long)."""
+    if len(text) > _QUOTED_CHARS:
+        return repr(text[:_QUOTED_CHARS]) + "…"
+    return repr(text)
+
 
 _TOKEN_SHAPES = bytes(
     byte if byte == 10 else 32 if byte in b" \t\r" else ord("x") for byte in range(256)
@@ -272,13 +283,15 @@ def frames_by_line(
             parsed = list(map(float, tokens))
         except ValueError:
             bad = next(t for t in tokens if not _is_float(t))
-            raise ParseError(f"Expected a number, got {bad!r}", path, number + 1) from None
+            raise ParseError(f"Expected a number, got {quoted(bad)}", path, number + 1) from None
         if not all(map(math.isfinite, parsed)):
             raise ParseError("Expected finite numbers, got NaN or infinity", path, number + 1)
         if max(map(abs, parsed), default=0.0) > MAX_MAGNITUDE:
             bad = next(t for t, v in zip(tokens, parsed, strict=True) if abs(v) > MAX_MAGNITUDE)
             raise ParseError(
-                f"Expected values within ±{int(MAX_MAGNITUDE):,}, got {bad!r}", path, number + 1
+                f"Expected values within ±{int(MAX_MAGNITUDE):,}, got {quoted(bad)}",
+                path,
+                number + 1,
             )
         rows.append(parsed)
         row += 1

@@ -22,12 +22,14 @@ from dataclasses import dataclass
 
 from mocapqa.core.motion import POSITION_CHANNELS, ROTATION_CHANNELS, EndSite
 from mocapqa.errors import ParseError
-from mocapqa.io.bvh_frames import MAX_MAGNITUDE
+from mocapqa.io.bvh_frames import MAX_MAGNITUDE, quoted
 
-__all__ = ["MAX_JOINTS", "Hierarchy", "parse_hierarchy"]
+__all__ = ["MAX_JOINTS", "MAX_NAME_CHARS", "Hierarchy", "parse_hierarchy"]
 
 MAX_JOINTS = 1000
 """Largest joint count accepted; more means a corrupt or hostile file."""
+MAX_NAME_CHARS = 255
+"""Longest joint name accepted (real rigs' longest are under 100 characters)."""
 _CHANNELS = {name.lower(): name for name in (*POSITION_CHANNELS, *ROTATION_CHANNELS)}
 
 
@@ -96,7 +98,7 @@ class _Parser:
     def _expect(self, word: str) -> _Token:
         token = self._next(repr(word))
         if token[0].upper() != word.upper():
-            raise self._fail(f"Expected {word!r}, got {token[0]!r}", token[1])
+            raise self._fail(f"Expected {word!r}, got {quoted(token[0])}", token[1])
         return token
 
     def _number(self, what: str) -> float:
@@ -104,11 +106,13 @@ class _Parser:
         try:
             value = float(text)
         except ValueError:
-            raise self._fail(f"Expected a number for {what}, got {text!r}", line) from None
+            raise self._fail(f"Expected a number for {what}, got {quoted(text)}", line) from None
         if not math.isfinite(value):
-            raise self._fail(f"Expected a finite number for {what}, got {text!r}", line)
+            raise self._fail(f"Expected a finite number for {what}, got {quoted(text)}", line)
         if abs(value) > MAX_MAGNITUDE:
-            raise self._fail(f"Expected {what} within ±{int(MAX_MAGNITUDE):,}, got {text!r}", line)
+            raise self._fail(
+                f"Expected {what} within ±{int(MAX_MAGNITUDE):,}, got {quoted(text)}", line
+            )
         return value
 
     def parse(self) -> Hierarchy:
@@ -116,14 +120,14 @@ class _Parser:
         if first is None:
             raise self._fail("Expected a BVH file starting with 'HIERARCHY', got an empty file", 1)
         if first[0].upper() != "HIERARCHY":
-            raise self._fail(f"Expected 'HIERARCHY', got {first[0][:40]!r}", first[1])
+            raise self._fail(f"Expected 'HIERARCHY', got {quoted(first[0])}", first[1])
         token: _Token | None = self._next("'ROOT'")
         while token is not None and token[0].upper() == "ROOT":
             self._joint(token, parent=-1)
             token = self._take()
         if token is not None:
             expected = "'ROOT' or 'MOTION'" if self.hierarchy.names else "'ROOT'"
-            raise self._fail(f"Expected {expected}, got {token[0][:40]!r}", token[1])
+            raise self._fail(f"Expected {expected}, got {quoted(token[0])}", token[1])
         return self.hierarchy
 
     def _name(self, keyword: _Token) -> tuple[str, bool]:
@@ -145,8 +149,13 @@ class _Parser:
     def _open_joint(self, keyword: _Token, parent: int) -> int:
         name, opened = self._name(keyword)
         hierarchy = self.hierarchy
+        if len(name) > MAX_NAME_CHARS:
+            raise self._fail(
+                f"Expected a joint name of at most {MAX_NAME_CHARS} characters, got {len(name)}",
+                keyword[1],
+            )
         if name in self.name_set:
-            raise self._fail(f"Expected unique joint names, got {name!r} twice", keyword[1])
+            raise self._fail(f"Expected unique joint names, got {quoted(name)} twice", keyword[1])
         if len(hierarchy.names) >= MAX_JOINTS:
             raise self._fail(f"Expected at most {MAX_JOINTS} joints, got more", keyword[1])
         index = len(hierarchy.names)
@@ -164,7 +173,9 @@ class _Parser:
         try:
             count = int(count_text)
         except ValueError:
-            raise self._fail(f"Expected a channel count, got {count_text!r}", count_line) from None
+            raise self._fail(
+                f"Expected a channel count, got {quoted(count_text)}", count_line
+            ) from None
         if not 0 <= count <= 6:
             raise self._fail(f"Expected 0 to 6 channels, got {count}", count_line)
         names = []
@@ -172,7 +183,9 @@ class _Parser:
             text, line = self._next("a channel name")
             channel = _CHANNELS.get(text.lower())
             if channel is None:
-                raise self._fail(f"Expected a channel name like 'Xrotation', got {text!r}", line)
+                raise self._fail(
+                    f"Expected a channel name like 'Xrotation', got {quoted(text)}", line
+                )
             names.append(channel)
         rotations = [c for c in names if c in ROTATION_CHANNELS]
         if len(set(names)) != len(names) or len(rotations) not in (0, 3):
@@ -219,13 +232,11 @@ class _Parser:
             elif word == "}":
                 if not seen_offset:
                     name = hierarchy.names[index]
-                    raise self._fail(f"Expected an OFFSET for joint {name!r}", opened_by[1])
+                    raise self._fail(f"Expected an OFFSET for joint {quoted(name)}", opened_by[1])
                 stack.pop()
             else:
-                raise self._fail(
-                    f"Expected 'OFFSET', 'CHANNELS', 'JOINT', 'End' or '}}', got {token[0][:40]!r}",
-                    token[1],
-                )
+                expected = "'OFFSET', 'CHANNELS', 'JOINT', 'End' or '}'"
+                raise self._fail(f"Expected {expected}, got {quoted(token[0])}", token[1])
 
 
 def parse_hierarchy(lines: Iterable[str], path: str, end: str) -> Hierarchy:
