@@ -10,6 +10,7 @@ findings as its source.
 from __future__ import annotations
 
 import codecs
+import csv
 import json
 import re
 import tracemalloc
@@ -490,6 +491,31 @@ def test_every_command_reads_an_odd_but_valid_take(
     captured = capsys.readouterr()
     assert code == 0, captured.err
     assert "Traceback" not in captured.err
+
+
+def test_batch_fails_only_the_bad_takes_naming_their_lines(
+    takes: dict[str, Take],
+    odd_take: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    folder = tmp_path / "takes"
+    folder.mkdir()
+    (folder / "odd.bvh").write_bytes(odd_take.read_bytes())
+    for name, (build, _) in BAD_FOR_COMMANDS.items():
+        (folder / f"{name}.bvh").write_bytes(build(takes["walk"]))
+    monkeypatch.setenv("MOCAPQA_DATA_DIR", str(tmp_path / "data"))
+    table = tmp_path / "results.csv"
+    code = main(["batch", str(folder), "--workers", "1", "--output", str(table)])
+    assert code == 2, capsys.readouterr().err
+    rows = {Path(row["source"]).stem: row for row in csv.DictReader(table.open())}
+    assert rows.pop("odd")["status"] == "done"
+    assert set(rows) == set(BAD_FOR_COMMANDS)
+    for name, row in rows.items():
+        assert row["status"] == "failed"
+        where = re.escape(str(folder / f"{name}.bvh"))
+        assert re.match(rf"{where}, {BAD_FOR_COMMANDS[name][1]}", row["error"]), row["error"]
 
 
 @pytest.fixture(scope="module")
