@@ -473,6 +473,25 @@ def test_every_command_refuses_a_bad_take_in_one_line(
     assert re.match(rf"error: {re.escape(str(path))}, {pattern}", lines[0]), lines[0]
 
 
+@pytest.mark.parametrize(
+    "command", [c for c in COMMAND_CASES if c not in ("info", "detect", "limits check")]
+)
+def test_an_output_in_a_missing_folder_is_one_line(
+    takes: dict[str, Take], tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str
+) -> None:
+    path = tmp_path / "take.bvh"
+    path.write_bytes(takes["walk"].data())
+    missing = tmp_path / "no such folder"
+    code = main(COMMANDS[command](path, missing))
+    err = capsys.readouterr().err
+    assert code == 3, err
+    assert re.fullmatch(
+        "error: Expected a writable output path, got No such file or directory: "
+        rf"{re.escape(str(missing))}/\S+\n",
+        err,
+    ), err
+
+
 @pytest.fixture(scope="module")
 def odd_take(takes: dict[str, Take], tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The walk as an odd exporter might write it: Biped names with spaces, XYZ order with

@@ -8,7 +8,6 @@ roles found by :func:`mocapqa.core.rig.find_roles` and, as plainly, the roles it
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
@@ -203,7 +202,7 @@ def convert_command(
             raise UnsupportedFormatError(
                 f"Expected a .bvh output for a BVH input, got {output.name!r}"
             )
-        writer: Callable[[], None] = lambda: write_bvh(output, take, precision=precision)  # noqa: E731
+        write_bvh(output, take, precision=precision)
     else:
         if roles is not None:
             raise InputError("Expected --mapping only for BVH input, got a keypoint take")
@@ -212,9 +211,5 @@ def convert_command(
                 f"Expected a keypoint output among {', '.join(KEYPOINT_WRITE_FORMATS)}, "
                 f"got {output.name!r}"
             )
-        writer = lambda: write_keypoints(output, take)  # noqa: E731
-    try:
-        writer()
-    except OSError as e:
-        raise InputError(f"Expected a writable output path, got {e.strerror}: {output}") from e
+        write_keypoints(output, take)
     typer.echo(f"wrote {output} ({suffix}, {take.n_frames} frames)")

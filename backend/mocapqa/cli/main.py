@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from rich.markup import escape
 
 from mocapqa.cli.app import app, err_console, exit_code_for
-from mocapqa.errors import MocapQAError
+from mocapqa.errors import InputError, MocapQAError
 
 __all__ = ["COMMAND_MODULES", "main", "modules_for"]
 
@@ -66,10 +66,21 @@ def main(argv: list[str] | None = None) -> int:
         code = e.code
         return code if isinstance(code, int) else (0 if code is None else 1)
     except MocapQAError as e:
-        # One line, never wrapped, and the message is not read as Rich markup.
-        err_console.print(f"[bold red]error:[/] {escape(str(e))}", soft_wrap=True)
-        return exit_code_for(e)
+        return _report(e)
+    except OSError as e:
+        # Readers turn their OSErrors into ParseErrors, so this is an output that cannot be
+        # written (a missing folder, no permission, a full disk). Writers write a temporary
+        # file first; the message names the output.
+        path = str(e.filename).removesuffix(".tmp") if e.filename else "?"
+        got = e.strerror or type(e).__name__
+        return _report(InputError(f"Expected a writable output path, got {got}: {path}"))
     return 0
+
+
+def _report(error: MocapQAError) -> int:
+    """Print one line, never wrapped and not read as Rich markup; return the exit code."""
+    err_console.print(f"[bold red]error:[/] {escape(str(error))}", soft_wrap=True)
+    return exit_code_for(error)
 
 
 if __name__ == "__main__":
