@@ -355,6 +355,10 @@ MALFORMED: dict[str, Callable[[Take, int], tuple[bytes, str]]] = {
         t.renamed({"LeftArm": "LinkerOberarmü"}).text().encode("latin-1"),
         rf"line {hierarchy_line(t, 'LeftArm')}: Expected UTF-8 or ASCII text",
     ),
+    "UTF-16 cut in the middle of a character": lambda t, h: (
+        t.text().encode("utf-16")[:-1],
+        rf"line {h + 9}: Expected UTF-16 text after its byte order mark, got undecodable",
+    ),
     "5,000 joints deep": lambda t, h: (
         chain(5000),
         rf"line {2 + 4 * MAX_JOINTS}: Expected at most {MAX_JOINTS} joints, got more",

@@ -70,8 +70,9 @@ def _decode(data: bytes, path: str) -> str:
         try:
             return data.decode("utf-16")
         except UnicodeDecodeError as e:
+            line = data[: e.start].decode("utf-16", errors="replace").count("\n") + 1
             raise ParseError(
-                "Expected UTF-16 text after its byte order mark, got odd bytes", path
+                "Expected UTF-16 text after its byte order mark, got undecodable bytes", path, line
             ) from e
     if b"\x00" in data[:65536]:
         raise ParseError("Expected a text file, got binary data (NUL bytes)", path, 1)
