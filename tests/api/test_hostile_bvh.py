@@ -147,6 +147,13 @@ REFUSED: dict[str, Callable[[Take, int], tuple[bytes, int, str, str, int | None]
         "joints (setting max_joints), got 20000",
         None,
     ),
+    "600 joints in UTF-16": lambda t, h: (
+        chain(600).decode().encode("utf-16"),
+        413,
+        "TooLargeError",
+        "joints (setting max_joints), got 600",
+        None,
+    ),
     "600 joints in lower case": lambda t, h: (
         lower_case_joints(600),
         413,

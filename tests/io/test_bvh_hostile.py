@@ -46,6 +46,7 @@ from mocapqa.errors import ParseError
 from mocapqa.io.bvh import NumberReader, parse_bvh
 from mocapqa.io.bvh_hierarchy import MAX_JOINTS
 from mocapqa.io.bvh_write import format_bvh
+from mocapqa.io.formats import detect_format, read_take
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.render.scene import track_from_motion
 
@@ -124,6 +125,16 @@ def test_formatting_variants_read_the_same_take(
     take = takes[rig]
     source = parse_bvh(take.data(), number_reader=reader)
     assert_same_take(parse_bvh(FORMATTING[variant](take), number_reader=reader), source)
+
+
+@pytest.mark.parametrize("variant", ["mixed-case keywords", "UTF-16 with byte order mark"])
+def test_a_variant_without_the_bvh_extension_is_known_by_its_content(
+    takes: dict[str, Take], tmp_path: Path, variant: str
+) -> None:
+    path = tmp_path / "take.txt"
+    path.write_bytes(FORMATTING[variant](takes["walk"]))
+    assert detect_format(path) == "bvh"
+    assert_same_take(read_take(path), parse_bvh(takes["walk"].data()))  # type: ignore[arg-type]
 
 
 BIPED = {

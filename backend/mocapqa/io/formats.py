@@ -14,6 +14,7 @@ Conventions
 
 from __future__ import annotations
 
+import codecs
 import json
 from collections.abc import Callable
 from pathlib import Path
@@ -113,10 +114,18 @@ def _csv_kind(head: bytes) -> str:
     return "mediapipe-csv" if "frame_number" in columns and "landmark" in columns else "csv"
 
 
+def _utf16_bvh(head: bytes) -> bool:
+    """Whether ``head`` is the start of a BVH saved as UTF-16 with its byte order mark."""
+    if head[:2] not in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE):
+        return False
+    text = head[: len(head) // 2 * 2].decode("utf-16", errors="replace")
+    return text.lstrip(" \t\r\n")[:9].upper() == "HIERARCHY"
+
+
 def _sniff(path: Path) -> str | None:
     head = _head(path)
     stripped = head.lstrip(b"\xef\xbb\xbf \t\r\n")
-    if stripped.startswith(b"HIERARCHY"):
+    if stripped[:9].upper() == b"HIERARCHY" or _utf16_bvh(head):
         return "bvh"
     if stripped.startswith(b"PathFileType"):
         return "trc"

@@ -20,6 +20,7 @@ The limits are parameters (:class:`ReadLimits`); the server builds them from its
 
 from __future__ import annotations
 
+import codecs
 import re
 import zipfile
 from dataclasses import dataclass
@@ -199,6 +200,9 @@ def _check_arrays(path: Path, kind: str, limits: ReadLimits) -> None:
 
 def _check_bvh_header(path: Path, limits: ReadLimits) -> None:
     data = path.read_bytes()
+    if data[:2] in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE):
+        # The reader takes UTF-16 too; counted in its UTF-8 form.
+        data = data.decode("utf-16", errors="replace").encode("utf-8")
     motion_line = _MOTION.search(data)
     motion = -1 if motion_line is None else motion_line.end()
     header_end = len(data) if motion_line is None else motion_line.start()
