@@ -12,13 +12,39 @@ export function csrfHeaders() {
   return match ? { "X-CSRF-Token": decodeURIComponent(match[1]) } : {};
 }
 
+// Responses started before a view asked for them (prefetch.js, as the page starts), by URL: the
+// first GET of that URL takes the started request instead of sending another. Same URL, same
+// credentials (the session cookie; a GET carries no CSRF header), same answer handling.
+const prefetched = new Map();
+
+function get(url) {
+  const started = prefetched.get(url);
+  prefetched.delete(url);
+  return started || fetch(url);
+}
+
+/** Start a GET of each path now, for the first request of the same path to take over. */
+export function prefetch(paths) {
+  for (const url of paths.map((path) => BASE + path)) {
+    if (prefetched.has(url)) continue;
+    const started = fetch(url);
+    started.catch(() => {}); // a failure surfaces where the response is taken, not as unhandled
+    prefetched.set(url, started);
+  }
+}
+
+/** Forget the started responses not taken yet (a later view asks afresh). */
+export function dropPrefetched() {
+  prefetched.clear();
+}
+
 export async function request(method, path, body) {
   const init = { method, headers: method === "GET" ? {} : csrfHeaders() };
   if (body !== undefined) {
     init.headers["Content-Type"] = "application/json";
     init.body = JSON.stringify(body);
   }
-  const response = await fetch(BASE + path, init);
+  const response = await (method === "GET" ? get(BASE + path) : fetch(BASE + path, init));
   if (response.status === 401 && !location.pathname.startsWith(SIGN_IN_PAGE)) location.assign(SIGN_IN_PAGE);
   if (!response.ok) throw await apiError(response.status, await response.text());
   if (response.status === 204) return null;
@@ -42,19 +68,33 @@ export const listTakes = (params = {}) => {
   const query = new URLSearchParams(Object.entries(params).filter(([, v]) => v !== "" && v != null));
   return request("GET", `/takes?${query}`);
 };
-export const getTake = (id) => request("GET", `/takes/${id}`);
+const takePath = (id) => `/takes/${id}`;
+const resultPath = (runId) => `/runs/${runId}/result`;
+function framesPath(runId, { start = 0, stop = null, step = 1, maxFrames = 800 } = {}) {
+  const query = new URLSearchParams({ start, step, max_frames: maxFrames });
+  if (stop != null) query.set("stop", stop);
+  return `/runs/${runId}/frames.f32?${query}`;
+}
+export const getTake = (id) => request("GET", takePath(id));
 export const deleteTake = (id) => request("DELETE", `/takes/${id}`);
 export const getRun = (id) => request("GET", `/runs/${id}`);
-export const getResult = (id) => request("GET", `/runs/${id}/result`);
+export const getResult = (id) => request("GET", resultPath(id));
 /** Raw and corrected points (and rotations or confidence) of frames start:stop:step, the step
  * grown to hold at most maxFrames; packed float32 (a quarter of the JSON window's bytes, nothing
  * to parse): points are Float32Array views, NaN where missing (see frames.js). */
-export async function getFramesPacked(id, { start = 0, stop = null, step = 1, maxFrames = 800 } = {}) {
-  const query = new URLSearchParams({ start, step, max_frames: maxFrames });
-  if (stop != null) query.set("stop", stop);
-  const response = await fetch(`${BASE}/runs/${id}/frames.f32?${query}`);
+export async function getFramesPacked(id, range = {}) {
+  const response = await get(BASE + framesPath(id, range));
   if (!response.ok) throw apiError(response.status, await response.text());
   return unpackFrames(await response.arrayBuffer());
+}
+/** Frames the take view draws first: a light overview of the whole take (its skeletons do not
+ * wait for the full one). */
+export const FIRST_FRAMES = 100;
+export const getFirstFrames = (runId) => getFramesPacked(runId, { maxFrames: FIRST_FRAMES });
+/** Start the take view's first requests: the take and, when the run is known, its result and
+ * first frames (see prefetch.js). */
+export function prefetchTake(takeId, runId) {
+  prefetch(runId ? [takePath(takeId), resultPath(runId), framesPath(runId, { maxFrames: FIRST_FRAMES })] : [takePath(takeId)]);
 }
 export const startRun = (takeId, options) => request("POST", `/takes/${takeId}/runs`, options);
 export const addReview = (takeId, review) => request("POST", `/takes/${takeId}/reviews`, review);

@@ -1,29 +1,46 @@
-// The router: #/ (takes), #/upload, #/shoots, #/shoot/ID[/review], #/take/ID?run=RID&frame=F, #/compare. One module per view.
-import { h } from "./dom.js";
-import { compareView } from "./compare.js";
-import { listView } from "./list.js";
-import { reviewQueueView, shootsView, shootView } from "./shoot.js";
-import { takeView } from "./take.js";
-import { uploadView } from "./upload.js";
+// The router: #/ (takes), #/upload, #/shoots, #/shoot/ID[/review], #/take/ID?run=RID&frame=F, #/compare. One module per view,
+// each loaded when its route is first opened, with every module it may load preloaded at once.
+import { h, preloadModulesOf } from "./dom.js";
+import { parseRoute } from "./route.js";
+import "./prefetch.js"; // the take view's first requests, started before the first route (see there)
 
 const main = document.getElementById("main");
 let teardowns = [];
+let routed = 0; // routes opened so far: a view whose module arrives after a newer route is not shown
+
+/** A view's module: what it may load is preloaded first (the server lists it: dom.js). */
+function viewModule(file, load) {
+  preloadModulesOf(new URL(file, import.meta.url).pathname);
+  return load();
+}
+const VIEWS = {
+  take: () => viewModule("./take.js", () => import("./take.js")),
+  upload: () => viewModule("./upload.js", () => import("./upload.js")),
+  compare: () => viewModule("./compare.js", () => import("./compare.js")),
+  shoot: () => viewModule("./shoot.js", () => import("./shoot.js")),
+  list: () => viewModule("./list.js", () => import("./list.js")),
+};
+
+async function open(parts, params, current) {
+  const addTeardown = (t) => teardowns.push(t);
+  const name = ["take", "upload", "compare"].includes(parts[0]) ? parts[0] : parts[0] === "shoots" || parts[0] === "shoot" ? "shoot" : "list";
+  const view = await VIEWS[name]();
+  if (current !== routed) return;
+  if (parts[0] === "take") return view.takeView(main, parts[1], params, addTeardown);
+  if (parts[0] === "upload") return view.uploadView(main);
+  if (parts[0] === "compare") return view.compareView(main, params, addTeardown);
+  if (parts[0] === "shoots") return view.shootsView(main);
+  if (parts[0] === "shoot" && parts[2] === "review") return view.reviewQueueView(main, parts[1], addTeardown);
+  if (parts[0] === "shoot") return view.shootView(main, parts[1], params, addTeardown);
+  return view.listView(main, params, route).then(() => { main.dataset.ready = "1"; });
+}
 
 function route() {
   for (const teardown of teardowns) teardown();
   teardowns = [];
   delete main.dataset.ready;
-  const [path, query] = location.hash.replace(/^#/, "").split("?");
-  const params = new URLSearchParams(query || "");
-  const parts = (path || "/").split("/").filter(Boolean);
-  const view = parts[0] === "take" ? takeView(main, parts[1], params, (t) => teardowns.push(t))
-    : parts[0] === "upload" ? uploadView(main)
-    : parts[0] === "compare" ? compareView(main, params, (t) => teardowns.push(t))
-    : parts[0] === "shoots" ? shootsView(main)
-    : parts[0] === "shoot" && parts[2] === "review" ? reviewQueueView(main, parts[1], (t) => teardowns.push(t))
-    : parts[0] === "shoot" ? shootView(main, parts[1], params, (t) => teardowns.push(t))
-    : listView(main, params, route).then(() => { main.dataset.ready = "1"; });
-  view.catch((e) => main.replaceChildren(h("p", { class: "error" }, e.message)));
+  const { parts, params } = parseRoute(location.hash);
+  open(parts, params, ++routed).catch((e) => main.replaceChildren(h("p", { class: "error" }, e.message)));
 }
 window.addEventListener("hashchange", route);
 route();

@@ -32,3 +32,11 @@ export function preloadModules(urls) {
     if (!document.head.querySelector(`link[rel="modulepreload"][href="${href}"]`)) document.head.append(h("link", { rel: "modulepreload", href }));
   }
 }
+
+/** Preload a module loaded on demand and every module it may load (static imports and further
+ * on-demand ones, Plotly aside), as the server listed them from the import graph in
+ * `<meta name="modules-of" data-module="URL">` (backend/mocapqa/api/index_page.py). */
+export function preloadModulesOf(url) {
+  const meta = document.head.querySelector(`meta[name="modules-of"][data-module="${url}"]`);
+  preloadModules(meta ? meta.content.split(" ").filter(Boolean) : [url]);
+}

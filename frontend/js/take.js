@@ -1,7 +1,7 @@
 // The take view: two 3D views with one camera, the player, findings, charts, review, re-run.
 import * as api from "./api.js";
 import * as charts from "./charts.js";
-import { badge, h, preloadModules } from "./dom.js";
+import { badge, h } from "./dom.js";
 import { fmt, nextStop, seconds, stepsRan } from "./format.js";
 import { filterFromParams, filterParams, findingAt, jointsOf, kindsOf, loopOfFinding } from "./findings.js";
 import { findingsList } from "./findings-list.js";
@@ -15,15 +15,12 @@ import { rerunPanel } from "./rerun.js";
 import { intervalDecisions } from "./decisions.js";
 
 const OVERVIEW_FRAMES = 800; // frames of a take drawn before any window is loaded
-const FIRST_FRAMES = 100; // a first, light overview: the skeletons do not wait for the full one
 const LIMITS_COLOR = "#e67e22";
 const DECISIONS = { a: "approved", f: "needs_fix", r: "rejected" }; // review keys
 const LOOP_MARGIN_S = 0.5; // "loop this finding": seconds shown before and after it
 
 export async function takeView(main, takeId, params, onTeardown) {
   const runParam = params.get("run");
-  // three.js: only the take view loads it, its modules together.
-  preloadModules(["/static/js/geometry.js", "/static/js/viewports.js", "/static/vendor/three/three.module.min.js", "/static/vendor/three/three.core.min.js"]);
   const scene = import("./scene3d.js");
   const take = await api.getTake(takeId);
   performance.mark("take-fetched");
@@ -42,7 +39,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   }
   const [result, first] = await Promise.all([
     api.getResult(run.id).then((r) => { performance.mark("result-fetched"); return r; }),
-    firstFrames(run.id).then((f) => { performance.mark("frames-fetched"); return f; })]);
+    api.getFirstFrames(run.id).then((f) => { performance.mark("frames-fetched"); return f; })]);
   // The re-run form's lists wait for nothing on screen.
   const formLists = Promise.all([api.listFilters(), api.getRunOptions()]);
   let overview = first;
@@ -334,7 +331,6 @@ export async function takeView(main, takeId, params, onTeardown) {
 }
 
 /** The first, light overview: the skeletons do not wait for the full one. */
-const firstFrames = (runId) => api.getFramesPacked(runId, { maxFrames: FIRST_FRAMES });
 
 function runPicker(take, run) {
   const select = h("select", { id: "run-pick", "aria-label": "run", onchange: (e) => { location.hash = api.takeLink(take.id, e.target.value); } },

@@ -31,6 +31,7 @@ from mocapqa.api.deps import Services
 from mocapqa.api.errors import install_error_handlers
 from mocapqa.api.form_parts import check_form_parts
 from mocapqa.api.http_guards import install_http_guards
+from mocapqa.api.index_page import index_page
 from mocapqa.api.routes import (
     decisions,
     filters,
@@ -205,9 +206,7 @@ def create_app(
 
     static = frontend_dir()
 
-    index_html = (
-        (static / "index.html").read_text().replace("{{PLOTLY_JS}}", f"/vendor/{plotly_name}")
-    )
+    index_html = index_page(static, f"/vendor/{plotly_name}")
 
     @app.get("/", include_in_schema=False)
     def index() -> HTMLResponse:
