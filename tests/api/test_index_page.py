@@ -100,7 +100,8 @@ def test_page_preloads_the_static_graph_and_lists_each_on_demand_module(tmp_path
         '<meta name="plotly-src" content="{{PLOTLY_JS}}">\n  {{ON_DEMAND_MODULES}}\n'
         '<script type="module" async src="/static/js/app.js"></script>\n  {{MODULE_PRELOADS}}\n'
     )
-    page = index_page(tmp_path, "/vendor/plotly-1.min.js")
+    page, modules = index_page(tmp_path, "/vendor/plotly-1.min.js")
+    assert modules == list(module_graph(tmp_path, ["/static/js/app.js"]))
     assert "{{" not in page
     assert '<meta name="plotly-src" content="/vendor/plotly-1.min.js">' in page
     assert re.findall(r'rel="modulepreload" href="([^"]+)"', page) == ["/static/js/dom.js"]

@@ -23,7 +23,6 @@ import plotly
 from fastapi import APIRouter, Depends, FastAPI, Request, Response
 from fastapi.middleware.gzip import GZipMiddleware
 from fastapi.responses import FileResponse, HTMLResponse, RedirectResponse
-from fastapi.staticfiles import StaticFiles
 
 from mocapqa import __version__
 from mocapqa.api.auth import quota_key_before_body, require
@@ -31,7 +30,7 @@ from mocapqa.api.deps import Services
 from mocapqa.api.errors import install_error_handlers
 from mocapqa.api.form_parts import check_form_parts
 from mocapqa.api.http_guards import install_http_guards
-from mocapqa.api.index_page import index_page
+from mocapqa.api.index_page import STATIC_URL, index_page
 from mocapqa.api.routes import (
     decisions,
     filters,
@@ -45,6 +44,7 @@ from mocapqa.api.routes import (
     takes,
     users,
 )
+from mocapqa.api.static_files import CompressedStaticFiles
 from mocapqa.config import Settings
 from mocapqa.jobs.demo import load_demo
 from mocapqa.jobs.engine import Engine
@@ -206,15 +206,18 @@ def create_app(
 
     static = frontend_dir()
 
-    index_html = index_page(static, f"/vendor/{plotly_name}")
+    page = index_page(static, f"/vendor/{plotly_name}")
+    static_files = CompressedStaticFiles(directory=static)
+    page_files = [a.removeprefix(STATIC_URL) for a in page.modules]
 
     @app.get("/", include_in_schema=False)
     def index() -> HTMLResponse:
-        return HTMLResponse(index_html, headers={"Cache-Control": "no-cache"})
+        static_files.warm(page_files)  # the first page's modules gzipped before they are asked
+        return HTMLResponse(page.html, headers={"Cache-Control": "no-cache"})
 
     @app.get("/take/{take_id}", include_in_schema=False)
     def take_page(take_id: str) -> RedirectResponse:
         return RedirectResponse(f"/#/take/{take_id}")
 
-    app.mount("/static", StaticFiles(directory=static), name="static")
+    app.mount(STATIC_URL.rstrip("/"), static_files, name="static")
     return app

@@ -29,6 +29,7 @@ from typing import NamedTuple
 
 __all__ = [
     "STATIC_URL",
+    "IndexPage",
     "ModuleImports",
     "index_page",
     "module_graph",
@@ -165,7 +166,16 @@ def reachable(graph: dict[str, ModuleImports], entry: str) -> list[str]:
     return list(seen)
 
 
-def index_page(root: Path, plotly_url: str) -> str:
+class IndexPage(NamedTuple):
+    """The page as served and the modules it may load."""
+
+    html: str
+    """``index.html`` with its placeholders filled in."""
+    modules: list[str]
+    """URL paths of every module the page preloads or lists (its entries included)."""
+
+
+def index_page(root: Path, plotly_url: str) -> IndexPage:
     """``index.html`` as served: Plotly's address and the module graph's preloads.
 
     Parameters
@@ -177,9 +187,9 @@ def index_page(root: Path, plotly_url: str) -> str:
 
     Returns
     -------
-    str
+    IndexPage
         The page, with ``{{PLOTLY_JS}}``, ``{{MODULE_PRELOADS}}`` and ``{{ON_DEMAND_MODULES}}``
-        replaced.
+        replaced, and the modules it names.
     """
     template = (root / "index.html").read_text(encoding="utf-8")
     entries = _MODULE_SCRIPT.findall(template)
@@ -192,8 +202,9 @@ def index_page(root: Path, plotly_url: str) -> str:
         for address in on_demand
         if (modules := [a for a in reachable(graph, address) if a not in preloaded + entries])
     ]
-    return (
+    html = (
         template.replace("{{PLOTLY_JS}}", plotly_url)
         .replace("{{MODULE_PRELOADS}}", "\n  ".join(links))
         .replace("{{ON_DEMAND_MODULES}}", "\n  ".join(metas))
     )
+    return IndexPage(html, list(graph))
