@@ -63,8 +63,8 @@ TREE = {
     'const s = import("./scene.js");\n',
     "js/chart.js": 'import { h } from "./dom.js";\n',
     "js/scene.js": 'import * as T from "../vendor/lib.js";\nimport "./missing.js";\n',
-    "vendor/lib.js": 'import{a}from"./core.js";',
-    "vendor/core.js": "export const a = 1;",
+    "vendor/lib.js": 'import{a}from"./core.js";/*' + "x" * 500 + "*/",
+    "vendor/core.js": "export const a = 1;/*" + "x" * 300 + "*/",
 }
 
 
@@ -106,10 +106,11 @@ def test_page_preloads_the_static_graph_and_lists_each_on_demand_module(tmp_path
     assert '<meta name="plotly-src" content="/vendor/plotly-1.min.js">' in page
     assert re.findall(r'rel="modulepreload" href="([^"]+)"', page) == ["/static/js/dom.js"]
     metas = dict(re.findall(r'name="modules-of" data-module="([^"]+)" content="([^"]+)"', page))
+    # Each on-demand module's list, the largest file first.
     assert metas == {
-        "/static/js/view.js": "/static/js/view.js /static/js/chart.js /static/js/scene.js"
-        " /static/vendor/lib.js /static/vendor/core.js",
-        "/static/js/scene.js": "/static/js/scene.js /static/vendor/lib.js /static/vendor/core.js",
+        "/static/js/view.js": "/static/vendor/lib.js /static/vendor/core.js /static/js/view.js"
+        " /static/js/scene.js /static/js/chart.js",
+        "/static/js/scene.js": "/static/vendor/lib.js /static/vendor/core.js /static/js/scene.js",
     }
 
 

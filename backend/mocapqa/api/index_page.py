@@ -32,6 +32,7 @@ __all__ = [
     "IndexPage",
     "ModuleImports",
     "index_page",
+    "largest_first",
     "module_graph",
     "module_imports",
     "reachable",
@@ -175,6 +176,17 @@ class IndexPage(NamedTuple):
     """URL paths of every module the page preloads or lists (its entries included)."""
 
 
+def largest_first(root: Path, addresses: list[str], left_out: list[str]) -> list[str]:
+    """``addresses`` but ``left_out``, the largest file first (ties in the given order).
+
+    All of a view's modules are requested at once, and it runs only when the last has arrived:
+    started first, the longest transfers and compilations (three.js's two files) overlap the
+    many small ones instead of coming last.
+    """
+    sizes = {a: path.stat().st_size for a in addresses if (path := _file_of(root, a))}
+    return sorted((a for a in addresses if a not in left_out), key=lambda a: -sizes.get(a, 0))
+
+
 def index_page(root: Path, plotly_url: str) -> IndexPage:
     """``index.html`` as served: Plotly's address and the module graph's preloads.
 
@@ -200,7 +212,7 @@ def index_page(root: Path, plotly_url: str) -> IndexPage:
     metas = [
         f'<meta name="modules-of" data-module="{address}" content="{" ".join(modules)}">'
         for address in on_demand
-        if (modules := [a for a in reachable(graph, address) if a not in preloaded + entries])
+        if (modules := largest_first(root, reachable(graph, address), preloaded + entries))
     ]
     html = (
         template.replace("{{PLOTLY_JS}}", plotly_url)
