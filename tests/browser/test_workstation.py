@@ -542,6 +542,7 @@ def test_timings_overlay_and_upload_progress(
         "() => performance.getEntriesByType('measure').filter((m) => m.name.startsWith('plot '))"
         ".map((m) => [m.name.slice(5), Math.round(m.startTime) / 1000, Math.round(m.duration)])"
     )
+    in_use = fresh.page.evaluate("() => performance.now()")
     # Scrubbing, measured two ways. "paced": 60 scrubber moves, each waited for two animation
     # frames (drawn, then painted), so at most half the display's rate (30/s at 60 Hz).
     # "per frame": a move in every animation frame, as a drag on the scrubber delivers them, for
@@ -580,6 +581,36 @@ def test_timings_overlay_and_upload_progress(
           return { perFrame: (performance.now() - t0) / 1000, drawn: views.renders - renders }; }"""
     )
     cpu_s = chromium_cpu_s() - cpu_before
+    # Playback of the 120 fps take for 3 s, read in the page: frames are dropped, time is kept.
+    from mocapqa.io.bvh import read_bvh
+
+    fps = read_bvh(path).fps
+    played = fresh.page.evaluate(
+        """async () => {
+          const frameNow = () =>
+            Number(document.getElementById('frame-label').textContent.split(' ')[1]);
+          const views = window.mocapqaViews;
+          const first = frameNow(), drawn = views.drawn, t0 = performance.now();
+          document.getElementById('play').click();
+          await new Promise((r) => setTimeout(r, 3000));
+          const last = frameNow(), seconds = (performance.now() - t0) / 1000;
+          document.getElementById('play').click();
+          return { frames: last - first, seconds, drawn: views.drawn - drawn }; }"""
+    )
+    # A camera drag on the raw view, as in the drag test.
+    box = fresh.page.locator("#view-raw").bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    fresh.page.mouse.move(x, y)
+    fresh.page.mouse.down()
+    for step in range(1, 13):
+        fresh.page.mouse.move(x + 12 * step, y + 3 * step)
+    fresh.page.mouse.up()
+    fresh.settle()
+    used_tasks = [
+        [round(start / 1000, 3), round(ms)]
+        for start, ms in fresh.page.evaluate("() => window.longTasks")
+        if start >= in_use
+    ]
     charts = check_decimated_charts(fresh.page)
     fresh.close()
     TIMINGS["big_take"] = {
@@ -601,7 +632,19 @@ def test_timings_overlay_and_upload_progress(
             for start, ms in long_tasks
             if ms > 100 and start + ms > marks["skeletons"]
         ],
+        "playback": {
+            "fps": fps,
+            "rate_vs_real_time": round(played["frames"] / (fps * played["seconds"]), 2),
+            "frames_drawn_per_s": round(played["drawn"] / played["seconds"], 1),
+        },
+        # Every task over 50 ms while the ready page was used (scrubbing, playback of the
+        # 120 fps take, a camera drag): [start s, ms].
+        "tasks_over_50ms_while_used": used_tasks,
     }
+    assert fps == pytest.approx(120.0, rel=1e-3)
+    # Time runs at the take's rate, dropping frames (at most 60 of its 120 per second can be
+    # drawn at the display's rate): at least half of it, as in the playback test.
+    assert played["frames"] >= 0.5 * fps * played["seconds"], played
     assert marks["skeletons"] > marks["fcp"]
     # One canvas draws both views; every move of the scrubber was drawn.
     assert scrub["canvases"] == 1
