@@ -121,6 +121,17 @@ def scrub(page: Page, frame: int) -> None:
     page.settle()
 
 
+def drag_camera(page: Page, selector: str) -> None:
+    """Drag the mouse across the middle of a 3D view in 12 moves (an orbit of its camera)."""
+    box = page.page.locator(selector).bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.page.mouse.move(x, y)
+    page.page.mouse.down()
+    for step in range(1, 13):
+        page.page.mouse.move(x + 12 * step, y + 3 * step)
+    page.page.mouse.up()
+
+
 def view_pixels(page: Page, selector: str) -> np.ndarray:
     png = page.page.locator(selector).screenshot()
     return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=np.int16)
@@ -133,13 +144,7 @@ def test_dragging_either_camera_keeps_the_page_answering(
     answers = []
     orbits = [page.page.evaluate("() => window.mocapqaViews.orbit")]
     for view in ("#view-raw", "#view-corrected"):
-        box = page.page.locator(view).bounding_box()
-        x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
-        page.page.mouse.move(x, y)
-        page.page.mouse.down()
-        for step in range(1, 13):
-            page.page.mouse.move(x + 12 * step, y + 3 * step)
-        page.page.mouse.up()
+        drag_camera(page, view)
         answers.append(page.answers_within())
         assert answers[-1] < ANSWER_S
         # A button still works at once after the drag.
@@ -597,14 +602,7 @@ def test_timings_overlay_and_upload_progress(
           document.getElementById('play').click();
           return { frames: last - first, seconds, drawn: views.drawn - drawn }; }"""
     )
-    # A camera drag on the raw view, as in the drag test.
-    box = fresh.page.locator("#view-raw").bounding_box()
-    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
-    fresh.page.mouse.move(x, y)
-    fresh.page.mouse.down()
-    for step in range(1, 13):
-        fresh.page.mouse.move(x + 12 * step, y + 3 * step)
-    fresh.page.mouse.up()
+    drag_camera(fresh, "#view-raw")
     fresh.settle()
     used_tasks = [
         [round(start / 1000, 3), round(ms)]
