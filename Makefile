@@ -70,7 +70,7 @@ typecheck: install-dev
 
 unit: install-dev system-deps js-deps
 	node --test tests/js/
-	bash scripts/with-postgres.sh $(BIN)/python -m pytest -q
+	bash scripts/with-postgres.sh $(BIN)/python -m pytest -q --durations=20
 
 # Line and branch coverage of the same suite: about a quarter slower, so not part of `make test`.
 coverage: install-dev system-deps js-deps

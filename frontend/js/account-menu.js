@@ -17,10 +17,11 @@ async function show() {
   const links = [h("a", { href: "/static/tokens.html", id: "nav-tokens" }, "Tokens")];
   if (who.can.includes("manage_users")) links.push(h("a", { href: "/static/users.html", id: "nav-users" }, "Users"));
   if (who.can.includes("read_audit")) links.push(h("a", { href: "/static/audit.html", id: "nav-audit" }, "Audit"));
+  // Only a signed-in session can sign out (a token or the open mode has nothing to end).
   const out = who.via === "session"
-    ? h("button", { id: "sign-out", class: "link", onclick: async () => { await signOut(); location.assign("/static/signin.html"); } }, "sign out")
-    : null;
-  slot.replaceChildren(...links, h("span", { id: "whoami" }, `${who.name} (${who.role})`), out);
+    ? [h("button", { id: "sign-out", class: "link", onclick: async () => { await signOut(); location.assign("/static/signin.html"); } }, "sign out")]
+    : [];
+  slot.replaceChildren(...links, h("span", { id: "whoami" }, `${who.name} (${who.role})`), ...out);
 }
 
 show();

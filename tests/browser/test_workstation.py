@@ -141,6 +141,10 @@ def test_dragging_either_camera_keeps_the_page_answering(
     live_server: str, takes: dict[str, Any], page: Page
 ) -> None:
     page.open_take(live_server, takes["knees"])
+    # The open mode's header: who, and no sign-out (nothing else, not a stray "null").
+    assert page.page.inner_text("#whoami") == "anonymous (admin)"
+    assert page.page.locator("#sign-out").count() == 0
+    assert "null" not in page.page.text_content("#account")
     answers = []
     orbits = [page.page.evaluate("() => window.mocapqaViews.orbit")]
     for view in ("#view-raw", "#view-corrected"):
