@@ -318,6 +318,33 @@ def test_chain_intervals_take_each_jumps_uncertainty() -> None:
     assert np.all(offsets[50:] == 0.0)
 
 
+def test_a_large_shift_closes_across_small_steps_that_look_like_a_burst() -> None:
+    # A −123° shift held over frames 202–218 at 30 fps (the onset and release of a Bandai
+    # upper arm), with natural counter-rotated steps of −5.8° and −3.3° at frames 209–210
+    # (one frame apart: a burst by timing) and −4.2° at 214. The burst's flips are all within
+    # the closure tolerance of the release (0.2 × 122°), so the release closes the onset.
+    n = 300
+    frames = np.array([202, 209, 210, 214, 219])
+    jumps = np.deg2rad([-122.6, -5.8, -3.3, -4.2, 122.2])
+    increments = np.zeros(n)
+    increments[frames] = jumps
+    args = (frames, jumps, np.zeros(5), increments, np.zeros(n), np.deg2rad(2.0),
+            np.deg2rad(0.5), 30.0, 0.2, 0.5, 0.1, 2.0)  # fmt: skip
+    offsets, (found,) = chain_intervals(*args)
+    assert (found.start_frame, found.end_frame) == (202, 218)
+    assert np.all(np.rad2deg(offsets[202:219]) < -110.0)
+    assert np.all(offsets[:202] == 0.0)
+    assert np.all(offsets[219:] == 0.0)
+    # A burst of real flips (40° and 20°, beyond that tolerance, not cancelling each other)
+    # still cannot be closed from
+    # outside: its last flip is never paired with an unrelated event far away.
+    flips = np.deg2rad([-122.6, -40.0, 20.0, -4.2, 122.2])
+    steps = np.zeros(n)
+    steps[frames] = flips
+    offsets, found_all = chain_intervals(frames, flips, *args[2:3], steps, *args[4:])
+    assert not any((f.start_frame, f.end_frame) == (202, 218) for f in found_all)
+
+
 def _held_shift(jitter_deg: float) -> np.ndarray:
     """Roll increments of a −10° shift held over frames 30–49 of 100, the roll inside
     alternating by ``jitter_deg`` (+ on even frames from 32 to 48), degrees."""

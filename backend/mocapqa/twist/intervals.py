@@ -106,8 +106,11 @@ def _groups(
     dropped. Once two events of one burst (events within ``burst_gap`` frames of each other)
     are open together, they may only be closed from inside that burst, so a burst's last flip
     is never paired with an unrelated event far away. Events left unmatched that lie within
-    ``burst_gap`` of each other form a burst. Groups whose spans overlap (a burst inside a held
-    level shift) are merged. Events farther apart than ``burst_gap`` cancel within the closure
+    ``burst_gap`` of each other form a burst. A lone event (none other within ``burst_gap``)
+    may close across a burst whose jumps are all within ``closure_fraction`` of its own: such a
+    burst is two or more small natural steps inside a large held shift (an arm's roll jittering
+    by 3–6° inside a 120° shift), not flips that the lone event could end. Groups whose spans
+    overlap (a burst inside a held level shift) are merged. Events farther apart than ``burst_gap`` cancel within the closure
     tolerance plus the root sum of squares of their jumps' ``uncertainty``; flips inside one
     burst get no such allowance.
     """
@@ -115,13 +118,21 @@ def _groups(
     paired = np.zeros(len(frames), dtype=bool)
     cluster = np.concatenate(([0], np.cumsum(np.diff(frames) > burst_gap)))
     bound = np.zeros(len(frames), dtype=bool)
+    alone = np.bincount(cluster)[cluster] == 1
     stack: list[int] = []
     for k in range(len(frames)):
         stack = [i for i in stack if frames[k] - frames[i] <= max_frames]
         level, largest, closed = float(jumps[k]), abs(float(jumps[k])), -1
+        # A lone event may close across a burst whose flips are all within its own closure
+        # tolerance: small natural steps inside a large held shift, not a burst it could end.
+        minor = closure_fraction * largest
         variance = float(uncertainty[k]) ** 2
         for p in range(len(stack) - 1, -1, -1):
-            if bound[stack[p]] and cluster[stack[p]] != cluster[k]:
+            if (
+                bound[stack[p]]
+                and cluster[stack[p]] != cluster[k]
+                and not (alone[k] and abs(float(jumps[stack[p]])) <= minor)
+            ):
                 break
             level = float(wrap_angle(np.array(level + jumps[stack[p]])))
             largest = max(largest, abs(float(jumps[stack[p]])))
