@@ -49,9 +49,11 @@ def motion_summary(
     -------
     dict
         Frames, fps, duration (s), joints, length unit, rotation orders (order → joint
-        count), root translation mode and why, roles found (role key → joint name), roles not
-        mapped, and limb chains (``"left upper_arm: A > B > C"``).
+        count), root translation mode and why, leading bind-pose frames (0 or 1, see
+        :func:`mocapqa.core.bindpose.leading_bind_pose`), roles found (role key → joint name),
+        roles not mapped, and limb chains (``"left upper_arm: A > B > C"``).
     """
+    from mocapqa.core.bindpose import leading_bind_pose
     from mocapqa.core.rig import find_roles, limb_chains
     from mocapqa.io.bvh_root import explain_root_translation
 
@@ -80,6 +82,7 @@ def motion_summary(
         "rotation_orders": orders,
         "root_translation": sk.root_translation,
         "root_translation_reason": explain_root_translation(motion, root_translation),
+        "bind_pose_frames": leading_bind_pose(motion.quats),
         "roles": {key: sk.names[j] for key, j in sorted(rig.roles.items())},
         "unmapped_roles": list(rig.unmapped),
         "limb_chains": chains,
@@ -132,6 +135,13 @@ def _print_table(path: Path, summary: dict[str, Any]) -> None:
             text = "\n".join(f"{role}: {joint}" for role, joint in value.items()) or "none"
         elif key == "unmapped_roles":
             text = f"[yellow]{', '.join(value)}[/]" if value else "none (all roles mapped)"
+        elif key == "bind_pose_frames":
+            text = (
+                "frame 0 (a T-pose, not motion: filters start on frame 1, twist detection skips "
+                "the step into it)"
+                if value
+                else "none"
+            )
         elif key == "limb_chains":
             text = "\n".join(value) or "none"
         elif key == "assumptions":

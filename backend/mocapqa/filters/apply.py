@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray
+from mocapqa.core.bindpose import leading_bind_pose
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
@@ -305,20 +306,25 @@ def filter_motion(
     scale = DataScale(1.0, NOTE_METRES_PER_UNIT, motion.fps)
     p = resolve_params(method, "default", scale, params)
     fps = motion.fps
+    # A bind-pose first frame is kept as it is and the filter starts on the motion.
+    skip = leading_bind_pose(motion.quats)
+    raw_quats, raw_translations = motion.quats[skip:], motion.translations[skip:]
     if method == "quat-pd":
-        quats = quat_pd_filter(motion.quats, fps, p)
-        translations = vector_pd_filter(motion.translations, fps, p)
+        quats = quat_pd_filter(raw_quats, fps, p)
+        translations = vector_pd_filter(raw_translations, fps, p)
     elif method == "euler-pd":
         orders = [motion.skeleton.rotation_order(j) for j in range(motion.skeleton.n_joints)]
-        quats = euler_pd_filter(motion.quats, orders, fps, p)
-        translations = vector_pd_filter(motion.translations, fps, p)
+        quats = euler_pd_filter(raw_quats, orders, fps, p)
+        translations = vector_pd_filter(raw_translations, fps, p)
     elif method == "quat-one-euro":
-        quats = quat_one_euro_filter(motion.quats, fps, p)
+        quats = quat_one_euro_filter(raw_quats, fps, p)
         pos_params = OneEuroParams(
             min_cutoff_hz=p.min_cutoff_hz, beta=0.0, d_cutoff_hz=p.d_cutoff_hz
         )
-        translations, _ = one_euro_filter(motion.translations, fps, pos_params)
+        translations, _ = one_euro_filter(raw_translations, fps, pos_params)
     else:
-        quats = butterworth_quats(motion.quats, fps, p)
-        translations, _ = butterworth_filter(motion.translations, fps, p)
+        quats = butterworth_quats(raw_quats, fps, p)
+        translations, _ = butterworth_filter(raw_translations, fps, p)
+    quats = np.concatenate([motion.quats[:skip], quats])
+    translations = np.concatenate([motion.translations[:skip], translations])
     return dataclasses.replace(motion, quats=quats, translations=translations)

@@ -14,6 +14,7 @@ from typing import Any, Literal, get_args
 import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.core.bindpose import leading_bind_pose
 from mocapqa.core.decimate import peak_frames
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
@@ -292,6 +293,10 @@ def detect_chains(
             dc = np.where(
                 good >= robust.min_conditioning, azimuth, child_increment_twists(child_quats, axes)
             )
+    # A bind-pose first frame is not motion: the step into frame 1 gets no increment.
+    skip = leading_bind_pose(quats)
+    dp[1 : skip + 1] = 0.0
+    dc[1 : skip + 1] = 0.0
     return detect_robust(dp, dc, fps, robust)
 
 

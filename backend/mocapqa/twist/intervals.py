@@ -110,9 +110,9 @@ def _groups(
     may close across a burst whose jumps are all within ``closure_fraction`` of its own: such a
     burst is two or more small natural steps inside a large held shift (an arm's roll jittering
     by 3–6° inside a 120° shift), not flips that the lone event could end. Groups whose spans
-    overlap (a burst inside a held level shift) are merged. Events farther apart than ``burst_gap`` cancel within the closure
-    tolerance plus the root sum of squares of their jumps' ``uncertainty``; flips inside one
-    burst get no such allowance.
+    overlap (a burst inside a held level shift) are merged. Events farther apart than
+    ``burst_gap`` cancel within the closure tolerance plus the root sum of squares of their
+    jumps' ``uncertainty``; flips inside one burst get no such allowance.
     """
     groups: list[list[int]] = []
     paired = np.zeros(len(frames), dtype=bool)
