@@ -22,6 +22,7 @@ from mocapqa.twist.angles import chain_geometry
 from mocapqa.twist.confidence import Calibration, default_calibration, fit_calibration
 from mocapqa.twist.intervals import FEATURES
 from mocapqa.twist.refine import refine_quats
+from tests.rigs import rerig
 
 
 @pytest.fixture(scope="module")
@@ -53,6 +54,28 @@ def test_every_child_of_a_corrected_joint_keeps_its_world_pose(real_take: Motion
     assert "CC_Base_L_CalfTwist02" in {names[j] for j in others}
     assert _same_rotation(world_before[:, others], world_after[:, others]) < 1e-9
     assert np.max(np.abs(positions_before - positions_after)) < 1e-3
+
+
+def test_twist_decisions_do_not_depend_on_the_joint_frames(real_take: Motion) -> None:
+    # Rigs orient their joint frames every way (Character Creator bakes them into the rotations,
+    # Xsens and Mixamo keep the world axes at rest): the same world motion with every joint
+    # frame turned at random gets the same intervals, levels, probabilities and corrected
+    # world poses.
+    turned = rerig(real_take, seed=7)
+    original, again = analyze_twist(real_take), analyze_twist(turned)
+    assert len(original.intervals) == 8
+    for a, b in zip(original.intervals, again.intervals, strict=True):
+        assert (a.joint, a.start_frame, a.end_frame, a.applied) == (
+            b.joint,
+            b.start_frame,
+            b.end_frame,
+            b.applied,
+        )
+        assert abs(a.offset_deg - b.offset_deg) < 1e-6
+        assert abs(a.confidence - b.confidence) < 1e-6
+    _, before = forward_kinematics(original.refined)
+    _, after = forward_kinematics(again.refined)
+    np.testing.assert_allclose(after, before, atol=1e-6)
 
 
 def test_real_errors_are_removed_and_far_frames_barely_move(real_take: Motion) -> None:
