@@ -28,6 +28,7 @@ def test_the_root_reading_is_detected_explained_and_overridable(
     assert detected["reading"]["root_translation"] == "add"
     assert detected["reading"]["root_translation_reason"].startswith("add (detected)")
     assert "Blender" in detected["reading"]["root_translation_reason"]
+    assert detected["reading"]["bind_pose_frames"] == 0
     chosen = post(client, take, root_translation="replace")
     detail = client.get(f"/api/v1/takes/{chosen['id']}").json()
     assert detail["reading"]["read_options"]["root_translation"] == "replace"
@@ -39,6 +40,18 @@ def test_the_root_reading_is_detected_explained_and_overridable(
     assert run["status"] == "done", run["error"]
     result = client.get(f"/api/v1/runs/{run['id']}/result").json()
     assert result["summary"]["root_translation"] == "replace"
+
+
+def test_a_bind_pose_first_frame_is_reported_with_the_take_and_the_run(
+    client: TestClient, corpus_dir: Path, wait_for_run: Waiter
+) -> None:
+    # 007_12 starts with a T-pose frame ("Imported" status in the corpus README).
+    take = post(client, corpus_dir / "bvh" / "cmu" / "iclone" / "007_12.bvh")
+    assert take["reading"]["bind_pose_frames"] == 1
+    run = wait_for_run(client, take["run_id"])
+    assert run["status"] == "done", run["error"]
+    result = client.get(f"/api/v1/runs/{run['id']}/result").json()
+    assert result["summary"]["bind_pose_frames"] == 1
 
 
 def test_an_assumed_frame_rate_is_shown_and_can_be_set_at_upload(

@@ -24,6 +24,7 @@ import numpy as np
 
 from mocapqa import __version__
 from mocapqa.core.arrays import BoolArray, FloatArray
+from mocapqa.core.bindpose import leading_bind_pose
 from mocapqa.core.decimate import peak_frames
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
@@ -194,6 +195,7 @@ def _analyze_motion(
             "n_joints": skeleton.n_joints,
             "length_unit": skeleton.length_unit,
             "root_translation": skeleton.root_translation,
+            "bind_pose_frames": leading_bind_pose(motion.quats),
             "roles": {key: skeleton.names[j] for key, j in sorted(rig.roles.items())},
             "missing_roles": list(rig.unmapped),
             "n_findings": len(findings),

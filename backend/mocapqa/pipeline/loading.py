@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
+from mocapqa.core.bindpose import leading_bind_pose
 from mocapqa.core.keypoints import LENGTH_UNITS, KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError, ParseError, TooLargeError
@@ -99,14 +100,16 @@ def reading_facts(take: Motion | KeypointSequence, read: ReadOptions) -> dict[st
     dict
         ``read_options`` (as chosen), ``fps``, ``length_unit`` and, for keypoints,
         ``assumptions`` (frame rate, unit, layout or frame numbers the file did not state);
-        for a BVH, ``root_translation``, ``root_translation_reason`` and ``joints`` (the
-        joint names, by which a run's ``mapping`` option is checked before it is queued).
+        for a BVH, ``root_translation``, ``root_translation_reason``, ``bind_pose_frames``
+        (:func:`mocapqa.core.bindpose.leading_bind_pose`) and ``joints`` (the joint names, by
+        which a run's ``mapping`` option is checked before it is queued).
     """
     facts: dict[str, Any] = {"read_options": read.to_json(), "fps": take.fps}
     if isinstance(take, Motion):
         facts["length_unit"] = take.skeleton.length_unit
         facts["root_translation"] = take.skeleton.root_translation
         facts["root_translation_reason"] = explain_root_translation(take, read.root_translation)
+        facts["bind_pose_frames"] = leading_bind_pose(take.quats)
         facts["joints"] = list(take.skeleton.names)
     else:
         facts["length_unit"] = take.length_unit
