@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from tests.rigs import rerig
 
 from mocapqa.bench.calibration import reliability
 from mocapqa.bench.natural import natural_error_figures, wilson_interval
@@ -22,7 +23,6 @@ from mocapqa.twist.angles import chain_geometry
 from mocapqa.twist.confidence import Calibration, default_calibration, fit_calibration
 from mocapqa.twist.intervals import FEATURES
 from mocapqa.twist.refine import refine_quats
-from tests.rigs import rerig
 
 
 @pytest.fixture(scope="module")
