@@ -10,7 +10,7 @@ import pytest
 from tests.rigs import rerig
 
 from mocapqa.bench.calibration import reliability
-from mocapqa.bench.natural import natural_error_figures, wilson_interval
+from mocapqa.bench.natural import clean_figures_at_rates, natural_error_figures, wilson_interval
 from mocapqa.cli.main import main
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
@@ -205,6 +205,16 @@ def test_the_same_decisions_at_every_frame_rate(corpus_dir: Path, path: str) -> 
         assert found == [True] * len(SHIFTS), (path, fps, found)
         assert extra == 0, (path, fps)
         assert left < 0.2 * 35.0, (path, fps, left)
+
+
+def test_a_clean_take_is_checked_at_other_rates(corpus_dir: Path) -> None:
+    walk = read_bvh(corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh")
+    figures = clean_figures_at_rates(walk, (24.0, 120.0))
+    assert [fps for fps, _ in figures] == [24.0, 120.0]
+    # At its own rate the take is analysed as read; at 24 fps, resampled.
+    own = analyze_twist(walk)
+    assert figures[1][1].n_intervals == len(own.intervals)
+    assert all(f.n_applied == 0 and f.max_change_deg < 1e-9 for _, f in figures)
 
 
 def test_below_ten_frames_per_second_nothing_is_reported(corpus_dir: Path) -> None:

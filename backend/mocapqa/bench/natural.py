@@ -16,13 +16,16 @@ import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.motion import Motion
+from mocapqa.kinematics.resample import resample_motion
 from mocapqa.metrics.twist import rotation_errors_deg
-from mocapqa.twist.analysis import TwistAnalysis, detect_chains
+from mocapqa.twist.analysis import TwistAnalysis, analyze_twist, detect_chains
 from mocapqa.twist.angles import wrap_angle
 
 __all__ = [
+    "CLEAN_RATES",
     "CleanTakeFigure",
     "NaturalErrorFigures",
+    "clean_figures_at_rates",
     "clean_take_figure",
     "natural_error_figures",
     "natural_jumps",
@@ -141,6 +144,30 @@ def clean_take_figure(motion: Motion, analysis: TwistAnalysis) -> CleanTakeFigur
         n_applied=sum(i.applied for i in analysis.intervals),
         max_change_deg=float(change.max(initial=0.0)),
     )
+
+
+CLEAN_RATES = (24.0, 25.0, 30.0, 48.0, 50.0, 60.0, 100.0, 120.0)
+"""Frame rates a clean take is resampled to for :func:`clean_figures_at_rates`, frames/s."""
+
+
+def clean_figures_at_rates(
+    motion: Motion, rates: tuple[float, ...] = CLEAN_RATES
+) -> list[tuple[float, CleanTakeFigure]]:
+    """The default refinement of a clean take resampled to each rate (slerp,
+    :func:`mocapqa.kinematics.resample.resample_motion`); the take itself at its own rate
+    (within 0.5 frames/s).
+
+    Returns
+    -------
+    list of (float, CleanTakeFigure)
+        Rate (frames/s) and what the defaults did at it: a clean take should get no interval
+        applied at any rate.
+    """
+    out = []
+    for fps in rates:
+        take = motion if abs(fps - motion.fps) <= 0.5 else resample_motion(motion, fps)
+        out.append((fps, clean_take_figure(take, analyze_twist(take))))
+    return out
 
 
 def wilson_interval(successes: int, total: int, z: float = 1.96) -> tuple[float, float]:

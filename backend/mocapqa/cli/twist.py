@@ -263,7 +263,12 @@ def _real_takes(data_dir: Path) -> list[Path]:
 def _print_real(data_dir: Path, console: Console, methods_chosen: list[str]) -> None:
     """Natural-error figures on the real-error takes and the default refinement of every take."""
     from mocapqa.bench.calibration import real_interval_records, reliability
-    from mocapqa.bench.natural import clean_take_figure, natural_error_figures
+    from mocapqa.bench.natural import (
+        CLEAN_RATES,
+        clean_figures_at_rates,
+        clean_take_figure,
+        natural_error_figures,
+    )
     from mocapqa.bench.twist import REAL_ERROR_TAKES
     from mocapqa.cli.twist_tables import calibration_table, clean_takes_table, natural_table
     from mocapqa.io.bvh import read_bvh
@@ -299,6 +304,23 @@ def _print_real(data_dir: Path, console: Console, methods_chosen: list[str]) -> 
         f"{sum(f.n_applied > 0 for _, f in clean_rows)}, intervals applied: "
         f"{sum(f.n_applied for _, f in clean_rows)}, largest change "
         f"{max((f.max_change_deg for _, f in clean_rows), default=0.0):.1f}°"
+    )
+    # The same clean takes at other common frame rates: the decisions should not change.
+    resampled = [
+        (path.name, fps, figure)
+        for path, (motion, _) in rows_clean
+        if path.name not in REAL_ERROR_TAKES
+        for fps, figure in clean_figures_at_rates(motion)
+    ]
+    applied = [(name, fps, f) for name, fps, f in resampled if f.n_applied]
+    console.print(
+        f"takes without real errors resampled to {', '.join(f'{r:g}' for r in CLEAN_RATES)} "
+        f"fps: {len(resampled)} take-rates, with an interval applied by default: {len(applied)}"
+        + "".join(
+            f"\n  {name} at {fps:g} fps: {f.n_applied} applied, largest change "
+            f"{f.max_change_deg:.1f}°"
+            for name, fps, f in applied
+        )
     )
 
 
