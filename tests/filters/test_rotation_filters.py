@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
+from mocapqa.bench.filters import Take
+from mocapqa.bench.rotation_filters import clean_change_table
 from mocapqa.errors import InputError
 from mocapqa.filters.butterworth import ButterworthParams, butterworth_quats
 from mocapqa.filters.euler_pd import euler_pd_filter, vector_pd_filter
@@ -18,6 +22,7 @@ from mocapqa.filters.quat_pd import (
     max_stable_frequency_hz,
     quat_pd_filter,
 )
+from mocapqa.io.bvh import read_bvh
 from mocapqa.kinematics.quaternion import geodesic_angle, unwrap
 
 
@@ -114,3 +119,18 @@ def test_vector_pd_tracks_a_step_without_overshoot_when_critically_damped() -> N
     out = vector_pd_filter(x, 30.0, QuatPDParams(natural_frequency_hz=2.0, damping_ratio=1.0))
     assert out.max() <= 1.0 + 1e-9
     assert out[-1, 0] == pytest.approx(1.0, abs=1e-3)
+
+
+def test_clean_takes_measure_each_filters_lag(corpus_dir: Path) -> None:
+    # A real walk and kick as recorded (no noise): the zero-phase offline filter changes them
+    # least, and every causal filter changes them by a measurable lag.
+    names = ["dataset-2_walk_normal_001.bvh", "dataset-1_kick_normal_001.bvh"]
+    takes = [
+        Take(n, read_bvh(corpus_dir / "bvh" / "bandai" / n), np.zeros((0, 0, 3))) for n in names
+    ]
+    rows = {r["method"]: r for r in clean_change_table(takes)}
+    assert set(rows) == {"quat-pd", "quat-one-euro", "euler-pd", "butterworth"}
+    for method in ("quat-pd", "quat-one-euro", "euler-pd"):
+        assert rows["butterworth"]["median change °"] < rows[method]["median change °"]
+        assert rows[method]["95th percentile °"] > 1.0
+    assert all(0.0 <= r["median change °"] <= r["95th percentile °"] for r in rows.values())

@@ -19,6 +19,8 @@ import numpy as np
 from mocapqa.bench.filters import Row, Take
 from mocapqa.bench.noise import rotation_noise
 from mocapqa.core.arrays import FloatArray
+from mocapqa.core.bindpose import leading_bind_pose
+from mocapqa.filters.apply import filter_motion
 from mocapqa.filters.butterworth import ButterworthParams, butterworth_quats
 from mocapqa.filters.euler_pd import axis_angle_pd_filter, euler_pd_filter
 from mocapqa.filters.quat_one_euro import QuatOneEuroParams, quat_one_euro_filter
@@ -27,7 +29,14 @@ from mocapqa.kinematics.forward import world_from_local
 from mocapqa.kinematics.quaternion import geodesic_angle
 from mocapqa.metrics.smoothness import acceleration_error, mean_distance
 
-__all__ = ["RotationCase", "quamo_table", "rotation_cases", "rotation_table", "tune_quat_pd"]
+__all__ = [
+    "RotationCase",
+    "clean_change_table",
+    "quamo_table",
+    "rotation_cases",
+    "rotation_table",
+    "tune_quat_pd",
+]
 
 MM_PER_CM = 10.0
 RotMethod = Callable[[FloatArray, Take], FloatArray]
@@ -116,6 +125,39 @@ def rotation_table(test: Sequence[RotationCase], tuned: QuatPDParams) -> list[Ro
         ),
     ]
     return [{"method": name, **_score(m, test)} for name, m in methods]
+
+
+def clean_change_table(takes: Sequence[Take]) -> list[Row]:
+    """What each rotation filter, with its defaults, changes on the takes as recorded.
+
+    No noise is added: the change is the filter's lag and smoothing of real motion, which a
+    user pays on a clean take. Per method, over every frame and joint with rotation channels
+    of ``takes`` (a bind-pose first frame left out): the median change of a local rotation, the
+    largest per-joint median (the most-changed joint, typically a thigh) and the 95th
+    percentile, degrees.
+    """
+    rows: list[Row] = []
+    for method in ("quat-pd", "quat-one-euro", "euler-pd", "butterworth"):
+        changes, joint_medians = [], []
+        for take in takes:
+            motion = take.motion
+            skip = leading_bind_pose(motion.quats)
+            rotating = [j for j in range(motion.skeleton.n_joints)
+                        if motion.skeleton.rotation_order(j)]  # fmt: skip
+            filtered = filter_motion(motion, method)
+            angles = np.rad2deg(
+                geodesic_angle(motion.quats[skip:, rotating], filtered.quats[skip:, rotating])
+            )
+            changes.append(angles.ravel())
+            joint_medians.append(np.median(angles, axis=0))
+        every = np.concatenate(changes)
+        rows.append({
+            "method": method,
+            "median change °": float(np.median(every)),
+            "most-changed joint, median °": float(np.max(np.concatenate(joint_medians))),
+            "95th percentile °": float(np.percentile(every, 95)),
+        })  # fmt: skip
+    return rows
 
 
 def quamo_table(test: Sequence[RotationCase], params: QuatPDParams) -> list[Row]:

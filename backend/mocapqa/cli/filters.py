@@ -138,6 +138,7 @@ def bench_filters(
         split_takes,
     )
     from mocapqa.bench.rotation_filters import (
+        clean_change_table,
         quamo_table,
         rotation_cases,
         rotation_table,
@@ -156,5 +157,10 @@ def bench_filters(
     tuned = tune_quat_pd(r_train)
     console.print(_table("Rotations (test takes)", rotation_table(r_test, tuned)))
     console.print(_table("QuaMo ablation (tuned gains; test takes)", quamo_table(r_test, tuned)))
+    console.print(
+        _table(
+            "Rotation filters on the test takes as recorded (no noise)", clean_change_table(test)
+        )
+    )
     console.print(_table("Pose2Sim raw TRC vs its Butterworth file", pose2sim_table(root)))
     console.print(_table("Speed", speed_table()))
