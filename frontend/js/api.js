@@ -107,23 +107,26 @@ export const downloadUrl = (runId, kind) => `${BASE}/runs/${runId}/download/${ki
 export const thumbnailUrl = (takeId, runId) => `${BASE}/takes/${takeId}/thumbnail?run=${runId || ""}`;
 export const takeLink = (takeId, runId) => `#/take/${takeId}${runId ? `?run=${runId}` : ""}`;
 
-// Upload with progress (fetch cannot report upload progress; XMLHttpRequest can).
-export function uploadTake(file, onProgress) {
+// A multipart POST with upload progress (fetch cannot report upload progress; XMLHttpRequest
+// can), carrying the session's CSRF header like every other state-changing request.
+function postForm(path, form, onProgress, what) {
   return new Promise((resolve, reject) => {
     const xhr = new XMLHttpRequest();
-    xhr.open("POST", `${BASE}/takes`);
+    xhr.open("POST", `${BASE}${path}`);
     for (const [name, value] of Object.entries(csrfHeaders())) xhr.setRequestHeader(name, value);
-    // Bytes of this file sent so far (the request's own overhead is left out).
-    xhr.upload.onprogress = (e) => { if (e.lengthComputable) onProgress(Math.min(file.size, e.loaded * (file.size / e.total))); };
-    xhr.onload = () => {
-      if (xhr.status === 201) resolve(JSON.parse(xhr.responseText));
-      else reject(apiError(xhr.status, xhr.responseText));
-    };
-    xhr.onerror = () => reject(new Error("network error during upload"));
-    const form = new FormData();
-    form.append("file", file);
+    xhr.upload.onprogress = (e) => { if (e.lengthComputable) onProgress(e.loaded, e.total); };
+    xhr.onload = () => (xhr.status === 201 ? resolve(JSON.parse(xhr.responseText)) : reject(apiError(xhr.status, xhr.responseText)));
+    xhr.onerror = () => reject(new Error(`network error during ${what}`));
     xhr.send(form);
   });
+}
+
+/** Upload one take; ``onProgress(bytes)`` gets the bytes of this file sent so far (the
+ * request's own overhead left out). */
+export function uploadTake(file, onProgress) {
+  const form = new FormData();
+  form.append("file", file);
+  return postForm("/takes", form, (loaded, total) => onProgress(Math.min(file.size, loaded * (file.size / total))), "upload");
 }
 
 export async function waitForRun(runId, onProgress, intervalMs = 300) {
@@ -154,14 +157,7 @@ export const shootLink = (id, query = "") => `#/shoot/${id}${query ? `?${query}`
 /** Import files and archives into a shoot (one multipart request, field `files` repeated);
  * `onProgress(sent, total)` reports the request's bytes sent. */
 export function importIntoShoot(id, files, onProgress = () => {}) {
-  return new Promise((resolve, reject) => {
-    const xhr = new XMLHttpRequest();
-    xhr.open("POST", `${BASE}/shoots/${id}/takes`);
-    xhr.upload.onprogress = (e) => { if (e.lengthComputable) onProgress(e.loaded, e.total); };
-    xhr.onload = () => (xhr.status === 201 ? resolve(JSON.parse(xhr.responseText)) : reject(apiError(xhr.status, xhr.responseText)));
-    xhr.onerror = () => reject(new Error("network error during the import"));
-    const form = new FormData();
-    for (const file of files) form.append("files", file, file.name);
-    xhr.send(form);
-  });
+  const form = new FormData();
+  for (const file of files) form.append("files", file, file.name);
+  return postForm(`/shoots/${id}/takes`, form, onProgress, "the import");
 }

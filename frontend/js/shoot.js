@@ -33,7 +33,7 @@ export async function shootsView(main) {
   main.replaceChildren(h("h1", {}, `Shoots (${shoots.length})`), form,
     h("table", { id: "shoot-list" }, h("thead", {}, h("tr", {}, ["name", "takes", "frames", "queued", "running", "done", "failed", "unreviewed"].map((c, k) =>
       h("th", { class: k === 2 || k === 7 ? "narrow-hide" : null }, c)))), h("tbody", {}, rows)),
-    shoots.length ? null : h("p", { class: "muted" }, "No shoot yet: create one, then import its takes."));
+    ...(shoots.length ? [] : [h("p", { class: "muted" }, "No shoot yet: create one, then import its takes.")]));
   main.dataset.ready = "1";
 }
 

@@ -102,6 +102,33 @@ def focused(page: Any) -> str:
     return str(page.evaluate("() => document.activeElement && document.activeElement.id"))
 
 
+def test_a_signed_in_reviewer_imports_takes_into_a_shoot(
+    team: dict[str, Any], chromium: Any, corpus_dir: Path
+) -> None:
+    # Signed in with the session cookie, the import is a state-changing request like any other:
+    # it must carry the CSRF token (it once did not, and every import was refused with 403).
+    context = chromium.new_context(viewport={"width": 1280, "height": 900})
+    page = context.new_page()
+    errors: list[str] = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    url = team["url"]
+    shoot = httpx.post(f"{url}/api/v1/shoots", json={"name": "Day 2"}, headers=team["bearer"])
+    sign_in(page, url, "rita")
+    page.goto(f"{url}/#/shoots")
+    page.wait_for_selector("main[data-ready='1'] #shoot-list", timeout=60_000)
+    assert "Day 2" in page.inner_text("#shoot-list")
+    assert "null" not in page.inner_text("main")  # no stray text where the empty note would be
+    open_shoot(page, url, shoot.json()["id"])
+    page.set_input_files(
+        "#import-files", str(corpus_dir / "bvh/bandai/dataset-1_bow_not-confident_001.bvh")
+    )
+    page.wait_for_selector("#import-kept, #import-error", timeout=120_000)
+    assert page.query_selector("#import-error") is None, page.inner_text("#import-result")
+    assert "kept (1)" in page.inner_text("#import-kept")
+    context.close()
+    assert not errors, errors
+
+
 def test_rename_and_delete_a_shoot_with_the_keyboard(team: dict[str, Any], chromium: Any) -> None:
     url, shoot_id = team["url"], team["shoot"]["id"]
     ARTIFACTS.mkdir(exist_ok=True)
