@@ -57,7 +57,9 @@ export function limitsFigure(limits) {
     type: "heatmap", x: limits.frames, y: limits.joints, z: limits.score_deg,
     colorscale: [[0, "#f7f9fb"], [0.001, "#fde0c5"], [1, "#b30000"]], zmin: 0, zmax,
     colorbar: { title: { text: "outside (°)" }, thickness: 14, x: 1.01, xpad: 4 },
-    hovertemplate: "%{y} at frame %{x:.0f}: %{z:.1f}° outside<extra></extra>",
+    // The anatomical read-out of each flagged cell ("right knee hyperextended 14°"), when sent.
+    ...(limits.readout ? { customdata: limits.readout } : {}),
+    hovertemplate: `%{y} at frame %{x:.0f}: %{z:.1f}° outside${limits.readout ? "<br>%{customdata}" : ""}<extra></extra>`,
   }];
   const layout = { margin: MARGIN, xaxis: frameAxis(), yaxis: { automargin: false, tickfont: { size: 10 } } };
   return { data, layout };

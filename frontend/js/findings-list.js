@@ -59,7 +59,7 @@ export function findingsList(findings, decided, onOpen, initial = null, onFilter
     class: `clickable finding${f === current ? " current" : ""}`, "data-start": f.start_frame, "data-joint": f.joint, "data-kind": f.kind,
     "data-interval": f.kind === "twist" ? f.id : null, "aria-current": f === current ? "true" : null,
   },
-  h("td", {}, f.kind), h("td", {}, f.joint), h("td", {}, `${f.start_frame}–${f.end_frame}`), h("td", {}, f.end_frame - f.start_frame + 1),
+  h("td", {}, f.kind), h("td", {}, f.joint, f.readout ? h("div", { class: "muted readout" }, f.readout) : null), h("td", {}, `${f.start_frame}–${f.end_frame}`), h("td", {}, f.end_frame - f.start_frame + 1),
   h("td", {}, f.value == null ? "–" : `${fmt(f.value, 1)} ${unitOf(f)}`), h("td", {}, f.kind === "twist" ? `${fmt(100 * f.confidence, 0)} %` : fmt(f.confidence, 2)),
   decided.enabled ? decided.cell(f) : null), () => { mark(f); onOpen(f); });
 

@@ -69,6 +69,11 @@ def test_findings_grouped_by_joint_filtered_and_walked(
         if worst is not None:
             assert f"worst {worst:.1f}" in heads.nth(k).inner_text()
     assert len(rows(page)) == len(findings)
+    # Each limits finding shows its anatomical read-out under the joint ("… over-inverted 136°").
+    readouts = [f["readout"] for f in findings if f["kind"] == "limits" and f.get("readout")]
+    assert readouts
+    shown = p.locator("#findings tr.finding .readout").all_inner_texts()
+    assert sorted(shown) == sorted(readouts)
     p.locator("#findings-panel").scroll_into_view_if_needed()
     shot(page, "findings-grouped")
 
