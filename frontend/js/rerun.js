@@ -11,7 +11,34 @@ const SHOWN_PARAMS = 4; // filter parameters shown before "more parameters"
 
 const unitText = (unit) => (unit ? h("span", { class: "unit" }, unit) : null);
 
-export function rerunPanel(take, run, filters, described) {
+// The rig's roles named by hand (the `mapping` run option, BVH takes): one list of the take's
+// joints per role, "automatic" keeping what the rig tables found. Choosing or focusing a joint
+// selects it in the 3D views (`onJoint`), so the role can be checked on the skeleton.
+function rolesGroup(roleKeys, joints, summary, mapping, onJoint) {
+  const found = summary.roles || {};
+  const missing = new Set(summary.missing_roles || []);
+  const selects = {};
+  const rows = roleKeys.map((role) => {
+    const automatic = found[role] && !(role in mapping) ? `automatic (${found[role]})` : missing.has(role) ? "automatic (not found)" : "automatic";
+    const select = h("select", { id: `mapping-${role}`, "data-role": role },
+      h("option", { value: "" }, automatic), joints.map((j) => h("option", { value: j, selected: mapping[role] === j }, j)));
+    const show = () => onJoint(select.value || found[role] || null);
+    select.addEventListener("change", show);
+    select.addEventListener("focus", show);
+    selects[role] = select;
+    return h("label", { class: "option-field" + (missing.has(role) ? " missing-role" : "") }, h("span", { class: "option-name" }, role.replace(/_/g, " ")), select);
+  });
+  const note = missing.size
+    ? h("p", { class: "error", id: "roles-missing" }, `Roles not found, their checks skipped: ${[...missing].join(", ")}. Pick their joints below.`)
+    : h("p", { class: "muted" }, "Every role was found; pick a joint to override one.");
+  const box = h("details", { class: "option-advanced", id: "options-roles", open: missing.size > 0 },
+    h("summary", {}, "Rig roles (mapping)"),
+    h("fieldset", { class: "option-group", "data-group": "roles" }, note, h("div", { class: "option-fields" }, rows)));
+  const chosen = () => Object.fromEntries(Object.entries(selects).filter(([, s]) => s.value).map(([role, s]) => [role, s.value]));
+  return { box, chosen };
+}
+
+export function rerunPanel(take, run, filters, described, context = {}) {
   const target = take.kind === "motion" ? "rotations" : "keypoints";
   const usable = filters.filter((f) => f.applies_to.includes(target));
   const available = checksFor(take.kind).filter((c) => described.checks.includes(c));
@@ -72,6 +99,10 @@ export function rerunPanel(take, run, filters, described) {
     return g.advanced ? h("details", { class: "option-advanced", id: `options-${g.name}` }, h("summary", {}, g.label), set) : set;
   };
   const groups = described.groups.map(group);
+  const joints = (take.reading && take.reading.joints) || [];
+  const roles = take.kind === "motion" && context.summary && joints.length && described.role_keys
+    ? rolesGroup(described.role_keys, joints, context.summary, run.options.mapping || {}, context.onJoint || (() => {}))
+    : null;
 
   // Presets fill the form; every field stays editable.
   const presets = usablePresets(described.presets, available);
@@ -96,6 +127,7 @@ export function rerunPanel(take, run, filters, described) {
       twist_apply: take.kind === "motion" && inputs.twist_apply ? inputs.twist_apply.value : undefined,
       filter_method: method.value, filter_preset: preset.value, max_points: inputs.max_points ? inputs.max_points.value : "",
       params: paramInputs.map((input) => [paramFields.find((p) => p.name === input.dataset.param), input.value]),
+      mapping: roles ? roles.chosen() : undefined,
     };
     const built = formOptions(values, fields);
     if (built.errors) {
@@ -114,5 +146,5 @@ export function rerunPanel(take, run, filters, described) {
   } }, "re-run");
   return h("div", { class: "panel", id: "rerun-panel" }, h("h2", {}, "Re-run with other options (earlier runs are kept)"),
     h("div", { class: "controls" }, h("label", {}, "preset ", presetPick)),
-    h("div", { class: "option-groups" }, groups), h("div", { class: "controls" }, start, message));
+    h("div", { class: "option-groups" }, groups, roles ? roles.box : null), h("div", { class: "controls" }, start, message));
 }

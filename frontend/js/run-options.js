@@ -33,7 +33,8 @@ export function usablePresets(presets, available) {
  * The options of a new run from the form's values.
  *
  * @param values  {checks: [..], twist_method?, twist_apply?, filter_method, filter_preset,
- *                 max_points?: text, params: [[field, text], ...]} (field as the registry's)
+ *                 max_points?: text, params: [[field, text], ...], mapping?: {role: joint}}
+ *                 (field as the registry's; mapping: the roles named by hand, BVH takes)
  * @param fields  the run-option fields by name (for max_points' bounds)
  * @returns {options} or {errors: [message, ...]}
  */
@@ -49,6 +50,7 @@ export function formOptions(values, fields) {
     checks: values.checks,
     filter_method: values.filter_method || null, filter_preset: values.filter_preset || null, filter_params: filterParams,
   };
+  if (values.mapping && Object.keys(values.mapping).length) options.mapping = { ...values.mapping };
   if (values.twist_method) options.twist_method = values.twist_method;
   if (values.twist_apply) options.twist_apply = values.twist_apply;
   if (fields.max_points) {

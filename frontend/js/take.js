@@ -107,7 +107,9 @@ export async function takeView(main, takeId, params, onTeardown) {
   if (bridgedRuns) timebar.setGaps(bridgedRuns);
   const rerunSlot = h("div", {});
   main.append(help, list.panel, timelines, review, stepsPanel(result), downloadsPanel(run, result), rerunSlot);
-  formLists.then(([filters, described]) => rerunSlot.replaceWith(rerunPanel(take, run, filters, described)));
+  // The mapping editor selects the joint it names in the 3D views, as a click on the joint does.
+  const onJoint = (name) => { if (!jointIndex.has(name)) return; store.set({ joint: name }); focusCharts(); render(); remember(); };
+  formLists.then(([filters, described]) => rerunSlot.replaceWith(rerunPanel(take, run, filters, described, { summary: result.summary, onJoint })));
 
   // Frames: the overview (whole take, decimated) or, when paused, a full-rate window around.
   const pick = (source, f) => {

@@ -116,6 +116,9 @@ test("the re-run form checks values against their fields and builds the options"
     { checks: ["filter"], filter_method: "butterworth", filter_preset: null, filter_params: { cutoff_hz: 4 }, max_points: 500 });
   assert.deepEqual(form.formOptions({ ...values, checks: [], max_points: "5", params: [[order, "0"]] }, fields).errors,
     ["order: expected at least 1, got 0", "max_points: expected at least 10, got 5", "checks: tick at least one check"]);
+  // Roles named by hand go with the run as its mapping; none named, no mapping option.
+  assert.deepEqual(form.formOptions({ ...values, mapping: { left_forearm: "SegA" } }, fields).options.mapping, { left_forearm: "SegA" });
+  assert.equal("mapping" in form.formOptions({ ...values, mapping: {} }, fields).options, false);
   const presets = { full: { checks: ["twist", "limits", "filter"] }, twist: { checks: ["twist"] }, filter: { checks: ["filter"] } };
   assert.deepEqual(form.usablePresets(presets, ["filter"]).map(([n, o]) => [n, o.checks]), [["full", ["filter"]], ["filter", ["filter"]]]);
   assert.equal(form.paramLabel("kalman.process_noise"), "kalman · process noise");

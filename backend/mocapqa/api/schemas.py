@@ -188,11 +188,13 @@ class FilterInfo(BaseModel):
 
 
 class RunOptionsInfo(BaseModel):
-    """The run options for the UI form: fields grouped by check, and named presets."""
+    """The run options for the UI form: fields grouped by check, named presets, and the rig
+    role keys a ``mapping`` may name."""
 
     checks: list[str]
     groups: list[dict[str, Any]]
     presets: dict[str, dict[str, Any]]
+    role_keys: list[str]
 
 
 TakeDetailOut.model_rebuild()

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal, get_args
 
-from mocapqa.core.rig import normalise_mapping
+from mocapqa.core.rig import ROLE_KEYS, normalise_mapping
 from mocapqa.errors import InputError, OptionError
 from mocapqa.filters.apply import apply_overrides
 from mocapqa.filters.registry import FILTERS, DataScale
@@ -299,7 +299,8 @@ editable). The filter's own presets are the filter registry's."""
 
 def describe_options() -> dict[str, Any]:
     """The run options for a form: fields grouped by check, with types, units, choices, bounds,
-    defaults and the check each field belongs to, and :data:`RUN_PRESETS` as JSON options.
+    defaults and the check each field belongs to, :data:`RUN_PRESETS` as JSON options, and the
+    role keys a ``mapping`` may name (:data:`mocapqa.core.rig.ROLE_KEYS`).
 
     Derived from :class:`AnalysisOptions` and the constants above, so a form offers exactly
     what ``from_json`` accepts. Filter parameters come from the filter registry
@@ -382,4 +383,6 @@ def describe_options() -> dict[str, Any]:
         "checks": list(CHECKS),
         "groups": groups,
         "presets": {name: options.to_json() for name, options in RUN_PRESETS.items()},
+        # The rig roles a ``mapping`` may name (BVH takes), in the rig module's order.
+        "role_keys": list(ROLE_KEYS),
     }
