@@ -108,6 +108,8 @@ def test_keypoint_take_is_filtered_and_downloads_read_back(
         ("broken.bvh", b"HIERARCHY\nROOT Hips\n{\n", 422, "line"),
         ("empty.bvh", b"", 422, "non-empty"),
         ("picture.png", b"\x89PNG\r\n\x1a\n0000", 415, "Expected one of"),
+        # The error names the file as the user sent it, not the server's temporary copy.
+        ("notes.txt", b"hello", 415, "unrecognised file 'notes.txt'"),
         ("numbers.trc", b"PathFileType\t4\t(X/Y/Z)\tx.trc\nnonsense\n", 422, ""),
     ],
 )

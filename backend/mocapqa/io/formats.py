@@ -143,13 +143,16 @@ def _sniff(path: Path) -> str | None:
     return None
 
 
-def detect_format(path: str | Path) -> str:
+def detect_format(path: str | Path, display_name: str | None = None) -> str:
     """Name the format of a take file or folder.
 
     Parameters
     ----------
     path : str or Path
         A file, or a folder of OpenPose JSON frames.
+    display_name : str, optional
+        The name the user knows the file by, for the error (an upload is read from a
+        temporary file); the path's own name when omitted.
 
     Returns
     -------
@@ -185,7 +188,7 @@ def detect_format(path: str | Path) -> str:
     if found is None:
         raise UnsupportedFormatError(
             f"Expected one of {', '.join(TAKE_FORMATS)} (by extension or content), "
-            f"got an unrecognised file {path.name!r}"
+            f"got an unrecognised file {display_name or path.name!r}"
         )
     return found
 

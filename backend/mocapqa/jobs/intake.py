@@ -148,7 +148,7 @@ def ingest_take(
                 out.write(chunk)
         if size == 0:
             raise ParseError("Expected a non-empty file, got 0 bytes", file_name)
-        format_name = detect_take_format(incoming)
+        format_name = detect_take_format(incoming, file_name)
         try:
             take = read_take_file(incoming, format_name, file_name, read, limits)
         except MocapQAError:

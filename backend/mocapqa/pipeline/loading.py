@@ -118,16 +118,16 @@ def reading_facts(take: Motion | KeypointSequence, read: ReadOptions) -> dict[st
     return facts
 
 
-def detect_take_format(path: Path) -> str:
+def detect_take_format(path: Path, display_name: str | None = None) -> str:
     """The format name of a take file (``"bvh"``, ``"trc"``, ``"csv"``, ...), by extension
-    or content.
+    or content; ``display_name`` names the file in the error (an upload's own name).
 
     Raises
     ------
     UnsupportedFormatError
         When no reader recognises the file.
     """
-    return detect_format(path)
+    return detect_format(path, display_name)
 
 
 def read_take_file(
