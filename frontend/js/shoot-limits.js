@@ -31,8 +31,13 @@ export function rerunNote(answer) {
 /** Whether `me` (GET /me) may choose a shoot's limits model. */
 export const mayChooseModel = (me) => new Set((me && me.can) || []).has("choose_limits_model");
 
-/** The panel: the model's name, and for an admin a picker that saves on change. */
-export async function limitsModelPanel(shoot, me) {
+// The picker saves the choice it settles on: arrow keys move through the models one change
+// event at a time, so a save waits this long after the last one (and the list keeps the focus).
+const SAVE_DELAY_MS = 500;
+
+/** The panel: the model's name, and for an admin a picker that saves the settled choice and a
+ * button that runs the stale takes again (`onQueued()` after runs were queued). */
+export async function limitsModelPanel(shoot, me, onQueued = () => {}) {
   const panel = h("div", { class: "controls", id: "limits-model-panel" });
   const label = h("span", {}, "joint-limits model ");
   const stale = h("span", { id: "limits-model-stale", class: "muted" }, staleNote(shoot));
@@ -50,9 +55,10 @@ export async function limitsModelPanel(shoot, me) {
   const message = h("span", { id: "limits-model-message", class: "muted", role: "status" });
   const select = h("select", { id: "limits-model", "aria-label": "joint-limits model of this shoot" },
     models.map((m) => h("option", { value: m.name, selected: m.name === shoot.limits_model }, modelLabel(m))));
-  select.addEventListener("change", async () => {
+  let pending = null;
+  const save = async () => {
     const chosen = select.value;
-    select.disabled = true;
+    if (chosen === shoot.limits_model) { message.className = "muted"; message.textContent = ""; return; }
     try {
       const saved = await api.setShootLimitsModel(shoot.id, chosen);
       shoot.limits_model = saved.limits_model;
@@ -64,7 +70,13 @@ export async function limitsModelPanel(shoot, me) {
       select.value = shoot.limits_model;
       message.className = "error";
       message.textContent = error.message;
-    } finally { select.disabled = false; }
+    }
+  };
+  select.addEventListener("change", () => {
+    clearTimeout(pending);
+    message.className = "muted";
+    message.textContent = "saving…";
+    pending = setTimeout(save, SAVE_DELAY_MS);
   });
   rerun.addEventListener("click", async () => {
     rerun.disabled = true;
@@ -74,6 +86,7 @@ export async function limitsModelPanel(shoot, me) {
       showStale();
       message.className = "muted";
       message.textContent = rerunNote(answer);
+      if (answer.queued.length) onQueued();
     } catch (error) {
       message.className = "error";
       message.textContent = error.message;

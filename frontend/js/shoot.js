@@ -198,11 +198,12 @@ function takeTable(page, state, apply) {
 export async function shootView(main, shootId, params, onTeardown) {
   let state = tableState(params);
   const [shoot, who] = await Promise.all([api.getShoot(shootId), me().catch(() => null)]);
-  const modelPanel = await limitsModelPanel(shoot, who);
+  // Runs queued from the model panel show their progress and redraw the table as they finish.
+  const modelPanel = await limitsModelPanel(shoot, who, () => restartPolling());
   const title = h("span", { id: "shoot-title" }, shoot.name);
   const progressBar = h("progress", { id: "shoot-progress", max: 1, value: 0 });
   const progressText = h("span", { id: "shoot-progress-text" });
-  const tableBox = h("div", {});
+  const tableBox = h("div", { id: "take-table-box" });
   const tableArea = h("div", { id: "shoot-table-area" });
   const heatmap = h("div", { id: "shoot-heatmap", class: "panel" });
   let timer = null;
@@ -305,6 +306,7 @@ export async function shootView(main, shootId, params, onTeardown) {
       await Promise.all([drawTable(), drawHeatmap()]);
     }
   };
+  const restartPolling = () => { clearTimeout(timer); wasRunning = true; poll().catch(showError); };
   const progressPanel = h("div", { class: "panel", id: "progress-panel" }, "analysis ", progressBar, " ", progressText);
 
   main.replaceChildren(
@@ -315,7 +317,7 @@ export async function shootView(main, shootId, params, onTeardown) {
       h("a", { class: "download", id: "export-json", href: api.summaryUrl(shootId, "json"), download: "" }, "summary JSON"),
       manageControls(shoot, who, (renamed) => { title.textContent = renamed.name; })),
     modelPanel,
-    importPanel(shootId, () => { clearTimeout(timer); wasRunning = true; poll().catch(showError); }),
+    importPanel(shootId, restartPolling),
     progressPanel,
     tableArea, heatmap);
   tableArea.replaceChildren(filterBar(state, apply), tableBox);

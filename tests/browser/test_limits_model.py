@@ -87,8 +87,23 @@ def test_admin_picks_the_model_a_shoot_uses(studio: dict[str, Any], chromium: An
     assert offered[0] == "default"
     assert {"canonical", "bandai", "character_creator", "cmu", "walks"} <= set(offered)
     assert page.input_value("#limits-model") == "default"
-    page.select_option("#limits-model", "walks")
+    # From the keyboard: each arrow key moves the choice, the list keeps the focus, and only
+    # the choice it settles on is saved (no save of the models passed over).
+    page.focus("#limits-model")
+    page.keyboard.press("ArrowDown")
+    page.keyboard.press("ArrowDown")
+    assert page.evaluate("() => document.activeElement.id") == "limits-model"
+    settled = page.input_value("#limits-model")
+    assert settled == offered[2]
     page.wait_for_selector("#limits-model-message:has-text('saved')", timeout=30_000)
+    assert page.evaluate("() => document.activeElement.id") == "limits-model"
+    assert settled in page.inner_text("#limits-model-message")
+    assert offered[1] not in page.inner_text("#limits-model-message")
+    page.select_option("#limits-model", "walks")
+    page.wait_for_selector(
+        "#limits-model-message:has-text('saved: runs started from now on use walks')",
+        timeout=30_000,
+    )
     assert "walks" in page.inner_text("#limits-model-message")
     page.screenshot(path=str(ARTIFACTS / "shoot-limits-model.png"))
     shoot = httpx.get(f"{url}/api/v1/shoots/{shoot_id}", headers=bearer).json()
@@ -101,6 +116,11 @@ def test_admin_picks_the_model_a_shoot_uses(studio: dict[str, Any], chromium: An
     )
     first = _poll(url, studio["take"]["run_id"], bearer)
     assert first["options"]["limits_model"] == "default"
+    # The take table is drawn again once the queued run has finished (the page polls again).
+    page.evaluate(
+        """() => { window.tableDraws = 0; new MutationObserver(() => { window.tableDraws += 1; })
+                   .observe(document.getElementById('take-table-box'), { childList: true }); }"""
+    )
     page.click("#limits-rerun")
     page.wait_for_selector("#limits-model-message:has-text('queued')", timeout=60_000)
     assert page.inner_text("#limits-model-message") == "1 run queued with walks"
@@ -112,6 +132,7 @@ def test_admin_picks_the_model_a_shoot_uses(studio: dict[str, Any], chromium: An
     second = _poll(url, again["id"], bearer)
     assert second["status"] == "done", second
     assert second["options"]["limits_model"] == "walks"
+    page.wait_for_function("() => window.tableDraws > 0", timeout=30_000)
     assert (
         httpx.get(f"{url}/api/v1/shoots/{shoot_id}", headers=bearer).json()["limits_stale_takes"]
         == 0
