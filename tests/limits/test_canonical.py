@@ -16,7 +16,7 @@ from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.kinematics.quaternion import conjugate, geodesic_angle, multiply, rotate
 from mocapqa.limits.analysis import LimitsReport, check_limits
 from mocapqa.limits.build import BuildParams, build_canonical_model, with_rig_frames
-from mocapqa.limits.canonical import CANONICAL_AXIS, rig_frames, rig_key
+from mocapqa.limits.canonical import CANONICAL_AXIS, frame_needs, rig_frames, rig_key
 from mocapqa.limits.charting import canonical_quats
 from mocapqa.limits.expmap import expmap_from_quats
 from mocapqa.limits.model import LimitsModel
@@ -225,3 +225,20 @@ def quat_about(motion: Motion, joint: int, degrees: float) -> np.ndarray:
     axis = motion.skeleton.offsets[child] / np.linalg.norm(motion.skeleton.offsets[child])
     half = np.deg2rad(degrees) / 2
     return np.r_[np.sin(half) * axis, np.cos(half)]
+
+
+def test_a_role_whose_frame_needs_a_missing_role_is_not_checked(cmu: Motion) -> None:
+    # The forearms and lower legs renamed beyond any role table: a hand would be read against
+    # the body frame instead of its forearm, an upper arm without its limb plane; both would
+    # flag a clean walk. They are listed as not checked instead; the clavicles stay checked.
+    renamed = rerig(cmu, seed=0, renames={"LeftForeArm": "SegA", "RightForeArm": "SegB",
+                                          "LeftLeg": "SegC", "RightLeg": "SegD"})  # fmt: skip
+    report = check_limits(renamed)
+    assert report.roles == ("left_clavicle", "right_clavicle")
+    for side in ("left", "right"):
+        for role in ("upper_arm", "forearm", "hand", "upper_leg", "lower_leg", "foot"):
+            assert f"{side}_{role}" in report.not_checked
+    assert report.flagged_fraction == 0.0
+    assert frame_needs("hand") == ("forearm",)
+    assert frame_needs("upper_arm") == ("clavicle", "forearm")
+    assert frame_needs("upper_leg") == ("lower_leg",)

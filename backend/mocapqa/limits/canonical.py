@@ -76,6 +76,18 @@ _PARENT_ROLE = {
     "lower_leg": "upper_leg",
     "foot": "lower_leg",
 }
+# Roles whose limb plane gives a proximal segment's flexion axis.
+_PLANE_ROLE = {"upper_arm": "forearm", "upper_leg": "lower_leg"}
+
+
+def frame_needs(role: str) -> tuple[str, ...]:
+    """The roles a role's canonical frame is measured with: its parent role (else the rotation
+    would be read against the body frame, which the model's role was not) and, for an upper
+    arm or upper leg, the next segment that gives its flexion axis. Without them the role is
+    not checked (a hand read against the body, not the forearm, reads as 100° out)."""
+    return tuple(r for r in (_PARENT_ROLE.get(role), _PLANE_ROLE.get(role)) if r is not None)
+
+
 _DISTAL_ROLE = {
     "clavicle": "upper_arm",
     "upper_arm": "forearm",
@@ -120,7 +132,8 @@ class CanonicalFrames:
     parent_frames : ndarray, shape (R, 4)
         The same for the parents (the body frame for a clavicle / upper leg).
     not_checked : tuple of str
-        Modelled role keys absent from the skeleton.
+        Modelled role keys absent from the skeleton, or whose frame needs one that is
+        (:func:`frame_needs`).
     """
 
     roles: tuple[str, ...]
@@ -251,7 +264,10 @@ def canonical_frames(
     """
     skeleton = motion if isinstance(motion, Skeleton) else motion.skeleton
     rig = find_roles(skeleton) if rig is None else rig
-    keys = [(s, r) for s in SIDES for r in MODELLED_ROLES if rig.joint(s, r) is not None]
+    keys = [
+        (s, r) for s in SIDES for r in MODELLED_ROLES
+        if rig.joint(s, r) is not None and all(rig.joint(s, n) is not None for n in frame_needs(r))  # type: ignore[arg-type]
+    ]  # fmt: skip
     if not keys:
         raise InputError(
             f"Expected a skeleton with limb roles, got none among {skeleton.names[:8]}"
@@ -340,9 +356,7 @@ def canonical_frames(
         roles.append(role_key(side, role))
         joints.append(joint)
         parents.append(parent)
-    missing = tuple(
-        role_key(s, r) for s in SIDES for r in MODELLED_ROLES if rig.joint(s, r) is None
-    )
+    missing = tuple(role_key(s, r) for s in SIDES for r in MODELLED_ROLES if (s, r) not in keys)
     return CanonicalFrames(
         roles=tuple(roles),
         joints=np.asarray(joints, dtype=np.intp),
