@@ -340,7 +340,9 @@ def test_options_form_grouped_with_units_presets_and_checks(
     groups = panel.locator("fieldset.option-group").evaluate_all(
         "fs => fs.map(f => f.dataset.group)"
     )
-    assert groups == ["twist", "limits", "filter", "advanced"]
+    # A BVH take also has its rig roles (the mapping), folded when every role was found.
+    assert groups == ["twist", "limits", "filter", "advanced", "roles"]
+    assert p.locator("#options-roles").get_attribute("open") is None
     # Every numeric field carries its unit: the advanced one, and the filter's parameters.
     p.click("#options-advanced summary")
     assert "samples" in p.inner_text("#options-advanced")
