@@ -96,6 +96,19 @@ def test_reviewer_reviews_viewer_cannot(team_server: tuple[str, str], chromium: 
     assert "rita" in page.inner_text("#review-history")
     assert not page.is_visible("#review-save")
     assert not page.is_visible("#rerun")
+    # Nor the accept / reject buttons of twist intervals (this walk has none: one is made here
+    # in a findings table, to check the rule that hides it for this role).
+    hidden = page.evaluate(
+        """() => {
+          const made = Object.assign(document.createElement('table'), { id: 'findings' });
+          const table = document.querySelector('#findings')
+            || document.querySelector('main').appendChild(made);
+          const row = table.appendChild(document.createElement('tbody')).insertRow();
+          const button = row.insertCell().appendChild(document.createElement('button'));
+          row.cells[0].className = 'decision';
+          return getComputedStyle(button).display; }"""
+    )
+    assert hidden == "none"
     status = page.evaluate(
         """async (id) => {
           const csrf = document.cookie.match(/mocapqa_csrf=([^;]*)/)[1];
