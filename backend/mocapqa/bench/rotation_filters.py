@@ -19,12 +19,12 @@ import numpy as np
 from mocapqa.bench.filters import Row, Take
 from mocapqa.bench.noise import rotation_noise
 from mocapqa.core.arrays import FloatArray
-from mocapqa.core.bindpose import leading_bind_pose
 from mocapqa.filters.apply import filter_motion
 from mocapqa.filters.butterworth import ButterworthParams, butterworth_quats
 from mocapqa.filters.euler_pd import axis_angle_pd_filter, euler_pd_filter
 from mocapqa.filters.quat_one_euro import QuatOneEuroParams, quat_one_euro_filter
 from mocapqa.filters.quat_pd import QuatPDParams, quat_pd_filter
+from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.kinematics.forward import world_from_local
 from mocapqa.kinematics.quaternion import geodesic_angle
 from mocapqa.metrics.smoothness import acceleration_error, mean_distance

@@ -50,12 +50,12 @@ def motion_summary(
     dict
         Frames, fps, duration (s), joints, length unit, rotation orders (order → joint
         count), root translation mode and why, leading bind-pose frames (0 or 1, see
-        :func:`mocapqa.core.bindpose.leading_bind_pose`), roles found (role key → joint name),
+        :func:`mocapqa.kinematics.bindpose.leading_bind_pose`), roles found (role key → joint name),
         roles not mapped, and limb chains (``"left upper_arm: A > B > C"``).
     """
-    from mocapqa.core.bindpose import leading_bind_pose
     from mocapqa.core.rig import find_roles, limb_chains
     from mocapqa.io.bvh_root import explain_root_translation
+    from mocapqa.kinematics.bindpose import leading_bind_pose
 
     sk = motion.skeleton
     rig = find_roles(sk, mapping)

@@ -20,7 +20,6 @@ from typing import Any
 import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray
-from mocapqa.core.bindpose import leading_bind_pose
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
@@ -33,6 +32,7 @@ from mocapqa.filters.one_euro import OneEuroParams, one_euro_filter
 from mocapqa.filters.quat_one_euro import quat_one_euro_filter
 from mocapqa.filters.quat_pd import quat_pd_filter
 from mocapqa.filters.registry import FILTERS, NOTE_METRES_PER_UNIT, DataScale
+from mocapqa.kinematics.bindpose import leading_bind_pose
 
 __all__ = [
     "ASSUMED_BODY_HEIGHT_M",

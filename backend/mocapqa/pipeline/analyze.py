@@ -24,12 +24,12 @@ import numpy as np
 
 from mocapqa import __version__
 from mocapqa.core.arrays import BoolArray, FloatArray
-from mocapqa.core.bindpose import leading_bind_pose
 from mocapqa.core.decimate import peak_frames
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles
 from mocapqa.errors import InputError
+from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
 from mocapqa.pipeline.frames import motion_pose
 from mocapqa.pipeline.loading import Take

@@ -17,13 +17,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-from mocapqa.core.bindpose import leading_bind_pose
 from mocapqa.core.keypoints import LENGTH_UNITS, KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError, ParseError, TooLargeError
 from mocapqa.io.bvh_root import ROOT_TRANSLATIONS, explain_root_translation
 from mocapqa.io.formats import detect_format, read_take, write_keypoints
 from mocapqa.io.guards import ReadLimits
+from mocapqa.kinematics.bindpose import leading_bind_pose
 
 __all__ = [
     "READING_FILE",
@@ -101,7 +101,7 @@ def reading_facts(take: Motion | KeypointSequence, read: ReadOptions) -> dict[st
         ``read_options`` (as chosen), ``fps``, ``length_unit`` and, for keypoints,
         ``assumptions`` (frame rate, unit, layout or frame numbers the file did not state);
         for a BVH, ``root_translation``, ``root_translation_reason``, ``bind_pose_frames``
-        (:func:`mocapqa.core.bindpose.leading_bind_pose`) and ``joints`` (the joint names, by
+        (:func:`mocapqa.kinematics.bindpose.leading_bind_pose`) and ``joints`` (the joint names, by
         which a run's ``mapping`` option is checked before it is queued).
     """
     facts: dict[str, Any] = {"read_options": read.to_json(), "fps": take.fps}

@@ -14,11 +14,11 @@ from typing import Any, Literal, get_args
 import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
-from mocapqa.core.bindpose import leading_bind_pose
 from mocapqa.core.decimate import peak_frames
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.errors import InputError
+from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.kinematics.euler import euler_from_quats
 from mocapqa.twist.angles import (
     ChainGeometry,

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from mocapqa.core.bindpose import leading_bind_pose
 from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.filters.apply import filter_motion
 from mocapqa.io.bvh import read_bvh
+from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.twist.analysis import detect_chains
 from mocapqa.twist.angles import chain_geometry
 

@@ -20,32 +20,15 @@ from __future__ import annotations
 import numpy as np
 
 from mocapqa.core.arrays import FloatArray
+from mocapqa.kinematics.quaternion import geodesic_angle
 
-__all__ = ["BIND_POSE_RATIO", "MIN_BIND_STEP_DEG", "leading_bind_pose", "step_angles_deg"]
+__all__ = ["BIND_POSE_RATIO", "MIN_BIND_STEP_DEG", "leading_bind_pose"]
 
 BIND_POSE_RATIO = 3.0
 """The step into frame 1 over the largest later step above which frame 0 is a bind pose."""
 
 MIN_BIND_STEP_DEG = 1.0
 """Smallest median step into frame 1 that can be a bind pose, degrees (a still take is not)."""
-
-
-def step_angles_deg(quats: FloatArray) -> FloatArray:
-    """Rotation angle between consecutive local rotations of every joint.
-
-    Parameters
-    ----------
-    quats : ndarray, shape (F, J, 4)
-        Unit quaternions (either sign convention: ``q`` and ``−q`` are the same rotation).
-
-    Returns
-    -------
-    ndarray, shape (F − 1, J)
-        Degrees, in [0, 180].
-    """
-    dots = np.abs(np.sum(quats[1:] * quats[:-1], axis=-1)).clip(0.0, 1.0)
-    angles: FloatArray = np.rad2deg(2.0 * np.arccos(dots))
-    return angles
 
 
 def leading_bind_pose(quats: FloatArray) -> int:
@@ -65,7 +48,7 @@ def leading_bind_pose(quats: FloatArray) -> int:
     """
     if quats.shape[0] < 3 or quats.shape[1] == 0:
         return 0
-    steps = step_angles_deg(quats)
+    steps = np.rad2deg(geodesic_angle(quats[:-1], quats[1:]))  # (F − 1, J)
     moving = steps.max(axis=0) > 1e-4
     if not moving.any():
         return 0
