@@ -30,10 +30,13 @@ export function twistFigure(twist) {
   twist.chains.forEach((chain, k) => {
     const visible = affected.size === 0 ? (k < 2 ? true : "legendonly") : (affected.has(chain.joint) ? true : "legendonly");
     const color = colors.get(chain.joint);
-    data.push({ type: "scatter", mode: "lines", x: frames, y: chain.theta_p_deg, name: `${chain.joint} θP`, legendgroup: chain.joint,
-      line: { color, width: 1.2 }, visible, hovertemplate: "frame %{x}: %{y:.1f}°" });
+    // One legend entry per chain (its name toggles both of its lines): a 100-joint rig has ten
+    // chains, and two entries each filled more of a narrow window than the plot did.
+    data.push({ type: "scatter", mode: "lines", x: frames, y: chain.theta_p_deg, name: chain.joint, legendgroup: chain.joint,
+      line: { color, width: 1.2 }, visible, hovertemplate: `${chain.joint} θP, frame %{x}: %{y:.1f}°<extra></extra>` });
     data.push({ type: "scatter", mode: "lines", x: frames, y: chain.offset_deg, name: `${chain.joint} offset`, legendgroup: chain.joint,
-      yaxis: "y2", line: { color, width: 1.6, dash: "dash" }, visible, hovertemplate: "frame %{x}: %{y:.1f}°" });
+      showlegend: false, yaxis: "y2", line: { color, width: 1.6, dash: "dash" }, visible,
+      hovertemplate: `${chain.joint} removed offset, frame %{x}: %{y:.1f}°<extra></extra>` });
   });
   // One band trace per chain, in that chain's colour.
   for (const joint of affected) {
@@ -43,9 +46,11 @@ export function twistFigure(twist) {
   const layout = {
     margin: MARGIN, barmode: "overlay", hovermode: "x",
     xaxis: { ...frameAxis(), anchor: "y2" },
-    yaxis: { domain: [0.52, 1], title: { text: "twist θP (°)" }, range: [-185, 185] },
-    yaxis2: { domain: [0, 0.45], title: { text: "removed offset (°)" } },
-    legend: { orientation: "h", y: -0.25 },
+    // Short axis titles: two long ones overlapped each other beside half-height panels.
+    yaxis: { domain: [0.52, 1], title: { text: "θP (°)" }, range: [-185, 185] },
+    yaxis2: { domain: [0, 0.45], title: { text: "offset (°)" } },
+    legend: { orientation: "h", y: -0.3, yanchor: "top", font: { size: 11 },
+      title: { text: "solid: twist θP · dashed: removed offset", side: "top" } },
   };
   return { data, layout };
 }
@@ -56,7 +61,8 @@ export function limitsFigure(limits) {
   const data = [{
     type: "heatmap", x: limits.frames, y: limits.joints, z: limits.score_deg,
     colorscale: [[0, "#f7f9fb"], [0.001, "#fde0c5"], [1, "#b30000"]], zmin: 0, zmax,
-    colorbar: { title: { text: "outside (°)" }, thickness: 14, x: 1.01, xpad: 4 },
+    // The title runs along the bar: on top it sat under the chart's toolbar.
+    colorbar: { title: { text: "outside (°)", side: "right" }, thickness: 14, x: 1.01, xpad: 4 },
     // The anatomical read-out of each flagged cell ("right knee hyperextended 14°"), when sent.
     ...(limits.readout ? { customdata: limits.readout } : {}),
     hovertemplate: `%{y} at frame %{x:.0f}: %{z:.1f}° outside${limits.readout ? "<br>%{customdata}" : ""}<extra></extra>`,

@@ -20,12 +20,14 @@ export function intervalDecisions(run, result) {
   const history = h("ul", { id: "decision-history" });
   const byId = new Map((twist ? twist.intervals : []).map((i) => [i.id, i]));
 
-  const showHistory = (rows) => history.replaceChildren(...rows.map((r) => {
-    const i = byId.get(r.interval_id);
-    const where = i ? `${i.joint} ${i.start_frame}–${i.end_frame}` : "";
-    return h("li", {}, `${new Date(r.created_at).toLocaleString()} · ${r.reviewer}: `, badge(LABELS[r.decision], BADGE[r.decision]),
-      ` interval ${r.interval_id} ${where}`, r.note ? ` — ${r.note}` : "");
-  }));
+  // An interval is named as its findings row shows it (joint and frames): the id is internal.
+  const label = (id) => {
+    const i = byId.get(id);
+    return i ? `${i.joint} frames ${i.start_frame}–${i.end_frame}` : `interval ${id}`;
+  };
+  const showHistory = (rows) => history.replaceChildren(...rows.map((r) =>
+    h("li", {}, `${new Date(r.created_at).toLocaleString()} · ${r.reviewer}: `, badge(LABELS[r.decision], BADGE[r.decision]),
+      ` ${label(r.interval_id)}`, r.note ? ` — ${r.note}` : "")));
 
   const fill = (id) => {
     const cell = cells.get(id);
@@ -54,7 +56,7 @@ export function intervalDecisions(run, result) {
       const reviewer = localStorage.getItem("mocapqa-reviewer") || "anonymous";
       await api.addDecision(run.id, id, { decision, note: note.value, reviewer });
       note.value = "";
-      message.textContent = `interval ${id} ${LABELS[decision]}`; message.className = "muted";
+      message.textContent = `${label(id)} ${LABELS[decision]}`; message.className = "muted";
       showHistory((await api.getDecisions(run.id)).history);
     } catch (e) {
       if (before) latest.set(id, before); else latest.delete(id);

@@ -57,7 +57,13 @@ def test_accept_and_reject_intervals_persist_and_the_download_has_them(
     assert "rejected" in decision_of(page, second)
     p.wait_for_function("() => document.querySelectorAll('#decision-history li').length === 2")
     history = p.inner_text("#decision-history")
-    assert f"interval {second}" in history.splitlines()[0]
+    # Named as its findings row shows it (joint and frames), not by the internal id.
+    shown = twist[second]
+    assert (
+        f"{shown['joint']} frames {shown['start_frame']}–{shown['end_frame']}"
+        in history.splitlines()[0]
+    )
+    assert f"interval {second}" not in history
     assert "rejected" in history.splitlines()[0]
     p.locator("#findings").scroll_into_view_if_needed()
     ARTIFACTS.mkdir(exist_ok=True)

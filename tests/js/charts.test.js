@@ -1,7 +1,7 @@
-// The limits heat map shows each flagged cell's anatomical read-out on hover (node --test).
+// Figure builders of the take view's charts (node --test): the limits heat map's hover, the twist legend.
 import assert from "node:assert/strict";
 import { test } from "node:test";
-import { limitsFigure } from "../../frontend/js/charts.js";
+import { limitsFigure, twistFigure } from "../../frontend/js/charts.js";
 
 const series = {
   joints: ["right_lower_leg", "left_hand"], frames: [0, 10],
@@ -22,4 +22,23 @@ test("a series without read-outs (an older run) hovers with the degrees only", (
   const [trace] = limitsFigure(older).data;
   assert.equal(trace.customdata, undefined);
   assert.doesNotMatch(trace.hovertemplate, /customdata/);
+});
+
+test("the twist chart lists each chain once in its legend; its name toggles both lines", () => {
+  const twist = {
+    frames: [0, 1, 2],
+    chains: ["L_Calf", "R_Calf", "L_Thigh"].map((joint) => ({ joint, theta_p_deg: [0, 1, 2], offset_deg: [0, 0, 0] })),
+    intervals: [{ joint: "R_Calf", start_frame: 1, end_frame: 1 }],
+  };
+  const { data, layout } = twistFigure(twist);
+  const listed = data.filter((t) => t.type === "scatter" && t.showlegend !== false).map((t) => t.name);
+  assert.deepEqual(listed, ["L_Calf", "R_Calf", "L_Thigh"]);
+  for (const joint of listed) {
+    const lines = data.filter((t) => t.type === "scatter" && t.legendgroup === joint);
+    assert.equal(lines.length, 2);
+    assert.equal(new Set(lines.map((t) => t.visible)).size, 1); // shown or hidden together
+  }
+  // Only the chain with a flagged interval is drawn at first.
+  assert.deepEqual(data.filter((t) => t.visible === true).map((t) => t.legendgroup), ["R_Calf", "R_Calf"]);
+  assert.match(layout.legend.title.text, /solid.*dashed/);
 });
