@@ -87,3 +87,26 @@ def test_accept_and_reject_intervals_persist_and_the_download_has_them(
     assert served == expected.content
     corrected = httpx.get(f"{live_server}/api/v1/runs/{knees['run']}/download/bvh", timeout=60)
     assert served != corrected.content  # the decisions changed the run's own choice
+
+
+def test_limb_spins_are_listed_with_their_read_out_and_nothing_to_accept(
+    live_server: str, knees: dict[str, Any], page: Page
+) -> None:
+    """005_05's right leg flips and right arm spins show as findings of their own kind, with
+    a sentence saying they were not corrected, and no accept/reject buttons; the kind filter
+    hides them."""
+    p = page.page
+    page.open_take(live_server, knees)
+    spins = [f for f in knees["result"]["findings"] if f["kind"] == "spin"]
+    assert any(f["shape"] == "flip" for f in spins)
+    assert any(f["shape"] == "spin" for f in spins)
+    rows = p.locator("#findings tbody tr", has=p.locator("td:first-child", has_text="spin"))
+    assert rows.count() == len(spins)
+    first = rows.first.inner_text()
+    assert "about its axis" in first
+    assert "not corrected" in first
+    assert rows.first.locator("button").count() == 0
+    p.uncheck("#filter-kind-spin")
+    assert rows.count() == 0
+    p.check("#filter-kind-spin")
+    assert rows.count() == len(spins)

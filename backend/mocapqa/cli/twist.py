@@ -18,6 +18,7 @@ from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
 
 if TYPE_CHECKING:
     from mocapqa.twist.analysis import TwistAnalysis
+    from mocapqa.twist.spin import LimbSpin
 
 __all__ = ["bench_twist", "detect", "refine"]
 
@@ -28,7 +29,9 @@ _APPLY_HELP = (
 )
 
 
-def _report(analysis: TwistAnalysis, path: Path, missing: list[str]) -> dict[str, Any]:
+def _report(
+    analysis: TwistAnalysis, path: Path, missing: list[str], spins: list[LimbSpin]
+) -> dict[str, Any]:
     return {
         "input": str(path),
         "method": analysis.method,
@@ -38,6 +41,7 @@ def _report(analysis: TwistAnalysis, path: Path, missing: list[str]) -> dict[str
         "fps": analysis.fps,
         "intervals": [i.to_json() for i in analysis.intervals],
         "joints": analysis.summaries(),
+        "spins": [spin.to_json() for spin in spins],
     }
 
 
@@ -69,6 +73,7 @@ def refine(
     from mocapqa.io.bvh_write import write_bvh
     from mocapqa.io.formats import require_frames
     from mocapqa.twist.analysis import analyze_twist
+    from mocapqa.twist.spin import find_limb_spins
 
     _check_method(method)
     roles = load_mapping(mapping)
@@ -76,9 +81,10 @@ def refine(
     require_frames(motion, input_path)
     missing = missing_roles(motion.skeleton, roles)
     analysis = analyze_twist(motion, method, roles, apply=apply)
+    spins = find_limb_spins(motion, mapping=roles)
     write_bvh(output, analysis.refined)
     if report is not None:
-        text = json.dumps(_report(analysis, input_path, missing), indent=2)
+        text = json.dumps(_report(analysis, input_path, missing, spins), indent=2)
         report.write_text(text, encoding="utf-8")
     console = Console(highlight=False)
     applied = [i for i in analysis.intervals if i.applied]
@@ -87,6 +93,8 @@ def refine(
         f"{len(applied)} of {len(analysis.intervals)} intervals applied ({frames} joint frames) "
         f"→ {output}"
     )
+    for spin in spins:
+        console.print(f"frames {spin.start_frame}–{spin.end_frame}: {spin.readout()}")
 
 
 @app.command()
@@ -101,6 +109,7 @@ def detect(
     from mocapqa.io.bvh import read_bvh
     from mocapqa.io.formats import require_frames
     from mocapqa.twist.analysis import analyze_twist
+    from mocapqa.twist.spin import find_limb_spins
 
     _check_method(method)
     roles = load_mapping(mapping)
@@ -108,8 +117,9 @@ def detect(
     require_frames(motion, input_path)
     missing = missing_roles(motion.skeleton, roles)
     analysis = analyze_twist(motion, method, roles, apply=apply)
+    spins = find_limb_spins(motion, mapping=roles)
     if as_json:
-        typer.echo(json.dumps(_report(analysis, input_path, missing), indent=2))
+        typer.echo(json.dumps(_report(analysis, input_path, missing, spins), indent=2))
         return
     table = Table(title=f"Twist intervals ({method}) in {input_path.name}")
     for column in ("id", "joint", "start", "end", "offset °", "confidence", "applied"):
@@ -124,7 +134,19 @@ def detect(
             f"{i.confidence:.2f}",
             "yes" if i.applied else "no",
         )
-    Console(highlight=False).print(table)
+    console = Console(highlight=False)
+    console.print(table)
+    if spins:
+        spun = Table(title=f"Limb spins and flips in {input_path.name} (reported, not corrected)")
+        for column in ("limb", "shape", "start", "end", "roll °", "hand/foot °", "peak °/s"):
+            spun.add_column(column, justify="left" if column in ("limb", "shape") else "right")
+        for spin in spins:
+            spun.add_row(
+                f"{spin.side} {spin.limb} ({spin.joint})", spin.shape, str(spin.start_frame),
+                str(spin.end_frame), f"{spin.value_deg:.1f}", f"{spin.end_roll_deg:.1f}",
+                f"{spin.peak_rate_deg_s:,.0f}",
+            )  # fmt: skip
+        console.print(spun)
 
 
 def _default_corpus() -> Path:

@@ -34,6 +34,7 @@ from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
 from mocapqa.limits.model import LimitsModel
 from mocapqa.pipeline.options import ParamValue
 from mocapqa.twist.analysis import analyze_twist
+from mocapqa.twist.spin import LimbSpin, find_limb_spins
 
 __all__ = [
     "Plot",
@@ -132,10 +133,13 @@ def run_twist(
     ``mapping`` (role key → joint name) overrides the roles found on the rig; the message names
     the roles that were not found, whose chains are not checked. Every interval is a finding,
     with its calibrated confidence, its id (for ``apply``) and whether the corrected take has it
-    removed.
+    removed. Limb spins and flips (:func:`mocapqa.twist.spin.find_limb_spins`) are findings of
+    kind ``spin``, never applied.
     """
     analysis = analyze_twist(motion, method=method, mapping=mapping, apply=apply)
-    missing = find_roles(motion.skeleton, mapping).unmapped
+    rig = find_roles(motion.skeleton, mapping)
+    missing = rig.unmapped
+    spins = find_limb_spins(motion, rig)
     findings = [
         {
             "kind": "twist",
@@ -149,7 +153,7 @@ def run_twist(
             "applied": interval.applied,
         }
         for interval in analysis.intervals
-    ]
+    ] + [spin_finding(spin) for spin in spins]
     plot = Plot(
         analysis.plotted_deg(),
         analysis.step_frames(),
@@ -158,12 +162,29 @@ def run_twist(
     unchecked = f"; roles not found, not checked: {', '.join(missing)}" if missing else ""
     return StepOutcome(
         "done",
-        f"{len(findings)} twist interval(s) on {len(analysis.chains)} chain(s), "
-        f"{sum(i.applied for i in analysis.intervals)} applied ({analysis.apply}){unchecked}",
+        f"{len(analysis.intervals)} twist interval(s) on {len(analysis.chains)} chain(s), "
+        f"{sum(i.applied for i in analysis.intervals)} applied ({analysis.apply}); "
+        f"{len(spins)} limb spin(s) reported, not corrected{unchecked}",
         findings,
         plot,
         analysis.refined,
     )
+
+
+def spin_finding(spin: LimbSpin) -> dict[str, Any]:
+    """The finding of a limb spin or flip (:mod:`mocapqa.twist.spin`): reported, never applied;
+    ``value`` is the summed roll of a spin or the largest step of a flip, degrees."""
+    return {
+        "kind": "spin",
+        "joint": spin.joint,
+        "start_frame": spin.start_frame,
+        "end_frame": spin.end_frame,
+        "value": round(spin.value_deg, 3),
+        "unit": "deg",
+        "confidence": None,
+        "shape": spin.shape,
+        "readout": spin.readout(),
+    }
 
 
 def violation_findings(

@@ -103,13 +103,14 @@ def limit_findings(limits: Mapping[str, Any] | None, min_frames: int = 1) -> lis
 
 def normalise_findings(findings: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Pipeline findings (``kind, joint, start_frame, end_frame, value, unit, confidence``)
-    in this module's keys: ``offset_deg`` for twist, ``violation_deg`` for limits."""
+    in this module's keys: ``offset_deg`` for twist intervals and limb spins (signed rolls),
+    ``violation_deg`` for limits."""
     out = []
     for record in findings:
         item = dict(record)
         kind = str(item.get("kind", ""))
         if "value" in item and item["value"] is not None:
-            key = "offset_deg" if kind == "twist" else "violation_deg"
+            key = "offset_deg" if kind in ("twist", "spin") else "violation_deg"
             item.setdefault(key, float(item["value"]))
         item["kind"] = "limit" if kind == "limits" else kind
         item["start_frame"] = int(item.get("start_frame", 0))
@@ -119,12 +120,14 @@ def normalise_findings(findings: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 
 def sheet_findings(findings: list[dict[str, Any]], max_tiles: int = 8) -> list[dict[str, Any]]:
-    """The findings a contact sheet shows: twist intervals first, then the largest limit
-    violations, at most ``max_tiles`` (normalised as by :func:`normalise_findings`)."""
+    """The findings a contact sheet shows: twist intervals first, then limb spins, then the
+    largest limit violations, at most ``max_tiles`` (normalised as by
+    :func:`normalise_findings`)."""
     normalised = normalise_findings(findings)
     twists = [f for f in normalised if f["kind"] == "twist"]
+    spins = [f for f in normalised if f["kind"] == "spin"]
     others = sorted(
-        (f for f in normalised if f["kind"] != "twist"),
+        (f for f in normalised if f["kind"] not in ("twist", "spin")),
         key=lambda f: -float(f.get("violation_deg", 0)),
     )
-    return [*twists, *others][:max_tiles]
+    return [*twists, *spins, *others][:max_tiles]

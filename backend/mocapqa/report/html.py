@@ -190,11 +190,13 @@ def build_report(
     fps_value = float(fps) if isinstance(fps, (int, float)) and fps > 0 else None
     if findings is None:
         twists = twist_findings(twist)
+        spins: list[dict[str, Any]] = []
         limit_runs = limit_findings(limits)
     else:
         given = normalise_findings([dict(f) for f in findings])
         twists = [f for f in given if f["kind"] == "twist"]
-        limit_runs = [f for f in given if f["kind"] != "twist"]
+        spins = [f for f in given if f["kind"] == "spin"]
+        limit_runs = [f for f in given if f["kind"] not in ("twist", "spin")]
     name = title or str(take.get("name", "take"))
     created = datetime.now(UTC).strftime("%Y-%m-%d %H:%M:%S UTC")
     parts = [
@@ -215,7 +217,7 @@ def build_report(
     missing = [s for s in ("twist", "limits") if (twist if s == "twist" else limits) is None]
     if missing:
         parts.append(_unavailable("; ".join(f"{s}: {reasons.get(s, 'not run')}" for s in missing)))
-    parts.append(_findings_table([*twists, *limit_runs], fps_value))
+    parts.append(_findings_table([*twists, *spins, *limit_runs], fps_value))
 
     sections: list[tuple[str, str, str, Mapping[str, Any] | None]] = [
         ("twist", "twist-timeline", "Twist timeline", twist),
