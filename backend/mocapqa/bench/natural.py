@@ -20,6 +20,7 @@ from mocapqa.kinematics.resample import resample_motion
 from mocapqa.metrics.twist import rotation_errors_deg
 from mocapqa.twist.analysis import TwistAnalysis, analyze_twist, detect_chains
 from mocapqa.twist.angles import wrap_angle
+from mocapqa.twist.spin import find_limb_spins
 
 __all__ = [
     "CLEAN_RATES",
@@ -74,11 +75,15 @@ class CleanTakeFigure:
         Intervals applied by the analysis' apply choice.
     max_change_deg : float
         Largest change of any joint rotation, degrees.
+    n_spins, n_flips : int
+        Limb spins and flips reported (:mod:`mocapqa.twist.spin`; never applied).
     """
 
     n_intervals: int
     n_applied: int
     max_change_deg: float
+    n_spins: int = 0
+    n_flips: int = 0
 
 
 def natural_jumps(motion: Motion, analysis: TwistAnalysis, jump_deg: float = 20.0) -> BoolArray:
@@ -137,12 +142,16 @@ def natural_error_figures(
 
 
 def clean_take_figure(motion: Motion, analysis: TwistAnalysis) -> CleanTakeFigure:
-    """Intervals found and applied, and the largest rotation change, on a real take."""
+    """Intervals found and applied, the largest rotation change and the limb spins and flips
+    reported, on a real take."""
     change = rotation_errors_deg(motion.quats, analysis.refined.quats)
+    shapes = [s.shape for s in find_limb_spins(motion)]
     return CleanTakeFigure(
         n_intervals=len(analysis.intervals),
         n_applied=sum(i.applied for i in analysis.intervals),
         max_change_deg=float(change.max(initial=0.0)),
+        n_spins=shapes.count("spin"),
+        n_flips=shapes.count("flip"),
     )
 
 

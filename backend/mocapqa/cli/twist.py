@@ -327,6 +327,11 @@ def _print_real(data_dir: Path, console: Console, methods_chosen: list[str]) -> 
         f"{sum(f.n_applied for _, f in clean_rows)}, largest change "
         f"{max((f.max_change_deg for _, f in clean_rows), default=0.0):.1f}°"
     )
+    spun = [p.name for p, (_, f) in rows_clean if f.n_spins + f.n_flips]
+    console.print(
+        f"real takes with a limb spin or flip reported (never applied): {len(spun)} of "
+        f"{len(rows_clean)}: {', '.join(spun) or 'none'}"
+    )
     # The same clean takes at other common frame rates: the decisions should not change.
     resampled = [
         (path.name, fps, figure)
@@ -335,9 +340,13 @@ def _print_real(data_dir: Path, console: Console, methods_chosen: list[str]) -> 
         for fps, figure in clean_figures_at_rates(motion)
     ]
     applied = [(name, fps, f) for name, fps, f in resampled if f.n_applied]
+    spinning = sorted({name for name, _, f in resampled if f.n_spins + f.n_flips})
     console.print(
         f"takes without real errors resampled to {', '.join(f'{r:g}' for r in CLEAN_RATES)} "
-        f"fps: {len(resampled)} take-rates, with an interval applied by default: {len(applied)}"
+        f"fps: {len(resampled)} take-rates, with an interval applied by default: {len(applied)}; "
+        f"with a limb spin or flip: "
+        f"{sum(1 for _, _, f in resampled if f.n_spins + f.n_flips)} "
+        f"(takes: {', '.join(spinning) or 'none'})"
         + "".join(
             f"\n  {name} at {fps:g} fps: {f.n_applied} applied, largest change "
             f"{f.max_change_deg:.1f}°"

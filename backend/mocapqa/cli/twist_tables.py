@@ -77,12 +77,16 @@ def natural_table(rows: Sequence[tuple[str, Any]]) -> Table:
 def clean_takes_table(rows: Sequence[tuple[Path, Any]]) -> Table:
     """Intervals found and applied by default, and the largest change, per real take."""
     table = Table(title="Real takes refined with the defaults (apply = confident)")
-    for column in ("take", "frames", "fps", "intervals found", "applied", "max change °"):
+    for column in (
+        "take", "frames", "fps", "intervals found", "applied", "max change °",
+        "limb spins / flips (reported)",
+    ):  # fmt: skip
         table.add_column(column, justify="left" if column == "take" else "right")
     for path, (motion, figure) in rows:
         table.add_row(
             f"{path.parent.name}/{path.name}", str(motion.n_frames), f"{motion.fps:.0f}",
             str(figure.n_intervals), str(figure.n_applied), f"{figure.max_change_deg:.1f}",
+            f"{figure.n_spins} / {figure.n_flips}",
         )  # fmt: skip
     return table
 
