@@ -34,6 +34,7 @@ from mocapqa.limits.build import (
 )
 from mocapqa.limits.model import LimitsModel
 from mocapqa.twist.inject import inject_twist_errors
+from mocapqa.twist.spin import find_limb_spins
 
 __all__ = [
     "EVALUATION_ONLY",
@@ -59,6 +60,9 @@ class TakeCounts:
         Role key → flagged frames summed over takes.
     per_joint_frames : dict
         Role key → frames summed over takes.
+    spun : ndarray of bool, shape (T,)
+        Takes with a limb spin or flip reported (:mod:`mocapqa.twist.spin`): real retarget
+        errors, which a limits check may rightly flag.
     """
 
     flagged: np.ndarray
@@ -67,11 +71,18 @@ class TakeCounts:
     injected: np.ndarray
     per_joint_flagged: dict[str, int]
     per_joint_frames: dict[str, int]
+    spun: np.ndarray
 
     @property
     def false_flag_rate(self) -> float:
         """Flagged share of clean joint-frames."""
         return float(self.flagged.sum() / max(self.joint_frames.sum(), 1))
+
+    @property
+    def unspun_false_flag_rate(self) -> float:
+        """Flagged share of the joint-frames of the takes without a limb spin or flip."""
+        keep = ~self.spun
+        return float(self.flagged[keep].sum() / max(self.joint_frames[keep].sum(), 1))
 
     @property
     def recall(self) -> float:
@@ -109,13 +120,14 @@ def count_takes(
         Smallest injected offset, degrees (up to 180°).
     """
     rng = np.random.default_rng(seed)
-    flagged, frames, hits, injected = [], [], [], []
+    flagged, frames, hits, injected, spun = [], [], [], [], []
     per_flagged: dict[str, int] = {}
     per_frames: dict[str, int] = {}
     for name, motion in takes:
         if name in EVALUATION_ONLY:
             continue
         report = check_limits(motion, model)
+        spun.append(bool(find_limb_spins(motion)))
         flagged.append(int((~report.valid).sum()))
         frames.append(int(report.valid.size))
         for k, role in enumerate(report.roles):
@@ -140,7 +152,7 @@ def count_takes(
         injected.append(take_injected)
     return TakeCounts(
         np.asarray(flagged), np.asarray(frames), np.asarray(hits), np.asarray(injected),
-        per_flagged, per_frames,
+        per_flagged, per_frames, np.asarray(spun, dtype=bool),
     )  # fmt: skip
 
 
