@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -66,6 +67,18 @@ def test_summary_of_the_demo_walk_with_twist_errors() -> None:
     assert summary["filter_residual_mm"] is None
     assert summary["missing_share"] == 0.0
     assert 0 <= summary["score"] < 100
+    assert summary["limb_spins"] == 0
+
+
+def test_limb_spins_are_counted_and_do_not_change_the_score(corpus_dir: Path) -> None:
+    take = corpus_dir / "bvh" / "cmu" / "iclone" / "005_03.bvh"
+    result = analyze(read_take_file(take, ""), AnalysisOptions())
+    summary = qa_summary(result)
+    spins = [f for f in result.report["findings"] if f["kind"] == "spin"]
+    assert summary["limb_spins"] == len(spins) == 3
+    without = dict(result.report)
+    without["findings"] = [f for f in result.report["findings"] if f["kind"] != "spin"]
+    assert qa_summary(replace(result, report=without))["score"] == summary["score"]
 
 
 def test_twist_fixes_cost_the_score(corpus_dir: Path) -> None:
@@ -88,6 +101,7 @@ def test_summary_of_keypoint_takes(corpus_dir: Path, relative: str) -> None:
     summary = _summary(corpus_dir / relative)
     assert summary["rig"] == "keypoints"
     assert summary["twist_intervals"] is None
+    assert summary["limb_spins"] is None
     assert summary["violation_share"] is None
     assert 0 <= summary["missing_share"] <= 1
     assert 0 <= summary["score"] <= 100

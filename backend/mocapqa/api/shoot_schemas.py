@@ -82,6 +82,9 @@ class ShootTakeOut(BaseModel):
     rig: str | None
     twist_intervals: int | None
     corrected_joint_frames: int | None
+    limb_spins: int | None = Field(
+        default=None, description="Limb spins and flips reported (never corrected)"
+    )
     violation_share: float | None
     worst_joint: str | None
     filter_residual_mm: float | None

@@ -26,6 +26,7 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("rig", "string"),
     ("twist_intervals", "int64"),
     ("corrected_joint_frames", "int64"),
+    ("limb_spins", "int64"),
     ("violation_share", "float64"),
     ("worst_joint", "string"),
     ("filter_residual_mm", "float64"),

@@ -47,6 +47,7 @@ SUMMARY_FIELDS = (
     "rig",
     "twist_intervals",
     "corrected_joint_frames",
+    "limb_spins",
     "violation_share",
     "worst_joint",
     "filter_residual_mm",
@@ -127,6 +128,7 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
     filter_ran = not motion and steps["filter"]["state"] == "done"
 
     twist = [f for f in findings if f["kind"] == "twist"]
+    spins = [f for f in findings if f["kind"] == "spin"]
     corrected = sum(int(f["end_frame"]) - int(f["start_frame"]) + 1 for f in twist)
     n_joints = int(info.get("n_joints") or info.get("n_keypoints") or 1)
 
@@ -155,6 +157,7 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
         "rig": rig,
         "twist_intervals": len(twist) if twist_ran else None,
         "corrected_joint_frames": corrected if twist_ran else None,
+        "limb_spins": len(spins) if twist_ran else None,
         "violation_share": violation_share,
         "worst_joint": worst_joint,
         "filter_residual_mm": residual,

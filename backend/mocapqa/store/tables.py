@@ -130,6 +130,7 @@ take_qa = Table(
     Column("rig", String(64), nullable=True),
     Column("twist_intervals", Integer, nullable=True),
     Column("corrected_joint_frames", Integer, nullable=True),
+    Column("limb_spins", Integer, nullable=True),
     Column("violation_share", Float, nullable=True),
     Column("worst_joint", String(255), nullable=True),
     Column("filter_residual_mm", Float, nullable=True),
