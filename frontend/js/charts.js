@@ -4,7 +4,10 @@
 
 import { PALETTE } from "./format.js";
 
-export const MARGIN = { l: 170, r: 120, t: 10, b: 40 };
+// The top margin holds the chart's toolbar (shown on hover), so it covers no data.
+export const MARGIN = { l: 170, r: 120, t: 30, b: 40 };
+/** Limb spins and flips (reported, never corrected), on the charts and the time bar. */
+export const SPIN_COLOR = "#8e44ad";
 const frameAxis = () => ({ title: { text: "frame" }, tickformat: "d" });
 
 function intervalBars(intervals, yBase, yTop, yaxis, color, name) {
@@ -22,7 +25,10 @@ function intervalBars(intervals, yBase, yTop, yaxis, color, name) {
 /** Chain colours: one per twist chain (joint name), in the order of the chains. */
 export const chainColors = (twist) => new Map(twist.chains.map((c, k) => [c.joint, PALETTE[k % PALETTE.length]]));
 
-export function twistFigure(twist) {
+/** The twist chart: θP and the removed offset per chain, the flagged intervals as bands in
+ * their chain's colour, and limb spins (`spins`: findings of kind "spin", reported and never
+ * corrected) as hatched grey bands on the chain of the limb's upper segment. */
+export function twistFigure(twist, spins = []) {
   const frames = twist.frames;
   const colors = chainColors(twist);
   const affected = new Set(twist.intervals.map((i) => i.joint));
@@ -42,6 +48,17 @@ export function twistFigure(twist) {
   for (const joint of affected) {
     const own = twist.intervals.filter((i) => i.joint === joint);
     data.push(intervalBars(own, -180, 180, "y", colors.get(joint) || PALETTE[3], joint));
+  }
+  const shown = (joint) => data.find((t) => t.legendgroup === joint && t.type === "scatter")?.visible ?? "legendonly";
+  for (const joint of new Set(spins.map((s) => s.joint))) {
+    if (!colors.has(joint)) continue;
+    const own = spins.filter((s) => s.joint === joint);
+    data.push({
+      ...intervalBars(own, -180, 180, "y", SPIN_COLOR, joint),
+      marker: { color: SPIN_COLOR, opacity: 0.3, pattern: { shape: "/", fgcolor: SPIN_COLOR } },
+      visible: shown(joint),
+      hovertemplate: "%{customdata[2]}: frames %{customdata[0]}–%{customdata[1]}<extra>limb spin (not corrected)</extra>",
+    });
   }
   const layout = {
     margin: MARGIN, barmode: "overlay", hovermode: "x",

@@ -11,7 +11,9 @@ const BADGE = { accept: "approved", reject: "rejected" };
 
 /** Decision cells for the findings rows of `run` and the panel parts below the table. */
 export function intervalDecisions(run, result) {
-  const twist = result.kind === "motion" && result.series && result.series.twist;
+  // Only a take with twist intervals has anything to accept or reject.
+  const series = result.kind === "motion" && result.series && result.series.twist;
+  const twist = series && series.intervals.length ? series : null;
   const latest = new Map(); // interval id -> "accept" | "reject"
   const cells = new Map(); // interval id -> the row's decision cell
   let current = null; // the last opened twist interval
@@ -80,13 +82,20 @@ export function intervalDecisions(run, result) {
       if (twist && f.kind === "twist" && byId.has(f.id)) { cells.set(f.id, cell); fill(f.id); }
       return cell;
     },
-    opened(f) { if (f.kind === "twist") current = f.id; },
+    /** The last opened finding: Y/X act on it when it is a twist interval, and on none after
+     * a spin or limits finding (never on an interval opened before it). */
+    opened(f) { current = f && f.kind === "twist" ? f.id : null; },
     /** Y / X on the focused (else the last opened) twist row; true when the key was used. */
     onKey(e) {
       const decision = DECISION_KEYS[e.key.toLowerCase()];
       if (!twist || !decision) return false;
-      const row = document.activeElement && document.activeElement.closest && document.activeElement.closest("tr[data-interval]");
-      const id = row ? Number(row.dataset.interval) : current;
+      const focused = document.activeElement && document.activeElement.closest && document.activeElement.closest("tr.finding");
+      if (focused && !focused.dataset.interval) {
+        message.textContent = `a ${focused.dataset.kind} finding is reported, not corrected: nothing to accept or reject`;
+        message.className = "muted";
+        return true;
+      }
+      const id = focused ? Number(focused.dataset.interval) : current;
       if (id == null || !byId.has(id)) { message.textContent = "open or focus a twist finding first"; message.className = "muted"; return true; }
       decide(id, decision);
       return true;

@@ -5,7 +5,7 @@ import { activatable, h } from "./dom.js";
 import { findingStops, fmt, sortFindings } from "./format.js";
 import { filterFindings, filterParams, groupByJoint, jointsOf, kindsOf, listOrder } from "./findings.js";
 
-const COLUMNS = [["kind", "kind"], ["joint", "joint"], ["start_frame", "frames"], ["duration", "frames long"], ["value", "offset / outside"], ["confidence", "confidence"]];
+const COLUMNS = [["kind", "kind"], ["joint", "joint"], ["start_frame", "frames"], ["duration", "frames long"], ["value", "offset / spin / outside"], ["confidence", "confidence"]];
 const UNITS = { deg: "°" };
 const unitOf = (f) => UNITS[f.unit] ?? f.unit ?? "";
 
@@ -59,8 +59,8 @@ export function findingsList(findings, decided, onOpen, initial = null, onFilter
     class: `clickable finding${f === current ? " current" : ""}`, "data-start": f.start_frame, "data-joint": f.joint, "data-kind": f.kind,
     "data-interval": f.kind === "twist" ? f.id : null, "aria-current": f === current ? "true" : null,
   },
-  h("td", {}, f.kind), h("td", {}, f.joint, f.readout ? h("div", { class: "muted readout" }, f.readout) : null), h("td", {}, `${f.start_frame}–${f.end_frame}`), h("td", {}, f.end_frame - f.start_frame + 1),
-  h("td", {}, f.value == null ? "–" : `${fmt(f.value, 1)} ${unitOf(f)}`), h("td", {}, f.kind === "twist" ? `${fmt(100 * f.confidence, 0)} %` : fmt(f.confidence, 2)),
+  h("td", {}, f.kind), h("td", {}, f.joint, f.readout ? h("div", { class: "muted readout" }, f.readout) : null), h("td", { class: "frames" }, `${f.start_frame}–${f.end_frame}`), h("td", {}, f.end_frame - f.start_frame + 1),
+  h("td", { class: "value" }, f.value == null ? "–" : `${fmt(f.value, 1)} ${unitOf(f)}`), h("td", {}, f.kind === "twist" ? `${fmt(100 * f.confidence, 0)} %` : fmt(f.confidence, 2)),
   decided.enabled ? decided.cell(f) : null), () => { mark(f); onOpen(f); });
 
   const groupHead = (g) => {

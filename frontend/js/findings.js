@@ -24,7 +24,8 @@ export function filterFindings(findings, filter = {}) {
     if (least != null && !(magnitude(f) >= least)) return false;
     if (!words.length) return true;
     const haystack = `${f.kind} ${f.joint} ${f.start_frame}–${f.end_frame} ${f.readout || ""}`.toLowerCase();
-    return words.every((w) => haystack.includes(w));
+    // A typed hyphen also matches the en dash of the frame ranges ("161-161" finds "161–161").
+    return words.every((w) => haystack.includes(w) || haystack.includes(w.replace(/-/g, "–")));
   });
 }
 

@@ -53,7 +53,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   store.reset();
   store.set({ frame: Math.max(0, Math.min(nFrames - 1, Number(params.get("frame")) || 0)), joint: params.get("joint") });
   const chainColor = result.series.twist ? charts.chainColors(result.series.twist) : new Map();
-  const findingColor = (f) => (f.kind === "twist" ? chainColor.get(f.joint) || "#c0392b" : LIMITS_COLOR);
+  const findingColor = (f) => (f.kind === "twist" ? chainColor.get(f.joint) || "#c0392b" : f.kind === "spin" ? charts.SPIN_COLOR : LIMITS_COLOR);
   let detail = null;
 
   // Layout
@@ -144,7 +144,8 @@ export async function takeView(main, takeId, params, onTeardown) {
     const chart = document.getElementById("chart-twist");
     const chains = result.series.twist ? result.series.twist.chains : [];
     if (!chart || !chains.some((c) => c.joint === store.state.joint)) return;
-    const visible = chart.data.map((trace) => (trace.type === "bar" ? true : trace.legendgroup === store.state.joint ? true : "legendonly"));
+    // Every trace of a chain (its lines, its interval bands, its spins) follows its legend group.
+    const visible = chart.data.map((trace) => (trace.legendgroup === store.state.joint ? true : "legendonly"));
     Plotly.restyle(chart, { visible });
   };
   const render = () => {
@@ -255,7 +256,10 @@ export async function takeView(main, takeId, params, onTeardown) {
       const stop = nextStop(list.stops(), store.state.frame, e.key.toLowerCase() === "n" ? 1 : -1);
       if (stop != null) {
         if (player.playing) togglePlay();
-        list.mark(list.shown.find((f) => f.start_frame === stop));
+        const reached = list.shown.find((f) => f.start_frame === stop);
+        list.mark(reached);
+        // The finding reached is the one opened: its joint selected, Y/X act on it if twist.
+        if (reached) { decided.opened(reached); store.set({ joint: reached.joint }); focusCharts(); }
         jump(stop);
       }
     } else if (e.key === "i" || e.key === "I") {
@@ -294,7 +298,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   const series = result.series;
   if (series.twist) {
     await timeline.add("chart-twist", `Twist θP and removed offset (${series.twist.intervals.length} flagged interval(s))`,
-      charts.twistFigure(series.twist), (p) => {
+      charts.twistFigure(series.twist, result.findings.filter((f) => f.kind === "spin")), (p) => {
         if (p.customdata) return p.customdata[0];
         const inside = series.twist.intervals.find((i) => i.start_frame <= p.x && p.x <= i.end_frame + 1);
         return inside ? inside.start_frame : p.x;

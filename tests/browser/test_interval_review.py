@@ -110,3 +110,14 @@ def test_limb_spins_are_listed_with_their_read_out_and_nothing_to_accept(
     assert rows.count() == 0
     p.check("#filter-kind-spin")
     assert rows.count() == len(spins)
+
+    # Y on a focused spin row decides nothing, not even the twist interval opened before it.
+    p.wait_for_selector("#findings td.decision button.decide-accept")
+    history = p.locator("#decision-history li")
+    before = history.count()
+    p.locator("#findings tr[data-interval]").first.click()
+    rows.first.focus()
+    p.keyboard.press("y")
+    assert "not corrected" in p.inner_text("#decision-message")
+    p.wait_for_timeout(300)  # a decision would be posted and listed by now
+    assert history.count() == before

@@ -69,8 +69,11 @@ def test_findings_grouped_by_joint_filtered_and_walked(
         if worst is not None:
             assert f"worst {worst:.1f}" in heads.nth(k).inner_text()
     assert len(rows(page)) == len(findings)
-    # Each limits finding shows its anatomical read-out under the joint ("… over-inverted 136°").
-    readouts = [f["readout"] for f in findings if f["kind"] == "limits" and f.get("readout")]
+    # Each limits finding shows its anatomical read-out under the joint ("… over-inverted 136°"),
+    # each limb spin its sentence ("right arm spun 24° about its axis …").
+    readouts = [
+        f["readout"] for f in findings if f["kind"] in ("limits", "spin") and f.get("readout")
+    ]
     assert readouts
     shown = p.locator("#findings tr.finding .readout").all_inner_texts()
     assert sorted(shown) == sorted(readouts)
@@ -91,9 +94,12 @@ def test_findings_grouped_by_joint_filtered_and_walked(
 
     # Filters: kind, joint, smallest magnitude, words.
     p.uncheck("#filter-kind-limits")
+    assert {r["kind"] for r in rows(page)} == {"twist", "spin"}
+    p.uncheck("#filter-kind-spin")
     assert {r["kind"] for r in rows(page)} == {"twist"}
     assert "shown" in p.inner_text("#findings-panel h2")
     p.check("#filter-kind-limits")
+    p.check("#filter-kind-spin")
     p.select_option("#filter-joint", busiest)
     assert {r["joint"] for r in rows(page)} == {busiest}
     p.select_option("#filter-joint", "")
@@ -124,6 +130,7 @@ def test_findings_grouped_by_joint_filtered_and_walked(
     assert page.frame() == starts[-2]
     # With only the twist kind kept, N and P stop at twist findings only.
     p.uncheck("#filter-kind-limits")
+    p.uncheck("#filter-kind-spin")
     p.evaluate("() => document.activeElement.blur()")
     scrub(page, 0)
     twist_starts = sorted({f["start_frame"] for f in findings if f["kind"] == "twist"})

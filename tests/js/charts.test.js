@@ -42,3 +42,23 @@ test("the twist chart lists each chain once in its legend; its name toggles both
   assert.deepEqual(data.filter((t) => t.visible === true).map((t) => t.legendgroup), ["R_Calf", "R_Calf"]);
   assert.match(layout.legend.title.text, /solid.*dashed/);
 });
+
+test("limb spins are hatched bands on their limb's chain, shown and hidden with it", () => {
+  const twist = {
+    frames: [0, 1, 2, 3],
+    chains: ["R_Upperarm", "L_Calf"].map((joint) => ({ joint, theta_p_deg: [0, 0, 0, 0], offset_deg: [0, 0, 0, 0] })),
+    intervals: [{ joint: "L_Calf", start_frame: 1, end_frame: 1 }],
+  };
+  const spins = [
+    { kind: "spin", joint: "R_Upperarm", start_frame: 2, end_frame: 3 },
+    { kind: "spin", joint: "R_Hand", start_frame: 0, end_frame: 0 }, // no chain: not drawn
+  ];
+  const { data } = twistFigure(twist, spins);
+  const bands = data.filter((t) => t.type === "bar" && /spin/.test(t.hovertemplate));
+  assert.equal(bands.length, 1);
+  assert.equal(bands[0].legendgroup, "R_Upperarm");
+  assert.deepEqual(bands[0].customdata, [[2, 3, "R_Upperarm"]]);
+  assert.equal(bands[0].marker.pattern.shape, "/");
+  // R_Upperarm has no twist interval, so its chain starts hidden, and its spin band with it.
+  assert.equal(bands[0].visible, "legendonly");
+});

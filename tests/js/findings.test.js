@@ -155,3 +155,10 @@ test("a findings filter goes into link parameters and comes back the same", () =
   const odd = findings.filterFromParams(new URLSearchParams("kinds=twist,bogus&only=Nobody&atleast=abc"), kinds, joints);
   assert.deepEqual(odd, { kinds: new Set(["twist"]), joint: "", minValue: null, text: "" });
 });
+
+test("a typed hyphen finds the en dash of a frame range", () => {
+  const spun = [{ kind: "spin", joint: "R_Thigh", start_frame: 161, end_frame: 161, value: 170 }];
+  assert.equal(findings.filterFindings(spun, { text: "161-161" }).length, 1);
+  assert.equal(findings.filterFindings(spun, { text: "161–161" }).length, 1);
+  assert.equal(findings.filterFindings(spun, { text: "162-162" }).length, 0);
+});

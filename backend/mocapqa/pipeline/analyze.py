@@ -31,7 +31,7 @@ from mocapqa.core.rig import find_roles
 from mocapqa.errors import InputError
 from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
-from mocapqa.pipeline.frames import motion_pose
+from mocapqa.pipeline.frames import motion_pose, rigid_bones
 from mocapqa.pipeline.loading import Take
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.pipeline.steps import (
@@ -205,7 +205,12 @@ def _analyze_motion(
         "steps": _steps_json(outcomes),
         "timings_s": {k: round(v, 4) for k, v in timings.items()},
         "findings": findings,
-        "points": {"names": names, "parents": parents, "n_joints": skeleton.n_joints},
+        "points": {
+            "names": names,
+            "parents": parents,
+            "bones": rigid_bones(motion),
+            "n_joints": skeleton.n_joints,
+        },
         "series": series,
     }
     return AnalysisResult(

@@ -12,7 +12,11 @@ from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Motion
 from mocapqa.kinematics.forward import end_site_positions, forward_kinematics
 
-__all__ = ["motion_points", "motion_pose"]
+__all__ = ["MOVING_SHARE", "motion_points", "motion_pose", "rigid_bones"]
+
+MOVING_SHARE = 0.01
+"""A joint whose translation from its parent moves by more than this share of the median
+bone length over a take is not joined to its parent by a bone (:func:`rigid_bones`)."""
 
 
 def motion_points(motion: Motion) -> tuple[list[str], list[int], FloatArray]:
@@ -52,3 +56,27 @@ def motion_pose(motion: Motion) -> tuple[list[str], list[int], FloatArray, Float
     positions = np.concatenate([world_positions, ends], axis=1)
     rotations = np.concatenate([world_quats, world_quats[:, site_parents]], axis=1)
     return names, parents, positions, rotations
+
+
+def rigid_bones(motion: Motion) -> list[list[int]]:
+    """The ``[parent, point]`` pairs the 3D view draws as bones, in :func:`motion_points`'
+    point order: every joint and End Site joined to its parent, except a joint whose
+    translation from its parent moves during the take (by more than :data:`MOVING_SHARE` of
+    the median OFFSET length).
+
+    Such a joint carries the take's travel, as Bandai's ``Hips`` under a ``joint_Root`` that
+    stays at the origin: a "bone" to it would stretch across the room.
+    """
+    skeleton = motion.skeleton
+    local = motion.local_translations()
+    moved = np.linalg.norm(local - local[:1], axis=2).max(axis=0) if motion.n_frames else None
+    lengths = np.linalg.norm(skeleton.offsets, axis=1)
+    scale = float(np.median(lengths[lengths > 0])) if (lengths > 0).any() else 1.0
+    bones = [
+        [int(parent), joint]
+        for joint, parent in enumerate(skeleton.parents)
+        if parent >= 0 and (moved is None or moved[joint] <= MOVING_SHARE * scale)
+    ]
+    first_site = skeleton.n_joints
+    bones += [[int(e.parent), first_site + k] for k, e in enumerate(skeleton.end_sites)]
+    return bones

@@ -111,8 +111,8 @@ def tiles_from_intervals(
     ----------
     intervals : sequence of mapping
         Each with ``joint`` (name or index), ``start_frame`` and ``end_frame`` (inclusive), and
-        optionally ``offset_deg`` or ``violation_deg`` for the caption. Records naming an
-        unknown joint are skipped.
+        optionally ``offset_deg`` or ``violation_deg`` for the caption (``kind`` "spin":
+        captioned as a limb spin, not corrected). Records naming an unknown joint are skipped.
     raw, corrected : SkeletonTrack
         The takes; ``corrected`` picks the frame of largest error.
     """
@@ -127,7 +127,10 @@ def tiles_from_intervals(
         )
         frames = f"frame {start}" if start == end else f"frames {start}–{end}"
         label = f"{raw.names[joint]} · {frames}"
-        if record.get("offset_deg") is not None:
+        if record.get("kind") == "spin" and record.get("offset_deg") is not None:
+            # A limb spin is reported, never corrected: both panels show the raw pose.
+            label += f" · spin {float(record['offset_deg']):+.1f}° (not corrected)"
+        elif record.get("offset_deg") is not None:
             label += f" · offset {float(record['offset_deg']):+.1f}°"
         if record.get("violation_deg") is not None:
             label += f" · violation {float(record['violation_deg']):.1f}°"
