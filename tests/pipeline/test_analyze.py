@@ -16,7 +16,7 @@ from mocapqa.jobs.demo import demo_paths
 from mocapqa.jobs.runner import write_outputs
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.pipeline.analyze import analyze
-from mocapqa.pipeline.frames import motion_points, motion_pose
+from mocapqa.pipeline.frames import motion_points, motion_pose, rigid_bones
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.pipeline.steps import true_runs, violation_findings
 from mocapqa.store.files import FileStore
@@ -177,3 +177,18 @@ def test_true_runs_are_first_and_last_of_each_run() -> None:
     flags = np.array([True, True, False, True, False, False, True])
     assert true_runs(flags).tolist() == [[0, 1], [3, 3], [6, 6]]
     assert true_runs(np.zeros(4, dtype=bool)).shape == (0, 2)
+
+
+def test_a_travelling_joint_is_not_joined_to_its_parent_by_a_bone(corpus_dir: Path) -> None:
+    """Bandai's Hips carries the take's travel under a joint_Root that stays at the origin:
+    the 3D view draws no bone between them, and every other bone of every rig."""
+    bandai = read_bvh(corpus_dir / "bvh" / "bandai" / "dataset-2_walk_normal_001.bvh")
+    bones = rigid_bones(bandai)
+    skeleton = bandai.skeleton
+    hips, root = skeleton.index("Hips"), skeleton.index("joint_Root")
+    assert [root, hips] not in bones
+    assert len(bones) == skeleton.n_joints - 2 + len(skeleton.end_sites)
+    walk = read_bvh(corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh")
+    assert len(rigid_bones(walk)) == walk.skeleton.n_joints - 1 + len(walk.skeleton.end_sites)
+    result = analyze(bandai, AnalysisOptions(checks=("twist",)))
+    assert result.report["points"]["bones"] == bones
