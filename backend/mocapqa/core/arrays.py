@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 
 from mocapqa.errors import ShapeError
 
-__all__ = ["BoolArray", "FloatArray", "IntArray", "as_float_array", "check_shape"]
+__all__ = ["BoolArray", "FloatArray", "IntArray", "as_float_array", "check_shape", "true_runs"]
 
 FloatArray = NDArray[np.float64]
 """float64 array of any shape (positions, quaternions, angles)."""
@@ -86,3 +86,20 @@ def as_float_array(
     if finite and not np.all(np.isfinite(array)):
         raise ShapeError(f"Expected `{name}` to be finite, got NaN or infinity")
     return array
+
+
+def true_runs(flags: BoolArray) -> IntArray:
+    """Runs of consecutive true values.
+
+    Parameters
+    ----------
+    flags : ndarray of bool, shape (F,)
+
+    Returns
+    -------
+    ndarray of int, shape (R, 2)
+        First and last index (both inside the run) of each run, in order.
+    """
+    edges = np.diff(np.concatenate(([0], flags.astype(np.int8), [0])))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    return np.stack([starts, stops - 1], axis=1).astype(np.intp)

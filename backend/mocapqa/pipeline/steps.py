@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.core.arrays import BoolArray, FloatArray, IntArray, true_runs
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion, Skeleton
 from mocapqa.core.rig import find_roles
@@ -96,23 +96,6 @@ class StepOutcome:
     motion: Motion | None = None
     keypoints: KeypointSequence | None = None
     bridged: BoolArray | None = None
-
-
-def true_runs(flags: BoolArray) -> IntArray:
-    """Runs of consecutive true values.
-
-    Parameters
-    ----------
-    flags : ndarray of bool, shape (F,)
-
-    Returns
-    -------
-    ndarray of int, shape (R, 2)
-        First and last index (both inside the run) of each run, in order.
-    """
-    edges = np.diff(np.concatenate(([0], flags.astype(np.int8), [0])))
-    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-    return np.stack([starts, stops - 1], axis=1).astype(np.intp)
 
 
 def _finding_edges(findings: list[dict[str, Any]]) -> IntArray:
@@ -213,9 +196,8 @@ def violation_findings(
         bad = ~valid[:, j]
         if not bad.any():
             continue
-        edges = np.diff(np.concatenate(([0], bad.astype(np.int8), [0])))
-        starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-        for start, stop in zip(starts, stops, strict=True):
+        for start, last in true_runs(bad).tolist():
+            stop = last + 1
             finding: dict[str, Any] = {
                 "kind": "limits",
                 "joint": joint,

@@ -36,7 +36,7 @@ from typing import Literal
 
 import numpy as np
 
-from mocapqa.core.arrays import FloatArray
+from mocapqa.core.arrays import FloatArray, true_runs
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import RigMap, find_roles
 from mocapqa.kinematics.bindpose import leading_bind_pose
@@ -158,12 +158,6 @@ def _wrap(degrees: FloatArray) -> FloatArray:
     return (degrees + 180.0) % 360.0 - 180.0
 
 
-def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
-    edges = np.diff(np.concatenate(([0], flags.astype(np.int8), [0])))
-    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-    return [(int(a), int(b) - 1) for a, b in zip(starts, stops, strict=True)]
-
-
 def find_limb_spins(
     motion: Motion,
     rig: RigMap | None = None,
@@ -223,7 +217,7 @@ def find_limb_spins(
             spin[:skip] = False
             flip[:skip] = False
             for shape, flags in (("spin", spin), ("flip", flip)):
-                for first, last in _runs(flags):
+                for first, last in true_runs(flags).tolist():
                     steps = slice(first, last + 1)
                     found.append(
                         LimbSpin(
