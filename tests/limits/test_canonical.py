@@ -22,6 +22,7 @@ from mocapqa.limits.expmap import expmap_from_quats
 from mocapqa.limits.model import LimitsModel
 from mocapqa.limits.occupancy import OccupancyParams
 from mocapqa.limits.storage import default_model_paths, load_model, model_bytes
+from mocapqa.twist.analysis import analyze_twist
 
 MAP_ONLY = BuildParams(
     occupancy=OccupancyParams(bin_deg=15.0, dilation_bins=2, tau_margin_deg=40.0, interpolate=True),
@@ -217,6 +218,43 @@ def test_a_new_rig_framed_once_from_its_takes_keeps_its_frames_through_a_damaged
     # A per-rig model cannot take frames.
     with pytest.raises(InputError):
         with_rig_frames(replace(bandai_model, frame="rig"), [walk], names)
+
+
+def test_a_take_framed_alone_leaves_out_its_twist_intervals(
+    corpus_dir: Path, bandai_model: LimitsModel
+) -> None:
+    """The damaged take above, framed from itself as a take of an unseen rig is, but without
+    the frames of the twist intervals the twist detector finds on it (as the pipeline and
+    ``limits check`` do): the thigh frame comes from the clean frames, so the corrupted
+    frames read 90° off, as when the rig is framed from clean takes."""
+    walk = read_bvh(corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh")
+    thigh = walk.skeleton.index("LeftUpLeg")
+    short = Motion(walk.skeleton, walk.quats[1:61].copy(), walk.translations[1:61], walk.fps)
+    turn = quat_about(short, thigh, 90.0)
+    quats = short.quats.copy()
+    quats[5:55, thigh] = multiply(quats[5:55, thigh], turn)
+    for child in short.skeleton.children(thigh):
+        quats[5:55, child] = multiply(conjugate(turn), quats[5:55, child])
+    damaged = Motion(short.skeleton, quats, short.translations, short.fps)
+    found = analyze_twist(damaged, apply="none").interval_frames()
+    assert found[5:55, thigh].mean() > 0.9
+    assert not found[:, thigh].all()
+    left_out = check_limits(damaged, bandai_model, ignore=found)
+    alone = check_limits(damaged, bandai_model)
+    clean = check_limits(short, bandai_model)
+    k = left_out.roles.index("left_upper_leg")
+
+    def shift(report: LimitsReport) -> np.ndarray:
+        offset = report.params_deg[5:55, k, 2] - clean.params_deg[5:55, k, 2]
+        return np.abs((offset + 180.0) % 360.0 - 180.0)
+
+    assert np.median(shift(alone)) < 30
+    assert np.median(shift(left_out)) > 80
+    # Nothing to leave out: the same frames as without the argument.
+    nothing = np.zeros(short.quats.shape[:2], dtype=bool)
+    np.testing.assert_array_equal(
+        check_limits(short, bandai_model, ignore=nothing).params_deg, clean.params_deg
+    )
 
 
 def quat_about(motion: Motion, joint: int, degrees: float) -> np.ndarray:

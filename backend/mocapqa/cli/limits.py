@@ -243,10 +243,14 @@ def limits_check(
     decides which joints play which role, so it changes the check. A per-rig model matches its
     joints by name and bone axis and ignores it; ``--mapping`` then only changes which roles
     are reported missing (the warning line and ``missing_roles`` in the JSON).
+
+    A rig the canonical model has not seen is framed from the take itself, leaving out the
+    frames of the twist intervals the twist detector finds on it (as the pipeline does).
     """
     from mocapqa.io.bvh import read_bvh
     from mocapqa.io.formats import require_frames
     from mocapqa.limits.analysis import check_limits
+    from mocapqa.twist.analysis import analyze_twist
 
     roles = load_mapping(mapping)
     motion = read_bvh(path)
@@ -255,7 +259,13 @@ def limits_check(
     model = _chosen_model(model_path, motion) if model_path is not None else None
     if frame_from is not None:
         model = _framed_from(motion, model, frame_from)
-    report = check_limits(motion, model, method="network" if network else "map", mapping=roles)
+    try:
+        ignore = analyze_twist(motion, mapping=roles, apply="none").interval_frames()
+    except InputError:
+        ignore = None  # no limb chains to check: nothing to leave out
+    report = check_limits(
+        motion, model, method="network" if network else "map", mapping=roles, ignore=ignore
+    )
     data = report.to_json(max_points=0)
     for joint in data["joints"]:
         del joint["frames"]

@@ -146,7 +146,10 @@ class LimitsReport:
 
 
 def charted(
-    motion: Motion, model: LimitsModel, mapping: Mapping[str, str] | None = None
+    motion: Motion,
+    model: LimitsModel,
+    mapping: Mapping[str, str] | None = None,
+    ignore: BoolArray | None = None,
 ) -> tuple[FloatArray, list[int], tuple[str, ...], tuple[str, ...]]:
     """``(s1, s2, τ)`` of the model's joints found on the take, and what is not checked.
 
@@ -157,6 +160,10 @@ def charted(
     mapping : mapping, optional
         Role key → joint name overriding the roles found (canonical models only; the take's
         frames are then estimated from the take, not taken from the model).
+    ignore : ndarray of bool, shape (F, J), optional
+        Frames of each joint inside a twist interval found on the take: when the take's
+        canonical frames are estimated from the take itself, those frames do not set them
+        (:func:`mocapqa.limits.canonical.canonical_frames`).
 
     Returns
     -------
@@ -185,9 +192,9 @@ def charted(
         return params, list(range(len(model.joints))), rest, tuple(j.name for j in model.joints)
     try:
         if mapping:
-            frames = take_frames(motion, rig=find_roles(motion.skeleton, mapping))
+            frames = take_frames(motion, rig=find_roles(motion.skeleton, mapping), ignore=ignore)
         else:
-            frames = take_frames(motion, known=_known_frames(motion, model))
+            frames = take_frames(motion, known=_known_frames(motion, model), ignore=ignore)
     except InputError as e:
         raise LimitsFileError(f"Expected a skeleton the canonical frames apply to: {e}") from e
     column = {role: k for k, role in enumerate(frames.roles)}
@@ -245,6 +252,7 @@ def check_limits(
     model: LimitsModel | None = None,
     method: str = "map",
     mapping: Mapping[str, str] | None = None,
+    ignore: BoolArray | None = None,
 ) -> LimitsReport:
     """Check every frame of a take against joint limits.
 
@@ -258,6 +266,9 @@ def check_limits(
     mapping : mapping, optional
         Role key → joint name overriding the roles found; with a canonical model it decides
         which joints are checked (a per-rig model matches joints by name and ignores it).
+    ignore : ndarray of bool, shape (F, J), optional
+        Frames inside the take's twist intervals, per joint (:func:`charted`): they are still
+        checked, but do not set the frames a take of an unknown rig is read in.
 
     Returns
     -------
@@ -274,7 +285,7 @@ def check_limits(
         raise InputError(f"Expected `method` 'map' or 'network', got {method!r}")
     if model is None:
         model = load_default_model(motion.skeleton)
-    params, columns, not_checked, names = charted(motion, model, mapping)
+    params, columns, not_checked, names = charted(motion, model, mapping, ignore)
     n_frames, n_joints = params.shape[:2]
     swing = np.zeros((n_frames, n_joints))
     twist = np.zeros((n_frames, n_joints))

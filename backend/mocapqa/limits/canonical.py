@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from mocapqa.core.arrays import FloatArray
+from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.motion import Motion, Skeleton
 from mocapqa.core.rig import SIDES, RigMap, find_roles, role_key
 from mocapqa.errors import InputError
@@ -163,19 +163,22 @@ def _frame_quat(x: FloatArray, y: FloatArray) -> FloatArray:
 
 
 def _median_direction(
-    vectors: FloatArray, axis: FloatArray, sign_ref: FloatArray
+    vectors: FloatArray, axis: FloatArray, sign_ref: FloatArray, ignore: BoolArray | None = None
 ) -> tuple[FloatArray, float]:
     """Robust direction of ``vectors`` ``(F, 3)`` around ``axis``, and their mean squared norm.
 
     The weighted circular median (weights = squared norms, so straight limbs weigh nothing)
     of the vectors' azimuths about ``axis``, on a 1° grid: up to half the frames may point
-    anywhere (a burst of twist errors) without moving it. Signed like ``sign_ref``.
+    anywhere (a burst of twist errors) without moving it. Frames flagged in ``ignore`` (F,)
+    weigh nothing, unless that leaves no weight at all. Signed like ``sign_ref``.
     """
     e1 = _unit(sign_ref - np.dot(sign_ref, axis) * axis)
     if np.linalg.norm(e1) < 0.5:
         e1 = _unit(np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0]))
     e2 = np.cross(axis, e1)
     weights = np.sum(vectors * vectors, axis=-1)
+    if ignore is not None and (weights * ~ignore).sum() > 0:
+        weights = weights * ~ignore
     azimuth = np.arctan2(vectors @ e2, vectors @ e1)
     best = 0.0
     # Coarse to fine: 10° steps round the circle, then 1° steps around the best.
@@ -238,6 +241,7 @@ def canonical_frames(
     motion: Motion | Skeleton,
     rig: RigMap | None = None,
     world: tuple[FloatArray, FloatArray] | None = None,
+    ignore: BoolArray | None = None,
 ) -> CanonicalFrames:
     """Canonical frame of every modelled role joint of a take.
 
@@ -251,6 +255,10 @@ def canonical_frames(
     world : (ndarray, ndarray), optional
         The take's world rotations ``(F, J, 4)`` and positions ``(F, J, 3)``, when computed;
         only the frames :func:`pose_sample` keeps are used.
+    ignore : ndarray of bool, shape (F, J), optional
+        Frames of each joint that must not set its flexion axis: those inside twist intervals
+        found on the take, whose roll about the bone is off by the interval's level (a hand
+        also ignores its forearm's). Unflagged frames alone decide, when there are any.
 
     Returns
     -------
@@ -280,6 +288,7 @@ def canonical_frames(
     keep = pose_sample(quats.shape[0])
     if keep is not None:
         quats, positions = quats[keep], positions[keep]
+        ignore = None if ignore is None else ignore[keep]
     body = {arms: _body_axes(rig, positions, arms) for arms in (True, False)}
     roles, joints, parents, frames, parent_frames = [], [], [], [], []
     cache: dict[int, FloatArray] = {}
@@ -321,8 +330,12 @@ def canonical_frames(
             parent = rig.joint(side, parent_role)  # type: ignore[arg-type]
             partner = world_long(side, parent_role, parent) if parent is not None else left_w
             sign_w = left_w
-        sign_ref = np.mean(_local(quats[:, joint], sign_w), axis=0)
         forearm = rig.joint(side, "forearm") if role == "hand" else None  # type: ignore[arg-type]
+        skip = None if ignore is None else ignore[:, joint]
+        if skip is not None and forearm is not None:
+            skip = skip | ignore[:, forearm]  # type: ignore[index]
+        kept = slice(None) if skip is None or skip.all() else ~skip
+        sign_ref = np.mean(_local(quats[kept, joint], sign_w[kept]), axis=0)
         if forearm is not None:
             # The wrist hardly bends, so its bend plane is a weak, rig-dependent signal: the
             # hand takes the forearm's flexion axis, as seen from its own frame.
@@ -330,7 +343,7 @@ def canonical_frames(
             normals = _local(quats[:, joint], rotate(quats[:, forearm], forearm_x[None]))
         else:
             normals = _local(quats[:, joint], np.cross(along, partner))
-        flexion, bend = _median_direction(normals, long_axes[joint], sign_ref)
+        flexion, bend = _median_direction(normals, long_axes[joint], sign_ref, skip)
         if bend < _MIN_BEND_SIN2:
             flexion = sign_ref
         cache[joint] = _frame_quat(flexion, long_axes[joint])
@@ -368,17 +381,22 @@ def canonical_frames(
 
 
 def take_frames(
-    motion: Motion, rig: RigMap | None = None, known: CanonicalFrames | None = None
+    motion: Motion,
+    rig: RigMap | None = None,
+    known: CanonicalFrames | None = None,
+    ignore: BoolArray | None = None,
 ) -> CanonicalFrames:
     """``known`` (frames of the rig estimated over many takes, :func:`rig_frames`) if given,
-    else the take's own frames, estimated from at most 4,000 evenly spaced frames."""
+    else the take's own frames, estimated from at most 4,000 evenly spaced frames, without the
+    frames ``ignore`` (F, J) flags (see :func:`canonical_frames`)."""
     if known is not None:
         return known
     sample = motion
     keep = pose_sample(motion.n_frames)
     if keep is not None:
         sample = Motion(motion.skeleton, motion.quats[keep], motion.translations[keep], motion.fps)
-    return canonical_frames(sample, rig)
+        ignore = None if ignore is None else ignore[keep]
+    return canonical_frames(sample, rig, ignore=ignore)
 
 
 def rig_key(motion: Motion) -> str:

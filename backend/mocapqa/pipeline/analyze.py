@@ -157,8 +157,13 @@ def _analyze_motion(
     if "limits" in options.checks:
         progress(55, "joint-limit check")
         clock = time.perf_counter()
+        twist_outcome = outcomes.get("twist")
         outcome = run_limits(
-            motion, options.mapping, options.limits_model or DEFAULT_MODEL, catalog
+            motion,
+            options.mapping,
+            options.limits_model or DEFAULT_MODEL,
+            catalog,
+            twist_findings=twist_outcome.findings if twist_outcome else None,
         )
         timings["limits_s"] = time.perf_counter() - clock
         outcomes["limits"] = plotted["limits"] = outcome

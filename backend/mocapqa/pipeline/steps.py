@@ -33,7 +33,7 @@ from mocapqa.limits.analysis import check_limits
 from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
 from mocapqa.limits.model import LimitsModel
 from mocapqa.pipeline.options import ParamValue
-from mocapqa.twist.analysis import analyze_twist
+from mocapqa.twist.analysis import analyze_twist, interval_frames
 from mocapqa.twist.spin import LimbSpin, find_limb_spins
 
 __all__ = [
@@ -234,12 +234,15 @@ def run_limits(
     mapping: dict[str, str] | None = None,
     model_name: str = DEFAULT_MODEL,
     catalog: ModelCatalog | None = None,
+    twist_findings: list[dict[str, Any]] | None = None,
 ) -> StepOutcome:
     """Check joint limits with the model ``model_name`` of ``catalog`` (the shipped models
     when None; the default choice is decided once per rig layout).
 
     ``mapping`` (role key → joint name) decides the roles the canonical model checks; the
     message counts the joints that are not checked and ``summary.not_checked`` names them.
+    ``twist_findings`` (the twist step's findings) keep the frames of their intervals from
+    setting the canonical frames of a rig the model has not seen.
 
     Raises
     ------
@@ -259,7 +262,15 @@ def run_limits(
             model = str(e)
     if isinstance(model, str):
         return StepOutcome("no_model", f"no model for this rig ({model_name}: {model})")
-    report = check_limits(motion, model, mapping=mapping)
+    ignore = None
+    if twist_findings:
+        ignore = interval_frames(
+            motion.skeleton.names,
+            motion.n_frames,
+            [(f["joint"], f["start_frame"], f["end_frame"]) for f in twist_findings
+             if f["kind"] == "twist"],
+        )  # fmt: skip
+    report = check_limits(motion, model, mapping=mapping, ignore=ignore)
     joints = list(report.joint_names)
     findings = violation_findings(report.valid, report.score_deg, joints, report.readout)
     heat = np.where(report.valid, 0.0, report.score_deg)

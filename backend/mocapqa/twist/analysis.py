@@ -8,6 +8,7 @@ series (θP, offset, flagged frames) in the shape documented in ``docs/twist.md`
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Literal, get_args
 
@@ -48,6 +49,7 @@ __all__ = [
     "TwistInterval",
     "analyze_twist",
     "detect_chains",
+    "interval_frames",
     "parse_apply",
 ]
 
@@ -55,6 +57,28 @@ Method = Literal["robust", "paper"]
 """A detection method: the robust default, or the paper as written."""
 METHODS: tuple[Method, ...] = get_args(Method)
 """The detection methods, the default first."""
+
+
+def interval_frames(
+    joint_names: Sequence[str], n_frames: int, intervals: Iterable[tuple[str, int, int]]
+) -> BoolArray:
+    """Frames of each joint inside a twist interval, shape (F, J).
+
+    Parameters
+    ----------
+    joint_names : sequence of str
+        The take's joints, in skeleton order.
+    n_frames : int
+    intervals : iterable of (str, int, int)
+        Joint name, first and last frame (inclusive) of each interval; unknown joints are
+        skipped.
+    """
+    index = {name: j for j, name in enumerate(joint_names)}
+    mask = np.zeros((n_frames, len(joint_names)), dtype=bool)
+    for joint, start, end in intervals:
+        if joint in index:
+            mask[max(start, 0) : end + 1, index[joint]] = True
+    return mask
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,6 +122,15 @@ class TwistAnalysis:
     detected_offsets_rad: FloatArray
     apply: str = "confident"
     found: tuple[DetectedInterval, ...] = ()
+
+    def interval_frames(self) -> BoolArray:
+        """Frames inside an interval found (applied or not), per joint: shape (F, J), True on
+        the frames of each interval's joint (its chain's parent)."""
+        return interval_frames(
+            self.joint_names,
+            self.refined.n_frames,
+            [(i.joint, i.start_frame, i.end_frame) for i in self.intervals],
+        )
 
     def summaries(self) -> list[dict[str, Any]]:
         """Per chain: joint, side, segment, interval count, flagged frames, largest offset."""
