@@ -6,15 +6,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from tests.rigs import rerig
 
 from mocapqa.core.decimate import sample_frames
 from mocapqa.core.keypoints import KeypointSequence
+from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.io.formats import read_take
 from mocapqa.jobs.demo import demo_paths
 from mocapqa.jobs.runner import write_outputs
 from mocapqa.kinematics.forward import forward_kinematics
+from mocapqa.kinematics.quaternion import conjugate, multiply
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.frames import motion_points, motion_pose, rigid_bones
 from mocapqa.pipeline.options import AnalysisOptions
@@ -192,3 +195,38 @@ def test_a_travelling_joint_is_not_joined_to_its_parent_by_a_bone(corpus_dir: Pa
     assert len(rigid_bones(walk)) == walk.skeleton.n_joints - 1 + len(walk.skeleton.end_sites)
     result = analyze(bandai, AnalysisOptions(checks=("twist",)))
     assert result.report["points"]["bones"] == bones
+
+
+def test_the_limits_step_frames_an_unseen_rig_without_the_twist_intervals(
+    corpus_dir: Path,
+) -> None:
+    """A short take of a rig no model has seen (the CMU walk with turned joint frames), its
+    left thigh rolled 90° on 50 of 60 frames with the children undoing it: framed from
+    itself, the roll set the thigh's frame and read as nothing; the pipeline hands the twist
+    step's intervals to the limits step, which frames the thigh from the clean frames and
+    flags the rolled ones."""
+    walk = read_bvh(corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh")
+    short = rerig(Motion(walk.skeleton, walk.quats[1:61], walk.translations[1:61], walk.fps), 5)
+    thigh = short.skeleton.index("LeftUpLeg")
+    child = short.skeleton.children(thigh)[0]
+    axis = short.skeleton.offsets[child] / np.linalg.norm(short.skeleton.offsets[child])
+    turn = np.r_[np.sin(np.pi / 4) * axis, np.cos(np.pi / 4)]
+    quats = short.quats.copy()
+    quats[5:55, thigh] = multiply(quats[5:55, thigh], turn)
+    for c in short.skeleton.children(thigh):
+        quats[5:55, c] = multiply(conjugate(turn), quats[5:55, c])
+    damaged = Motion(short.skeleton, quats, short.translations, short.fps)
+
+    def flagged(options: AnalysisOptions) -> float:
+        report = analyze(damaged, options).report
+        assert report["steps"]["limits"]["state"] == "done"
+        frames = np.zeros(damaged.n_frames, dtype=bool)
+        for f in report["findings"]:
+            if f["kind"] == "limits" and f["joint"] == "LeftUpLeg":
+                frames[f["start_frame"] : f["end_frame"] + 1] = True
+        return float(frames[5:55].mean())
+
+    with_twist = flagged(AnalysisOptions(checks=("twist", "limits")))
+    alone = flagged(AnalysisOptions(checks=("limits",)))
+    assert with_twist >= 0.85  # 45 of the 50 rolled frames
+    assert alone == 0.0
