@@ -104,7 +104,7 @@ def test_findings_are_normalised_by_kind() -> None:
     ]
     out = normalise_findings(given)
     assert out[0]["offset_deg"] == -20.0
-    assert out[1]["kind"] == "limit"
+    assert out[1]["kind"] == "limits"
     assert out[1]["violation_deg"] == 4.0
     twist = {"intervals": [{"joint": "A", "start_frame": 3, "end_frame": 9, "offset_deg": 12.5}]}
     assert twist_findings(twist)[0]["offset_deg"] == 12.5

@@ -88,7 +88,7 @@ def limit_findings(limits: Mapping[str, Any] | None, min_frames: int = 1) -> lis
             if stop - start < min_frames:
                 continue
             finding = {
-                "kind": "limit",
+                "kind": "limits",
                 "joint": str(joint.get("name")),
                 "start_frame": int(frames[start]),
                 "end_frame": int(frames[stop - 1]),
@@ -112,7 +112,7 @@ def normalise_findings(findings: list[dict[str, Any]]) -> list[dict[str, Any]]:
         if "value" in item and item["value"] is not None:
             key = "offset_deg" if kind in ("twist", "spin") else "violation_deg"
             item.setdefault(key, float(item["value"]))
-        item["kind"] = "limit" if kind == "limits" else kind
+        item["kind"] = kind
         item["start_frame"] = int(item.get("start_frame", 0))
         item["end_frame"] = int(item.get("end_frame", item["start_frame"]))
         out.append(item)

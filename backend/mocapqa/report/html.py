@@ -107,7 +107,7 @@ def _findings_table(findings: Sequence[Mapping[str, Any]], fps: float | None) ->
         return '<p class="muted">No flagged intervals.</p>'
     head = (
         "<tr><th>#</th><th>kind</th><th>joint</th><th>frames</th><th>time (s)</th>"
-        "<th>offset / violation (deg)</th><th>confidence</th><th>read-out</th></tr>"
+        "<th>offset / spin / violation (deg)</th><th>confidence</th><th>read-out</th></tr>"
     )
     rows = []
     for k, f in enumerate(findings, start=1):
