@@ -136,7 +136,8 @@ def test_import_progress_sort_review_export(
     columns = p.locator("#shoot-takes th[data-sort]").evaluate_all(
         "(ths) => ths.map((th) => th.dataset.sort)"
     )
-    assert len(columns) == 14
+    assert len(columns) == 15
+    assert "limb_spins" in columns
     for column in columns:
         header = f"#shoot-takes th[data-sort='{column}']"
         for _ in range(2):
