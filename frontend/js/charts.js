@@ -31,7 +31,9 @@ export const chainColors = (twist) => new Map(twist.chains.map((c, k) => [c.join
 export function twistFigure(twist, spins = []) {
   const frames = twist.frames;
   const colors = chainColors(twist);
-  const affected = new Set(twist.intervals.map((i) => i.joint));
+  // Drawn at first: the chains with a flagged interval or a limb spin (else the first two).
+  const chainJoints = new Set(twist.chains.map((c) => c.joint));
+  const affected = new Set([...twist.intervals, ...spins.filter((s) => chainJoints.has(s.joint))].map((i) => i.joint));
   const data = [];
   twist.chains.forEach((chain, k) => {
     const visible = affected.size === 0 ? (k < 2 ? true : "legendonly") : (affected.has(chain.joint) ? true : "legendonly");
@@ -47,7 +49,7 @@ export function twistFigure(twist, spins = []) {
   // One band trace per chain, in that chain's colour.
   for (const joint of affected) {
     const own = twist.intervals.filter((i) => i.joint === joint);
-    data.push(intervalBars(own, -180, 180, "y", colors.get(joint) || PALETTE[3], joint));
+    if (own.length) data.push(intervalBars(own, -180, 180, "y", colors.get(joint) || PALETTE[3], joint));
   }
   const shown = (joint) => data.find((t) => t.legendgroup === joint && t.type === "scatter")?.visible ?? "legendonly";
   for (const joint of new Set(spins.map((s) => s.joint))) {

@@ -59,6 +59,7 @@ test("limb spins are hatched bands on their limb's chain, shown and hidden with 
   assert.equal(bands[0].legendgroup, "R_Upperarm");
   assert.deepEqual(bands[0].customdata, [[2, 3, "R_Upperarm"]]);
   assert.equal(bands[0].marker.pattern.shape, "/");
-  // R_Upperarm has no twist interval, so its chain starts hidden, and its spin band with it.
-  assert.equal(bands[0].visible, "legendonly");
+  // R_Upperarm has no twist interval, but a spin: its chain is drawn at first, band and all.
+  assert.equal(bands[0].visible, true);
+  assert.deepEqual([...new Set(data.filter((t) => t.visible === true).map((t) => t.legendgroup))].sort(), ["L_Calf", "R_Upperarm"]);
 });
