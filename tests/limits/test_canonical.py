@@ -278,5 +278,27 @@ def test_a_role_whose_frame_needs_a_missing_role_is_not_checked(cmu: Motion) -> 
             assert f"{side}_{role}" in report.not_checked
     assert report.flagged_fraction == 0.0
     assert frame_needs("hand") == ("forearm",)
-    assert frame_needs("upper_arm") == ("clavicle", "forearm")
+    assert frame_needs("upper_arm") == ("forearm",)  # a missing clavicle is stood in for
+    assert frame_needs("forearm") == ("upper_arm",)
     assert frame_needs("upper_leg") == ("lower_leg",)
+
+
+def test_an_upper_arm_without_a_clavicle_is_checked_against_the_mean_clavicle(
+    cmu: Motion,
+) -> None:
+    """A rig without clavicles (Human3.6M-style) still gets its upper arms checked: the
+    missing clavicle stands at the model's mean clavicle pose relative to the chest. On the
+    CMU walk with its clavicles renamed beyond the role tables, the upper arms read within a
+    few degrees of the full rig's reading and nothing is flagged."""
+    renamed = rerig(cmu, seed=1, renames={"LeftShoulder": "SegA", "RightShoulder": "SegB"})
+    report = check_limits(renamed)
+    full = check_limits(cmu)
+    assert "left_clavicle" in report.not_checked
+    for side in ("left", "right"):
+        role = f"{side}_upper_arm"
+        assert role in report.roles
+        mine, theirs = report.roles.index(role), full.roles.index(role)
+        assert not (~report.valid[:, mine]).any()
+        # The walk's clavicles hardly move, so the stand-in is close to the real one.
+        gap = report.params_deg[:, mine] - full.params_deg[:, theirs]
+        assert np.median(np.abs((gap + 180.0) % 360.0 - 180.0)) < 10.0

@@ -23,7 +23,13 @@ from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles
 from mocapqa.errors import InputError, LimitsFileError
 from mocapqa.kinematics.quaternion import multiply
-from mocapqa.limits.canonical import CANONICAL_AXIS, CanonicalFrames, rig_key, take_frames
+from mocapqa.limits.canonical import (
+    CANONICAL_AXIS,
+    STAND_IN_PARENTS,
+    CanonicalFrames,
+    rig_key,
+    take_frames,
+)
 from mocapqa.limits.charting import canonical_params
 from mocapqa.limits.discriminator import network_valid
 from mocapqa.limits.expmap import limit_params_from_quats
@@ -201,6 +207,15 @@ def charted(
     columns = [k for k, j in enumerate(model.joints) if j.role in column]
     picked = [column[model.joints[k].role] for k in columns]
     references = np.stack([model.joints[k].reference for k in columns])
+    by_role = {j.role: j for j in model.joints}
+    for c, k in enumerate(columns):
+        # A missing parent role (an upper arm's clavicle) stands at the model's mean pose of
+        # that role relative to the body: conj(A_body ⊗ ref_parent) ⊗ A_child.
+        role = model.joints[k].role
+        side, _, own = role.partition("_")
+        stand_in = by_role.get(f"{side}_{STAND_IN_PARENTS.get(own, '')}")
+        if role in frames.stand_ins and stand_in is not None:
+            references[c] = multiply(stand_in.reference, references[c])
     # conj(reference) ⊗ conj(A_parent) ⊗ A_child = conj(A_parent ⊗ reference) ⊗ A_child: the
     # reference joins the parent's constant frame, saving one product per frame.
     charted_frames = replace(

@@ -56,13 +56,16 @@ from mocapqa.limits.rig import MODELLED_ROLES, axis_label
 
 __all__ = [
     "CANONICAL_AXIS",
+    "STAND_IN_PARENTS",
     "CanonicalFrames",
     "canonical_frames",
+    "frame_needs",
     "pose_sample",
     "rig_frames",
     "rig_key",
     "role_parent",
     "take_frames",
+    "without_stand_ins",
 ]
 
 # The long axis of every canonical frame.
@@ -80,12 +83,22 @@ _PARENT_ROLE = {
 _PLANE_ROLE = {"upper_arm": "forearm", "upper_leg": "lower_leg"}
 
 
+STAND_IN_PARENTS = {"upper_arm": "clavicle"}
+"""Roles checked without their parent role: the missing parent is taken at the model's mean
+pose relative to the body (a clavicle moves little against the chest; rigs such as Human3.6M's
+have none)."""
+
+
 def frame_needs(role: str) -> tuple[str, ...]:
     """The roles a role's canonical frame is measured with: its parent role (else the rotation
-    would be read against the body frame, which the model's role was not) and, for an upper
-    arm or upper leg, the next segment that gives its flexion axis. Without them the role is
-    not checked (a hand read against the body, not the forearm, reads as 100° out)."""
-    return tuple(r for r in (_PARENT_ROLE.get(role), _PLANE_ROLE.get(role)) if r is not None)
+    would be read against the body frame, which the model's role was not; except a parent in
+    :data:`STAND_IN_PARENTS`) and, for an upper arm or upper leg, the next segment that gives
+    its flexion axis. Without them the role is not checked (a hand read against the body, not
+    the forearm, reads as 100° out)."""
+    parent = _PARENT_ROLE.get(role)
+    if STAND_IN_PARENTS.get(role) == parent:
+        parent = None
+    return tuple(r for r in (parent, _PLANE_ROLE.get(role)) if r is not None)
 
 
 _DISTAL_ROLE = {
@@ -134,6 +147,10 @@ class CanonicalFrames:
     not_checked : tuple of str
         Modelled role keys absent from the skeleton, or whose frame needs one that is
         (:func:`frame_needs`).
+    stand_ins : tuple of str
+        Role keys whose parent role is missing but may be stood in for (an upper arm without
+        a clavicle, :data:`STAND_IN_PARENTS`): their parent frame is the body frame in the
+        skeleton parent, which a check turns by the model's mean pose of the missing role.
     """
 
     roles: tuple[str, ...]
@@ -142,6 +159,7 @@ class CanonicalFrames:
     frames: FloatArray
     parent_frames: FloatArray
     not_checked: tuple[str, ...]
+    stand_ins: tuple[str, ...] = ()
 
 
 def _unit(v: FloatArray) -> FloatArray:
@@ -290,7 +308,7 @@ def canonical_frames(
         quats, positions = quats[keep], positions[keep]
         ignore = None if ignore is None else ignore[keep]
     body = {arms: _body_axes(rig, positions, arms) for arms in (True, False)}
-    roles, joints, parents, frames, parent_frames = [], [], [], [], []
+    roles, joints, parents, frames, parent_frames, stand_ins = [], [], [], [], [], []
     cache: dict[int, FloatArray] = {}
     long_axes: dict[int, FloatArray] = {}
 
@@ -366,6 +384,8 @@ def canonical_frames(
             up_l = np.mean(_local(quats[:, parent], up_w), axis=0)
             # Legs hang: their body frame's long axis points down, so standing is near identity.
             parent_frames.append(_frame_quat(left_l, up_l if role in _ARM_ROLES else -up_l))
+            if role in STAND_IN_PARENTS:
+                stand_ins.append(role_key(side, role))
         roles.append(role_key(side, role))
         joints.append(joint)
         parents.append(parent)
@@ -377,6 +397,23 @@ def canonical_frames(
         frames=np.stack(frames),
         parent_frames=np.stack(parent_frames),
         not_checked=missing,
+        stand_ins=tuple(stand_ins),
+    )
+
+
+def without_stand_ins(frames: CanonicalFrames) -> CanonicalFrames:
+    """``frames`` without the roles whose parent role is stood in for (listed as not
+    checked instead)."""
+    if not frames.stand_ins:
+        return frames
+    keep = [k for k, role in enumerate(frames.roles) if role not in frames.stand_ins]
+    return CanonicalFrames(
+        roles=tuple(frames.roles[k] for k in keep),
+        joints=frames.joints[keep],
+        parents=frames.parents[keep],
+        frames=frames.frames[keep],
+        parent_frames=frames.parent_frames[keep],
+        not_checked=frames.not_checked + frames.stand_ins,
     )
 
 

@@ -19,7 +19,7 @@ import numpy as np
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import RigMap
-from mocapqa.limits.canonical import CanonicalFrames, take_frames
+from mocapqa.limits.canonical import CanonicalFrames, take_frames, without_stand_ins
 from mocapqa.limits.expmap import swing_twist_params, twist_frames
 
 __all__ = [
@@ -112,6 +112,7 @@ def canonical_quats(
     motion: Motion, rig: RigMap | None = None, known: CanonicalFrames | None = None
 ) -> tuple[CanonicalFrames, FloatArray]:
     """Canonical frames of a take (:func:`mocapqa.limits.canonical.take_frames`) and its
-    canonical rotations ``(F, R, 4)``."""
-    frames = take_frames(motion, rig, known)
+    canonical rotations ``(F, R, 4)``, for building a model: roles whose parent role is only
+    stood in for are left out (their rotations are relative to the body, not to that role)."""
+    frames = without_stand_ins(take_frames(motion, rig, known))
     return frames, canonical_rotations(motion, frames)
