@@ -59,7 +59,13 @@ from mocapqa.limits.build import (
     role_rotations,
     stored_frames,
 )
-from mocapqa.limits.canonical import CanonicalFrames, canonical_frames, pose_sample, rig_key
+from mocapqa.limits.canonical import (
+    CanonicalFrames,
+    canonical_frames,
+    pose_sample,
+    rig_key,
+    without_stand_ins,
+)
 from mocapqa.limits.charting import canonical_rotations
 from mocapqa.limits.model import LimitsModel, StoredFrames
 from mocapqa.limits.rig import MODELLED_ROLES, rig_fingerprint
@@ -205,7 +211,7 @@ def _rig_frames(
             frames = canonical_frames(group[0].skeleton, world=pooled)
         except InputError as e:
             raise InputError(f"{group[0].name}: {e}") from e
-        known[key] = frames
+        known[key] = without_stand_ins(frames)  # a build leaves stood-in roles out
         stored[key] = stored_frames(group[0].skeleton, frames)
     return known, stored
 

@@ -28,6 +28,7 @@ from mocapqa.limits.canonical import (
     STAND_IN_PARENTS,
     CanonicalFrames,
     rig_key,
+    stand_in_roles,
     take_frames,
 )
 from mocapqa.limits.charting import canonical_params
@@ -247,8 +248,9 @@ def _known_frames(motion: Motion, model: LimitsModel) -> CanonicalFrames | None:
         return None
     missing = tuple(j.role for j in model.joints if j.role not in stored.roles)
     return CanonicalFrames(
-        stored.roles, joints, parents, stored.frames, stored.parent_frames, missing
-    )
+        stored.roles, joints, parents, stored.frames, stored.parent_frames, missing,
+        stand_in_roles(stored.roles),
+    )  # fmt: skip
 
 
 def limit_params(motion: Motion, model: LimitsModel) -> FloatArray:

@@ -64,6 +64,7 @@ __all__ = [
     "rig_frames",
     "rig_key",
     "role_parent",
+    "stand_in_roles",
     "take_frames",
     "without_stand_ins",
 ]
@@ -87,6 +88,19 @@ STAND_IN_PARENTS = {"upper_arm": "clavicle"}
 """Roles checked without their parent role: the missing parent is taken at the model's mean
 pose relative to the body (a clavicle moves little against the chest; rigs such as Human3.6M's
 have none)."""
+
+
+def stand_in_roles(roles: Sequence[str]) -> tuple[str, ...]:
+    """The role keys among ``roles`` whose parent role is missing from them and stood in for
+    (:data:`STAND_IN_PARENTS`): an upper arm without its side's clavicle."""
+    present = set(roles)
+    out = []
+    for key in roles:
+        side, _, role = key.partition("_")
+        parent = STAND_IN_PARENTS.get(role)
+        if parent is not None and f"{side}_{parent}" not in present:
+            out.append(key)
+    return tuple(out)
 
 
 def frame_needs(role: str) -> tuple[str, ...]:
@@ -308,7 +322,7 @@ def canonical_frames(
         quats, positions = quats[keep], positions[keep]
         ignore = None if ignore is None else ignore[keep]
     body = {arms: _body_axes(rig, positions, arms) for arms in (True, False)}
-    roles, joints, parents, frames, parent_frames, stand_ins = [], [], [], [], [], []
+    roles, joints, parents, frames, parent_frames = [], [], [], [], []
     cache: dict[int, FloatArray] = {}
     long_axes: dict[int, FloatArray] = {}
 
@@ -384,8 +398,6 @@ def canonical_frames(
             up_l = np.mean(_local(quats[:, parent], up_w), axis=0)
             # Legs hang: their body frame's long axis points down, so standing is near identity.
             parent_frames.append(_frame_quat(left_l, up_l if role in _ARM_ROLES else -up_l))
-            if role in STAND_IN_PARENTS:
-                stand_ins.append(role_key(side, role))
         roles.append(role_key(side, role))
         joints.append(joint)
         parents.append(parent)
@@ -397,7 +409,7 @@ def canonical_frames(
         frames=np.stack(frames),
         parent_frames=np.stack(parent_frames),
         not_checked=missing,
-        stand_ins=tuple(stand_ins),
+        stand_ins=stand_in_roles(roles),
     )
 
 
