@@ -220,13 +220,20 @@ def test_the_limits_step_frames_an_unseen_rig_without_the_twist_intervals(
     def flagged(options: AnalysisOptions) -> float:
         report = analyze(damaged, options).report
         assert report["steps"]["limits"]["state"] == "done"
+        messages.append(report["steps"]["limits"]["message"])
         frames = np.zeros(damaged.n_frames, dtype=bool)
         for f in report["findings"]:
             if f["kind"] == "limits" and f["joint"] == "LeftUpLeg":
                 frames[f["start_frame"] : f["end_frame"] + 1] = True
         return float(frames[5:55].mean())
 
+    messages = []
+
     with_twist = flagged(AnalysisOptions(checks=("twist", "limits")))
     alone = flagged(AnalysisOptions(checks=("limits",)))
     assert with_twist >= 0.85  # 45 of the 50 rolled frames
     assert alone == 0.0
+    # The step says how it read the take.
+    assert "estimated from this take, " in messages[0]
+    assert "inside twist intervals left out" in messages[0]
+    assert "estimated from this take)" in messages[1]

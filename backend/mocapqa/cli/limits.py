@@ -288,10 +288,9 @@ def limits_check(
             f"{worst[0]['frame']}: {worst[0]['readout']}" if worst else "",
         )
     console.print(table)
-    kind = "canonical frames" if report.rig_family == "canonical" else "rig frames"
     console.print(
-        f"model: {report.rig_family} ({kind}); not checked ({len(report.not_checked)}): "
-        f"{', '.join(report.not_checked) or 'none'}"
+        f"model: {report.rig_family} ({report.framing}); not checked "
+        f"({len(report.not_checked)}): {', '.join(report.not_checked) or 'none'}"
     )
 
 

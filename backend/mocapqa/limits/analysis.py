@@ -69,6 +69,10 @@ class LimitsReport:
     not_checked : tuple of str
         The take's joints this check does not cover (no role, or a role the model lacks),
         and the model's roles missing from the take.
+    framing : str
+        How the take's joints were read: by the rig's own model, in the rig's stored
+        canonical frames, or in frames estimated from the take (and how many frames inside
+        twist intervals were left out of that estimate).
     """
 
     joint_names: tuple[str, ...]
@@ -83,6 +87,7 @@ class LimitsReport:
     method: str
     excess_deg: FloatArray
     not_checked: tuple[str, ...] = ()
+    framing: str = ""
 
     def readout(self, frame: int, joint: int) -> str:
         """Anatomical read-out of one frame and joint ("right knee hyperextended 14°").
@@ -149,6 +154,7 @@ class LimitsReport:
             "flagged_fraction": self.flagged_fraction,
             "joints": joints,
             "not_checked": list(self.not_checked),
+            "framing": self.framing,
         }
 
 
@@ -336,7 +342,21 @@ def check_limits(
         method=method,
         excess_deg=excess,
         not_checked=not_checked,
+        framing=_framing(motion, model, mapping, ignore),
     )
+
+
+def _framing(
+    motion: Motion, model: LimitsModel, mapping: Mapping[str, str] | None, ignore: BoolArray | None
+) -> str:
+    """How :func:`charted` read the take (:attr:`LimitsReport.framing`)."""
+    if model.frame != "canonical":
+        return "the rig's own model"
+    if not mapping and _known_frames(motion, model) is not None:
+        return "canonical frames stored for this rig"
+    left_out = 0 if ignore is None else int(ignore.any(axis=1).sum())
+    extra = f", {left_out} frame(s) inside twist intervals left out" if left_out else ""
+    return f"canonical frames estimated from this take{extra}"
 
 
 def joint_map_json(model: LimitsModel, joint: str) -> dict[str, Any]:

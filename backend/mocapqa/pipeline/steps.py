@@ -290,7 +290,8 @@ def run_limits(
 
     return StepOutcome(
         "done",
-        f"{len(findings)} violation interval(s), model {model_name} ({report.rig_family}); "
+        f"{len(findings)} violation interval(s), model {model_name} ({report.rig_family}, "
+        f"{report.framing}); "
         f"{len(report.not_checked)} joint(s) not checked (listed in summary.not_checked)",
         findings,
         Plot(heat, _finding_edges(findings), at),
