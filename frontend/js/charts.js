@@ -23,11 +23,13 @@ function intervalBars(intervals, yBase, yTop, yaxis, color, name) {
 }
 
 /** Chain colours: one per twist chain (joint name), in the order of the chains. */
-export const chainColors = (twist) => new Map(twist.chains.map((c, k) => [c.joint, PALETTE[k % PALETTE.length]]));
+// Purple and orange are the spins' and the limits' colours: a chain never takes them.
+const CHAIN_PALETTE = PALETTE.filter((c) => c !== "#9467bd" && c !== "#ff7f0e");
+export const chainColors = (twist) => new Map(twist.chains.map((c, k) => [c.joint, CHAIN_PALETTE[k % CHAIN_PALETTE.length]]));
 
 /** The twist chart: θP and the removed offset per chain, the flagged intervals as bands in
  * their chain's colour, and limb spins (`spins`: findings of kind "spin", reported and never
- * corrected) as hatched grey bands on the chain of the limb's upper segment. */
+ * corrected) as hatched purple bands on the chain of the limb's upper segment. */
 export function twistFigure(twist, spins = []) {
   const frames = twist.frames;
   const colors = chainColors(twist);
@@ -69,7 +71,7 @@ export function twistFigure(twist, spins = []) {
     yaxis: { domain: [0.52, 1], title: { text: "θP (°)" }, range: [-185, 185] },
     yaxis2: { domain: [0, 0.45], title: { text: "offset (°)" } },
     legend: { orientation: "h", y: -0.3, yanchor: "top", font: { size: 11 },
-      title: { text: "solid: twist θP · dashed: removed offset", side: "top" } },
+      title: { text: `solid: twist θP · dashed: removed offset${spins.length ? " · hatched: limb spin (not corrected)" : ""}`, side: "top" } },
   };
   return { data, layout };
 }

@@ -3,7 +3,7 @@
 // link serves the raw take with exactly the accepted corrections (an undecided interval keeps
 // the run's own choice, shown as "applied" / "not applied").
 import * as api from "./api.js";
-import { badge, h } from "./dom.js";
+import { badge, h, toast } from "./dom.js";
 
 export const DECISION_KEYS = { y: "accept", x: "reject" }; // on the focused or last opened twist row
 const LABELS = { accept: "accepted", reject: "rejected" };
@@ -17,6 +17,7 @@ export function intervalDecisions(run, result) {
   const latest = new Map(); // interval id -> "accept" | "reject"
   const cells = new Map(); // interval id -> the row's decision cell
   let current = null; // the last opened twist interval
+  let lastKind = null; // the kind of the last opened finding
   const message = h("span", { id: "decision-message", class: "muted" });
   const note = h("input", { id: "decision-note", placeholder: "note for the next decision", "aria-label": "decision note" });
   const history = h("ul", { id: "decision-history" });
@@ -59,11 +60,13 @@ export function intervalDecisions(run, result) {
       await api.addDecision(run.id, id, { decision, note: note.value, reviewer });
       note.value = "";
       message.textContent = `${label(id)} ${LABELS[decision]}`; message.className = "muted";
+      toast(message.textContent);
       showHistory((await api.getDecisions(run.id)).history);
     } catch (e) {
       if (before) latest.set(id, before); else latest.delete(id);
       fill(id);
       message.textContent = e.message; message.className = "error";
+      toast(e.message);
     }
   }
 
@@ -84,19 +87,28 @@ export function intervalDecisions(run, result) {
     },
     /** The last opened finding: Y/X act on it when it is a twist interval, and on none after
      * a spin or limits finding (never on an interval opened before it). */
-    opened(f) { current = f && f.kind === "twist" ? f.id : null; },
+    opened(f) { current = f && f.kind === "twist" ? f.id : null; lastKind = f ? f.kind : null; },
     /** Y / X on the focused (else the last opened) twist row; true when the key was used. */
     onKey(e) {
       const decision = DECISION_KEYS[e.key.toLowerCase()];
-      if (!twist || !decision) return false;
+      if (!decision) return false;
+      if (!twist) { toast("this run has no twist intervals to accept or reject"); return true; }
       const focused = document.activeElement && document.activeElement.closest && document.activeElement.closest("tr.finding");
       if (focused && !focused.dataset.interval) {
         message.textContent = `a ${focused.dataset.kind} finding is reported, not corrected: nothing to accept or reject`;
         message.className = "muted";
+        toast(message.textContent);
         return true;
       }
       const id = focused ? Number(focused.dataset.interval) : current;
-      if (id == null || !byId.has(id)) { message.textContent = "open or focus a twist finding first"; message.className = "muted"; return true; }
+      if (id == null || !byId.has(id)) {
+        message.textContent = lastKind && lastKind !== "twist"
+          ? `a ${lastKind} finding is reported, not corrected: nothing to accept or reject`
+          : "open or focus a twist finding first";
+        message.className = "muted";
+        toast(message.textContent);
+        return true;
+      }
       decide(id, decision);
       return true;
     },

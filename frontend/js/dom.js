@@ -40,3 +40,17 @@ export function preloadModulesOf(url) {
   const meta = document.head.querySelector(`meta[name="modules-of"][data-module="${url}"]`);
   preloadModules(meta ? meta.content.split(" ").filter(Boolean) : [url]);
 }
+
+/** A short message at the bottom of the window, read out by screen readers, gone after a few
+ * seconds: feedback for a key press whose result is not on screen (one at a time). */
+export function toast(text, seconds = 3) {
+  let el = document.getElementById("toast");
+  if (!el) {
+    el = h("div", { id: "toast", role: "status", "aria-live": "polite" });
+    document.body.append(el);
+  }
+  el.textContent = text;
+  el.hidden = false;
+  clearTimeout(el.timer);
+  el.timer = setTimeout(() => { el.hidden = true; }, seconds * 1000);
+}

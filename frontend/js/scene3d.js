@@ -67,6 +67,12 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   const { names, parents, nJoints, oriented } = skeleton;
   // Keypoint takes of a known layout come with their bones; others are joined by parents.
   const bones = skeleton.bones && skeleton.bones.length ? skeleton.bones : geo.bonesOf(parents);
+  // A BVH joint the server joined by no bone (a static root left at the origin while its child
+  // carries the travel, as Bandai's joint_Root) is not drawn; the root followed is its child.
+  const inBone = new Set(bones.flat());
+  const loose = new Set(oriented && skeleton.bones && skeleton.bones.length ? names.map((_, j) => j).filter((j) => !inBone.has(j)) : []);
+  const firstRoot = parents.indexOf(-1);
+  const drawnRoot = loose.has(firstRoot) ? parents.findIndex((p, j) => p === firstRoot && !loose.has(j)) : firstRoot;
   const sides = oriented ? geo.boneSides(overview.raw[0], overview.raw_rotations[0], bones) : null;
   // bodyBox answers in Z-up terms: its floor is the lowest data Y, its half the body's size.
   const box = geo.bodyBox([overview.raw, overview.corrected], 0.1);
@@ -100,7 +106,7 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
     grid.position.y = floorY;
     parts.scene.add(grid);
     if (oriented) {
-      const path = overview.raw.map((points) => points[parents.indexOf(-1)]).filter(geo.present);
+      const path = overview.raw.map((points) => points[drawnRoot]).filter(geo.present);
       const line = new THREE.Line(new THREE.BufferGeometry().setFromPoints(path.map((p) => new THREE.Vector3(p[0], floorY + size * 0.002, p[2]))),
         new THREE.LineBasicMaterial({ color: 0x95a5a6 }));
       parts.scene.add(line);
@@ -112,7 +118,7 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   tooltip.hidden = true;
   document.body.append(tooltip);
 
-  const root = oriented ? parents.indexOf(-1) : -1;
+  const root = oriented ? drawnRoot : -1;
   let focus = "body";
   let frame = null, triadsOn = false, overlayOn = false, renders = 0, drawn = 0, scheduled = 0, marked = false;
   const sizeOf = (view) => [view.div.clientWidth, view.div.clientHeight];
@@ -184,7 +190,7 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
     }
     const jp = view.joints.geometry.attributes.position, jc = view.joints.geometry.attributes.color;
     points.forEach((p, j) => {
-      const ok = geo.present(p);
+      const ok = geo.present(p) && !loose.has(j);
       jp.array[3 * j] = ok ? p[0] : NaN; jp.array[3 * j + 1] = ok ? p[1] : NaN; jp.array[3 * j + 2] = ok ? p[2] : NaN;
       // A bridged keypoint is drawn purple at full strength (the filter's value, not a detection).
       const isBridged = bridged && bridged[j];
@@ -260,7 +266,7 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
     const points = view === views.raw ? frame.raw : frame.corrected;
     let best = null, bestDistance = 10;
     points.forEach((p, j) => {
-      if (!geo.present(p)) return;
+      if (!geo.present(p) || loose.has(j)) return;
       const [x, y] = project(view, p);
       const d = Math.hypot(x - e.clientX, y - e.clientY);
       if (d < bestDistance) { best = j; bestDistance = d; }

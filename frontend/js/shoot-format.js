@@ -75,7 +75,7 @@ export const TAKE_COLUMNS = [
   { key: "duration_s", label: "duration", format: (v) => (v == null ? "–" : `${fmt(v, 1)} s`), narrow: true },
   { key: "rig", label: "rig", format: (v) => v || "–", narrow: true },
   { key: "twist_intervals", label: "twist", format: count },
-  { key: "limb_spins", label: "spins", format: count, narrow: true },
+  { key: "limb_spins", label: "spins", format: count, narrow: true, title: "limb spins and flips reported (never corrected)" },
   { key: "violation_share", label: "outside limits", format: percent },
   { key: "worst_joint", label: "worst joint", format: (v) => v || "–", narrow: true },
   { key: "filter_residual_mm", label: "filter mm", format: (v) => fmt(v, 2), narrow: true },

@@ -177,9 +177,10 @@ function filterBar(state, apply) {
 function takeTable(page, state, apply) {
   const header = TAKE_COLUMNS.map((c) => {
     const sorted = state.sort === c.key;
-    const th = h("th", { class: `sortable${c.narrow ? " narrow-hide" : ""}`, "data-sort": c.key, "aria-sort": sorted ? (state.order === "asc" ? "ascending" : "descending") : "none" },
+    const th = h("th", { class: `sortable${c.narrow ? " narrow-hide" : ""}`, "data-sort": c.key, "aria-sort": sorted ? (state.order === "asc" ? "ascending" : "descending") : "none", title: c.title || null },
       c.label, sorted ? (state.order === "asc" ? " ▲" : " ▼") : "");
-    return activatable(th, () => apply(nextSort(state, c.key)));
+    // From the state when clicked, not when drawn: two clicks before the answer toggle twice.
+    return activatable(th, () => apply((now) => nextSort(now, c.key)));
   });
   const rows = page.items.map((t) => activatable(h("tr", { class: "clickable", "data-take": t.take_id, "aria-label": `open ${t.name}` },
     h("td", { class: "thumb-cell" }, t.status === "done" ? h("img", { class: "thumb", src: api.thumbnailUrl(t.take_id, t.run_id), alt: "" }) : null),
@@ -191,7 +192,10 @@ function takeTable(page, state, apply) {
       if (c.key === "score") td.firstChild.style.color = scoreColor(t.score);
       return td;
     })), () => { location.hash = api.takeLink(t.take_id, t.run_id); }));
-  return h("div", { class: "table-scroll" }, h("table", { id: "shoot-takes" },
+  // The order in words too: a narrow window hides some sorted columns' headers.
+  const by = TAKE_COLUMNS.find((c) => c.key === state.sort);
+  const caption = h("caption", { id: "shoot-sort", class: "muted" }, by ? `sorted by ${by.label} ${state.order === "asc" ? "▲" : "▼"}` : "");
+  return h("div", { class: "table-scroll" }, h("table", { id: "shoot-takes" }, caption,
     h("thead", {}, h("tr", {}, h("th", {}, ""), header)), h("tbody", {}, rows)));
 }
 
@@ -210,9 +214,11 @@ export async function shootView(main, shootId, params, onTeardown) {
   let alive = true;
   onTeardown(() => { alive = false; clearTimeout(timer); });
 
+  let drawn = 0; // the latest table request: an older answer arriving late is dropped
   const drawTable = async () => {
+    const request = ++drawn;
     const page = await api.shootTakes(shootId, takesQuery(state));
-    if (!alive) return;
+    if (!alive || request !== drawn) return;
     const info = pageInfo(state.offset, state.limit, page.total);
     const move = (offset) => h("button", { disabled: offset == null, onclick: () => apply({ offset }) });
     const previous = move(info.previous); previous.append("‹ previous"); previous.id = "page-previous";
@@ -225,7 +231,8 @@ export async function shootView(main, shootId, params, onTeardown) {
     if (focused) tableBox.querySelector(`th[data-sort="${focused}"]`)?.focus();
     tableArea.dataset.query = takesQuery(state);
   };
-  function apply(patch) {
+  function apply(change) {
+    const patch = typeof change === "function" ? change(state) : change;
     const resetsPage = !("offset" in patch);
     const before = state;
     state = { ...state, ...patch, ...(resetsPage ? { offset: 0 } : {}) };

@@ -53,6 +53,10 @@ export async function takeView(main, takeId, params, onTeardown) {
   store.reset();
   store.set({ frame: Math.max(0, Math.min(nFrames - 1, Number(params.get("frame")) || 0)), joint: params.get("joint") });
   const chainColor = result.series.twist ? charts.chainColors(result.series.twist) : new Map();
+  // Drawn and coloured in this order, so a twist interval shows over a spin over a long limits
+  // run (on the time bar and on a joint flagged by several).
+  const KIND_ORDER = { limits: 0, spin: 1, twist: 2 };
+  const byKind = (a, b) => (KIND_ORDER[a.kind] ?? 0) - (KIND_ORDER[b.kind] ?? 0);
   const findingColor = (f) => (f.kind === "twist" ? chainColor.get(f.joint) || "#c0392b" : f.kind === "spin" ? charts.SPIN_COLOR : LIMITS_COLOR);
   let detail = null;
 
@@ -99,7 +103,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   const list = findingsList(result.findings, decided, (f) => { decided.opened(f); store.set({ joint: f.joint }); focusCharts(); jump(f.start_frame); viewsRow.scrollIntoView({ block: "start" }); },
     linkedFilter, (query) => { filterQuery = query; remember(); });
   const timebar = createTimebar({
-    nFrames, marks: result.findings.map((f) => ({ start: f.start_frame, end: f.end_frame, color: findingColor(f), label: `${f.kind} · ${f.joint} · ${f.start_frame}–${f.end_frame}` })),
+    nFrames, marks: [...result.findings].sort(byKind).map((f) => ({ start: f.start_frame, end: f.end_frame, color: findingColor(f), label: `${f.kind} · ${f.joint} · ${f.start_frame}–${f.end_frame}` })),
     onJump: (f) => { if (player.playing) togglePlay(); jump(f); }, onRange: (r) => setRange(r),
   });
   document.getElementById("player").append(timebar.el);
@@ -116,7 +120,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     const k = Math.max(0, Math.min(source.frames.length - 1, Math.round((f - source.frames[0]) / source.step)));
     return k;
   };
-  const intervals = result.findings.filter((f) => jointIndex.has(f.joint));
+  const intervals = result.findings.filter((f) => jointIndex.has(f.joint)).sort(byKind);
   const flaggedAt = (f) => {
     const flagged = new Map();
     for (const i of intervals) if (f >= i.start_frame && f <= i.end_frame) flagged.set(jointIndex.get(i.joint), findingColor(i));
@@ -260,6 +264,8 @@ export async function takeView(main, takeId, params, onTeardown) {
         list.mark(reached);
         // The finding reached is the one opened: its joint selected, Y/X act on it if twist.
         if (reached) { decided.opened(reached); store.set({ joint: reached.joint }); focusCharts(); }
+        // Y/X then act on the finding reached, not on a row focused before.
+        if (document.activeElement && document.activeElement.closest && document.activeElement.closest("tr.finding")) document.activeElement.blur();
         jump(stop);
       }
     } else if (e.key === "i" || e.key === "I") {
@@ -297,8 +303,9 @@ export async function takeView(main, takeId, params, onTeardown) {
 
   const series = result.series;
   if (series.twist) {
-    await timeline.add("chart-twist", `Twist θP and removed offset (${series.twist.intervals.length} flagged interval(s))`,
-      charts.twistFigure(series.twist, result.findings.filter((f) => f.kind === "spin")), (p) => {
+    const spins = result.findings.filter((f) => f.kind === "spin");
+    await timeline.add("chart-twist", `Twist θP and removed offset (${series.twist.intervals.length} flagged interval(s)${spins.length ? `, ${spins.length} limb spin(s)` : ""})`,
+      charts.twistFigure(series.twist, spins), (p) => {
         if (p.customdata) return p.customdata[0];
         const inside = series.twist.intervals.find((i) => i.start_frame <= p.x && p.x <= i.end_frame + 1);
         return inside ? inside.start_frame : p.x;

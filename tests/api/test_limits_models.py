@@ -132,7 +132,7 @@ def test_runs_of_a_shoot_use_its_model(team: Team, cmu_walk: Path) -> None:
     assert second["options"]["limits_model"] == "walks"
     assert second["summary"]["steps"]["limits"] == "done"
     report = client.get(f"{API}/runs/{second['id']}/result", headers=admin).json()
-    assert "model walks (cmu)" in report["steps"]["limits"]["message"]
+    assert "model walks (cmu, the rig's own model)" in report["steps"]["limits"]["message"]
     assert (
         client.get(f"{API}/runs/{run['id']}", headers=admin).json()["options"]["limits_model"]
         == "bandai"

@@ -59,7 +59,7 @@ class Page:
 
 @pytest.fixture
 def page(chromium: Any) -> Iterator[Page]:
-    opened = Page(chromium)
+    opened = Page(chromium, width=1600)  # every column shows from 1440 px
     yield opened
     assert opened.errors == []
     opened.page.close()

@@ -120,14 +120,14 @@ def normalise_findings(findings: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 
 def sheet_findings(findings: list[dict[str, Any]], max_tiles: int = 8) -> list[dict[str, Any]]:
-    """The findings a contact sheet shows: twist intervals first, then limb spins, then the
-    largest limit violations, at most ``max_tiles`` (normalised as by
-    :func:`normalise_findings`)."""
+    """The findings a contact sheet shows: twist intervals first, then the largest limit
+    violations, at most ``max_tiles`` (normalised as by :func:`normalise_findings`). Limb
+    spins are left out: a sheet compares raw and corrected poses, and a spin is never
+    corrected (the findings table lists them)."""
     normalised = normalise_findings(findings)
     twists = [f for f in normalised if f["kind"] == "twist"]
-    spins = [f for f in normalised if f["kind"] == "spin"]
     others = sorted(
         (f for f in normalised if f["kind"] not in ("twist", "spin")),
         key=lambda f: -float(f.get("violation_deg", 0)),
     )
-    return [*twists, *spins, *others][:max_tiles]
+    return [*twists, *others][:max_tiles]

@@ -217,7 +217,9 @@ def build_report(
     missing = [s for s in ("twist", "limits") if (twist if s == "twist" else limits) is None]
     if missing:
         parts.append(_unavailable("; ".join(f"{s}: {reasons.get(s, 'not run')}" for s in missing)))
-    parts.append(_findings_table([*twists, *spins, *limit_runs], fps_value))
+    # In frame order, as the take view lists them ungrouped.
+    listed = sorted([*twists, *spins, *limit_runs], key=lambda f: (f["start_frame"], f["kind"]))
+    parts.append(_findings_table(listed, fps_value))
 
     sections: list[tuple[str, str, str, Mapping[str, Any] | None]] = [
         ("twist", "twist-timeline", "Twist timeline", twist),
