@@ -121,3 +121,34 @@ def test_limb_spins_are_listed_with_their_read_out_and_nothing_to_accept(
     assert "not corrected" in p.inner_text("#decision-message")
     p.wait_for_timeout(300)  # a decision would be posted and listed by now
     assert history.count() == before
+
+
+def test_n_then_y_decides_the_twist_interval_reached_and_says_so_on_screen(
+    live_server: str, knees: dict[str, Any], page: Page
+) -> None:
+    """A spin row clicked (and so focused), then N walks on to a twist interval: Y accepts the
+    interval reached, not the focused spin row, and the answer shows in a toast."""
+    p = page.page
+    page.open_take(live_server, knees)
+    p.wait_for_selector("#findings td.decision button.decide-accept")
+    spin = p.locator("#findings tr.finding[data-kind='spin']").first
+    spin.click()
+    reached = None
+    for _ in range(60):
+        p.keyboard.press("n")
+        current = p.locator("#findings tr.finding.current")
+        if current.count() and current.get_attribute("data-kind") == "twist":
+            reached = current.get_attribute("data-interval")
+            break
+    assert reached is not None
+    p.keyboard.press("y")
+    p.wait_for_function(
+        "(id) => document.querySelector(`#findings tr[data-interval='${id}'] td.decision`)"
+        "?.innerText.includes('accepted')",
+        arg=reached,
+    )
+    # Once the server has saved it, the answer shows at the bottom of the window.
+    p.wait_for_function(
+        "() => { const t = document.getElementById('toast');"
+        " return t && !t.hidden && t.textContent.includes('accepted'); }"
+    )
