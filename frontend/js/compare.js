@@ -32,6 +32,7 @@ export async function compareView(main, params, onTeardown = () => {}) {
       metric("frames", (x) => x.summary.n_frames), metric("frame rate (fps)", (x) => fmt(x.summary.fps, 2)),
       metric("duration (s)", (x) => fmt(x.summary.duration_s, 2)), metric("findings", (x) => x.summary.n_findings),
       metric("twist intervals", (x) => x.summary.findings_by_kind.twist || 0), metric("largest removed offset", maxOffset),
+      metric("limb spins (reported, not corrected)", (x) => x.summary.findings_by_kind.spin || 0),
       metric("joint-limit intervals", (x) => (x.steps.limits.state === "done" ? x.summary.findings_by_kind.limits || 0 : x.steps.limits.state)),
       metric("filter", (x) => (x.steps.filter.state === "done" ? x.series.filter?.method || x.options.filter_method : x.steps.filter.state)),
       metric("server time (s)", (x, run) => fmt(run.server_time_s, 3)))));

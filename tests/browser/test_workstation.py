@@ -702,6 +702,11 @@ def test_compare_matches_findings_and_diffs_options(
     )
     # B ran no limits check: A's limits findings are only in A.
     assert "only in A" in matches
+    # The counts by kind add up to the findings, spins included.
+    table = p.inner_text("#compare-table")
+    spins = sum(f["kind"] == "spin" for f in knees["result"]["findings"])
+    assert spins > 0
+    assert f"limb spins (reported, not corrected)\t{spins}\t{spins}" in table
     assert p.evaluate("() => document.getElementById('compare-twist').data.length") == 4
     # Both runs side by side in 3D, one camera: a drag in A's view turns B's too.
     assert p.locator("#compare-3d canvas").count() == 1  # one canvas draws both runs
