@@ -25,8 +25,9 @@ frame is a bind pose (:func:`mocapqa.kinematics.bindpose.leading_bind_pose`) is 
 These are reported, never applied: which side of a spin is the natural roll is not known
 without a model of the limb's natural range (the limits check flags the side that is out of
 range), and a wrong choice would roll a clean stretch. :data:`SPIN_RATE_DEG_S` is above every
-roll of the kind on the corpus takes of other subjects (the largest is 865°/s, on a Character
-Creator basketball take; Bandai and CMU stay under 500°/s): a figure about that corpus.
+roll of the kind on the corpus takes of other subjects (the largest is 870°/s, on a Character
+Creator basketball take; Bandai stays under 520°/s, CMU under 320°/s): a figure about that
+corpus.
 """
 
 from __future__ import annotations
