@@ -8,11 +8,11 @@ from its root (shoulder, hip) to its end joint (wrist, ankle):
 * **spin** — the end segment (hand, foot) stays: it counter-rotates against the limb in its
   parent's frame. On a nearly straight arm or leg the roll hardly moves a joint position, so it
   shows only in the segments' orientations and in the skinning. Subject 005's Character
-  Creator dance takes hold runs of 15–42° per frame at 60 fps (900–2,600°/s), summing to up to
-  160° in five frames, with the hand turning by less than 7° per frame;
+  Creator dance takes hold runs of 15–45° per frame at 60 fps (900–2,700°/s), summing to up to
+  184° in five frames (``005_03`` frames 26–30, the hand turning 7° meanwhile);
 * **flip** — the end segment turns with the limb by 90° or more in one frame (a knee or elbow
   pole flip: the middle joint jumps to the mirror side of the limb's axis while the root and
-  end joints stay). ``005_05``'s right leg flips by about 175° five times in 0.5 s.
+  end joints stay). ``005_05``'s right leg flips by 105–176° ten times in frames 161–194.
 
 A step between two frames is an event when the upper segment's world rotation about the limb
 axis is faster than :data:`SPIN_RATE_DEG_S`, the middle segment turns with it (its roll about
