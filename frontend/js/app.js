@@ -5,6 +5,11 @@ import { parseRoute } from "./route.js";
 import "./prefetch.js"; // the take view's first requests, started before the first route (see there)
 
 const main = document.getElementById("main");
+// Shown while a route loads for longer than a blink: the previous page stays until the new one
+// is drawn, and on a slow network it would otherwise look like nothing happened.
+const loading = h("div", { id: "route-loading", role: "status", "aria-live": "polite", hidden: true }, "loading…");
+document.body.append(loading);
+let loadingTimer = null;
 let teardowns = [];
 let routed = 0; // routes opened so far: a view whose module arrives after a newer route is not shown
 
@@ -40,7 +45,17 @@ function route() {
   teardowns = [];
   delete main.dataset.ready;
   const { parts, params } = parseRoute(location.hash);
-  open(parts, params, ++routed).catch((e) => main.replaceChildren(h("p", { class: "error" }, e.message)));
+  const mine = ++routed;
+  clearTimeout(loadingTimer);
+  loadingTimer = setTimeout(() => { if (mine === routed) loading.hidden = false; }, 300);
+  main.setAttribute("aria-busy", "true");
+  const done = () => {
+    if (mine !== routed) return;
+    clearTimeout(loadingTimer);
+    loading.hidden = true;
+    main.removeAttribute("aria-busy");
+  };
+  open(parts, params, mine).then(done, (e) => { done(); main.replaceChildren(h("p", { class: "error" }, e.message)); });
 }
 window.addEventListener("hashchange", route);
 route();
