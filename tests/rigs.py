@@ -51,3 +51,18 @@ def rerig(motion: Motion, seed: int, renames: dict[str, str] | None = None) -> M
         root_translation=skeleton.root_translation,
     )
     return Motion(turned, quats, translations, motion.fps)
+
+
+def roll_joint(motion: Motion, joint: int, degrees: float, frames: slice) -> Motion:
+    """``motion`` with ``joint`` rolled by ``degrees`` about its bone (its first child's
+    OFFSET) on ``frames``, every child undoing the roll: a twist error whose children keep
+    their world poses."""
+    child = motion.skeleton.children(joint)[0]
+    axis = motion.skeleton.offsets[child] / np.linalg.norm(motion.skeleton.offsets[child])
+    half = np.deg2rad(degrees) / 2
+    turn = np.r_[np.sin(half) * axis, np.cos(half)]
+    quats = motion.quats.copy()
+    quats[frames, joint] = multiply(quats[frames, joint], turn)
+    for c in motion.skeleton.children(joint):
+        quats[frames, c] = multiply(conjugate(turn), quats[frames, c])
+    return Motion(motion.skeleton, quats, motion.translations, motion.fps)

@@ -7,13 +7,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tests.rigs import RENAMES, rerig
+from tests.rigs import RENAMES, rerig, roll_joint
 
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.kinematics.forward import forward_kinematics
-from mocapqa.kinematics.quaternion import conjugate, geodesic_angle, multiply, rotate
+from mocapqa.kinematics.quaternion import geodesic_angle, multiply, rotate
 from mocapqa.limits.analysis import LimitsReport, check_limits
 from mocapqa.limits.build import BuildParams, build_canonical_model, with_rig_frames
 from mocapqa.limits.canonical import CANONICAL_AXIS, frame_needs, rig_frames, rig_key
@@ -194,12 +194,7 @@ def test_a_new_rig_framed_once_from_its_takes_keeps_its_frames_through_a_damaged
     walk = read_bvh(root / names[0])
     thigh = walk.skeleton.index("LeftUpLeg")
     short = Motion(walk.skeleton, walk.quats[1:61].copy(), walk.translations[1:61], walk.fps)
-    turn = quat_about(short, thigh, 90.0)
-    quats = short.quats.copy()
-    quats[5:55, thigh] = multiply(quats[5:55, thigh], turn)
-    for child in short.skeleton.children(thigh):
-        quats[5:55, child] = multiply(conjugate(turn), quats[5:55, child])
-    damaged = Motion(short.skeleton, quats, short.translations, short.fps)
+    damaged = roll_joint(short, thigh, 90.0, slice(5, 55))
     assert rig_key(damaged) not in bandai_model.rig_frames
     alone = check_limits(damaged, bandai_model)
     framed = with_rig_frames(bandai_model, [walk], names)
@@ -230,12 +225,7 @@ def test_a_take_framed_alone_leaves_out_its_twist_intervals(
     walk = read_bvh(corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh")
     thigh = walk.skeleton.index("LeftUpLeg")
     short = Motion(walk.skeleton, walk.quats[1:61].copy(), walk.translations[1:61], walk.fps)
-    turn = quat_about(short, thigh, 90.0)
-    quats = short.quats.copy()
-    quats[5:55, thigh] = multiply(quats[5:55, thigh], turn)
-    for child in short.skeleton.children(thigh):
-        quats[5:55, child] = multiply(conjugate(turn), quats[5:55, child])
-    damaged = Motion(short.skeleton, quats, short.translations, short.fps)
+    damaged = roll_joint(short, thigh, 90.0, slice(5, 55))
     found = analyze_twist(damaged, apply="none").interval_frames()
     assert found[5:55, thigh].mean() > 0.9
     assert not found[:, thigh].all()
@@ -255,14 +245,6 @@ def test_a_take_framed_alone_leaves_out_its_twist_intervals(
     np.testing.assert_array_equal(
         check_limits(short, bandai_model, ignore=nothing).params_deg, clean.params_deg
     )
-
-
-def quat_about(motion: Motion, joint: int, degrees: float) -> np.ndarray:
-    """Rotation of ``degrees`` about the joint's bone (its child's OFFSET), scalar-last."""
-    child = motion.skeleton.children(joint)[0]
-    axis = motion.skeleton.offsets[child] / np.linalg.norm(motion.skeleton.offsets[child])
-    half = np.deg2rad(degrees) / 2
-    return np.r_[np.sin(half) * axis, np.cos(half)]
 
 
 def test_a_role_whose_frame_needs_a_missing_role_is_not_checked(cmu: Motion) -> None:

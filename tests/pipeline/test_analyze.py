@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tests.rigs import rerig
+from tests.rigs import rerig, roll_joint
 
 from mocapqa.core.decimate import sample_frames
 from mocapqa.core.keypoints import KeypointSequence
@@ -17,7 +17,6 @@ from mocapqa.io.formats import read_take
 from mocapqa.jobs.demo import demo_paths
 from mocapqa.jobs.runner import write_outputs
 from mocapqa.kinematics.forward import forward_kinematics
-from mocapqa.kinematics.quaternion import conjugate, multiply
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.frames import motion_points, motion_pose, rigid_bones
 from mocapqa.pipeline.options import AnalysisOptions
@@ -208,14 +207,7 @@ def test_the_limits_step_frames_an_unseen_rig_without_the_twist_intervals(
     walk = read_bvh(corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh")
     short = rerig(Motion(walk.skeleton, walk.quats[1:61], walk.translations[1:61], walk.fps), 5)
     thigh = short.skeleton.index("LeftUpLeg")
-    child = short.skeleton.children(thigh)[0]
-    axis = short.skeleton.offsets[child] / np.linalg.norm(short.skeleton.offsets[child])
-    turn = np.r_[np.sin(np.pi / 4) * axis, np.cos(np.pi / 4)]
-    quats = short.quats.copy()
-    quats[5:55, thigh] = multiply(quats[5:55, thigh], turn)
-    for c in short.skeleton.children(thigh):
-        quats[5:55, c] = multiply(conjugate(turn), quats[5:55, c])
-    damaged = Motion(short.skeleton, quats, short.translations, short.fps)
+    damaged = roll_joint(short, thigh, 90.0, slice(5, 55))
 
     def flagged(options: AnalysisOptions) -> float:
         report = analyze(damaged, options).report
