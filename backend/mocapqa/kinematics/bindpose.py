@@ -20,12 +20,14 @@ from __future__ import annotations
 import numpy as np
 
 from mocapqa.core.arrays import FloatArray
-from mocapqa.kinematics.quaternion import geodesic_angle
 
 __all__ = ["BIND_POSE_RATIO", "MIN_BIND_STEP_DEG", "leading_bind_pose"]
 
 BIND_POSE_RATIO = 3.0
 """The step into frame 1 over the largest later step above which frame 0 is a bind pose."""
+
+_MOVING_STEP_DEG = 1e-4
+"""Largest step of a joint that counts as not moving at all, degrees."""
 
 MIN_BIND_STEP_DEG = 1.0
 """Smallest median step into frame 1 that can be a bind pose, degrees (a still take is not)."""
@@ -48,10 +50,13 @@ def leading_bind_pose(quats: FloatArray) -> int:
     """
     if quats.shape[0] < 3 or quats.shape[1] == 0:
         return 0
-    steps = np.rad2deg(geodesic_angle(quats[:-1], quats[1:]))  # (F − 1, J)
-    moving = steps.max(axis=0) > 1e-4
+    # A step's angle 2·arccos|q_t · q_t+1| falls as |dot| rises, so the median and the largest
+    # step are read from |dot| and only those two become angles: one dot product per cell
+    # rather than an angle (on a long take the angles cost more than the twist detection).
+    closeness = np.abs(np.einsum("fjc,fjc->fj", quats[:-1], quats[1:]))  # (F − 1, J)
+    moving = closeness.min(axis=0) < np.cos(np.deg2rad(_MOVING_STEP_DEG) / 2.0)
     if not moving.any():
         return 0
-    median = np.median(steps[:, moving], axis=1)
-    first, later = float(median[0]), float(median[1:].max())
+    median = np.median(closeness[:, moving], axis=1)
+    first, later = np.rad2deg(2.0 * np.arccos(np.clip([median[0], median[1:].min()], 0.0, 1.0)))
     return int(first >= MIN_BIND_STEP_DEG and first > BIND_POSE_RATIO * later)
