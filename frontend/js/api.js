@@ -151,7 +151,8 @@ export const limitsModels = () => request("GET", "/limits-models");
 export const setShootLimitsModel = (id, name) => request("PUT", `/shoots/${id}/limits-model`, { name });
 export const rerunStaleLimits = (id) => request("POST", `/shoots/${id}/limits-reruns`);
 export const nextForReview = (id, after) => request("GET", `/shoots/${id}/next${after ? `?after=${after}` : ""}`);
-export const summaryUrl = (id, kind) => `${BASE}/shoots/${id}/summary.${kind}`;
+/** The shoot summary download; `query` (exportQuery) narrows and orders it like the table. */
+export const summaryUrl = (id, kind, query = "") => `${BASE}/shoots/${id}/summary.${kind}${query ? `?${query}` : ""}`;
 export const shootLink = (id, query = "") => `#/shoot/${id}${query ? `?${query}` : ""}`;
 
 /** Import files and archives into a shoot (one multipart request, field `files` repeated);

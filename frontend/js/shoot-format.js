@@ -177,6 +177,13 @@ export function heatmapQuery(page, state = TABLE_DEFAULTS) {
   return takesQuery({ ...TABLE_DEFAULTS, ...state, limit: safe.limit, offset: safe.offset });
 }
 
+/** The query string of the summary export: the table's filters, sort and order (not its page),
+ * so a download holds the takes the table lists, in its order. */
+export function exportQuery(state) {
+  const full = { ...TABLE_DEFAULTS, ...state };
+  return takesQuery(Object.fromEntries(Object.entries(full).filter(([key]) => key !== "limit" && key !== "offset")));
+}
+
 /** Whether the table's state filters the takes (so an empty heat map says why). */
 export function isFiltered(state) {
   return TABLE_FILTERS.some((key) => state[key] !== "" && state[key] != null);

@@ -8,7 +8,7 @@ import { loadPlotly, untabbableModebar } from "./plotly.js";
 import { fmt } from "./format.js";
 import { limitsModelPanel } from "./shoot-limits.js";
 import {
-  decisionForKey, deleteConfirmed, formatCell, HEATMAP_SIZES, heatmapChanged, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
+  decisionForKey, deleteConfirmed, exportQuery, formatCell, HEATMAP_SIZES, heatmapChanged, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
   importLines, isFiltered, nextSort, pageInfo, progressSummary, scoreColor, shootControls, TAKE_COLUMNS, tableState, takesQuery, viewQuery,
 } from "./shoot-format.js";
 
@@ -231,12 +231,26 @@ export async function shootView(main, shootId, params, onTeardown) {
     if (focused) tableBox.querySelector(`th[data-sort="${focused}"]`)?.focus();
     tableArea.dataset.query = takesQuery(state);
   };
+  // The downloads hold what the table lists (its filters and order), and say so when filtered.
+  const exportLinks = {
+    csv: h("a", { class: "download", id: "export-csv", download: "" }),
+    json: h("a", { class: "download", id: "export-json", download: "" }),
+  };
+  const labelExports = () => {
+    for (const [kind, link] of Object.entries(exportLinks)) {
+      link.href = api.summaryUrl(shootId, kind, exportQuery(state));
+      link.textContent = `${isFiltered(state) ? "filtered " : ""}summary ${kind.toUpperCase()}`;
+      link.title = isFiltered(state) ? "the takes that pass the table's filters, in its order" : "every take, in the table's order";
+    }
+  };
+  labelExports();
   function apply(change) {
     const patch = typeof change === "function" ? change(state) : change;
     const resetsPage = !("offset" in patch);
     const before = state;
     state = { ...state, ...patch, ...(resetsPage ? { offset: 0 } : {}) };
     history.replaceState(null, "", api.shootLink(shootId, viewQuery(state)));
+    labelExports();
     drawTable().catch(showError);
     if (heatmapChanged(before, state)) { // the heat map shows the table's takes, from its first page
       heat = heatmapPage(0, heat.limit);
@@ -320,8 +334,7 @@ export async function shootView(main, shootId, params, onTeardown) {
     h("h1", {}, h("a", { href: "#/shoots" }, "Shoots"), " / ", title),
     h("div", { class: "controls", id: "shoot-actions" },
       h("a", { class: "button primary", id: "review-queue", href: `#/shoot/${shootId}/review` }, "review queue"),
-      h("a", { class: "download", id: "export-csv", href: api.summaryUrl(shootId, "csv"), download: "" }, "summary CSV"),
-      h("a", { class: "download", id: "export-json", href: api.summaryUrl(shootId, "json"), download: "" }, "summary JSON"),
+      exportLinks.csv, exportLinks.json,
       manageControls(shoot, who, (renamed) => { title.textContent = renamed.name; })),
     modelPanel,
     importPanel(shootId, restartPolling),

@@ -149,6 +149,21 @@ def test_import_files_table_queue_export_and_delete(client: TestClient, corpus_d
     assert {t["name"]: t["score"] for t in as_json["takes"]} == {
         r["name"]: float(r["score"]) for r in rows
     }
+    # With the take table's filters and order (what the dashboard's links send), the export
+    # holds the table's takes in the table's order, and says which filters it applied.
+    chosen = {"review_status": "approved"}
+    only = list(csv.DictReader(io.StringIO(
+        client.get(f"{API}/shoots/{sid}/summary.csv", params=chosen).text)))  # fmt: skip
+    assert [r["name"] for r in only] == [r["name"] for r in approved]
+    ordered = {"sort": "score", "order": "desc", "has_findings": "false"}
+    table = client.get(f"{API}/shoots/{sid}/takes", params=ordered).json()["items"]
+    as_json = client.get(f"{API}/shoots/{sid}/summary.json", params=ordered).json()
+    assert [t["name"] for t in as_json["takes"]] == [t["name"] for t in table]
+    assert as_json["filters"] == {"has_findings": False}
+    assert (as_json["sort"], as_json["order"]) == ("score", "desc")
+    bad = client.get(f"{API}/shoots/{sid}/summary.csv", params={"min_score": 500})
+    assert bad.status_code == 422
+    assert "min_score" in bad.text
 
     refused = client.delete(f"{API}/shoots/{sid}")
     assert refused.status_code == 422

@@ -204,7 +204,16 @@ def test_import_progress_sort_review_export(
     table = list(csv.reader(io.StringIO(text)))
     assert table[0] == list(EXPORT_COLUMNS)
     assert len(table) == 1 + 4
-    assert p.get_attribute("#export-json", "href").endswith("/summary.json")
+    assert p.get_attribute("#export-json", "href").endswith("/summary.json?sort=score&order=asc")
+    # Filtered, the downloads hold the table's takes only, and say so.
+    p.select_option("#shoot-review_status", "approved")
+    p.wait_for_function("document.getElementById('export-csv').textContent.startsWith('filtered')")
+    with p.expect_download() as download_info:
+        p.click("#export-csv")
+    only = list(csv.DictReader(io.StringIO(Path(download_info.value.path()).read_text())))
+    assert sorted(r["review_status"] for r in only) == ["approved", "approved"]
+    p.select_option("#shoot-review_status", "")
+    p.wait_for_function("document.getElementById('export-csv').textContent === 'summary CSV'")
 
     # The heat map (Plotly, loaded by this view only): one row per take, lowest score first;
     # the keypoint take, which has no joint limits, is an empty row.

@@ -1,7 +1,7 @@
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import {
-  decisionForKey, deleteConfirmed, formatCell, HEATMAP_MAX_TAKES, heatmapChanged, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
+  decisionForKey, deleteConfirmed, exportQuery, formatCell, HEATMAP_MAX_TAKES, heatmapChanged, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
   heatmapRows, importLines, isFiltered, nextSort, pageInfo, progressSummary, scoreColor, shootControls, tableState, takesQuery, viewQuery,
   TABLE_DEFAULTS,
 } from "../../frontend/js/shoot-format.js";
@@ -210,4 +210,10 @@ test("heatmapFigure labels rows by rank (same names stay apart) and sizes rows e
   const big = heatmapFigure({ joints: ["A"], takes: Array.from({ length: 500 }, (_, k) => ({ name: `t${k}` })), values: [Array(500).fill(0)] }, 0);
   assert.equal(big.height, 120 + 22 * 500);
   assert.equal(big.y[499], "500. t499");
+});
+
+test("exportQuery sends the table's filters, sort and order, never its page", () => {
+  const state = { ...TABLE_DEFAULTS, sort: "name", order: "desc", offset: 50, limit: 25, rig: " cmu ", has_findings: "true" };
+  assert.equal(exportQuery(state), "sort=name&order=desc&rig=cmu&has_findings=true");
+  assert.equal(exportQuery(TABLE_DEFAULTS), "sort=score&order=asc");
 });

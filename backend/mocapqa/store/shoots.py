@@ -74,6 +74,12 @@ class TakeFilter:
         self.has_findings = has_findings
         self.search = search
 
+    def chosen(self) -> dict[str, Any]:
+        """The filters that are set, by name (for an export to say what it holds)."""
+        names = ("status", "review_status", "rig", "min_score", "max_score", "has_findings",
+                 "search")  # fmt: skip
+        return {n: getattr(self, n) for n in names if getattr(self, n) is not None}
+
     def clauses(self) -> list[ColumnElement[bool]]:
         """The SQL conditions."""
         found: list[ColumnElement[bool]] = []
@@ -311,11 +317,19 @@ class ShootStore:
             }
         return [found[i] for i in ids if i in found], total
 
-    def rows(self, shoot_id: str, batch: int = 1000) -> Iterator[dict[str, Any]]:
-        """Every take row of a shoot, by name, read ``batch`` at a time (for exports)."""
+    def rows(
+        self,
+        shoot_id: str,
+        batch: int = 1000,
+        filters: TakeFilter | None = None,
+        sort: str = "name",
+        descending: bool = False,
+    ) -> Iterator[dict[str, Any]]:
+        """The take rows of a shoot that pass ``filters`` (every row when None), in the order of
+        :meth:`page`, read ``batch`` at a time (for exports)."""
         offset = 0
         while True:
-            page, _ = self.page(shoot_id, batch, offset, sort="name")
+            page, _ = self.page(shoot_id, batch, offset, sort, descending, filters)
             yield from page
             if len(page) < batch:
                 return

@@ -242,8 +242,10 @@ EXPORT_COLUMNS = (
 """Columns of the shoot summary export, in order."""
 
 
-def _export_rows(store: ShootStore, shoot_id: str) -> Iterator[dict[str, Any]]:
-    for row in store.rows(shoot_id):
+def _export_rows(
+    store: ShootStore, shoot_id: str, filters: TakeFilter, sort: str, descending: bool
+) -> Iterator[dict[str, Any]]:
+    for row in store.rows(shoot_id, filters=filters, sort=sort, descending=descending):
         yield {column: row.get(column) for column in EXPORT_COLUMNS}
 
 
@@ -255,22 +257,32 @@ def _export_rows(store: ShootStore, shoot_id: str) -> Iterator[dict[str, Any]]:
     },
     response_class=Response,
 )
-def export_summary(shoot_id: str, kind: Literal["csv", "json"], services: ServicesDep) -> Response:
-    """The shoot's QA summary, one row per take (columns in docs/qa-summary.md)."""
+def export_summary(
+    shoot_id: str,
+    kind: Literal["csv", "json"],
+    services: ServicesDep,
+    filters: Filters,
+    sort: ShootSort = "name",
+    order: Literal["asc", "desc"] = "asc",
+) -> Response:
+    """The shoot's QA summary, one row per take (columns in docs/qa-summary.md): every take by
+    name, or the take table's takes in its order when given its filters, ``sort`` and ``order``
+    (what the dashboard's export links send)."""
     store = _store(services)
     shoot = store.get(shoot_id)
     stem = "".join(c if c.isalnum() or c in "-_" else "_" for c in shoot["name"])
     disposition = {"Content-Disposition": f'attachment; filename="{stem}.summary.{kind}"'}
     if kind == "json":
-        rows = list(_export_rows(store, shoot_id))
-        body = json.dumps({"shoot": shoot["name"], "takes": rows}, default=str)
+        rows = list(_export_rows(store, shoot_id, filters, sort, order == "desc"))
+        about = {"shoot": shoot["name"], "filters": filters.chosen(), "sort": sort, "order": order}
+        body = json.dumps({**about, "takes": rows}, default=str)
         return Response(body, media_type="application/json", headers=disposition)
 
     def lines() -> Iterator[str]:
         buffer = io.StringIO()
         writer = csv.DictWriter(buffer, list(EXPORT_COLUMNS))
         writer.writeheader()
-        for row in _export_rows(store, shoot_id):
+        for row in _export_rows(store, shoot_id, filters, sort, order == "desc"):
             writer.writerow(row)
             yield buffer.getvalue()
             buffer.seek(0)
