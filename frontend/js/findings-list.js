@@ -2,7 +2,7 @@
 // worst value), sortable, filtered by kind, joint, smallest value and text. N/P walk the
 // findings the filters keep, across groups; the one reached is marked and its group opened.
 import { activatable, h } from "./dom.js";
-import { findingStops, fmt, sortFindings } from "./format.js";
+import { fmt, sortFindings } from "./format.js";
 import { filterFindings, filterParams, groupByJoint, jointsOf, kindsOf, listOrder } from "./findings.js";
 
 const COLUMNS = [["kind", "kind"], ["joint", "joint"], ["start_frame", "frames"], ["duration", "frames long"], ["value", "offset / spin / outside"], ["confidence", "confidence"]];
@@ -113,8 +113,6 @@ export function findingsList(findings, decided, onOpen, initial = null, onFilter
     panel,
     /** The findings the filters keep, in list order. */
     get shown() { return grouped ? listOrder(groupByJoint(shown, key, dir)) : sortFindings(shown, key, dir); },
-    /** Start frames of the kept findings: N/P stops. */
-    stops: () => findingStops(shown),
     mark,
     get current() { return current; },
   };

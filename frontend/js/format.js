@@ -43,13 +43,18 @@ export function stepsRan(run) {
 /** Run checks a take of this kind can run (twist and limits need joint rotations). */
 export const checksFor = (kind) => (kind === "motion" ? ["twist", "limits", "filter"] : ["filter"]);
 
-/** The start frames of findings, sorted and unique: the stops of N/P navigation. */
-export const findingStops = (findings) => [...new Set(findings.map((f) => f.start_frame))].sort((a, b) => a - b);
-
-/** The next (dir 1) or previous (dir −1) stop from `frame`, or null at the end. */
-export function nextStop(stops, frame, dir) {
-  if (dir > 0) return stops.find((s) => s > frame) ?? null;
-  for (let k = stops.length - 1; k >= 0; k--) if (stops[k] < frame) return stops[k];
+/**
+ * The finding N (dir 1) or P (dir −1) opens, or null at either end. The findings kept are walked
+ * in time order (start frame, then their order in `findings`), one finding at a time: from the
+ * `current` one while the player stands on its start (two findings starting on one frame are two
+ * stops), else from `frame` (the next to start after it, or the last to start before it).
+ */
+export function nextFinding(findings, current, frame, dir) {
+  const order = findings.map((f, k) => [f, k]).sort((a, b) => a[0].start_frame - b[0].start_frame || a[1] - b[1]).map(([f]) => f);
+  const at = current && current.start_frame === frame ? order.indexOf(current) : -1;
+  if (at >= 0) return order[at + dir] ?? null;
+  if (dir > 0) return order.find((f) => f.start_frame > frame) ?? null;
+  for (let k = order.length - 1; k >= 0; k--) if (order[k].start_frame < frame) return order[k];
   return null;
 }
 

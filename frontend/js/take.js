@@ -2,7 +2,7 @@
 import * as api from "./api.js";
 import * as charts from "./charts.js";
 import { badge, h } from "./dom.js";
-import { fmt, nextStop, seconds, stepsRan } from "./format.js";
+import { fmt, nextFinding, seconds, stepsRan } from "./format.js";
 import { filterFromParams, filterParams, findingAt, jointsOf, kindsOf, loopOfFinding } from "./findings.js";
 import { findingsList } from "./findings-list.js";
 import { createTimebar, parseRange, withIn, withOut } from "./timebar.js";
@@ -257,16 +257,15 @@ export async function takeView(main, takeId, params, onTeardown) {
       jump(store.state.frame + (e.key === "ArrowRight" ? 1 : -1) * (e.shiftKey ? 10 : 1));
     } else if (e.key === "n" || e.key === "N" || e.key === "p" || e.key === "P") {
       // N/P walk the findings the list's filters keep, across its groups.
-      const stop = nextStop(list.stops(), store.state.frame, e.key.toLowerCase() === "n" ? 1 : -1);
-      if (stop != null) {
+      const reached = nextFinding(list.shown, list.current, store.state.frame, e.key.toLowerCase() === "n" ? 1 : -1);
+      if (reached) {
         if (player.playing) togglePlay();
-        const reached = list.shown.find((f) => f.start_frame === stop);
         list.mark(reached);
         // The finding reached is the one opened: its joint selected, Y/X act on it if twist.
-        if (reached) { decided.opened(reached); store.set({ joint: reached.joint }); focusCharts(); }
+        decided.opened(reached); store.set({ joint: reached.joint }); focusCharts();
         // Y/X then act on the finding reached, not on a row focused before.
         if (document.activeElement && document.activeElement.closest && document.activeElement.closest("tr.finding")) document.activeElement.blur();
-        jump(stop);
+        jump(reached.start_frame);
       }
     } else if (e.key === "i" || e.key === "I") {
       setRange(withIn(store.state.loop, store.state.frame, nFrames));

@@ -119,15 +119,22 @@ def test_findings_grouped_by_joint_filtered_and_walked(
     p.locator(f"#findings tr.group-head[data-joint='{busiest}']").click()
     scrub(page, 0)
     p.evaluate("() => document.activeElement.blur()")
-    starts = sorted({f["start_frame"] for f in findings if f["start_frame"] > 0})
-    for start in starts:
+    # One stop per finding, in time order: two findings starting on one frame are two stops.
+    later = sorted((f["start_frame"], f["joint"], f["kind"]) for f in findings if f["start_frame"] > 0)
+    visited = []
+    for _ in later:
         p.keyboard.press("n")
-        assert page.frame() == start
         current = [r for r in rows(page) if r["current"]]
         assert len(current) == 1
-        assert current[0]["start"] == start
+        assert page.frame() == current[0]["start"]
+        visited.append((current[0]["start"], current[0]["joint"], current[0]["kind"]))
+    assert sorted(visited) == later
+    assert [v[0] for v in visited] == sorted(v[0] for v in visited)
+    p.keyboard.press("n")
+    assert visited[-1][0] == page.frame()  # the last finding: N stays
     p.keyboard.press("p")
-    assert page.frame() == starts[-2]
+    back = [r for r in rows(page) if r["current"]]
+    assert (back[0]["start"], back[0]["joint"], back[0]["kind"]) == visited[-2]
     # With only the twist kind kept, N and P stop at twist findings only.
     p.uncheck("#filter-kind-limits")
     p.uncheck("#filter-kind-spin")

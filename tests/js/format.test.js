@@ -28,13 +28,21 @@ test("keypoint takes are offered the filter only", () => {
   assert.deepEqual(format.checksFor("motion"), ["twist", "limits", "filter"]);
 });
 
-test("N/P stops go to the next and previous finding start", () => {
-  const stops = format.findingStops([finding(30, 1), finding(10, 1), finding(30, 2)]);
-  assert.deepEqual(stops, [10, 30]);
-  assert.equal(format.nextStop(stops, 10, 1), 30);
-  assert.equal(format.nextStop(stops, 30, 1), null);
-  assert.equal(format.nextStop(stops, 30, -1), 10);
-  assert.equal(format.nextStop(stops, 5, -1), null);
+test("N/P walk the findings one at a time in time order, two on one frame included", () => {
+  const [a, b, c] = [finding(30, 1), finding(10, 1), finding(30, 2)];
+  const list = [a, b, c];
+  assert.equal(format.nextFinding(list, null, 0, 1), b);
+  assert.equal(format.nextFinding(list, b, 10, 1), a);
+  assert.equal(format.nextFinding(list, a, 30, 1), c); // same start frame: its own stop
+  assert.equal(format.nextFinding(list, c, 30, 1), null);
+  assert.equal(format.nextFinding(list, c, 30, -1), a);
+  assert.equal(format.nextFinding(list, a, 30, -1), b);
+  assert.equal(format.nextFinding(list, b, 10, -1), null);
+  // Moved away from the current finding's start: from the frame, not from the finding.
+  assert.equal(format.nextFinding(list, b, 20, 1), a);
+  assert.equal(format.nextFinding(list, a, 40, -1), c);
+  assert.equal(format.nextFinding(list, null, 5, -1), null);
+  assert.equal(format.nextFinding([], null, 5, 1), null);
 });
 
 test("findings of two runs are matched by kind, joint and overlapping frames", () => {
