@@ -404,3 +404,28 @@ def test_the_disagreement_limit_is_chosen_without_the_rig_it_is_checked_on() -> 
     assert checks["c"].chosen == 1.5
     assert (checks["c"].right_blocked, checks["c"].wrong_blocked) == (0, 1)
     assert (checks["c"].right_applied, checks["c"].wrong_applied) == (2, 1)
+
+
+def test_an_onset_with_a_small_step_beside_it_is_still_closed_by_its_release() -> None:
+    # The guide take's right arm: an 85° onset at frame 32, a 3° natural roll step at 33 (an
+    # event too: counter-rotated, above the chain's 2° threshold) and the lone 82° release at
+    # 47. The two events at 32–33 form a cluster, but not a burst of flips: the release closes
+    # it as a whole and the level is held over 32–46.
+    n = 80
+    frames = np.array([32, 33, 47])
+    jumps = np.deg2rad([-85.0, -3.0, 83.0])
+    increments = np.zeros(n)
+    increments[frames] = jumps
+    offsets, found = chain_intervals(
+        frames, jumps, np.zeros(3), increments, np.zeros(n), np.deg2rad(2.0),
+        np.deg2rad(0.5), 30.0, 0.2, 0.5, 0.1, 2.0,
+    )  # fmt: skip
+    assert [(f.start_frame, f.end_frame) for f in found] == [(32, 46)]
+    assert np.allclose(np.rad2deg(offsets[34:47]), -88.0, atol=3.5)
+    # Two comparable flips stay one burst that a lone event far away may not end.
+    flips = np.deg2rad([-85.0, 60.0, 25.0])
+    _, bursts = chain_intervals(
+        frames, flips, np.zeros(3), increments, np.zeros(n), np.deg2rad(2.0),
+        np.deg2rad(0.5), 30.0, 0.2, 0.5, 0.1, 2.0,
+    )  # fmt: skip
+    assert all(f.end_frame < 47 for f in bursts)

@@ -90,6 +90,17 @@ def _closes(
     return abs(level) <= max(threshold, fraction * largest) + slack
 
 
+def _one_onset(
+    jumps: FloatArray, stack: list[int], cluster: IntArray, which: int, fraction: float
+) -> bool:
+    """Whether the open events of cluster ``which`` are one onset and natural steps: at most
+    one jump larger than ``fraction`` of the largest. A lone release may close such a cluster
+    as a whole (an 85° onset with a 3° roll step in the next frame is a level shift, not a
+    burst of flips)."""
+    sizes = np.abs(jumps[[i for i in stack if cluster[i] == which]])
+    return bool(np.sum(sizes > fraction * sizes.max()) <= 1)
+
+
 def _groups(
     frames: IntArray,
     jumps: FloatArray,
@@ -132,7 +143,9 @@ def _groups(
                 bound[stack[p]]
                 and cluster[stack[p]] != cluster[k]
                 and not (alone[k] and abs(float(jumps[stack[p]])) <= minor)
-            ):
+                and not (alone[k] and _one_onset(jumps, stack, cluster, cluster[stack[p]],
+                                                 closure_fraction))
+            ):  # fmt: skip
                 break
             level = float(wrap_angle(np.array(level + jumps[stack[p]])))
             largest = max(largest, abs(float(jumps[stack[p]])))
