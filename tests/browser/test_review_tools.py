@@ -120,7 +120,9 @@ def test_findings_grouped_by_joint_filtered_and_walked(
     scrub(page, 0)
     p.evaluate("() => document.activeElement.blur()")
     # One stop per finding, in time order: two findings starting on one frame are two stops.
-    later = sorted((f["start_frame"], f["joint"], f["kind"]) for f in findings if f["start_frame"] > 0)
+    later = sorted(
+        (f["start_frame"], f["joint"], f["kind"]) for f in findings if f["start_frame"] > 0
+    )
     visited = []
     for _ in later:
         p.keyboard.press("n")
