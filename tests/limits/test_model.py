@@ -13,7 +13,7 @@ from mocapqa.limits.analysis import check_limits, joint_map_json
 from mocapqa.limits.build import BuildParams, build_model
 from mocapqa.limits.discriminator import DiscriminatorParams
 from mocapqa.limits.model import LimitsModel
-from mocapqa.limits.occupancy import OccupancyParams
+from mocapqa.limits.occupancy import OccupancyParams, evaluate
 from mocapqa.limits.storage import (
     default_model_paths,
     load_default_model,
@@ -24,7 +24,7 @@ from mocapqa.limits.storage import (
 
 BANDAI = ("dataset-1_walk_normal_001.bvh", "dataset-2_walk_normal_001.bvh")
 TINY = BuildParams(
-    occupancy=OccupancyParams(bin_deg=15.0, dilation_bins=1, tau_margin_deg=20.0),
+    occupancy=OccupancyParams(bin_deg=15.0, dilation_bins=1, tau_margin_deg=20.0, interpolate=True),
     discriminator=DiscriminatorParams(n_valid=300, hidden_sizes=(8,), max_iter=150),
 )
 
@@ -82,9 +82,18 @@ def test_a_model_survives_a_save_and_load(bandai_model: LimitsModel, tmp_path: P
     loaded = load_model(path)
     assert loaded.fingerprint == bandai_model.fingerprint
     assert loaded.corpus_hash == bandai_model.corpus_hash
+    # The loaded maps check exactly as the built ones: the interpolated twist surface too
+    # (a loader that dropped the flag read every shipped map as steps at the bin edges).
+    rng = np.random.default_rng(0)
+    params = rng.uniform(-np.pi, np.pi, (2000, 3))
     for a, b in zip(loaded.joints, bandai_model.joints, strict=True):
         np.testing.assert_array_equal(a.occupancy.occupied, b.occupancy.occupied)
         np.testing.assert_allclose(a.occupancy.tau_max, b.occupancy.tau_max, rtol=1e-6)
+        assert a.occupancy.interpolate == b.occupancy.interpolate
+        assert b.occupancy.interpolate == bandai_model.occupancy_params.interpolate
+        np.testing.assert_allclose(
+            evaluate(a.occupancy, params)[2], evaluate(b.occupancy, params)[2], atol=1e-4
+        )
         assert a.network is not None
         assert b.network is not None
         np.testing.assert_array_equal(a.network.hidden_weights, b.network.hidden_weights)

@@ -131,7 +131,9 @@ def save_model(model: LimitsModel, path: str | Path) -> None:
     Path(path).write_bytes(model_bytes(model))
 
 
-def _joint_from_file(k: int, entry: dict[str, Any], data: Any, bin_deg: float) -> JointLimits:
+def _joint_from_file(
+    k: int, entry: dict[str, Any], data: Any, params: OccupancyParams
+) -> JointLimits:
     network = None
     if f"{k}/hidden_weights" in data.files:
         network = Network(
@@ -150,10 +152,11 @@ def _joint_from_file(k: int, entry: dict[str, Any], data: Any, bin_deg: float) -
             f"{reference.shape}"
         )
     occupancy = OccupancyMap(
-        bin_deg,
+        params.bin_deg,
         np.asarray(data[f"{k}/occupied"], dtype=bool),
         np.asarray(data[f"{k}/tau_min"], dtype=np.float64),
         np.asarray(data[f"{k}/tau_max"], dtype=np.float64),
+        params.interpolate,
     )
     return JointLimits(
         role=str(entry["role"]),
@@ -181,7 +184,7 @@ def _model_from_npz(data: Any, where: str) -> LimitsModel:
         )
     params = OccupancyParams(**meta["occupancy"])
     joints = tuple(
-        _joint_from_file(k, entry, data, params.bin_deg) for k, entry in enumerate(meta["joints"])
+        _joint_from_file(k, entry, data, params) for k, entry in enumerate(meta["joints"])
     )
     return LimitsModel(
         rig_family=str(meta["rig_family"]),
