@@ -137,3 +137,46 @@ def read_mapping_text() -> dict[str, str]:
     import tomllib
 
     return dict(tomllib.loads(MAPPING_TOML))
+
+
+def test_limits_build_takes_a_mapping_and_stores_it_with_the_rig(
+    odd_walk: Path, mapping_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mocapqa.limits.storage import load_model
+
+    folder = tmp_path / "takes"
+    folder.mkdir()
+    (folder / "odd_walk.bvh").symlink_to(odd_walk)
+    without, with_mapping = tmp_path / "without.npz", tmp_path / "with.npz"
+    build = ["limits", "build", str(folder), "--no-networks", "--all-takes"]
+    assert main([*build, "-o", str(without)]) == 0
+    assert main([*build, "-o", str(with_mapping), "--mapping", str(mapping_file)]) == 0
+    # By name the renamed forearms are not found, so neither are the hands below them.
+    assert not {"left_forearm", "left_hand"} & {j.role for j in load_model(without).joints}
+    mapped = load_model(with_mapping)
+    assert {"left_forearm", "right_forearm", "left_hand"} <= {j.role for j in mapped.joints}
+    (stored,) = mapped.rig_frames.values()
+    assert stored.joints[stored.roles.index("left_forearm")] == "LeftLimbB"
+    # A take of the rig is checked with the roles stored for it.
+    capsys.readouterr()
+    assert main(["limits", "check", str(odd_walk), "--model", str(with_mapping), "--json"]) == 0
+    checked = {j["role"] for j in json.loads(capsys.readouterr().out)["joints"]}
+    assert {"left_forearm", "right_forearm"} <= checked
+
+
+def test_limits_build_refuses_a_mapping_it_cannot_use(
+    odd_walk: Path, mapping_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    folder = tmp_path / "takes"
+    folder.mkdir()
+    (folder / "odd_walk.bvh").symlink_to(odd_walk)
+    out = ["-o", str(tmp_path / "m.npz"), "--no-networks", "--all-takes"]
+    # A per-rig model matches its joints by name.
+    per_rig = ["limits", "build", str(folder), *out, "--rig", "cmu", "--mapping", str(mapping_file)]
+    assert main(per_rig) == 3
+    assert "matches its joints by name" in capsys.readouterr().err
+    other = tmp_path / "other.json"
+    other.write_text('{"left_forearm": "L_Elbow"}', encoding="utf-8")
+    assert main(["limits", "build", str(folder), *out, "--mapping", str(other)]) == 3
+    assert "every joint the mapping names (L_Elbow)" in " ".join(capsys.readouterr().err.split())
+    assert not (tmp_path / "m.npz").exists()

@@ -210,3 +210,24 @@ def test_a_folder_without_takes_with_roles_is_an_input_error(
 ) -> None:
     with pytest.raises(InputError, match="got none"):
         build_on_engine(engine, tmp_path, SETTINGS)
+
+
+def test_a_mapping_reaches_the_build_on_the_cluster(
+    engine: Engine, corpus: Path, tmp_path: Path
+) -> None:
+    # The CMU walk's hands named by hand as the finger bases below them (a choice no name rule
+    # makes): the frames stored for that rig show whether the mapping was used.
+    mapping = {"left_hand": "LeftFingerBase", "right_hand": "RightFingerBase"}
+    takes = canonical_takes(corpus, all_takes=True, mapping=mapping)
+    settings = replace(SETTINGS, discriminator=None)
+    here = build_canonical_model(
+        [m for _, m in takes], [n for n, _ in takes], settings, mapping=mapping
+    )
+    there = build_on_engine(engine, corpus, settings, all_takes=True, mapping=mapping)
+    _assert_same(here, there)
+    walk = next(f for f in there.rig_frames.values() if "LeftFingerBase" in f.joints)
+    assert walk.joints[walk.roles.index("left_hand")] == "LeftFingerBase"
+    plain = build_on_engine(engine, corpus, settings, all_takes=True)
+    assert not any("LeftFingerBase" in f.joints for f in plain.rig_frames.values())
+    with pytest.raises(InputError, match="every joint the mapping names"):
+        build_on_engine(engine, corpus, SETTINGS, mapping={"left_hand": "NoSuchJoint"})

@@ -16,7 +16,7 @@ child is flagged; and check speed in joint-frames per second for the map and the
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -288,19 +288,23 @@ def role_takes(corpus_dir: Path) -> list[tuple[str, Motion]]:
 
 
 def canonical_takes(
-    corpus_dir: Path, all_takes: bool = False, exclude: set[str] | frozenset[str] = frozenset()
+    corpus_dir: Path,
+    all_takes: bool = False,
+    exclude: set[str] | frozenset[str] = frozenset(),
+    mapping: Mapping[str, str] | None = None,
 ) -> tuple[tuple[str, Motion], ...]:
     """The takes a canonical model is built from: every take with roles, of any rig.
 
     Takes of a rig family with two or more takes follow the fixed split (only the build
     takes, unless ``all_takes``); single takes of other rigs are all used. Names in
-    ``exclude`` are left out.
+    ``exclude`` are left out. ``mapping`` gives roles to the takes whose skeleton has the
+    joints it names (:func:`mocapqa.core.rig.mapped_roles`).
     """
     read = [(path.name, read_bvh(path)) for path in corpus_files(corpus_dir)]
     held = set() if all_takes else held_back_names([(n, split_group(m.skeleton)) for n, m in read])
     return tuple(
         (n, m) for n, m in read
-        if rig_fingerprint(m.skeleton) and n not in held and n not in exclude
+        if rig_fingerprint(m.skeleton, mapping) and n not in held and n not in exclude
     )  # fmt: skip
 
 

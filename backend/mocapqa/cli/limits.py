@@ -15,6 +15,8 @@ from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
 from mocapqa.errors import InputError
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from mocapqa.core.motion import Motion
     from mocapqa.limits.build import BuildParams
     from mocapqa.limits.catalog import ModelCatalog
@@ -97,6 +99,7 @@ def limits_build(
             "(0: in this process, the default)."
         ),
     ] = 0,
+    mapping: MappingOption = None,
 ) -> None:
     """Build a joint-limits model from a folder of BVH takes.
 
@@ -104,14 +107,27 @@ def limits_build(
     with roles. With --rig: a model in that rig's own joint frames. --scheduler or --workers
     runs the per-take part of either build on Dask, the training here (same model; worth it
     for folders of hundreds of takes on workers with cores of their own, docs/limits.md).
+
+    ``--mapping`` gives a canonical build the roles of a rig whose joint names are not
+    recognised: it applies to the takes whose skeleton has every joint it names (a folder may
+    hold other rigs too), and the model stores those roles with the rig's frames, so its takes
+    are checked the same way. A per-rig build (--rig) matches joints by name and takes none.
     """
     from dataclasses import replace
+    from functools import partial
 
     from rich.progress import Progress
 
     from mocapqa.bench.limits import canonical_takes, rig_takes
+    from mocapqa.core.rig import require_mapped
     from mocapqa.limits.build import build_canonical_model, build_model
 
+    roles = load_mapping(mapping)
+    if roles and rig is not None:
+        raise InputError(
+            f"--mapping {mapping}: a per-rig model (--rig {rig}) matches its joints by name; "
+            "leave out --rig for a canonical model that uses the mapping"
+        )
     settings = _build_params(bin_deg, dilation, margin_deg, paper, networks)
     if n_valid is not None and settings.discriminator is not None:
         settings = replace(settings, discriminator=replace(settings.discriminator, n_valid=n_valid))
@@ -120,17 +136,21 @@ def limits_build(
         settings = replace(settings, discriminator=networks_asked)
     left_out = set(exclude or ())
     if scheduler or workers > 0:
-        model = _build_on_dask(corpus_dir, rig, settings, all_takes, left_out, scheduler, workers)
+        model = _build_on_dask(
+            corpus_dir, rig, settings, all_takes, left_out, scheduler, workers, roles
+        )
         _write_model(model, output)
         return
+    builder: Callable[..., LimitsModel]
     if rig is None:
-        takes = canonical_takes(corpus_dir, all_takes, left_out)
-        builder = build_canonical_model
+        takes = canonical_takes(corpus_dir, all_takes, left_out, roles)
+        builder = partial(build_canonical_model, mapping=roles)
     else:
         takes = rig_takes(corpus_dir, rig, all_takes, left_out)
         builder = build_model
     if not takes:
         raise InputError(f"Expected BVH takes with limb roles in {corpus_dir}, got none")
+    require_mapped(roles, [m.skeleton for _, m in takes])
     with Progress(console=console, transient=True) as progress:
         task = progress.add_task("building joints", total=None)
         n_done = [0]
@@ -167,7 +187,7 @@ def _write_model(model: LimitsModel, output: Path) -> None:
 
 def _build_on_dask(
     corpus_dir: Path, rig: str | None, settings: BuildParams, all_takes: bool,
-    left_out: set[str], scheduler: str | None, workers: int,
+    left_out: set[str], scheduler: str | None, workers: int, mapping: dict[str, str] | None,
 ) -> LimitsModel:  # fmt: skip
     """A canonical (``rig`` None) or per-rig build whose per-take part runs on Dask, with a
     progress bar."""
@@ -211,6 +231,7 @@ def _build_on_dask(
             left_out,
             on_total=lambda total: progress.update(task, total=total),
             step=step,
+            mapping=mapping,
         )
 
 

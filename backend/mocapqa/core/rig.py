@@ -21,7 +21,7 @@ accepted too (see :func:`normalise_mapping`).
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -38,7 +38,9 @@ __all__ = [
     "RigMap",
     "find_roles",
     "limb_chains",
+    "mapped_roles",
     "normalise_mapping",
+    "require_mapped",
     "role_key",
     "split_side",
 ]
@@ -274,6 +276,34 @@ def find_roles(skeleton: Skeleton, mapping: Mapping[str, str] | None = None) -> 
                 previous = roles[key]
     unmapped = tuple(key for key in ROLE_KEYS if key not in roles)
     return RigMap(roles=roles, unmapped=unmapped)
+
+
+def mapped_roles(skeleton: Skeleton, mapping: Mapping[str, str] | None) -> RigMap:
+    """:func:`find_roles` with ``mapping`` where the skeleton has every joint it names, else
+    without it: a folder of several rigs is mapped with one rig's mapping, which applies to
+    that rig's takes only."""
+    if mapping and all(name in skeleton.names for name in normalise_mapping(mapping).values()):
+        return find_roles(skeleton, mapping)
+    return find_roles(skeleton)
+
+
+def require_mapped(mapping: Mapping[str, str] | None, skeletons: Sequence[Skeleton]) -> None:
+    """Refuse a mapping that :func:`mapped_roles` would apply to none of ``skeletons`` (a
+    mapping of another rig, a misspelt joint).
+
+    Raises
+    ------
+    InputError
+        Naming the joints no skeleton has all of.
+    """
+    if not mapping:
+        return
+    names = set(normalise_mapping(mapping).values())
+    if not any(names <= set(s.names) for s in skeletons):
+        raise InputError(
+            f"Expected a take with every joint the mapping names ({', '.join(sorted(names))}), "
+            "got none"
+        )
 
 
 def limb_chains(rig: RigMap) -> list[Chain]:

@@ -46,7 +46,7 @@ from mocapqa.bench.limits import (
 )
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Skeleton
-from mocapqa.core.rig import SIDES
+from mocapqa.core.rig import SIDES, mapped_roles, require_mapped
 from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.jobs.engine import Engine
@@ -115,13 +115,14 @@ class TakeSummary:
         return Path(self.path).name
 
 
-def take_summary(path: str) -> TakeSummary:
-    """Task: read one BVH file and summarise it (round 1)."""
+def take_summary(path: str, mapping: dict[str, str] | None = None) -> TakeSummary:
+    """Task: read one BVH file and summarise it (round 1); ``mapping`` gives roles where the
+    skeleton has its joints."""
     motion = read_bvh(path)
     return TakeSummary(
         path=path,
         group=split_group(motion.skeleton),
-        has_roles=bool(rig_fingerprint(motion.skeleton)),
+        has_roles=bool(rig_fingerprint(motion.skeleton, mapping)),
         rig=rig_key(motion),
         n_frames=motion.n_frames,
         skeleton=motion.skeleton,
@@ -184,7 +185,7 @@ def _gather(
 
 
 def _rig_frames(
-    engine: Engine, takes: Sequence[TakeSummary], step: Step
+    engine: Engine, takes: Sequence[TakeSummary], step: Step, mapping: dict[str, str] | None
 ) -> tuple[dict[str, CanonicalFrames], dict[str, StoredFrames]]:
     """Frames of every rig among ``takes`` (round 2), each estimated over all its takes as
     :func:`mocapqa.limits.canonical.rig_frames` does, keyed by rig key."""
@@ -208,7 +209,8 @@ def _rig_frames(
         worlds = [next(samples) for _ in group]
         pooled = (np.concatenate([w[0] for w in worlds]), np.concatenate([w[1] for w in worlds]))
         try:
-            frames = canonical_frames(group[0].skeleton, world=pooled)
+            rig = mapped_roles(group[0].skeleton, mapping)
+            frames = canonical_frames(group[0].skeleton, rig=rig, world=pooled)
         except InputError as e:
             raise InputError(f"{group[0].name}: {e}") from e
         known[key] = without_stand_ins(frames)  # a build leaves stood-in roles out
@@ -225,6 +227,7 @@ def build_on_engine(
     exclude: frozenset[str] | set[str] = frozenset(),
     on_total: Callable[[int], None] | None = None,
     step: Step | None = None,
+    mapping: dict[str, str] | None = None,
 ) -> LimitsModel:
     """The model of ``mocapqa limits build``, with the per-take work on ``engine``: without
     ``rig`` the canonical model of :func:`mocapqa.limits.build.build_canonical_model` over
@@ -248,6 +251,9 @@ def build_on_engine(
         with the files' count.
     step : callable, optional
         Called with a description after each step (a task done, a role or joint built).
+    mapping : dict, optional
+        Role key → joint name for a canonical build: the roles of the takes whose skeleton
+        has its joints (:func:`mocapqa.core.rig.mapped_roles`).
 
     Raises
     ------
@@ -265,8 +271,10 @@ def build_on_engine(
     if on_total is not None:
         on_total(len(paths))
     summaries: list[TakeSummary] = _gather(
-        engine, [(take_summary, (p,)) for p in paths], tick, "reading takes"
+        engine, [(take_summary, (p, mapping)) for p in paths], tick, "reading takes"
     )
+
+    require_mapped(mapping, [s.skeleton for s in summaries])
 
     def total(n_more: int) -> None:
         if on_total is not None:
@@ -274,7 +282,7 @@ def build_on_engine(
 
     if rig is None:
         takes = _canonical_takes(corpus_dir, summaries, all_takes, exclude)
-        return _canonical_model(engine, takes, settings, total, tick)
+        return _canonical_model(engine, takes, settings, total, tick, mapping)
     groups = [(s.name, s.group) for s in summaries]
     takes = [summaries[i] for i in rig_positions(groups, rig, corpus_dir, all_takes, exclude)]
     return _rig_model(engine, takes, settings, total, tick)
@@ -294,12 +302,12 @@ def _canonical_takes(
 
 def _canonical_model(
     engine: Engine, takes: Sequence[TakeSummary], settings: BuildParams,
-    total: Callable[[int], None], tick: Step,
+    total: Callable[[int], None], tick: Step, mapping: dict[str, str] | None,
 ) -> LimitsModel:  # fmt: skip
     """Rounds 2 and 3 of a canonical build of ``takes`` and its training; ``total`` is called
     with the steps to come after round 1."""
     total(2 * len(takes) + len(SIDES) * len(MODELLED_ROLES))
-    known, stored = _rig_frames(engine, takes, tick)
+    known, stored = _rig_frames(engine, takes, tick, mapping)
     calls = [(take_rotations, (t.path, known[t.rig])) for t in takes]
     rotations = _gather(engine, calls, tick, "charting takes")
     return canonical_model_from_rotations(

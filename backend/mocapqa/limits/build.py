@@ -10,7 +10,7 @@ discriminator on the map's synthetic labels.
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -203,6 +203,7 @@ def build_canonical_model(
     take_names: Sequence[str],
     settings: BuildParams = DEFAULT_BUILD,
     progress: Callable[[str], None] | None = None,
+    mapping: Mapping[str, str] | None = None,
 ) -> LimitsModel:
     """Build one rig-independent model per role from takes of any rigs with roles.
 
@@ -218,6 +219,9 @@ def build_canonical_model(
     settings : BuildParams
     progress : callable, optional
         Called with a role key after each role is built.
+    mapping : mapping, optional
+        Role key → joint name for the rigs whose joints it names (the others keep the roles
+        found by name); stored with those rigs' frames, so their takes are checked with it.
 
     Returns
     -------
@@ -230,7 +234,7 @@ def build_canonical_model(
         If there are no takes, the names do not match, or a take has no limb roles.
     """
     _check_names(len(motions), take_names)
-    known, stored = _frames_by_rig(motions, take_names)
+    known, stored = _frames_by_rig(motions, take_names, mapping)
     rotations = [canonical_quats(m, known=known[rig_key(m)]) for m in motions]
     return canonical_model_from_rotations(
         take_names,
@@ -356,7 +360,7 @@ def stored_frames(skeleton: Skeleton, frames: CanonicalFrames) -> StoredFrames:
 
 
 def _frames_by_rig(
-    motions: Sequence[Motion], take_names: Sequence[str]
+    motions: Sequence[Motion], take_names: Sequence[str], mapping: Mapping[str, str] | None
 ) -> tuple[dict[str, CanonicalFrames], dict[str, StoredFrames]]:
     """Canonical frames of every rig among ``motions``, each estimated over all its takes,
     keyed by :func:`mocapqa.limits.canonical.rig_key`; and the same as stored in a model."""
@@ -367,7 +371,7 @@ def _frames_by_rig(
     stored: dict[str, StoredFrames] = {}
     for key, members in groups.items():
         try:
-            frames = rig_frames([motions[i] for i in members])
+            frames = rig_frames([motions[i] for i in members], mapping)
         except InputError as e:
             raise InputError(f"{take_names[members[0]]}: {e}") from e
         known[key] = frames
@@ -376,7 +380,10 @@ def _frames_by_rig(
 
 
 def with_rig_frames(
-    model: LimitsModel, motions: Sequence[Motion], take_names: Sequence[str]
+    model: LimitsModel,
+    motions: Sequence[Motion],
+    take_names: Sequence[str],
+    mapping: Mapping[str, str] | None = None,
 ) -> LimitsModel:
     """A canonical model that also knows the frames of the rigs of ``motions``.
 
@@ -392,6 +399,6 @@ def with_rig_frames(
     """
     if model.frame != "canonical":
         raise InputError(f"Expected a canonical limits model, got a {model.rig_family!r} one")
-    _, stored = _frames_by_rig(motions, take_names)
+    _, stored = _frames_by_rig(motions, take_names, mapping)
     added = {k: v for k, v in stored.items() if k not in model.rig_frames}
     return replace(model, rig_frames={**model.rig_frames, **added})

@@ -40,7 +40,7 @@ up by :func:`rig_key`); only a rig the model has not seen is framed from the tak
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,7 +48,7 @@ from scipy.spatial.transform import Rotation
 
 from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.motion import Motion, Skeleton
-from mocapqa.core.rig import SIDES, RigMap, find_roles, role_key
+from mocapqa.core.rig import SIDES, RigMap, find_roles, mapped_roles, role_key
 from mocapqa.errors import InputError
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.kinematics.quaternion import conjugate, rotate
@@ -468,12 +468,15 @@ def rig_key(motion: Motion) -> str:
     return digest.hexdigest()[:16]
 
 
-def rig_frames(motions: Sequence[Motion]) -> CanonicalFrames:
+def rig_frames(
+    motions: Sequence[Motion], mapping: Mapping[str, str] | None = None
+) -> CanonicalFrames:
     """Canonical frames of one rig estimated over several of its takes at once.
 
     The world poses of every take are pooled, so the medians of
     :func:`canonical_frames` run over all their frames: one short or damaged take cannot move
-    them. Every take must have the same :func:`rig_key`.
+    them. Every take must have the same :func:`rig_key`. ``mapping`` (role key → joint name)
+    sets roles where the rig has its joints (:func:`mocapqa.core.rig.mapped_roles`).
 
     Raises
     ------
@@ -492,4 +495,5 @@ def rig_frames(motions: Sequence[Motion]) -> CanonicalFrames:
         np.concatenate([w[0] for w in worlds]),
         np.concatenate([w[1] for w in worlds]),
     )
-    return canonical_frames(motions[0], world=pooled)
+    rig = mapped_roles(motions[0].skeleton, mapping)
+    return canonical_frames(motions[0], rig=rig, world=pooled)

@@ -14,11 +14,13 @@ parent; ``+y`` as a last resort.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Skeleton
-from mocapqa.core.rig import SIDES, find_roles, role_key
+from mocapqa.core.rig import SIDES, mapped_roles, role_key
 
 __all__ = [
     "MODELLED_ROLES",
@@ -65,19 +67,24 @@ def axis_label(axis: FloatArray) -> str:
     return ("+" if axis[i] >= 0 else "-") + "xyz"[i]
 
 
-def rig_fingerprint(skeleton: Skeleton) -> dict[str, tuple[str, str]]:
+def rig_fingerprint(
+    skeleton: Skeleton, mapping: Mapping[str, str] | None = None
+) -> dict[str, tuple[str, str]]:
     """Role key → (joint name, axis label) for the modelled roles found on ``skeleton``.
 
     Parameters
     ----------
     skeleton : Skeleton
+    mapping : mapping, optional
+        Role key → joint name, applied where the skeleton has its joints
+        (:func:`mocapqa.core.rig.mapped_roles`).
 
     Returns
     -------
     dict
         For example ``{"left_upper_arm": ("LeftArm", "+x"), ...}``.
     """
-    rig = find_roles(skeleton)
+    rig = mapped_roles(skeleton, mapping)
     out: dict[str, tuple[str, str]] = {}
     for side in SIDES:
         for role in MODELLED_ROLES:
