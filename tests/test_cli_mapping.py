@@ -180,3 +180,27 @@ def test_limits_build_refuses_a_mapping_it_cannot_use(
     assert main(["limits", "build", str(folder), *out, "--mapping", str(other)]) == 3
     assert "every joint the mapping names (L_Elbow)" in " ".join(capsys.readouterr().err.split())
     assert not (tmp_path / "m.npz").exists()
+
+
+def test_a_rig_named_only_by_its_mapping_gets_the_limits_check(cmu_walk: Path) -> None:
+    from mocapqa.core.rig import find_roles
+    from mocapqa.pipeline.analyze import analyze
+
+    motion = read_bvh(cmu_walk)
+    roles = find_roles(motion.skeleton).roles
+    # Every joint renamed to a number: no name rule finds a role.
+    names = tuple(f"j{k}" for k in range(motion.skeleton.n_joints))
+    anonymous = replace(motion, skeleton=replace(motion.skeleton, names=names))
+    mapping = {key: names[joint] for key, joint in roles.items()}
+    options = {"checks": ("limits",), "max_points": 100}
+    plain = analyze(anonymous, AnalysisOptions(**options)).report  # type: ignore[arg-type]
+    assert plain["steps"]["limits"]["state"] == "no_model"
+    assert "name them with a mapping" in plain["steps"]["limits"]["message"]
+    mapped = analyze(anonymous, AnalysisOptions(**options, mapping=mapping)).report  # type: ignore[arg-type]
+    assert mapped["steps"]["limits"]["state"] == "done", mapped["steps"]["limits"]
+    named = analyze(motion, AnalysisOptions(**options)).report  # type: ignore[arg-type]
+    # The same walk checked under its own names and under numbers with the mapping alike.
+    assert mapped["steps"]["limits"]["message"] == named["steps"]["limits"]["message"]
+    assert mapped["findings"] == [
+        {**f, "joint": names[motion.skeleton.index(f["joint"])]} for f in named["findings"]
+    ]

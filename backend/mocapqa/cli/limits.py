@@ -279,7 +279,7 @@ def limits_check(
     missing = missing_roles(motion.skeleton, roles)
     model = _chosen_model(model_path, motion) if model_path is not None else None
     if frame_from is not None:
-        model = _framed_from(motion, model, frame_from)
+        model = _framed_from(motion, model, frame_from, roles)
     try:
         ignore = analyze_twist(motion, mapping=roles, apply="none").interval_frames()
     except InputError:
@@ -409,9 +409,11 @@ def limits_show(
     console.print(f"wrote {output}")
 
 
-def _framed_from(motion: Motion, model: LimitsModel | None, folder: Path) -> LimitsModel:
+def _framed_from(
+    motion: Motion, model: LimitsModel | None, folder: Path, mapping: dict[str, str] | None
+) -> LimitsModel:
     """``model`` (default: the shipped one) with the frames of ``motion``'s rig estimated over
-    the takes of that rig under ``folder``."""
+    the takes of that rig under ``folder`` (with the roles of ``mapping``)."""
     from mocapqa.io.bvh import read_bvh
     from mocapqa.limits.build import with_rig_frames
     from mocapqa.limits.canonical import rig_key
@@ -427,4 +429,4 @@ def _framed_from(motion: Motion, model: LimitsModel | None, folder: Path) -> Lim
     takes = [(p.name, m) for p in sorted(folder.rglob("*.bvh")) if rig_key(m := read_bvh(p)) == key]
     if not takes:
         raise InputError(f"Expected BVH takes of the checked take's rig under {folder}, got none")
-    return with_rig_frames(model, [m for _, m in takes], [n for n, _ in takes])
+    return with_rig_frames(model, [m for _, m in takes], [n for n, _ in takes], mapping)

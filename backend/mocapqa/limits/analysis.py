@@ -194,7 +194,7 @@ def charted(
     LimitsFileError
         If the model does not cover the take's rig.
     """
-    check_rig(model, motion.skeleton)
+    check_rig(model, motion.skeleton, mapping)
     if model.frame != "canonical":
         index = [motion.skeleton.index(j.name) for j in model.joints]
         axes = np.stack([j.axis for j in model.joints])
@@ -307,7 +307,7 @@ def check_limits(
     if method not in ("map", "network"):
         raise InputError(f"Expected `method` 'map' or 'network', got {method!r}")
     if model is None:
-        model = load_default_model(motion.skeleton)
+        model = load_default_model(motion.skeleton, mapping)
     params, columns, not_checked, names = charted(motion, model, mapping, ignore)
     n_frames, n_joints = params.shape[:2]
     swing = np.zeros((n_frames, n_joints))

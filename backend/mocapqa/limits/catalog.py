@@ -24,6 +24,8 @@ from typing import TYPE_CHECKING, Any
 from mocapqa.errors import ConflictError, LimitsFileError, OptionError
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     from mocapqa.core.motion import Skeleton
     from mocapqa.limits.model import LimitsModel
 
@@ -198,8 +200,10 @@ class ModelCatalog:
             )
         return checked
 
-    def load(self, name: str, skeleton: Skeleton) -> LimitsModel:
-        """The model ``name`` chooses for ``skeleton``.
+    def load(
+        self, name: str, skeleton: Skeleton, mapping: Mapping[str, str] | None = None
+    ) -> LimitsModel:
+        """The model ``name`` chooses for ``skeleton`` (whose roles ``mapping`` may name).
 
         Raises
         ------
@@ -214,11 +218,11 @@ class ModelCatalog:
 
         self.require(name)
         if name == DEFAULT_MODEL:
-            return load_default_model(skeleton)
+            return load_default_model(skeleton, mapping)
         found = self._path(name)
         assert found is not None  # checked by require
         model = _load_path(found[1])
-        check_rig(model, skeleton)
+        check_rig(model, skeleton, mapping)
         return model
 
     def register(self, source: Path, name: str, replace: bool = False) -> ModelEntry:

@@ -13,6 +13,7 @@ rigs in :data:`mocapqa.limits.storage.PREFERRED_RIG_MODELS`.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from mocapqa import __version__
@@ -142,8 +143,12 @@ class LimitsModel:
         raise LimitsFileError(f"Expected a joint of the model {names}, got {name_or_role!r}")
 
 
-def check_rig(model: LimitsModel, skeleton: Skeleton) -> None:
-    """Raise LimitsFileError unless ``model`` applies to ``skeleton``.
+def check_rig(
+    model: LimitsModel, skeleton: Skeleton, mapping: Mapping[str, str] | None = None
+) -> None:
+    """Raise LimitsFileError unless ``model`` applies to ``skeleton`` (a canonical model to any
+    skeleton with limb roles, found by name or named by ``mapping``; a per-rig model to its
+    rig's joint names).
 
     Raises
     ------
@@ -151,10 +156,10 @@ def check_rig(model: LimitsModel, skeleton: Skeleton) -> None:
         Naming the model's rig family, the skeleton's and the first differences.
     """
     if model.frame == "canonical":
-        if not rig_fingerprint(skeleton):
+        if not rig_fingerprint(skeleton, mapping):
             raise LimitsFileError(
                 f"Expected a skeleton with limb roles for the canonical limits model, got none "
-                f"among {list(skeleton.names[:6])}"
+                f"among {list(skeleton.names[:6])}; name them with a mapping (docs/rigs.md)"
             )
         return
     problems = fingerprint_mismatches(model.fingerprint, skeleton)

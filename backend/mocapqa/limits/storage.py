@@ -29,7 +29,7 @@ import functools
 import io
 import json
 import zipfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import asdict
 from importlib import resources
 from pathlib import Path
@@ -269,8 +269,11 @@ def _shipped_models() -> tuple[LimitsModel, ...]:
     return tuple(load_model(path) for path in default_model_paths())
 
 
-def load_default_model(skeleton: Skeleton) -> LimitsModel:
-    """The shipped limits model for ``skeleton``: the canonical one, for any rig with roles.
+def load_default_model(
+    skeleton: Skeleton, mapping: Mapping[str, str] | None = None
+) -> LimitsModel:
+    """The shipped limits model for ``skeleton``: the canonical one, for any rig with roles
+    (found by name, or named by ``mapping``, role key → joint name).
 
     A shipped per-rig model is preferred only when it is listed in :data:`PREFERRED_RIG_MODELS`
     (measured better on its rig: Character Creator today, see ``docs/limits.md``).
@@ -298,7 +301,7 @@ def load_default_model(skeleton: Skeleton) -> LimitsModel:
             return model
     for model in models:
         if model.frame == "canonical":
-            check_rig(model, skeleton)
+            check_rig(model, skeleton, mapping)
             return model
     families = []
     for model in models:

@@ -214,7 +214,7 @@ def violation_findings(
     return findings
 
 
-RigKey = tuple[tuple[str, ...], bytes, bytes]
+RigKey = tuple[tuple[str, ...], bytes, bytes, tuple[tuple[str, str], ...]]
 _RIGS: dict[RigKey, Skeleton] = {}
 _SHIPPED = ModelCatalog()
 
@@ -222,9 +222,10 @@ _SHIPPED = ModelCatalog()
 @functools.lru_cache(maxsize=16)
 def _default_for_rig(key: RigKey) -> LimitsModel | str:
     # The default choice reads only shipped, read-only package data: decide it once per rig
-    # layout (names, parents and rest offsets, which decide the fingerprint), not once per run.
+    # layout (names, parents and rest offsets, which decide the fingerprint) and mapping, not
+    # once per run.
     try:
-        return _SHIPPED.load(DEFAULT_MODEL, _RIGS[key])
+        return _SHIPPED.load(DEFAULT_MODEL, _RIGS[key], dict(key[3]))
     except LimitsFileError as e:
         return str(e)
 
@@ -252,12 +253,13 @@ def run_limits(
     skeleton = motion.skeleton
     model: LimitsModel | str
     if model_name == DEFAULT_MODEL:
-        key = (skeleton.names, skeleton.parents.tobytes(), skeleton.offsets.tobytes())
+        named = tuple(sorted((mapping or {}).items()))
+        key = (skeleton.names, skeleton.parents.tobytes(), skeleton.offsets.tobytes(), named)
         _RIGS.setdefault(key, skeleton)
         model = _default_for_rig(key)
     else:
         try:
-            model = (catalog or _SHIPPED).load(model_name, skeleton)
+            model = (catalog or _SHIPPED).load(model_name, skeleton, mapping)
         except LimitsFileError as e:
             model = str(e)
     if isinstance(model, str):
