@@ -269,9 +269,7 @@ def _shipped_models() -> tuple[LimitsModel, ...]:
     return tuple(load_model(path) for path in default_model_paths())
 
 
-def load_default_model(
-    skeleton: Skeleton, mapping: Mapping[str, str] | None = None
-) -> LimitsModel:
+def load_default_model(skeleton: Skeleton, mapping: Mapping[str, str] | None = None) -> LimitsModel:
     """The shipped limits model for ``skeleton``: the canonical one, for any rig with roles
     (found by name, or named by ``mapping``, role key → joint name).
 
