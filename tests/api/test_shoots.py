@@ -128,6 +128,14 @@ def test_import_files_table_queue_export_and_delete(client: TestClient, corpus_d
     assert first["take"]["take_id"] == page["items"][0]["take_id"]
     skipped = client.get(f"{API}/shoots/{sid}/next", params={"after": first["take"]["take_id"]})
     assert skipped.json()["take"]["take_id"] == page["items"][1]["take_id"]
+    # Skipping again and again walks every waiting take in order, then comes round.
+    order = [t["take_id"] for t in page["items"] if t["status"] == "done"]
+    seen, at = [], None
+    for _ in range(len(order) + 1):
+        at = client.get(f"{API}/shoots/{sid}/next", params={"after": at} if at else {}).json()
+        at = at["take"]["take_id"]
+        seen.append(at)
+    assert seen == [*order, order[0]]
     review = {"status": "approved", "reviewer": "lead"}
     posted = client.post(f"{API}/takes/{first['take']['take_id']}/reviews", json=review)
     assert posted.status_code == 201, posted.text

@@ -10,7 +10,7 @@ from collections.abc import Iterator
 from datetime import UTC, datetime
 from typing import Any
 
-from sqlalchemy import Engine, and_, delete, func, insert, select, update
+from sqlalchemy import Engine, and_, delete, func, insert, or_, select, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.sql.elements import ColumnElement
 
@@ -110,6 +110,22 @@ def _plain(mapping: Any) -> dict[str, Any]:
     if isinstance(value, datetime) and value.tzinfo is None:
         row["created_at"] = value.replace(tzinfo=UTC)
     return row
+
+
+def _after_in_order(row: Any) -> ColumnElement[bool]:
+    """Rows after ``row`` (its score, name and take id) in the review order: score ascending
+    with missing scores last, then name, then take id."""
+    same_score_later = or_(
+        take_qa.c.name > row["name"],
+        and_(take_qa.c.name == row["name"], take_qa.c.take_id > row["take_id"]),
+    )
+    if row["score"] is None:
+        return and_(take_qa.c.score.is_(None), same_score_later)
+    return or_(
+        take_qa.c.score > row["score"],
+        take_qa.c.score.is_(None),
+        and_(take_qa.c.score == row["score"], same_score_later),
+    )
 
 
 class ShootStore:
@@ -385,7 +401,9 @@ class ShootStore:
         """The unreviewed analysed take with the lowest score (ties by name), and how many
         unreviewed analysed takes remain.
 
-        ``after`` (a take id) skips that take, so a client can move on without deciding.
+        ``after`` (a take id) moves on without deciding: the take that follows it in that
+        order, round to the first after the last, so skipping again and again visits every
+        take waiting for review (None when ``after`` is the only one).
         """
         self.require(shoot_id)
         where = and_(
@@ -393,18 +411,36 @@ class ShootStore:
             take_qa.c.status == "done",
             take_qa.c.review_status == "unreviewed",
         )
+        order = (take_qa.c.score.asc().nulls_last(), take_qa.c.name, take_qa.c.take_id)
         query = (
             select(take_qa, takes.c.format, takes.c.fps, takes.c.n_joints)
             .join(takes, takes.c.id == take_qa.c.take_id)
-            .where(where)
-            .order_by(take_qa.c.score.asc().nulls_last(), take_qa.c.name, take_qa.c.take_id)
-            .limit(2)
+            .order_by(*order)
+            .limit(1)
         )
         with self.engine.connect() as conn:
-            found = [_plain(r) for r in conn.execute(query).mappings()]
             remaining = int(conn.execute(select(func.count()).where(where)).scalar_one())
-        found = [r for r in found if r["take_id"] != after]
-        return (found[0] if found else None), remaining
+            skipped = None
+            if after is not None:
+                skipped = (
+                    conn.execute(
+                        select(take_qa.c.score, take_qa.c.name, take_qa.c.take_id).where(
+                            take_qa.c.shoot_id == shoot_id, take_qa.c.take_id == after
+                        )
+                    )
+                    .mappings()
+                    .first()
+                )
+            found = None
+            if skipped is not None:
+                later = conn.execute(query.where(where, _after_in_order(skipped))).mappings()
+                found = later.first()
+                if found is None:  # past the last: round to the first that is not it
+                    first = query.where(where, take_qa.c.take_id != after)
+                    found = conn.execute(first).mappings().first()
+            else:
+                found = conn.execute(query.where(where)).mappings().first()
+        return (_plain(found) if found is not None else None), remaining
 
     # batches ---------------------------------------------------------------------------
     def finished(self, sha256s: list[str], options: dict[str, Any]) -> dict[str, str]:
