@@ -204,3 +204,21 @@ def test_a_rig_named_only_by_its_mapping_gets_the_limits_check(cmu_walk: Path) -
     assert mapped["findings"] == [
         {**f, "joint": names[motion.skeleton.index(f["joint"])]} for f in named["findings"]
     ]
+
+
+def test_a_take_no_check_could_read_is_not_scored_as_clean(cmu_walk: Path) -> None:
+    from mocapqa.pipeline.analyze import analyze
+    from mocapqa.pipeline.summary import qa_summary
+
+    motion = read_bvh(cmu_walk)
+    names = tuple(f"j{k}" for k in range(motion.skeleton.n_joints))
+    anonymous = replace(motion, skeleton=replace(motion.skeleton, names=names))
+    result = analyze(anonymous, AnalysisOptions(checks=("twist", "limits"), max_points=100))
+    twist = result.report["steps"]["twist"]
+    assert twist["state"] == "no_roles"
+    assert "nothing checked" in twist["message"]
+    assert "left_upper_arm" in twist["message"]
+    assert qa_summary(result)["score"] is None
+    # The same walk under its own names is checked and scored.
+    named = analyze(motion, AnalysisOptions(checks=("twist", "limits"), max_points=100))
+    assert qa_summary(named)["score"] is not None

@@ -1,6 +1,8 @@
 """The pipeline's steps: each calls one algorithm entry point and normalises its output.
 
-* twist — :func:`mocapqa.twist.analysis.analyze_twist`
+* twist — :func:`mocapqa.twist.analysis.analyze_twist`; a rig on which no limb chain is found
+  (no roles by name or mapping) reports ``"no_roles"`` naming what is missing, so an
+  unchecked take is never read as a clean one
 * limits — the run's model from :class:`mocapqa.limits.catalog.ModelCatalog` and
   :func:`mocapqa.limits.analysis.check_limits`; a rig the model does not cover reports
   ``"no_model"`` ("no model for this rig") instead of failing the run
@@ -37,6 +39,7 @@ from mocapqa.twist.analysis import analyze_twist, interval_frames
 from mocapqa.twist.spin import LimbSpin, find_limb_spins
 
 __all__ = [
+    "STEP_STATES",
     "Plot",
     "StepOutcome",
     "run_filter_keypoints",
@@ -67,6 +70,11 @@ class Plot:
     at: Callable[[IntArray], dict[str, Any]]
 
 
+STEP_STATES = ("done", "skipped", "no_model", "no_roles")
+"""What became of a step: it ran; it was not asked for (or does not apply to the take's kind);
+the limits step found no model for the rig; the twist step found no limb chain on it."""
+
+
 @dataclass(frozen=True, slots=True)
 class StepOutcome:
     """What one step produced.
@@ -74,7 +82,7 @@ class StepOutcome:
     Parameters
     ----------
     state : str
-        ``"done"``, ``"skipped"`` or ``"no_model"``.
+        One of :data:`STEP_STATES`.
     message : str
         One line for the UI.
     findings : list of dict
@@ -122,6 +130,12 @@ def run_twist(
     analysis = analyze_twist(motion, method=method, mapping=mapping, apply=apply)
     rig = find_roles(motion.skeleton, mapping)
     missing = rig.unmapped
+    if not analysis.chains:
+        return StepOutcome(
+            "no_roles",
+            f"no limb chain found, nothing checked (roles not found: {', '.join(missing)}); "
+            "name the joints with a mapping (docs/rigs.md)",
+        )
     spins = find_limb_spins(motion, rig)
     findings = [
         {

@@ -10,7 +10,8 @@ One flat, JSON-ready dict per take, the same for the batch table, the API and th
 * ``filter_residual_mm`` — RMS distance between raw and filtered keypoints, mm (keypoint takes
   in a metric unit; None otherwise)
 * ``missing_share`` — share of missing keypoint samples (0 for BVH takes)
-* ``score`` — 0–100, see :func:`qa_score`
+* ``score`` — 0–100, see :func:`qa_score`; None for a motion take on which neither the twist
+  nor the limits check ran (nothing was checked, so nothing can be called clean)
 
 Checks that did not run leave their fields None; they then cost the score nothing.
 """
@@ -164,13 +165,20 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
         "missing_share": missing,
         "joint_violations": joint_violations,
     }
-    summary["score"] = qa_score(
-        {
-            "twist_intervals": float(len(twist)) if twist_ran else None,
-            "corrected_share": corrected / max(n_frames * n_joints, 1) if twist_ran else None,
-            "violation_share": violation_share,
-            "missing_share": missing,
-            "filter_residual_mm": residual,
-        }
+    # A motion take on which neither check ran (a rig whose roles were not found, a run of
+    # the filter only) has no score: 100 would read as "checked and clean".
+    checked = twist_ran or limits_ran or not motion
+    summary["score"] = (
+        qa_score(
+            {
+                "twist_intervals": float(len(twist)) if twist_ran else None,
+                "corrected_share": corrected / max(n_frames * n_joints, 1) if twist_ran else None,
+                "violation_share": violation_share,
+                "missing_share": missing,
+                "filter_residual_mm": residual,
+            }
+        )
+        if checked
+        else None
     )
     return summary
