@@ -9,13 +9,14 @@ import pytest
 from headless_chromium import CHROMIUM_ARGS, CHROMIUM_PATH
 from mocapqa.cli.main import main
 
-KICK = "bvh/bandai/dataset-1_kick_normal_001.bvh"
+# A take with twist intervals, limb spins and joint-limit violations (its real knee errors).
+TAKE = "bvh/cmu/iclone/005_05.bvh"
 
 
 @pytest.fixture(scope="module")
 def report_file(corpus_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     output = tmp_path_factory.mktemp("report") / "report.html"
-    assert main(["report", str(corpus_dir / KICK), "-o", str(output)]) == 0
+    assert main(["report", str(corpus_dir / TAKE), "-o", str(output)]) == 0
     return output
 
 

@@ -14,7 +14,8 @@ from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.report.findings import limit_findings, normalise_findings, twist_findings
 from mocapqa.report.html import build_report, report_from_analysis
 
-KICK = "bvh/bandai/dataset-1_kick_normal_001.bvh"
+# A take with twist intervals, limb spins and joint-limit violations (its real knee errors).
+TAKE = "bvh/cmu/iclone/005_05.bvh"
 MEDIAPIPE = "keypoints/mediapipe/etfrobotics_full-body-kinematics/landmarks.csv"
 TINY_PNG = (
     b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\x00\x00\x01\x00\x00\x00\x01\x08\x02\x00\x00"
@@ -24,8 +25,8 @@ TINY_PNG = (
 
 
 @pytest.fixture(scope="module")
-def kick_analysis(corpus_dir: Path) -> dict[str, Any]:
-    return analyze(read_take(corpus_dir / KICK), AnalysisOptions()).report
+def knees_analysis(corpus_dir: Path) -> dict[str, Any]:
+    return analyze(read_take(corpus_dir / TAKE), AnalysisOptions()).report
 
 
 def _external_references(page: str) -> list[str]:
@@ -34,8 +35,8 @@ def _external_references(page: str) -> list[str]:
     return re.findall(r"""(?:src|href)\s*=\s*["'](?!data:|#)([^"']+)""", markup)
 
 
-def test_report_is_self_contained(kick_analysis: dict[str, Any]) -> None:
-    page = report_from_analysis(kick_analysis, {"name": "kick"}, contact_sheet_png=TINY_PNG)
+def test_report_is_self_contained(knees_analysis: dict[str, Any]) -> None:
+    page = report_from_analysis(knees_analysis, {"name": "knees"}, contact_sheet_png=TINY_PNG)
     assert page.startswith("<!DOCTYPE html>")
     assert _external_references(page) == []
     assert "Content-Security-Policy" in page
@@ -45,10 +46,10 @@ def test_report_is_self_contained(kick_analysis: dict[str, Any]) -> None:
     assert "data:image/png;base64," in page
 
 
-def test_report_lists_every_finding_and_both_timelines(kick_analysis: dict[str, Any]) -> None:
-    page = report_from_analysis(kick_analysis, {"name": "kick"})
-    findings = kick_analysis["findings"]
-    assert findings, "the kick take has limit violations in the corpus run"
+def test_report_lists_every_finding_and_both_timelines(knees_analysis: dict[str, Any]) -> None:
+    page = report_from_analysis(knees_analysis, {"name": "knees"})
+    findings = knees_analysis["findings"]
+    assert {f["kind"] for f in findings} == {"twist", "spin", "limits"}
     table = page.split('id="findings"', 1)[1].split("</table>", 1)[0]
     assert table.count("<tr>") == len(findings) + 1  # header row
     assert 'id="twist-timeline"' in page
