@@ -1,7 +1,7 @@
 // Accept / reject per twist interval in the findings table. A decision shows at once and is
-// saved as a row of the run's decision history (the newest per interval counts); the download
-// link serves the raw take with exactly the accepted corrections (an undecided interval keeps
-// the run's own choice, shown as "applied" / "not applied").
+// saved as a row of the run's decision history (the newest per interval counts). Each row says
+// what the reviewed download does with the interval: an accepted one is corrected, a rejected
+// one left as recorded, an undecided one follows the run's own choice ("run: applied").
 import * as api from "./api.js";
 import { badge, h, toast } from "./dom.js";
 
@@ -44,9 +44,11 @@ export function intervalDecisions(run, result) {
       button.addEventListener("keydown", (e) => { if (e.key === "Enter" || e.key === " ") e.stopPropagation(); });
       return button;
     });
+    const corrected = decision ? decision === "accept" : f.applied;
     cell.replaceChildren(
-      h("span", { class: "applied muted" }, f.applied ? "applied" : "not applied"), " · ",
-      decision ? badge(LABELS[decision], BADGE[decision]) : h("span", { class: "muted" }, "undecided"), " ",
+      h("span", { class: "applied muted", title: "the run's twist_apply choice, in its corrected BVH" }, f.applied ? "run: applied" : "run: not applied"), " · ",
+      decision ? badge(LABELS[decision], BADGE[decision]) : h("span", { class: "muted" }, "undecided"),
+      h("span", { class: "outcome muted", title: "what the reviewed download does with this interval" }, corrected ? " → corrected" : " → left as recorded"), " ",
       ...buttons);
   };
 
@@ -56,8 +58,8 @@ export function intervalDecisions(run, result) {
     fill(id);
     current = id;
     try {
-      const reviewer = localStorage.getItem("mocapqa-reviewer") || "anonymous";
-      await api.addDecision(run.id, id, { decision, note: note.value, reviewer });
+      // The server records the signed-in user as the reviewer.
+      await api.addDecision(run.id, id, { decision, note: note.value });
       note.value = "";
       message.textContent = `${label(id)} ${LABELS[decision]}`; message.className = "muted";
       toast(message.textContent);
@@ -117,9 +119,9 @@ export function intervalDecisions(run, result) {
       if (!twist) return null;
       return h("div", { id: "decisions" },
         h("div", { class: "controls" },
-          h("a", { href: api.decidedUrl(run.id), download: "", id: "download-decided", class: "download" }, "Download with accepted corrections"),
+          h("a", { href: api.decidedUrl(run.id), download: "", id: "download-decided", class: "download" }, "Download reviewed take"),
           note, message),
-        h("p", { class: "muted" }, "An undecided interval keeps the run's choice (applied or not); the download is the raw take with exactly the corrected intervals' levels removed (no motion filter)."),
+        h("p", { class: "muted" }, "The reviewed take is the raw take with the intervals marked \u201c\u2192 corrected\u201d removed: every accepted one, and each undecided one the run applied; rejected ones are left as recorded. No motion filter. The run's own \u201ccorrected BVH\u201d (Downloads) is its choice before review."),
         history);
     },
   };

@@ -354,7 +354,7 @@ function runPicker(take, run) {
 }
 
 function downloadsPanel(run, result) {
-  const labels = { bvh: "corrected BVH", csv: "filtered keypoints (CSV)", trc: "filtered keypoints (TRC)", report: "JSON report", "report.html": "HTML report" };
+  const labels = { bvh: "corrected BVH (the run's choice, before review)", csv: "filtered keypoints (CSV)", trc: "filtered keypoints (TRC)", report: "JSON report", "report.html": "HTML report" };
   const kinds = [...(result.downloads || ["report"]), "report.html"];
   return h("div", { class: "panel" }, h("h2", {}, "Downloads"),
     kinds.map((k) => h("a", { href: api.downloadUrl(run.id, k), download: "", id: `download-${k.replace(".", "-")}`, class: "download" }, labels[k] || k)));

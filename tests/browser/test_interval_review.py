@@ -44,17 +44,22 @@ def test_accept_and_reject_intervals_persist_and_the_download_has_them(
     # Each twist row shows its confidence in %, whether the run applied it, and no decision yet.
     cells = p.locator(f"#findings tr[data-interval='{first}'] td")
     assert cells.nth(5).inner_text() == f"{round(100 * twist[first]['confidence'])} %"
-    applied = "not applied" if not twist[first]["applied"] else "applied"
+    applied = "run: not applied" if not twist[first]["applied"] else "run: applied"
     assert decision_of(page, first).startswith(applied)
     assert "undecided" in decision_of(page, first)
+    # ... and what the reviewed download will do with it: the run's choice until decided.
+    outcome = "→ corrected" if twist[first]["applied"] else "→ left as recorded"
+    assert outcome in decision_of(page, first)
 
     # The mouse accepts the first; the decision shows before the server has answered.
     p.click(f"#findings tr[data-interval='{first}'] button.decide-accept")
     assert "accepted" in decision_of(page, first)
+    assert "→ corrected" in decision_of(page, first)
     # The keyboard rejects the second: focus its row, press X.
     p.locator(f"#findings tr[data-interval='{second}']").focus()
     p.keyboard.press("x")
     assert "rejected" in decision_of(page, second)
+    assert "→ left as recorded" in decision_of(page, second)
     p.wait_for_function("() => document.querySelectorAll('#decision-history li').length === 2")
     history = p.inner_text("#decision-history")
     # Named as its findings row shows it (joint and frames), not by the internal id.
