@@ -225,6 +225,14 @@ class AnalysisOptions:
             "limits_model": self.limits_model,
         }
 
+    def request_json(self) -> dict[str, Any]:
+        """The body of a run request for these options (``POST /takes/{id}/runs``): the JSON
+        less ``limits_model``, which a run does not choose (its shoot's model, or the
+        default, decides)."""
+        body = self.to_json()
+        del body["limits_model"]
+        return body
+
     @classmethod
     def from_json(cls, data: dict[str, Any] | None) -> AnalysisOptions:
         """Options from a JSON dict; missing fields take their defaults.
@@ -382,7 +390,7 @@ def describe_options() -> dict[str, Any]:
     return {
         "checks": list(CHECKS),
         "groups": groups,
-        "presets": {name: options.to_json() for name, options in RUN_PRESETS.items()},
+        "presets": {name: options.request_json() for name, options in RUN_PRESETS.items()},
         # The rig roles a ``mapping`` may name (BVH takes), in the rig module's order.
         "role_keys": list(ROLE_KEYS),
     }
