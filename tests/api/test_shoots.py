@@ -169,6 +169,15 @@ def test_import_files_table_queue_export_and_delete(client: TestClient, corpus_d
     assert [t["name"] for t in as_json["takes"]] == [t["name"] for t in table]
     assert as_json["filters"] == {"has_findings": False}
     assert (as_json["sort"], as_json["order"]) == ("score", "desc")
+    # A take named like a formula is text in the CSV, whatever a spreadsheet makes of it.
+    named = client.post(
+        f"{API}/shoots/{sid}/takes",
+        files=[("files", ("=HYPERLINK(1).bvh", (paths[0]).read_bytes()))],
+    )
+    assert named.status_code == 201, named.text
+    cells = list(csv.DictReader(io.StringIO(client.get(f"{API}/shoots/{sid}/summary.csv").text)))
+    formula = [r["name"] for r in cells if "HYPERLINK" in r["name"]]
+    assert formula and all(n.startswith("'=") for n in formula)
     bad = client.get(f"{API}/shoots/{sid}/summary.csv", params={"min_score": 500})
     assert bad.status_code == 422
     assert "min_score" in bad.text

@@ -242,6 +242,18 @@ EXPORT_COLUMNS = (
 """Columns of the shoot summary export, in order."""
 
 
+_FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
+
+
+def _spreadsheet_text(value: Any) -> Any:
+    """A CSV cell a spreadsheet shows as text: a string starting like a formula (a take named
+    ``=HYPERLINK(...).bvh``) gets a leading apostrophe (OWASP's CSV-injection advice); numbers
+    and other strings are left as they are."""
+    if isinstance(value, str) and value.startswith(_FORMULA_STARTS):
+        return "'" + value
+    return value
+
+
 def _export_rows(
     store: ShootStore, shoot_id: str, filters: TakeFilter, sort: str, descending: bool
 ) -> Iterator[dict[str, Any]]:
@@ -283,7 +295,7 @@ def export_summary(
         writer = csv.DictWriter(buffer, list(EXPORT_COLUMNS))
         writer.writeheader()
         for row in _export_rows(store, shoot_id, filters, sort, order == "desc"):
-            writer.writerow(row)
+            writer.writerow({k: _spreadsheet_text(v) for k, v in row.items()})
             yield buffer.getvalue()
             buffer.seek(0)
             buffer.truncate()
