@@ -177,7 +177,8 @@ def test_import_files_table_queue_export_and_delete(client: TestClient, corpus_d
     assert named.status_code == 201, named.text
     cells = list(csv.DictReader(io.StringIO(client.get(f"{API}/shoots/{sid}/summary.csv").text)))
     formula = [r["name"] for r in cells if "HYPERLINK" in r["name"]]
-    assert formula and all(n.startswith("'=") for n in formula)
+    assert formula
+    assert all(n.startswith("'=") for n in formula)
     bad = client.get(f"{API}/shoots/{sid}/summary.csv", params={"min_score": 500})
     assert bad.status_code == 422
     assert "min_score" in bad.text
