@@ -87,3 +87,24 @@ def test_csv_unknown_landmark_names_line() -> None:
     text = "frame_number,landmark,x,y,z\n0,NOSE,1,2,3\n0,TAIL,1,2,3\n"
     with pytest.raises(ParseError, match=r"line 3, field 'landmark'"):
         parse_mediapipe_csv(text, "m.csv")
+
+
+def test_pbtxt_refuses_deep_nesting_and_names_the_line() -> None:
+    from mocapqa.errors import ParseError
+    from mocapqa.io.mediapipe import parse_mediapipe_pbtxt
+
+    # 100,000 nested blocks (1.4 MB) used to take over a minute; refused at the ninth level.
+    deep = "landmarks {\n" * 100_000 + "}\n" * 100_000
+    with pytest.raises(ParseError, match="nested at most 8 deep") as caught:
+        parse_mediapipe_pbtxt(deep, "deep.pbtxt")
+    assert caught.value.line == 9
+
+
+def test_pbtxt_names_the_line_of_a_bad_token_after_many_landmarks() -> None:
+    from mocapqa.errors import ParseError
+    from mocapqa.io.mediapipe import parse_mediapipe_pbtxt
+
+    text = "landmarks {\n" + " landmark { x: 1 y: 1 z: 1 }\n" * 5000 + " landmark { x: ! }\n}\n"
+    with pytest.raises(ParseError) as caught:
+        parse_mediapipe_pbtxt(text, "many.pbtxt")
+    assert caught.value.line == 5002

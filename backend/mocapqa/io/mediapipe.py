@@ -283,14 +283,22 @@ _PBTXT_TOKEN = re.compile(
 )
 
 
+_SPACE = re.compile(r"\s*")
+_PBTXT_MAX_DEPTH = 8
+"""Deepest block nesting a landmarks file may have (MediaPipe's own use two)."""
+
+
 def _pbtxt_blocks(text: str, path: str) -> dict[str, list[list[dict[str, float]]]]:
     blocks: dict[str, list[list[dict[str, float]]]] = {}
     stack: list[str] = []
     current: dict[str, float] | None = None
     pos = 0
+    line, counted = 1, 0  # the line of ``pos``, counted up to ``counted`` (linear in the text)
     while pos < len(text):
         match = _PBTXT_TOKEN.match(text, pos)
-        line = text.count("\n", 0, pos) + 1
+        start = _SPACE.match(text, pos).end()  # type: ignore[union-attr]  # always matches
+        line += text.count("\n", counted, start)  # the line of the token itself
+        counted = start
         if match is None or match.end() == pos:
             if text[pos:].strip():
                 raise ParseError(
@@ -300,6 +308,10 @@ def _pbtxt_blocks(text: str, path: str) -> dict[str, list[list[dict[str, float]]
         pos = match.end()
         key, value, opened, closed = match.groups()
         if opened:
+            if len(stack) >= _PBTXT_MAX_DEPTH:
+                raise ParseError(
+                    f"Expected blocks nested at most {_PBTXT_MAX_DEPTH} deep, got deeper", path, line
+                )
             stack.append(opened)
             if len(stack) == 1:
                 blocks.setdefault(opened, []).append([])
