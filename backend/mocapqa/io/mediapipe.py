@@ -309,9 +309,8 @@ def _pbtxt_blocks(text: str, path: str) -> dict[str, list[list[dict[str, float]]
         key, value, opened, closed = match.groups()
         if opened:
             if len(stack) >= _PBTXT_MAX_DEPTH:
-                raise ParseError(
-                    f"Expected blocks nested at most {_PBTXT_MAX_DEPTH} deep, got deeper", path, line
-                )
+                deepest = f"Expected blocks nested at most {_PBTXT_MAX_DEPTH} deep, got deeper"
+                raise ParseError(deepest, path, line)
             stack.append(opened)
             if len(stack) == 1:
                 blocks.setdefault(opened, []).append([])
