@@ -4,6 +4,7 @@ export; real takes from the corpus."""
 from __future__ import annotations
 
 import csv
+import gzip
 import io
 import tarfile
 import time
@@ -284,6 +285,24 @@ def test_archive_bombs_are_refused_before_extracting(
         response = client.post(f"{API}/shoots/{sid}/takes", files=[("files", ("m.zip", many))])
         assert response.status_code == 413
         assert "at most 3 members" in response.json()["detail"]
+        # A 1.5 GB GNU long name (tarfile would read it whole into memory) in a .tar.gz of a
+        # few MB is refused from its header, before tarfile opens the archive.
+        declared = 1_500_000_000
+        info = tarfile.TarInfo("././@LongLink").get_info()
+        info.update(size=declared, type=tarfile.GNUTYPE_LONGNAME)
+        header = tarfile.TarInfo._create_header(  # type: ignore[attr-defined]
+            info, tarfile.GNU_FORMAT, "utf-8", "surrogateescape"
+        )
+        packed = io.BytesIO()
+        with gzip.GzipFile(fileobj=packed, mode="wb", compresslevel=9) as out:
+            out.write(header)
+            for _ in range(8):
+                out.write(b"a" * (1 << 20))
+        response = client.post(
+            f"{API}/shoots/{sid}/takes", files=[("files", ("n.tar.gz", packed.getvalue()))]
+        )
+        assert response.status_code == 413, response.text
+        assert f"at most 65536 bytes, got one of {declared}" in response.json()["detail"]
         assert client.get(f"{API}/shoots/{sid}").json()["n_takes"] == 0
         assert not list((settings.data_dir / "incoming").iterdir())
 
