@@ -123,3 +123,12 @@ def test_files_are_written_whole_and_ids_are_checked(tmp_path: Path) -> None:
     assert [p.name for p in target.parent.iterdir()] == ["report.json"]
     with pytest.raises(NotFoundError, match="Expected a 32-character hex id"):
         files.run_dir("../../etc")
+
+
+def test_a_take_of_a_shoot_deleted_meanwhile_is_not_found_not_a_database_error(
+    repository: Repository,
+) -> None:
+    # An import whose shoot is deleted under it: the take's insert fails its foreign key.
+    with pytest.raises(NotFoundError, match="Expected shoot 'gone' to exist"):
+        repository.add_take({**take_values("late.bvh"), "shoot_id": "gone"}, {})
+    assert repository.list_takes()[1] == 0

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Any, BinaryIO
 
-from mocapqa.errors import MocapQAError, TooLargeError
+from mocapqa.errors import MocapQAError, NotFoundError, TooLargeError
 from mocapqa.jobs.archive import archive_kind, unpack
 from mocapqa.jobs.batch import MOTION_SUFFIXES
 from mocapqa.jobs.intake import CHUNK_BYTES, MAX_NAME_CHARS, ingest_take
@@ -101,6 +101,8 @@ def import_uploads(
         When an archive passes a limit (earlier uploads of the same request are kept).
     InputError
         When an archive cannot be read at all.
+    NotFoundError
+        When the shoot is deleted while the import runs (the take being stored is removed).
     """
     report = ImportReport()
 
@@ -118,6 +120,8 @@ def import_uploads(
                 shoot_id=shoot_id,
                 owner_id=owner_id,
             )
+        except NotFoundError:
+            raise  # the shoot itself is gone: the import stops (404)
         except MocapQAError as e:
             report.failed.append({"name": label or name, "error": str(e)})
         else:

@@ -24,6 +24,7 @@ from sqlalchemy import (
     update,
 )
 from sqlalchemy.engine import Connection
+from sqlalchemy.exc import IntegrityError
 
 from mocapqa import __version__
 from mocapqa.core.text import display_name
@@ -119,12 +120,25 @@ class Repository:
         Returns
         -------
         take_id, run_id : str
+
+        Raises
+        ------
+        NotFoundError
+            When ``values`` names a shoot that no longer exists (deleted during an import).
         """
         take_id = str(values.get("id") or new_id())
-        with self.engine.begin() as conn:
-            conn.execute(insert(takes).values(**{**values, "id": take_id, "created_at": utc_now()}))
-            run_id = self._insert_run(conn, take_id, str(values["sha256"]), options)
-            sync_take(conn, take_id)
+        try:
+            with self.engine.begin() as conn:
+                row = {**values, "id": take_id, "created_at": utc_now()}
+                conn.execute(insert(takes).values(**row))
+                run_id = self._insert_run(conn, take_id, str(values["sha256"]), options)
+                sync_take(conn, take_id)
+        except IntegrityError as e:
+            shoot_id = values.get("shoot_id")
+            if shoot_id is not None:
+                # The shoot was deleted while its import ran.
+                raise NotFoundError(f"Expected shoot {shoot_id!r} to exist, got none") from e
+            raise
         return take_id, run_id
 
     def get_take(self, take_id: str) -> dict[str, Any]:

@@ -252,6 +252,11 @@ class ShootStore:
         """Delete a shoot with its takes, runs and reviews; returns (take ids, run ids)."""
         self.get(shoot_id)
         with self.engine.begin() as conn:
+            # Lock the shoot first, so no take is added between listing its takes and deleting
+            # them (its files would be left behind): FOR UPDATE blocks PostgreSQL's foreign-key
+            # check of a new take, and the write takes SQLite's one write lock now.
+            conn.execute(select(shoots.c.id).where(shoots.c.id == shoot_id).with_for_update())
+            conn.execute(update(shoots).where(shoots.c.id == shoot_id).values(name=shoots.c.name))
             take_ids = [
                 str(t)
                 for t in conn.execute(select(takes.c.id).where(takes.c.shoot_id == shoot_id))
