@@ -16,6 +16,7 @@ from mocapqa.api.app import create_app
 from mocapqa.api.auth import CSRF_COOKIE, CSRF_HEADER, SESSION_COOKIE, quota_key_before_body
 from mocapqa.api.routes.session import sign_in_link
 from mocapqa.config import Settings
+from mocapqa.errors import ConflictError
 from mocapqa.render.service import RenderService
 from mocapqa.store.accounts import Accounts
 from mocapqa.store.roles import Role
@@ -374,3 +375,43 @@ def test_quota_key_before_body_names_the_user_of_a_valid_credential_only(
     assert key((b"authorization", b"Basic eDp5")) is None
     assert key((b"cookie", f"{SESSION_COOKIE}={expired}".encode())) is None
     assert {t["id"]: t["last_used_at"] for t in accounts.list_tokens()} == used_before
+
+
+def test_two_admins_demoting_each_other_leave_one(
+    team: tuple[TestClient, dict[str, dict[str, str]]],
+) -> None:
+    import threading
+
+    client, _ = team
+    accounts: Accounts = client.app.state.accounts  # type: ignore[attr-defined]
+    accounts.add_user("second", Role.ADMIN, PASSWORD)
+    # A disabled admin may be demoted: it is not the enabled admin that must remain.
+    accounts.add_user("idle", Role.ADMIN, PASSWORD)
+    accounts.update_user("idle", disabled=True)
+    assert accounts.update_user("idle", role=Role.VIEWER).role is Role.VIEWER
+    # Both enabled admins demote themselves at once, many times over: one always remains.
+    for _ in range(10):
+        start = threading.Barrier(2)
+        outcomes: list[str] = []
+
+        def demote(name: str, start: threading.Barrier, outcomes: list[str]) -> None:
+            start.wait()
+            try:
+                accounts.update_user(name, role=Role.VIEWER)
+                outcomes.append("demoted")
+            except ConflictError:
+                outcomes.append("refused")
+
+        threads = [
+            threading.Thread(target=demote, args=(n, start, outcomes)) for n in ("admin", "second")
+        ]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        admins = [u for u in accounts.list_users() if u.role is Role.ADMIN and not u.disabled]
+        assert len(admins) == 1, outcomes
+        assert sorted(outcomes) == ["demoted", "refused"]
+        # Restore the second admin for the next round.
+        for name in ("admin", "second"):
+            accounts.update_user(name, role=Role.ADMIN)

@@ -204,22 +204,32 @@ class Accounts:
             values["disabled"] = disabled
         if password is not None:
             values["password_hash"] = _hasher.hash(password) if password else None
-        demoting = user.role is Role.ADMIN and (
-            (role is not None and role is not Role.ADMIN) or disabled
+        # Only an enabled admin who stops being one (demoted or disabled) can leave no admin.
+        demoting = (
+            user.role is Role.ADMIN
+            and not user.disabled
+            and ((role is not None and role is not Role.ADMIN) or bool(disabled))
         )
         with self.engine.begin() as conn:
+            if demoting:
+                # Two admins demoting each other at once must not both succeed: PostgreSQL
+                # locks the admin rows here (the second waits for the first to commit), SQLite
+                # serialises the writes; the count below is taken after this change.
+                conn.execute(
+                    select(users.c.id).where(users.c.role == Role.ADMIN.value).with_for_update()
+                )
+            if values:
+                conn.execute(update(users).where(users.c.id == user.id).values(**values))
             if demoting:
                 admins = conn.execute(
                     select(func.count())
                     .select_from(users)
                     .where(users.c.role == Role.ADMIN.value, users.c.disabled.is_(False))
                 ).scalar_one()
-                if int(admins) <= 1:
-                    raise ConflictError(
+                if int(admins) < 1:
+                    raise ConflictError(  # rolls the change back
                         f"Expected another enabled admin to remain, got {name!r} as the last one"
                     )
-            if values:
-                conn.execute(update(users).where(users.c.id == user.id).values(**values))
             if disabled:
                 conn.execute(
                     update(tokens)
