@@ -28,6 +28,23 @@ from mocapqa.store.repository import Repository
         ({"filter_method": "quat-pd", "filter_preset": "no-such"}, "filter_preset"),
         ({"filter_preset": "default"}, "filter_preset"),
         ({"twist_method": "magic"}, "body.twist_method"),
+        # Durations and frequencies out of any filter's range, and ids that int() alone
+        # would read (10 from "1_0", other scripts' digits).
+        (
+            {"filter_method": "quat-pd", "filter_params": {"natural_frequency_hz": 1e12}},
+            "filter_params.natural_frequency_hz",
+        ),
+        (
+            {"filter_method": "butterworth", "filter_params": {"cutoff_hz": 1e-300}},
+            "filter_params.cutoff_hz",
+        ),
+        # The walk runs at 120 fps: a cut-off of 61 Hz is past its Nyquist frequency.
+        (
+            {"filter_method": "butterworth", "filter_params": {"cutoff_hz": 61.0}},
+            "filter_params.cutoff_hz",
+        ),
+        ({"twist_apply": "1_0"}, "twist_apply"),
+        ({"twist_apply": "١,٢"}, "twist_apply"),
     ],
 )
 def test_bvh_run_options_are_checked_at_the_request(
@@ -48,6 +65,11 @@ def test_keypoint_run_options_are_checked_at_the_request(
     bad = client.post(f"/api/v1/takes/{take['id']}/runs", json={"filter_method": "quat-pd"})
     assert bad.status_code == 422
     assert bad.json()["field"] == "filter_method"
+    window = {"filter_method": "adaptive", "filter_params": {"window_s": 1e9}}
+    bad = client.post(f"/api/v1/takes/{take['id']}/runs", json=window)
+    assert bad.status_code == 422
+    assert bad.json()["field"] == "filter_params.window_s"
+    assert "0.0001 to 60 s" in bad.json()["detail"]
     params = {"filter_method": "kalman", "filter_params": {"process_noise": "loud"}}
     bad = client.post(f"/api/v1/takes/{take['id']}/runs", json=params)
     assert bad.status_code == 422

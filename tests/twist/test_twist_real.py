@@ -124,7 +124,7 @@ def test_apply_choices_and_levels_rebuild_the_refined_take(real_take: Motion) ->
     for bad in ("maybe", "", "1,-2", "a,b"):
         with pytest.raises(InputError, match="apply"):
             analyze_twist(real_take, apply=bad)
-    with pytest.raises(InputError, match="interval ids below"):
+    with pytest.raises(InputError, match="interval ids 0 to 7"):
         analyze_twist(real_take, apply="999")
 
 

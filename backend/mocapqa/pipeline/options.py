@@ -52,6 +52,22 @@ MAX_POINTS_RANGE = (10, 100_000)
 """Smallest and largest ``max_points`` (time samples per plotted series)."""
 
 
+UNIT_RANGES = {"_s": (1e-4, 60.0, "s"), "_hz": (1e-3, 1e4, "Hz")}
+"""Range of every filter parameter by the unit its name ends in: durations and frequencies
+outside them are no motion filter (a 10⁹ s window would allocate terabytes; a 10⁻³⁰⁰ Hz
+cut-off breaks the filter design), so they are refused when the run is asked for."""
+
+
+def _check_unit_range(name: str, value: object) -> None:
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        return
+    for suffix, (low, high, unit) in UNIT_RANGES.items():
+        if name.endswith(suffix) and not low <= value <= high:
+            raise OptionError(
+                f"filter_params.{name}", f"Expected {low:g} to {high:g} {unit}, got {value!r}"
+            )
+
+
 def _same_kind(value: Any, current: Any) -> bool:
     """Whether an override ``value`` can stand in for a parameter's ``current`` value."""
     if isinstance(value, str):
@@ -156,17 +172,31 @@ class AnalysisOptions:
                     f"Expected a finite {type(current).__name__} (filter {method!r}), "
                     f"got {value!r}",
                 )
+            _check_unit_range(name, value)
 
-    def check_take_kind(self, kind: str) -> None:
-        """Refuse options that do not suit a take of ``kind`` ("motion" or "keypoints").
+    def check_take_kind(self, kind: str, fps: float | None = None) -> None:
+        """Refuse options that do not suit a take of ``kind`` ("motion" or "keypoints") at
+        ``fps`` frames per second (when known).
 
         Raises
         ------
         OptionError
             Naming the option: a keypoint filter on a BVH, a rotation filter on keypoints,
             a preset or parameters with no filter to apply them to, a rig mapping for
-            keypoints.
+            keypoints, a cut-off frequency at or above the take's Nyquist frequency.
         """
+        if fps is not None and fps > 0:
+            for name, value in self.filter_params.items():
+                if (
+                    name.endswith("cutoff_hz")
+                    and isinstance(value, int | float)
+                    and value >= fps / 2
+                ):
+                    raise OptionError(
+                        f"filter_params.{name}",
+                        f"Expected a cut-off below the take's Nyquist frequency "
+                        f"{fps / 2:g} Hz ({fps:g} fps), got {value:g} Hz",
+                    )
         wanted = "rotations" if kind == "motion" else "keypoints"
         if kind != "motion" and self.mapping:
             raise OptionError("mapping", "Expected the mapping option only for BVH takes")

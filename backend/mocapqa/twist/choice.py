@@ -10,6 +10,7 @@ constant offset, so the refined take is exactly the raw one with the applied lev
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -30,6 +31,9 @@ APPLY_CHOICES = ("confident", "all", "none")
 minimum-evidence rule, the default), ``all`` or ``none``."""
 
 
+_IDS = re.compile(r"[0-9]+(,[0-9]+)*")
+
+
 def parse_apply(value: str | frozenset[int]) -> str | frozenset[int]:
     """One of :data:`APPLY_CHOICES`, or the set of interval ids in ``"3,7"``.
 
@@ -43,10 +47,12 @@ def parse_apply(value: str | frozenset[int]) -> str | frozenset[int]:
     text = str(value).strip()
     if text in APPLY_CHOICES:
         return text
-    try:
-        ids = frozenset(int(v) for v in text.split(",") if v.strip())
-    except ValueError:
-        ids = frozenset({-1})
+    # ASCII digits only: int() would also read "1_0" as 10 and other scripts' digits.
+    ids = (
+        frozenset(int(v) for v in text.split(","))
+        if _IDS.fullmatch(text.replace(" ", ""))
+        else frozenset({-1})
+    )
     if not ids or min(ids) < 0:
         raise InputError(
             f"Expected apply to be one of {list(APPLY_CHOICES)} or interval ids like '0,3', "
@@ -145,7 +151,14 @@ def choose_intervals(
         For an interval id the take does not have.
     """
     if isinstance(choice, frozenset) and choice and max(choice) >= len(found):
-        raise InputError(f"Expected interval ids below {len(found)} in apply, got {sorted(choice)}")
+        if not found:
+            raise InputError(
+                f"Expected no interval ids in apply on a take with no twist interval, got "
+                f"{sorted(choice)}"
+            )
+        raise InputError(
+            f"Expected interval ids 0 to {len(found) - 1} in apply, got {sorted(choice)}"
+        )
     offsets = np.zeros_like(detected)
     intervals = []
     for k, i in enumerate(found):

@@ -50,7 +50,7 @@ def start_run(
     ``mapping``) the take's joints (422 naming the field), not when the run executes.
     """
     parsed = AnalysisOptions.from_json((options or AnalysisOptionsIn()).model_dump())
-    parsed.check_take_kind(str(take["kind"]))
+    parsed.check_take_kind(str(take["kind"]), float(take["fps"]) if take.get("fps") else None)
     parsed.check_joints(joints_of(services.files, str(take["id"])))
     require_run_slot(services, client)
     run_id = services.repository.add_run(str(take["id"]), parsed.to_json())
