@@ -17,7 +17,10 @@ export async function compareView(main, params, onTeardown = () => {}) {
   const pick = (name) => h("select", { id: `compare-${name}`, onchange: (e) => {
     const next = new URLSearchParams(params); next.set(name, e.target.value); location.hash = `#/compare?${next}`; } },
     h("option", { value: "" }, "choose…"), options.map(([v, l]) => h("option", { value: v, selected: v === params.get(name) }, l)));
-  main.replaceChildren(h("h1", {}, "Compare two takes or runs"), h("div", { class: "controls" }, "A ", pick("a"), " B ", pick("b")));
+  // Each choice is as wide as the window allows, not as the longest take name (they can be
+  // 240 characters): the closed list cuts the name, the open one shows it whole.
+  const labelled = (name) => h("label", { class: "compare-pick" }, `${name.toUpperCase()} `, pick(name));
+  main.replaceChildren(h("h1", {}, "Compare two takes or runs"), h("div", { class: "controls" }, labelled("a"), labelled("b")));
   const ids = [params.get("a"), params.get("b")].filter(Boolean);
   const results = await Promise.all(ids.map(async (id) => ({ run: await api.getRun(id), result: await api.getResult(id).catch(() => null) })));
   if (!results.length) return;

@@ -44,6 +44,25 @@ export function viewQuery(state) {
   return query.toString();
 }
 
+/** What is wrong with the table's score range, or null: a bound that is not a number from 0
+ * to 100 (the API's bounds), or a min score above the max score (no take could match; the API
+ * would answer an empty page). `fields` are the filters to mark, `text` the message. */
+export function scoreRangeProblem(state) {
+  const bounds = { min_score: "min score", max_score: "max score" };
+  const values = {};
+  for (const [key, label] of Object.entries(bounds)) {
+    const raw = String(state[key] ?? "").trim();
+    if (raw === "") continue;
+    const value = Number(raw);
+    if (!Number.isFinite(value) || value < 0 || value > 100) return { fields: [key], text: `${label} must be a number from 0 to 100 (got "${raw}")` };
+    values[key] = value;
+  }
+  if (values.min_score != null && values.max_score != null && values.min_score > values.max_score) {
+    return { fields: ["min_score", "max_score"], text: `min score (${values.min_score}) is above max score (${values.max_score}): no take can match` };
+  }
+  return null;
+}
+
 /** Clicking a column header: the same column flips the order, a new one sorts ascending. Any
  * sort goes back to the first page. */
 export function nextSort(state, column) {
@@ -202,15 +221,84 @@ export function heatmapPager(page, total) {
   return { ...info, text: `takes ${info.text}` };
 }
 
+/** Row labels of the heat map are at most this many characters, rank included: a long take
+ * name would otherwise take the chart's width from its cells. */
+export const HEATMAP_LABEL_CHARS = 40;
+/** Every joint column gets at least this many pixels, so each joint's label has room; a page
+ * of many joints then scrolls sideways inside the chart's box, never the page. */
+export const HEATMAP_COLUMN_PX = 26;
+const LABEL_CHAR_PX = 7; // about one character of Plotly's 12 px tick font
+/** The joint labels' angle: -45° needs about 17 px a column, -90° would need a taller margin. */
+export const HEATMAP_TICK_ANGLE = -45;
+
+/** A text cut to at most `max` characters (code points), keeping its start and its end with an
+ * ellipsis between: "take_very_long…_end.bvh" (a take's end often says which it is). */
+export function middleEllipsis(text, max = HEATMAP_LABEL_CHARS) {
+  const chars = Array.from(String(text ?? ""));
+  const size = Math.max(1, Math.floor(max));
+  if (chars.length <= size) return chars.join("");
+  const head = Math.ceil((size - 1) / 2);
+  const tail = size - 1 - head;
+  return `${chars.slice(0, head).join("")}…${tail ? chars.slice(chars.length - tail).join("") : ""}`;
+}
+
+/** A name for a Plotly hover label: its characters as Plotly shows them (&, < and > as
+ * entities, so a name is never read as markup) in lines of at most `width` characters joined
+ * by <br> (a 240-character file name on one line is wider than the window and gets cut). */
+export function hoverLines(text, width = 60) {
+  const chars = Array.from(String(text ?? ""));
+  const lines = [];
+  for (let at = 0; at < chars.length; at += width) lines.push(chars.slice(at, at + width).join(""));
+  const escape = (line) => line.replace(/&/g, "&amp;").replace(/</g, "&lt;").replace(/>/g, "&gt;");
+  return lines.map(escape).join("<br>");
+}
+
+/** The heat map's colours, light yellow at 0 % to dark red at the page's largest share (Plotly's
+ * YlOrRd turned round): the chart and the colour key above it use the same stops. */
+export const HEATMAP_COLORSCALE = [
+  [0, "rgb(255,255,204)"], [0.125, "rgb(255,237,160)"], [0.25, "rgb(254,217,118)"], [0.375, "rgb(254,178,76)"],
+  [0.5, "rgb(253,141,60)"], [0.625, "rgb(252,78,42)"], [0.75, "rgb(227,26,28)"], [0.875, "rgb(189,0,38)"], [1, "rgb(128,0,38)"],
+];
+
+/** The colour key's CSS background: the heat map's colour scale from left (0 %) to right. */
+export function heatmapKeyGradient(scale = HEATMAP_COLORSCALE) {
+  return `linear-gradient(to right, ${scale.map(([at, colour]) => `${colour} ${Number((100 * at).toFixed(2))}%`).join(", ")})`;
+}
+
 /** The chart of one page: one row per take, labelled with its rank in the shoot (so takes
- * with the same name stay separate rows), z in percent (heatmapRows), and a height that gives
- * every row the same number of pixels whatever the page size. */
+ * with the same name stay separate rows) and its name cut to HEATMAP_LABEL_CHARS
+ * (middleEllipsis), the full "rank. name" in `text` for the hover (hoverLines); z in percent (heatmapRows)
+ * and `zmax`, the largest share on the page (the colour key's end); every joint and every take
+ * labelled (`xaxis` / `yaxis`: tick mode "array"; Plotly's automatic ticks skip categories
+ * when they are crowded), with fixed ranges (the first take on top); the margins the labels need (joints above and below the cells); a
+ * height that gives every row the same number of pixels whatever the page size, and
+ * `minWidth`: the width at which every joint column has HEATMAP_COLUMN_PX. */
 export function heatmapFigure(data, offset) {
-  const labels = data.takes.map((t, k) => `${offset + k + 1}. ${t.name}`);
+  const names = data.takes.map((t, k) => `${offset + k + 1}. ${t.name}`);
+  const labels = data.takes.map((t, k) => {
+    const rank = `${offset + k + 1}. `;
+    return rank + middleEllipsis(t.name, Math.max(8, HEATMAP_LABEL_CHARS - rank.length));
+  });
+  const z = heatmapRows(data);
+  const zmax = Math.max(0, ...z.flat().filter((v) => v != null));
+  const longest = Math.max(0, ...labels.map((l) => Array.from(l).length));
+  const longestJoint = Math.max(0, ...data.joints.map((j) => Array.from(String(j)).length));
+  // The joints are labelled above and below the cells (a tall page scrolls in its box, and
+  // one of the two is in view at either end), each at HEATMAP_TICK_ANGLE.
+  const jointRoom = Math.round(30 + Math.abs(Math.sin((HEATMAP_TICK_ANGLE * Math.PI) / 180)) * LABEL_CHAR_PX * longestJoint);
+  const margin = { l: 12 + LABEL_CHAR_PX * longest, r: 20, t: jointRoom, b: jointRoom };
   return {
     x: data.joints,
     y: labels,
-    z: heatmapRows(data),
-    height: Math.max(260, 120 + HEATMAP_ROW_PX * data.takes.length),
+    z,
+    zmax: zmax > 0 ? zmax : 1,
+    text: names.map((name) => { const hover = hoverLines(name); return data.joints.map(() => hover); }),
+    // Fixed ranges, the first take on top: the invisible trace that gives the joints' top axis
+    // its categories would otherwise pad an automatic range by 5 % (250 px on a 230-take page).
+    xaxis: { tickmode: "array", tickvals: [...data.joints], ticktext: [...data.joints], range: [-0.5, data.joints.length - 0.5] },
+    yaxis: { tickmode: "array", tickvals: [...labels], ticktext: [...labels], range: [data.takes.length - 0.5, -0.5] },
+    margin,
+    minWidth: margin.l + margin.r + HEATMAP_COLUMN_PX * data.joints.length,
+    height: Math.max(260, margin.t + margin.b + HEATMAP_ROW_PX * data.takes.length),
   };
 }

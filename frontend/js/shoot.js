@@ -8,11 +8,13 @@ import { loadPlotly, untabbableModebar } from "./plotly.js";
 import { fmt } from "./format.js";
 import { limitsModelPanel } from "./shoot-limits.js";
 import {
-  decisionForKey, deleteConfirmed, exportQuery, formatCell, HEATMAP_SIZES, heatmapChanged, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
-  importLines, isFiltered, nextSort, pageInfo, progressSummary, scoreColor, shootControls, TAKE_COLUMNS, tableState, takesQuery, viewQuery,
+  decisionForKey, deleteConfirmed, exportQuery, formatCell, HEATMAP_COLORSCALE, HEATMAP_SIZES, HEATMAP_TICK_ANGLE, heatmapChanged, heatmapFigure,
+  heatmapKeyGradient, heatmapPage, heatmapPager, heatmapQuery, importLines, isFiltered, nextSort, pageInfo, progressSummary, scoreColor,
+  scoreRangeProblem, shootControls, TAKE_COLUMNS, tableState, takesQuery, viewQuery,
 } from "./shoot-format.js";
 
 const POLL_MS = 1000;
+const ALL_COLUMNS_KEY = "mocapqa-shoot-all-columns"; // the take table's "all columns" choice, kept in the browser
 
 export async function shootsView(main) {
   const shoots = await api.listShoots();
@@ -155,23 +157,70 @@ function manageControls(shoot, who, onRenamed) {
   return out;
 }
 
-function filterBar(state, apply) {
+/** The take table's filters. Every field has a visible label (a typed number says nothing by
+ * itself); a score range that can match no take is said at once beside the fields. The
+ * "all columns" toggle shows the columns a narrow window hides (the table then scrolls in
+ * its box). */
+function filterBar(state, apply, allColumns) {
   const select = (key, label, options) => h("label", {}, `${label} `, h("select", { id: `shoot-${key}`, onchange: (e) => apply({ [key]: e.target.value }) },
     options.map(([v, text]) => h("option", { value: v, selected: String(state[key]) === v }, text))));
-  const input = (key, label, attrs) => {
-    const el = h("input", { id: `shoot-${key}`, value: state[key], "aria-label": label, placeholder: label, ...attrs });
+  const fields = {};
+  const input = (key, attrs, onInput = () => {}) => {
+    const el = h("input", { id: `shoot-${key}`, value: state[key], ...attrs });
     let timer = null;
-    el.addEventListener("input", () => { clearTimeout(timer); timer = setTimeout(() => apply({ [key]: el.value }), 350); });
+    el.addEventListener("input", () => { onInput(); clearTimeout(timer); timer = setTimeout(() => apply({ [key]: el.value }), 350); });
+    fields[key] = el;
     return el;
   };
-  return h("div", { class: "controls shoot-filters" },
-    input("search", "search name", { type: "search" }),
+  const scoreMessage = h("span", { id: "shoot-score-message", role: "alert" });
+  const checkScores = () => {
+    const problem = scoreRangeProblem({ min_score: fields.min_score.value, max_score: fields.max_score.value });
+    for (const key of ["min_score", "max_score"]) fields[key].setAttribute("aria-invalid", String(!!problem && problem.fields.includes(key)));
+    scoreMessage.textContent = problem ? problem.text : "";
+    scoreMessage.className = problem ? "error" : "";
+  };
+  const labelled = (label, el) => h("label", { for: el.id }, `${label} `, el);
+  const bar = h("div", { class: "controls shoot-filters" },
+    input("search", { type: "search", "aria-label": "search name", placeholder: "search name" }),
     select("status", "run", [["", "any"], ["queued", "queued"], ["running", "running"], ["done", "done"], ["failed", "failed"]]),
     select("review_status", "review", [["", "any"], ...Object.entries(REVIEW)]),
     select("has_findings", "findings", [["", "any"], ["true", "some"], ["false", "none"]]),
-    input("rig", "rig", { class: "short" }),
-    input("min_score", "min score", { type: "number", min: 0, max: 100, class: "short" }),
-    input("max_score", "max score", { type: "number", min: 0, max: 100, class: "short" }));
+    labelled("rig", input("rig", { class: "short" })),
+    labelled("min score", input("min_score", { type: "number", min: 0, max: 100, step: "any", placeholder: "0", class: "short" }, () => checkScores())),
+    labelled("max score", input("max_score", { type: "number", min: 0, max: 100, step: "any", placeholder: "100", class: "short" }, () => checkScores())),
+    scoreMessage, allColumns);
+  checkScores();
+  return bar;
+}
+
+/** The "all columns" toggle (shown only where the window hides columns): a pressed button that
+ * marks the table area, the choice kept in the browser. */
+function allColumnsToggle(area) {
+  const button = h("button", { type: "button", id: "shoot-all-columns", class: "columns-toggle", "aria-pressed": "false",
+    title: "show the duration, rig, spins, worst joint, filter, missing and reviewer columns too (the table scrolls sideways in its box)" }, "all columns");
+  const set = (on) => {
+    button.setAttribute("aria-pressed", String(on));
+    area.classList.toggle("all-columns", on);
+  };
+  let stored = null;
+  try { stored = localStorage.getItem(ALL_COLUMNS_KEY); } catch { /* storage refused: not kept */ }
+  set(stored === "1");
+  button.addEventListener("click", () => {
+    const on = button.getAttribute("aria-pressed") !== "true";
+    set(on);
+    try { localStorage.setItem(ALL_COLUMNS_KEY, on ? "1" : "0"); } catch { /* storage refused: not kept */ }
+  });
+  return button;
+}
+
+/** A selector finding again, after a redraw of `box`, the element of it that has the focus:
+ * by a header's column, a row's take or the element's id (null when the focus is elsewhere). */
+function focusedIn(box) {
+  const el = document.activeElement;
+  if (!el || el === box || !box.contains(el)) return null;
+  if (el.dataset.sort) return `th[data-sort="${CSS.escape(el.dataset.sort)}"]`;
+  if (el.dataset.take) return `tr[data-take="${CSS.escape(el.dataset.take)}"]`;
+  return el.id ? `#${CSS.escape(el.id)}` : null;
 }
 
 function takeTable(page, state, apply) {
@@ -217,6 +266,12 @@ export async function shootView(main, shootId, params, onTeardown) {
   let drawn = 0; // the latest table request: an older answer arriving late is dropped
   const drawTable = async () => {
     const request = ++drawn;
+    const problem = scoreRangeProblem(state);
+    if (problem) { // no take can match: no request, and no silent "0–0 of 0" (the filter bar says why)
+      tableBox.replaceChildren(h("p", { class: "muted", id: "shoot-table-empty" }, "No takes listed: the score range above matches none."));
+      tableArea.dataset.query = takesQuery(state);
+      return;
+    }
     const page = await api.shootTakes(shootId, takesQuery(state));
     if (!alive || request !== drawn) return;
     const info = pageInfo(state.offset, state.limit, page.total);
@@ -224,11 +279,15 @@ export async function shootView(main, shootId, params, onTeardown) {
     const previous = move(info.previous); previous.append("‹ previous"); previous.id = "page-previous";
     const next = move(info.next); next.append("next ›"); next.id = "page-next";
     // The filter bar stays (a poll must not take the focus from the search field); the table
-    // and pager are redrawn, and a focused header keeps the focus.
-    const focused = document.activeElement && document.activeElement.dataset ? document.activeElement.dataset.sort : null;
+    // and pager are redrawn, and what had the focus in them keeps it: the same header, the
+    // same take's row (polled every second while takes are analysed), the same pager button.
+    const focused = focusedIn(tableBox);
     tableBox.replaceChildren(takeTable(page, state, apply),
       h("div", { class: "controls" }, previous, h("span", { id: "page-info" }, info.text), next));
-    if (focused) tableBox.querySelector(`th[data-sort="${focused}"]`)?.focus();
+    if (focused) {
+      const again = tableBox.querySelector(focused);
+      if (again && !again.disabled) again.focus({ preventScroll: true });
+    }
     tableArea.dataset.query = takesQuery(state);
   };
   // The downloads hold what the table lists (its filters and order), and say so when filtered.
@@ -267,6 +326,11 @@ export async function shootView(main, shootId, params, onTeardown) {
   const drawHeatmap = async () => {
     const ticket = ++heatDrawn;
     const shown = state;
+    const problem = scoreRangeProblem(shown);
+    if (problem) { // as the table: no request, the reason in words
+      heatmap.replaceChildren(h("h2", {}, "Joint limits"), h("p", { class: "muted", id: "heatmap-empty" }, `No take matches the table's filters: ${problem.text}.`));
+      return;
+    }
     const [Plotly, first] = await Promise.all([loadPlotly(), api.shootHeatmap(shootId, heatmapQuery(heat, shown))]);
     let data = first;
     const safe = heatmapPage(heat.offset, heat.limit, data.total);
@@ -296,14 +360,27 @@ export async function shootView(main, shootId, params, onTeardown) {
     }
     const figure = heatmapFigure(data, heat.offset);
     const chart = h("div", { id: "heatmap-chart", "data-offset": heat.offset });
-    heatmap.replaceChildren(title, controls, h("div", { class: "heatmap-scroll", id: "heatmap-scroll", tabindex: "0", "aria-label": "heat map, scrolls" }, chart));
+    chart.style.minWidth = `${figure.minWidth}px`; // every joint column keeps its room: the box scrolls sideways instead
+    // The colour key stays in view at the top of the scrolling box (the chart's own colour bar
+    // would scroll away with a tall page); the joints are labelled above and below the cells.
+    const bar = h("span", { class: "heatmap-key-bar" });
+    bar.style.background = heatmapKeyGradient();
+    const key = h("div", { class: "heatmap-key", id: "heatmap-key" }, "share of frames outside the limits: ",
+      h("span", {}, "0 %"), bar, h("span", { id: "heatmap-key-max" }, `${fmt(figure.zmax, 1)} %`));
+    heatmap.replaceChildren(title, controls, h("div", { class: "heatmap-scroll", id: "heatmap-scroll", tabindex: "0", "aria-label": "heat map, scrolls" }, key, chart));
+    const joints = { ...figure.xaxis, tickangle: HEATMAP_TICK_ANGLE, automargin: true };
     await Plotly.newPlot(chart, [{
-      type: "heatmap", x: figure.x, y: figure.y, z: figure.z,
-      colorscale: "YlOrRd", reversescale: true, zmin: 0, hoverongaps: false,
-      colorbar: { title: { text: "%" } }, hovertemplate: "%{y}<br>%{x}: %{z:.1f} %<extra></extra>",
+      type: "heatmap", x: figure.x, y: figure.y, z: figure.z, text: figure.text,
+      colorscale: HEATMAP_COLORSCALE, zmin: 0, zmax: figure.zmax, hoverongaps: false, showscale: false,
+      hovertemplate: "%{text}<br>%{x}: %{z:.1f} % of frames outside<extra></extra>",
+    }, { // no data to draw: it only gives the joints' axis above the cells its categories
+      type: "scatter", mode: "markers", x: figure.x, y: figure.x.map(() => figure.y[0]), xaxis: "x2",
+      marker: { opacity: 0 }, hoverinfo: "skip", showlegend: false,
     }], {
-      height: figure.height, margin: { l: 180, r: 20, t: 10, b: 110 },
-      yaxis: { autorange: "reversed", automargin: true }, xaxis: { tickangle: -45, automargin: true },
+      height: figure.height, margin: figure.margin,
+      yaxis: { ...figure.yaxis, automargin: true },
+      xaxis: { ...joints, side: "bottom" },
+      xaxis2: { ...joints, side: "top", overlaying: "x", matches: "x" },
     }, { responsive: true, displaylogo: false });
     untabbableModebar(chart);
   };
@@ -340,7 +417,7 @@ export async function shootView(main, shootId, params, onTeardown) {
     importPanel(shootId, restartPolling),
     progressPanel,
     tableArea, heatmap);
-  tableArea.replaceChildren(filterBar(state, apply), tableBox);
+  tableArea.replaceChildren(filterBar(state, apply, allColumnsToggle(tableArea)), tableBox);
   await drawTable();
   await poll();
   main.dataset.ready = "1";
@@ -348,13 +425,13 @@ export async function shootView(main, shootId, params, onTeardown) {
 }
 
 export async function reviewQueueView(main, shootId, onTeardown) {
-  const shoot = await api.getShoot(shootId);
-  const reviewer = h("input", { id: "queue-reviewer", value: localStorage.getItem("mocapqa-reviewer") || "", placeholder: "your name", "aria-label": "reviewer" });
+  // The server records each review as the signed-in user: there is no name to type.
+  const [shoot, who] = await Promise.all([api.getShoot(shootId), me().catch(() => null)]);
   const notes = h("textarea", { id: "queue-notes", placeholder: "notes (optional, saved with the next decision)", "aria-label": "notes" });
   const card = h("div", { class: "panel", id: "queue-card" });
   const message = h("p", { id: "queue-message", class: "muted" });
   const help = h("p", { class: "muted", id: "keys-help" },
-    "Keys: A approve · F needs fix · R reject (each saves, with the notes, and moves to the next take) · S skip · O open the take · ? shows or hides this line · keys typed in the fields are text");
+    "Keys: A approve · F needs fix · R reject (each saves, with the notes, and moves to the next take) · S skip · O open the take · ? shows or hides this line · keys typed in the notes are text");
   let current = null;
   let busy = false;
 
@@ -386,8 +463,7 @@ export async function reviewQueueView(main, shootId, onTeardown) {
     if (!current || busy) return;
     busy = true;
     try {
-      localStorage.setItem("mocapqa-reviewer", reviewer.value);
-      await api.addReview(current.take_id, { status: decision, notes: notes.value, reviewer: reviewer.value || "anonymous" });
+      await api.addReview(current.take_id, { status: decision, notes: notes.value });
       notes.value = "";
       message.textContent = `${current.name}: ${REVIEW[decision]}`; message.className = "muted";
       await show();
@@ -405,7 +481,7 @@ export async function reviewQueueView(main, shootId, onTeardown) {
   document.addEventListener("keydown", onKey);
   onTeardown(() => document.removeEventListener("keydown", onKey));
   main.replaceChildren(h("h1", {}, h("a", { href: "#/shoots" }, "Shoots"), " / ", h("a", { href: api.shootLink(shootId) }, shoot.name), " / review queue"),
-    h("div", { class: "controls" }, "Reviewer ", reviewer), help, card, notes, message);
+    ...(who ? [h("p", { class: "muted", id: "queue-who" }, `Reviews are recorded as ${who.name}.`)] : []), help, card, notes, message);
   await show();
   main.dataset.ready = "1";
 }

@@ -257,6 +257,21 @@ def test_heatmap_pages_beyond_200_takes(
         " return [b.scrollHeight, b.clientHeight]; }"
     )
     assert box[0] > box[1]
+    # Scrolled to its end, the box still shows the colour key at its top, and the joints are
+    # labelled below the cells as above them.
+    sticky = page.evaluate(
+        "() => { const b = document.getElementById('heatmap-scroll'); b.scrollTop = b.scrollHeight;"
+        " const key = document.getElementById('heatmap-key').getBoundingClientRect();"
+        " return [Math.round(key.top - b.getBoundingClientRect().top), key.height]; }"
+    )
+    assert abs(sticky[0]) <= 2
+    assert sticky[1] > 0
+    joints = page.evaluate("() => document.getElementById('heatmap-chart').data[0].x")
+    for axis in ("x", "x2"):
+        shown = page.locator(f"#heatmap-chart .{axis}tick text").evaluate_all(
+            "(texts) => texts.map((t) => t.textContent)"
+        )
+        assert shown == joints
     # Lowest score first: the 115 twist-error walks, then the clean walks from rank 116 on.
     assert labels[114].endswith("_twist_errors.bvh")
     assert labels[115].endswith("_cmu_12_01_walk.bvh")

@@ -104,6 +104,20 @@ def test_import_progress_sort_review_export(
     rejected = p.inner_text("#import-skipped") + p.inner_text("#import-failed")
     assert "notes.txt" in rejected
 
+    # While the takes are analysed the table is redrawn every second: a focused take row keeps
+    # the focus (by its take id) instead of losing it to the page.
+    p.wait_for_selector("#shoot-takes tbody tr[data-take]", timeout=60_000)
+    p.focus("#shoot-takes tbody tr[data-take]")
+    focused_take = p.evaluate(
+        "() => { const row = document.activeElement; row.dataset.before = '1';"
+        " return row.dataset.take; }"
+    )
+    if p.get_attribute("#progress-panel", "data-finished") == "0":  # a redraw is still to come
+        p.wait_for_function(
+            "() => !document.querySelector('#shoot-takes tr[data-before]')", timeout=60_000
+        )
+        assert p.evaluate("() => document.activeElement.dataset.take") == focused_take
+
     # Live progress: the bar reaches "done" without a reload.
     p.wait_for_selector("#progress-panel[data-finished='1']", timeout=ANALYSIS_MS)
     p.wait_for_function(
@@ -153,12 +167,34 @@ def test_import_progress_sort_review_export(
         "() => document.querySelectorAll('#shoot-takes tbody tr').length === 1", timeout=30_000
     )
     assert p.inner_text("#page-info") == "1–1 of 1"
+    # The score bounds are labelled; a min score above the max score is said beside them, and
+    # the table lists nothing (no silent "0–0 of 0").
+    assert p.inner_text("label[for='shoot-min_score']").strip() == "min score"
+    assert p.inner_text("label[for='shoot-max_score']").strip() == "max score"
+    p.fill("#shoot-min_score", "95")
+    p.fill("#shoot-max_score", "50")
+    p.wait_for_selector("#shoot-table-empty", timeout=30_000)
+    assert p.inner_text("#shoot-score-message").startswith("min score (95) is above max score (50)")
+    assert p.get_attribute("#shoot-min_score", "aria-invalid") == "true"
+    assert p.locator("#page-info").count() == 0
+    p.fill("#shoot-max_score", "")
+    p.wait_for_selector("#page-info", timeout=30_000)
+    assert p.inner_text("#shoot-score-message") == ""
+    assert p.get_attribute("#shoot-min_score", "aria-invalid") == "false"
+    p.fill("#shoot-min_score", "")
+    p.wait_for_function(
+        "() => !document.getElementById('shoot-table-area').dataset.query.includes('min_score')"
+        " && document.getElementById('page-info')?.innerText === '1–1 of 1'",
+        timeout=30_000,
+    )
 
     # The review queue, lowest score first, walked with A, F, R.
     p.click("#review-queue")
     p.wait_for_selector("main[data-ready='1'] #queue-card[data-take]", timeout=30_000)
-    p.fill("#queue-reviewer", "ana")
-    p.click("h1")  # leave the input so the keys reach the queue
+    # No reviewer field: the server records the signed-in user, and the page says who.
+    assert p.locator("#queue-reviewer").count() == 0
+    assert "Reviews are recorded as anonymous" in p.inner_text("#queue-who")
+    p.click("h1")
     assert "A approve" in p.inner_text("#keys-help")
     p.keyboard.press("?")
     assert p.locator("#keys-help").is_hidden()
@@ -214,6 +250,11 @@ def test_import_progress_sort_review_export(
     assert sorted(r["review_status"] for r in only) == ["approved", "approved"]
     p.select_option("#shoot-review_status", "")
     p.wait_for_function("document.getElementById('export-csv').textContent === 'summary CSV'")
+    # The heat map follows the filters too: wait for it to hold every take again.
+    p.wait_for_function(
+        "() => document.getElementById('heatmap-chart')?.data?.[0]?.y?.length === 4",
+        timeout=60_000,
+    )
 
     # The heat map (Plotly, loaded by this view only): one row per take, lowest score first;
     # the keypoint take, which has no joint limits, is an empty row.
@@ -285,13 +326,25 @@ def test_import_progress_sort_review_export(
     assert row[3:7] == ["0", "0", "4", "0"]  # queued, running, done, failed
     p.screenshot(path=str(ARTIFACTS / "shoot-list.png"), full_page=True)
 
-    # A 900 px window scrolls only down.
+    # A 900 px window scrolls only down. It hides the secondary columns (below 1440 px), and
+    # "all columns" shows them: the table then scrolls inside its box, never the page.
     narrow = Page(chromium, width=900, height=900)
     narrow.open(f"{live_server}/#/shoot/{shoot_id}")
     narrow.page.wait_for_selector("#shoot-takes tbody tr")
     narrow.page.wait_for_selector("#shoot-heatmap h2", timeout=60_000)
     assert narrow.no_sideways_scroll()
     narrow.page.screenshot(path=str(ARTIFACTS / "shoot-900px.png"), full_page=True)
+    rig = "#shoot-takes th[data-sort='rig']"
+    assert narrow.page.is_hidden(rig)
+    narrow.page.focus("#shoot-all-columns")
+    narrow.page.keyboard.press("Enter")
+    narrow.page.wait_for_selector(rig, state="visible")
+    assert narrow.page.get_attribute("#shoot-all-columns", "aria-pressed") == "true"
+    assert narrow.page.locator("#shoot-takes thead th:visible").count() == 16
+    assert narrow.no_sideways_scroll()
+    narrow.page.screenshot(path=str(ARTIFACTS / "shoot-900px-all-columns.png"), full_page=True)
+    narrow.page.keyboard.press("Enter")
+    narrow.page.wait_for_selector(rig, state="hidden")
     narrow.open(f"{live_server}/#/shoots")
     assert narrow.no_sideways_scroll()
     assert narrow.errors == []
@@ -323,16 +376,64 @@ def test_archive_and_broken_file_show_kept_skipped_and_failed(
 
 
 def test_dropped_files_are_imported(live_server: str, page: Page, corpus_dir: Path) -> None:
+    """Two takes dropped on the drop zone, one of them the twist-error walk under a
+    240-character name: the names wrap, the heat map keeps its cells and labels every joint."""
     shoot = httpx.post(f"{live_server}/api/v1/shoots", json={"name": "Drop day"}, timeout=30)
     shoot.raise_for_status()
     page.open(f"{live_server}/#/shoot/{shoot.json()['id']}")
     take = corpus_dir / TAKES[0]
+    long_name = "take_" + "very_long_name_" * 15 + "end_of_it.bvh"
+    assert len(long_name) == 243
     dropped = page.page.evaluate_handle(
-        "([name, text]) => { const d = new DataTransfer();"
-        " d.items.add(new File([text], name)); return d; }",
-        [take.name, take.read_text()],
+        "(files) => { const d = new DataTransfer();"
+        " for (const [name, text] of files) d.items.add(new File([text], name)); return d; }",
+        [[take.name, take.read_text()], [long_name, demo_paths()[0].read_text()]],
     )
     page.page.dispatch_event("#import-zone", "drop", {"dataTransfer": dropped})
     page.page.wait_for_selector("#import-kept", timeout=120_000)
-    assert f"kept (1)\n{take.name}" in page.page.inner_text("#import-kept")
-    page.page.wait_for_selector("#progress-panel[data-finished='1']", timeout=ANALYSIS_MS)
+    kept = page.page.inner_text("#import-kept")
+    assert "kept (2)" in kept
+    assert take.name in kept
+    assert long_name in kept
+    page.page.wait_for_function(
+        "() => document.querySelectorAll('#shoot-takes tbody .badge.done').length === 2",
+        timeout=ANALYSIS_MS,
+    )
+
+    # At 800 px: the long name wraps (import list, table), nothing scrolls the page sideways.
+    p = page.page
+    p.set_viewport_size({"width": 800, "height": 900})
+    p.wait_for_selector("#heatmap-chart .main-svg", timeout=60_000)
+    p.wait_for_function(
+        "() => document.getElementById('heatmap-chart')?.data?.[0]?.y?.length === 2",
+        timeout=60_000,
+    )
+    # Plotly follows the window (responsive): the cells end inside the heat map's box again.
+    p.wait_for_function(
+        "() => document.querySelector('#heatmap-chart .nsewdrag').getBoundingClientRect().right"
+        " <= document.getElementById('heatmap-scroll').getBoundingClientRect().right",
+        timeout=30_000,
+    )
+    assert page.no_sideways_scroll()
+    heat = p.evaluate(
+        """() => { const chart = document.getElementById('heatmap-chart');
+          const d = chart.data[0];
+          const cells = chart.querySelector('.nsewdrag').getBoundingClientRect();
+          const box = document.getElementById('heatmap-scroll').getBoundingClientRect();
+          const labels = (axis) => [...chart.querySelectorAll(`.${axis}tick text`)]
+            .map((t) => t.textContent);
+          return { y: d.y, x: d.x, text: d.text, width: cells.width, right: cells.right,
+            box: box.right, bottom: labels('x'), top: labels('x2') }; }"""
+    )
+    row = next(k for k, label in enumerate(heat["y"]) if "very_long" in label)
+    assert len(heat["y"][row]) <= 40
+    assert heat["y"][row].startswith(f"{row + 1}. take_very_long")
+    assert heat["y"][row].endswith("end_of_it.bvh")
+    # The hover names it in full, in lines that fit the window.
+    assert heat["text"][row][0].replace("<br>", "") == f"{row + 1}. {long_name}"
+    # Every joint labelled, below and above the cells; the cells keep their width.
+    assert heat["x"]
+    assert heat["bottom"] == heat["x"]
+    assert heat["top"] == heat["x"]
+    assert heat["width"] >= 26 * len(heat["x"])
+    p.screenshot(path=str(ARTIFACTS / "shoot-long-name-800px.png"), full_page=True)

@@ -1,9 +1,9 @@
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import {
-  decisionForKey, deleteConfirmed, exportQuery, formatCell, HEATMAP_MAX_TAKES, heatmapChanged, heatmapFigure, heatmapPage, heatmapPager, heatmapQuery,
-  heatmapRows, importLines, isFiltered, nextSort, pageInfo, progressSummary, scoreColor, shootControls, tableState, takesQuery, viewQuery,
-  TABLE_DEFAULTS,
+  decisionForKey, deleteConfirmed, exportQuery, formatCell, HEATMAP_COLORSCALE, HEATMAP_COLUMN_PX, HEATMAP_LABEL_CHARS, HEATMAP_MAX_TAKES, heatmapChanged,
+  heatmapFigure, heatmapKeyGradient, heatmapPage, heatmapPager, heatmapQuery, heatmapRows, hoverLines, importLines, isFiltered, middleEllipsis, nextSort, pageInfo,
+  progressSummary, scoreColor, scoreRangeProblem, shootControls, tableState, takesQuery, viewQuery, TABLE_DEFAULTS,
 } from "../../frontend/js/shoot-format.js";
 
 test("tableState parses numbers, clamps the page size and rejects unknown orders", () => {
@@ -206,10 +206,93 @@ test("heatmapFigure labels rows by rank (same names stay apart) and sizes rows e
   assert.equal(new Set(figure.y).size, 3);
   assert.deepEqual(figure.x, data.joints);
   assert.deepEqual(figure.z, [[50, 25], [0, 10], [null, null]]);
+  assert.equal(figure.zmax, 50); // the colour key's end: the page's largest share, in percent
   assert.equal(figure.height, 260); // small pages keep a readable minimum
   const big = heatmapFigure({ joints: ["A"], takes: Array.from({ length: 500 }, (_, k) => ({ name: `t${k}` })), values: [Array(500).fill(0)] }, 0);
-  assert.equal(big.height, 120 + 22 * 500);
+  assert.equal(big.height, big.margin.t + big.margin.b + 22 * 500);
   assert.equal(big.y[499], "500. t499");
+  assert.equal(big.zmax, 1); // nothing outside: a scale that still goes up
+});
+
+test("middleEllipsis keeps a long name's start and end within the limit", () => {
+  assert.equal(middleEllipsis("walk.bvh", 40), "walk.bvh");
+  const exact = "x".repeat(40);
+  assert.equal(middleEllipsis(exact, 40), exact);
+  const long = `take_${"very_long_name_".repeat(15)}end.bvh`; // 237 characters, as in the browser review
+  const short = middleEllipsis(long, 40);
+  assert.equal(short.length, 40);
+  assert.equal(short, "take_very_long_name_…y_long_name_end.bvh"); // 20 + 1 + 19
+  assert.ok(long.startsWith(short.split("…")[0]));
+  assert.ok(long.endsWith(short.split("…")[1]));
+  assert.equal([...short].filter((c) => c === "…").length, 1);
+  assert.equal(middleEllipsis("abcdefghij", 5), "ab…ij");
+  assert.equal(middleEllipsis("abcdefghij", 4), "ab…j");
+  assert.equal(middleEllipsis("abcdefghij", 1), "…");
+  // Characters, not UTF-16 units: an emoji is never cut in half.
+  const emoji = middleEllipsis("😀".repeat(30), 9);
+  assert.equal([...emoji].length, 9);
+  assert.equal(emoji, `${"😀".repeat(4)}…${"😀".repeat(4)}`);
+});
+
+test("heatmapFigure shortens long row labels, keeps the full name for the hover, labels every joint", () => {
+  const long = `take_${"very_long_name_".repeat(15)}end.bvh`;
+  const joints = ["CC_Base_L_Thigh", "CC_Base_L_Calf", "CC_Base_L_Foot", "CC_Base_R_Thigh", "CC_Base_R_Calf", "CC_Base_R_Foot",
+    "CC_Base_L_Upperarm", "CC_Base_L_Forearm", "CC_Base_R_Upperarm", "CC_Base_R_Forearm", "UpperLeg_R"];
+  const data = { joints, takes: [{ name: long }, { name: "walk.bvh" }, { name: long }], values: joints.map(() => [0.1, 0, 0.2]) };
+  const figure = heatmapFigure(data, 0);
+  for (const label of figure.y) assert.ok([...label].length <= HEATMAP_LABEL_CHARS, label);
+  assert.ok(figure.y[0].startsWith("1. take_very_long"));
+  assert.ok(figure.y[0].endsWith("_end.bvh"));
+  assert.equal(figure.y[1], "2. walk.bvh");
+  assert.notEqual(figure.y[0], figure.y[2]); // the rank keeps equal long names apart
+  // The hover names the take in full: one text per cell.
+  assert.equal(figure.text.length, 3);
+  assert.equal(figure.text[0].length, joints.length);
+  assert.equal(figure.text[0][5].replaceAll("<br>", ""), `1. ${long}`);
+  assert.equal(figure.text[2][0], hoverLines(`3. ${long}`));
+  assert.equal(figure.text[1][0], "2. walk.bvh");
+  // Every joint column and every row is labelled (Plotly's automatic ticks skip some).
+  assert.deepEqual(figure.xaxis, { tickmode: "array", tickvals: joints, ticktext: joints, range: [-0.5, 10.5] });
+  // The first take on top; fixed ranges (no automatic padding around the cells).
+  assert.deepEqual(figure.yaxis, { tickmode: "array", tickvals: figure.y, ticktext: figure.y, range: [2.5, -0.5] });
+  // The labels' margin is bounded by the label limit, and each joint column has its minimum.
+  assert.ok(figure.margin.l <= 12 + 7 * HEATMAP_LABEL_CHARS);
+  assert.equal(figure.minWidth, figure.margin.l + figure.margin.r + HEATMAP_COLUMN_PX * joints.length);
+  assert.ok(figure.margin.t > 0 && figure.margin.t === figure.margin.b); // joints above and below
+  const many = heatmapFigure({ joints: Array.from({ length: 60 }, (_, k) => `J${k}`), takes: [{ name: "a" }], values: Array(60).fill([0]) }, 0);
+  assert.equal(many.xaxis.tickvals.length, 60);
+  assert.ok(many.minWidth >= 60 * HEATMAP_COLUMN_PX);
+});
+
+test("hoverLines breaks a long name into lines and never lets it read as markup", () => {
+  assert.equal(hoverLines("walk.bvh"), "walk.bvh");
+  const long = "x".repeat(130);
+  assert.equal(hoverLines(long, 60), `${"x".repeat(60)}<br>${"x".repeat(60)}<br>${"x".repeat(10)}`);
+  assert.equal(hoverLines("a<b>&c.bvh"), "a&lt;b&gt;&amp;c.bvh");
+  assert.equal(hoverLines("😀".repeat(3), 2), "😀😀<br>😀");
+  assert.equal(hoverLines(""), "");
+});
+
+test("heatmapKeyGradient draws the chart's colour scale from 0 % to the largest share", () => {
+  const gradient = heatmapKeyGradient();
+  assert.ok(gradient.startsWith("linear-gradient(to right, rgb(255,255,204) 0%"));
+  assert.ok(gradient.endsWith("rgb(128,0,38) 100%)"));
+  assert.equal(gradient.match(/rgb\(/g).length, HEATMAP_COLORSCALE.length);
+  assert.equal(heatmapKeyGradient([[0, "red"], [1, "blue"]]), "linear-gradient(to right, red 0%, blue 100%)");
+});
+
+test("scoreRangeProblem: a min score above the max score, or a bound outside 0–100", () => {
+  assert.equal(scoreRangeProblem(TABLE_DEFAULTS), null);
+  assert.equal(scoreRangeProblem({ min_score: "40", max_score: "" }), null);
+  assert.equal(scoreRangeProblem({ min_score: "50", max_score: "50" }), null);
+  assert.equal(scoreRangeProblem({ min_score: 0, max_score: 100 }), null);
+  assert.deepEqual(scoreRangeProblem({ min_score: "95", max_score: "50" }), {
+    fields: ["min_score", "max_score"], text: "min score (95) is above max score (50): no take can match",
+  });
+  assert.deepEqual(scoreRangeProblem({ min_score: " 9.5 ", max_score: "9" }).fields, ["min_score", "max_score"]);
+  assert.deepEqual(scoreRangeProblem({ min_score: "", max_score: "140" }), { fields: ["max_score"], text: 'max score must be a number from 0 to 100 (got "140")' });
+  assert.deepEqual(scoreRangeProblem({ min_score: "abc" }).fields, ["min_score"]);
+  assert.deepEqual(scoreRangeProblem(tableState(new URLSearchParams("min_score=80&max_score=20"))).fields, ["min_score", "max_score"]);
 });
 
 test("exportQuery sends the table's filters, sort and order, never its page", () => {
