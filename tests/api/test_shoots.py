@@ -112,6 +112,11 @@ def test_import_files_table_queue_export_and_delete(client: TestClient, corpus_d
     assert found.json()["total"] == 2
     ranged = client.get(f"{API}/shoots/{sid}/takes", params={"min_score": 101})
     assert ranged.status_code == 422
+    crossed = {"min_score": 5, "max_score": 1}
+    for route in ("takes", "heatmap", "summary.csv", "summary.json"):
+        answer = client.get(f"{API}/shoots/{sid}/{route}", params=crossed)
+        assert answer.status_code == 422, route
+        assert answer.json()["field"] == "min_score"
     assert client.get(f"{API}/shoots/{sid}/takes", params={"sort": "nope"}).status_code == 422
     second = client.get(f"{API}/shoots/{sid}/takes", params={"limit": 2, "offset": 2}).json()
     assert [r["take_id"] for r in second["items"]] == [r["take_id"] for r in page["items"][2:]]

@@ -25,7 +25,7 @@ from mocapqa.api.shoot_schemas import (
     ShootTakeOut,
     ShootTakePageOut,
 )
-from mocapqa.errors import InputError
+from mocapqa.errors import InputError, OptionError
 from mocapqa.jobs.batch_output import COLUMNS
 from mocapqa.jobs.shoot_import import ImportLimits, import_uploads
 from mocapqa.store.repository import ReviewStatus, RunStatus
@@ -174,7 +174,12 @@ def take_filter(
     has_findings: bool | None = None,
     search: Annotated[str | None, Query(max_length=255)] = None,
 ) -> TakeFilter:
-    """The take table's filters from the query (the take table and the heat map share them)."""
+    """The take table's filters from the query (the take table, the heat map and the
+    exports share them); a ``min_score`` above ``max_score`` is 422, not an empty page."""
+    if min_score is not None and max_score is not None and min_score > max_score:
+        raise OptionError(
+            "min_score", f"Expected min_score at most max_score ({max_score:g}), got {min_score:g}"
+        )
     return TakeFilter(status, review_status, rig, min_score, max_score, has_findings, search)
 
 
