@@ -274,3 +274,26 @@ def test_a_multipart_body_the_parser_refuses_is_422_naming_the_body(
     route that reads JSON alike."""
     response = signed_in.post(path, content=b"garbage", headers={"Content-Type": content_type})
     assert_names(response, "body", words)
+
+
+HUGE_JSON = (
+    '{"fps": 30, "keypoints": ["a", "b"], "frames": ' + str([[[1e300, 2, 3], [1, 2, 3]]] * 3) + "}"
+)
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "field"),
+    [
+        # A coordinate no take holds: the filter squared it into infinity inside the run.
+        ("huge.json", HUGE_JSON, "positions"),
+        ("fast.json", '{"fps": 1e300, "keypoints": ["a"], "frames": [[[1, 2, 3]]]}', "fps"),
+        ("none.json", '{"fps": 30, "keypoints": [], "frames": [[], []]}', "keypoints"),
+    ],
+)
+def test_keypoints_no_take_holds_are_refused_at_the_upload(
+    name: str, content: str, field: str, signed_in: TestClient
+) -> None:
+    response = signed_in.post("/api/v1/takes", files={"file": (name, content.encode())})
+    assert response.status_code == 422, response.text
+    assert field in (response.json().get("field") or response.json()["detail"])
+    no_takes(signed_in)

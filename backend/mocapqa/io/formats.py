@@ -20,10 +20,13 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Literal
 
+import numpy as np
+
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import ParseError, UnsupportedFormatError
 from mocapqa.io.bvh import NumberReader, read_bvh
+from mocapqa.io.bvh_frames import MAX_MAGNITUDE
 from mocapqa.io.guards import ReadLimits, check_take_input, check_take_size
 from mocapqa.io.keypoint_arrays import (
     read_keypoint_npy,
@@ -40,6 +43,7 @@ from mocapqa.io.trc import read_trc, write_trc
 __all__ = [
     "KEYPOINT_FORMATS",
     "KEYPOINT_WRITE_FORMATS",
+    "MAX_FPS",
     "TAKE_FORMATS",
     "detect_format",
     "read_take",
@@ -256,20 +260,45 @@ def read_take(
     return take
 
 
+MAX_FPS = 100_000.0
+"""Highest frame rate a take may have, frames per second (a rate given with ``--fps`` or read
+from a file): far above any capture system, low enough that per-second rates stay finite."""
+
+
 def require_frames(take: Motion | KeypointSequence, path: str | Path) -> None:
     """Refuse a take without frames (a BVH's ``Frames: 0``): nothing to analyse or draw.
 
     Readers accept such a take, so ``mocapqa info`` and ``convert`` work on a rig-only BVH;
     everything that analyses, filters or renders a take calls this first.
 
+    Also refuses a keypoint take without keypoints, with a coordinate beyond ±1e9 or a frame
+    rate over 100,000 fps (the limits a BVH's reader and ``--fps`` already keep).
+
     Raises
     ------
     ParseError
-        Naming the file (and the ``Frames`` field of a BVH).
+        Naming the file and the field (``Frames`` of a BVH, ``keypoints``, ``positions``,
+        ``fps``).
     """
     if take.n_frames == 0:
         field = "Frames" if isinstance(take, Motion) else None
         raise ParseError("Expected at least one frame, got 0", path, field=field)
+    if isinstance(take, KeypointSequence):
+        # The keypoint readers keep any finite number: refuse what no take holds, as the BVH
+        # reader does (MAX_MAGNITUDE), before a filter squares it into infinity.
+        if take.n_keypoints == 0:
+            raise ParseError("Expected at least one keypoint, got 0", path, field="keypoints")
+        largest = float(np.nanmax(np.abs(take.positions), initial=0.0))
+        if largest > MAX_MAGNITUDE:
+            raise ParseError(
+                f"Expected coordinates within ±{MAX_MAGNITUDE:g}, got {largest:g}",
+                path,
+                field="positions",
+            )
+        if take.fps > MAX_FPS:
+            raise ParseError(
+                f"Expected fps at most {MAX_FPS:g}, got {take.fps:g}", path, field="fps"
+            )
 
 
 def _read(
