@@ -263,10 +263,20 @@ def test_tar_import_reports_links(client: TestClient, corpus_dir: Path) -> None:
         "takes.tar.gz:takes/soft.bvh": "symbolic link",
         "takes.tar.gz:takes/hard.bvh": "hard link",
     }
+    # An unreadable archive is listed as failed, naming it; the other files of the request
+    # are imported as usual (it used to fail the request after storing the files before it).
+    bandai_walk = (corpus_dir / BANDAI[0]).read_bytes()
     garbage = client.post(
-        f"{API}/shoots/{sid}/takes", files=[("files", ("bad.tar.gz", b"not a tar at all"))]
+        f"{API}/shoots/{sid}/takes",
+        files=[
+            ("files", ("bad.tar.gz", b"not a tar at all")),
+            ("files", ("walk.bvh", bandai_walk)),
+        ],
     )
-    assert garbage.status_code == 422
+    assert garbage.status_code == 201, garbage.text
+    failed = {f["name"]: f["error"] for f in garbage.json()["failed"]}
+    assert "readable .tar.gz" in failed["bad.tar.gz"]
+    assert [c["name"] for c in garbage.json()["created"]] == ["walk.bvh"]
 
 
 def test_archive_bombs_are_refused_before_extracting(

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Any, BinaryIO
 
-from mocapqa.errors import MocapQAError, NotFoundError, TooLargeError
+from mocapqa.errors import InputError, MocapQAError, NotFoundError, TooLargeError
 from mocapqa.jobs.archive import archive_kind, unpack
 from mocapqa.jobs.batch import MOTION_SUFFIXES
 from mocapqa.jobs.intake import CHUNK_BYTES, MAX_NAME_CHARS, ingest_take
@@ -99,8 +99,6 @@ def import_uploads(
     ------
     TooLargeError
         When an archive passes a limit (earlier uploads of the same request are kept).
-    InputError
-        When an archive cannot be read at all.
     NotFoundError
         When the shoot is deleted while the import runs (the take being stored is removed).
     """
@@ -137,9 +135,16 @@ def import_uploads(
             _receive(source, received, name, limits.max_upload_bytes)
             members = scratch / "members"
             members.mkdir()
-            for member in unpack(
-                received, name, members, limits.max_members, limits.max_unpacked_bytes
-            ):
+            try:
+                unpacked = unpack(
+                    received, name, members, limits.max_members, limits.max_unpacked_bytes
+                )
+            except TooLargeError:
+                raise
+            except InputError as e:  # unreadable: listed as failed, the other uploads go on
+                report.failed.append({"name": name, "error": str(e)})
+                continue
+            for member in unpacked:
                 label = _label(name, member.name)
                 if member.path is None:
                     report.failed.append({"name": label, "error": str(member.problem)})
