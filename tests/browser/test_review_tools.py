@@ -462,3 +462,29 @@ def test_keypoint_confidence_fades_and_bridged_gaps_show(
         "() => document.querySelector('.joint-tooltip').textContent.includes('bridged')"
     )
     shot(page, "keypoint-gap")
+
+
+def test_a_short_window_unpins_the_player_bar(
+    live_server: str, knees: dict[str, Any], page: Page
+) -> None:
+    """At 200 % zoom (a 640×360 window in CSS pixels) a pinned player bar hid most of the 3D
+    views; below 760 px of height it sits in the page's flow instead, and above it stays
+    pinned to the bottom while the findings scroll."""
+    p = page.page
+    page.open_take(live_server, knees)
+    position = "() => getComputedStyle(document.getElementById('player')).position"
+    assert p.evaluate(position) == "sticky"
+    p.set_viewport_size({"width": 640, "height": 360})
+    p.wait_for_function(f"({position})() === 'static'")
+    views = p.evaluate(
+        "() => { const v = document.querySelector('canvas').getBoundingClientRect();"
+        " const b = document.getElementById('player').getBoundingClientRect();"
+        " return [v.bottom, b.top]; }"
+    )
+    assert views[0] <= views[1]  # the bar below the views, not over them
+    # Nothing scrolls sideways once the charts have followed the narrow window.
+    p.wait_for_function("() => document.documentElement.scrollWidth <= window.innerWidth")
+    p.screenshot(path=str(ARTIFACTS / "take-short-window.png"))
+    p.set_viewport_size({"width": 1280, "height": 900})
+    p.wait_for_function(f"({position})() === 'sticky'")
+    p.wait_for_function("() => document.documentElement.scrollWidth <= window.innerWidth")
