@@ -9,8 +9,19 @@ export const DECISION_KEYS = { y: "accept", x: "reject" }; // on the focused or 
 const LABELS = { accept: "accepted", reject: "rejected" };
 const BADGE = { accept: "approved", reject: "rejected" };
 
+/** The newest other finished run of `take` whose decision history is not empty, with that
+ * history's length, or null; `getDecisions` is api.getDecisions (a parameter for tests). */
+export async function decidedElsewhere(take, run, getDecisions = api.getDecisions) {
+  const others = (take?.runs || []).map((r, k) => [r, k + 1]).filter(([r]) => r.id !== run.id && r.status === "done").reverse();
+  for (const [other, number] of others) {
+    const body = await getDecisions(other.id).catch(() => null);
+    if (body && body.history.length) return { run: other, number, count: body.history.length };
+  }
+  return null;
+}
+
 /** Decision cells for the findings rows of `run` and the panel parts below the table. */
-export function intervalDecisions(run, result) {
+export function intervalDecisions(run, result, take = null) {
   // Only a take with twist intervals has anything to accept or reject.
   const series = result.kind === "motion" && result.series && result.series.twist;
   const twist = series && series.intervals.length ? series : null;
@@ -19,6 +30,8 @@ export function intervalDecisions(run, result) {
   let current = null; // the last opened twist interval
   let lastKind = null; // the kind of the last opened finding
   const message = h("span", { id: "decision-message", class: "muted" });
+  // Decisions belong to a run: a re-run starts undecided, and says where earlier ones are.
+  const elsewhere = h("p", { id: "decisions-elsewhere", class: "notice", hidden: true });
   const note = h("input", { id: "decision-note", placeholder: "note for the next decision", "aria-label": "decision note" });
   const history = h("ul", { id: "decision-history" });
   const byId = new Map((twist ? twist.intervals : []).map((i) => [i.id, i]));
@@ -72,10 +85,16 @@ export function intervalDecisions(run, result) {
     }
   }
 
-  const loaded = twist ? api.getDecisions(run.id).then((body) => {
+  const loaded = twist ? api.getDecisions(run.id).then(async (body) => {
     for (const i of body.intervals) if (i.decision) latest.set(i.id, i.decision);
     for (const id of cells.keys()) fill(id);
     showHistory(body.history);
+    if (body.history.length || !take) return;
+    const found = await decidedElsewhere(take, run);
+    if (!found) return;
+    elsewhere.replaceChildren(`Run ${found.number} holds ${found.count} decision${found.count === 1 ? "" : "s"} on its twist intervals; this run has none yet (decisions belong to the run they were made on). `,
+      h("a", { href: api.takeLink(take.id, found.run.id), id: "decisions-elsewhere-link" }, `open run ${found.number}`));
+    elsewhere.hidden = false;
   }).catch((e) => { message.textContent = e.message; message.className = "error"; }) : Promise.resolve();
 
   return {
@@ -118,6 +137,7 @@ export function intervalDecisions(run, result) {
     footer() {
       if (!twist) return null;
       return h("div", { id: "decisions" },
+        elsewhere,
         h("div", { class: "controls" },
           h("a", { href: api.decidedUrl(run.id), download: "", id: "download-decided", class: "download" }, "Download reviewed take"),
           note, message),

@@ -96,7 +96,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · I/O in/out point · L loop in/out · shift+L loop the finding · C close-in · A/F/R approve, needs fix, reject the take (saves) · Y/X accept, reject the focused or last opened twist interval (saves) · Enter on a row opens it · ? shows or hides this line");
   const timelines = h("div", {});
   const review = reviewPanel(take);
-  const decided = intervalDecisions(run, result);
+  const decided = intervalDecisions(run, result, take);
   // The findings filter travels in the link too (kinds, only, atleast, q).
   const linkedFilter = filterFromParams(params, kindsOf(result.findings), jointsOf(result.findings));
   let filterQuery = filterParams(linkedFilter, kindsOf(result.findings));

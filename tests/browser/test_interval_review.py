@@ -157,3 +157,39 @@ def test_n_then_y_decides_the_twist_interval_reached_and_says_so_on_screen(
         "() => { const t = document.getElementById('toast');"
         " return t && !t.hidden && t.textContent.includes('accepted'); }"
     )
+
+
+def test_a_re_run_says_which_run_holds_the_decisions(
+    live_server: str, corpus_dir: Path, page: Page
+) -> None:
+    """Decisions belong to the run they were made on: the take's re-run starts undecided and
+    says so, with a link back to the decided run."""
+    import time
+
+    take = upload(live_server, corpus_dir / KNEES_TAKE)
+    twist = next(f for f in take["result"]["findings"] if f["kind"] == "twist")
+    decided = httpx.post(
+        f"{live_server}/api/v1/runs/{take['run']}/intervals/{twist['id']}/decisions",
+        json={"decision": "reject"},
+        timeout=30,
+    )
+    assert decided.status_code == 201, decided.text
+    rerun = httpx.post(
+        f"{live_server}/api/v1/takes/{take['id']}/runs", json={"twist_apply": "all"}, timeout=30
+    ).json()
+    deadline = time.monotonic() + 300
+    while (
+        httpx.get(f"{live_server}/api/v1/runs/{rerun['id']}", timeout=30).json()["status"] != "done"
+    ):
+        assert time.monotonic() < deadline, "the re-run did not finish"
+        time.sleep(0.3)
+    page.open_take(live_server, {"id": take["id"], "run": rerun["id"]})
+    p = page.page
+    p.wait_for_selector("#decisions-elsewhere:not([hidden])", timeout=30_000)
+    notice = p.inner_text("#decisions-elsewhere")
+    assert "Run 1 holds 1 decision" in notice
+    assert "this run has none yet" in notice
+    p.click("#decisions-elsewhere-link")
+    p.wait_for_function(f"() => location.hash.includes('run={take['run']}')")
+    p.wait_for_selector("main[data-ready='1'] #decision-history li", timeout=60_000)
+    assert p.locator("#decisions-elsewhere:not([hidden])").count() == 0
