@@ -415,3 +415,23 @@ def test_two_admins_demoting_each_other_leave_one(
         # Restore the second admin for the next round.
         for name in ("admin", "second"):
             accounts.update_user(name, role=Role.ADMIN)
+
+
+def test_unknown_fields_and_admin_only_listings_are_refused_not_ignored(
+    team: tuple[TestClient, dict[str, dict[str, str]]],
+) -> None:
+    client, headers = team
+    # A token request naming another user used to mint one for the caller.
+    minted = client.post(
+        "/api/v1/tokens", json={"name": "ci", "user": "admin"}, headers=headers["rev1"]
+    )
+    assert minted.status_code == 422
+    assert minted.json()["field"] == "body.user"
+    made = client.post(
+        "/api/v1/users", json={"name": "new", "disabled": True}, headers=headers["admin"]
+    )
+    assert made.status_code == 422
+    assert client.get("/api/v1/users", headers=headers["admin"]).json()[-1]["name"] != "new"
+    # Everyone's tokens are an admin's listing: a viewer asking gets 403, not their own list.
+    assert client.get("/api/v1/tokens?everyone=true", headers=headers["viewer"]).status_code == 403
+    assert client.get("/api/v1/tokens?everyone=true", headers=headers["admin"]).status_code == 200

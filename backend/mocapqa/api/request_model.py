@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from pydantic import BaseModel, field_validator
+from pydantic import BaseModel, ConfigDict, field_validator
 
 __all__ = ["RequestModel", "unstorable_text"]
 
@@ -43,7 +43,11 @@ def _check(value: Any) -> None:
 
 
 class RequestModel(BaseModel):
-    """A JSON request body whose every string can be stored and echoed (see the module)."""
+    """A JSON request body whose every string can be stored and echoed (see the module), and
+    whose every field is known: an unknown one is a 422 naming it, not silently dropped (a
+    token request naming another ``user`` used to mint one for the caller)."""
+
+    model_config = ConfigDict(extra="forbid")
 
     @field_validator("*", mode="before")
     @classmethod

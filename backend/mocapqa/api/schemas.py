@@ -163,6 +163,12 @@ class ReviewIn(RequestModel):
 
     status: ReviewStatus
     notes: str = Field("", max_length=10_000)
+    reviewer: str | None = Field(
+        None,
+        max_length=255,
+        description="Ignored: the reviewer is the signed-in user (accepted so that clients "
+        "that send a name are not refused)",
+    )
 
 
 class ReviewOut(BaseModel):

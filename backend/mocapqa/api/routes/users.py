@@ -66,8 +66,13 @@ def change_user(
 
 @router.get("/tokens", responses=responses(401, 403))
 def list_tokens(principal: Anyone, accounts: AccountsDep, everyone: bool = False) -> list[TokenOut]:
-    """The caller's personal tokens; with ``everyone=true``, every user's (admins)."""
-    if everyone and allows(principal.role, Action.MANAGE_USERS):
+    """The caller's personal tokens; with ``everyone=true``, every user's (admins; 403 for
+    anyone else, rather than their own list under a request for everyone's)."""
+    if everyone:
+        if not allows(principal.role, Action.MANAGE_USERS):
+            raise ForbiddenError(
+                f"Expected an admin to list every user's tokens, got a {principal.role.value}"
+            )
         return [TokenOut.model_validate(t) for t in accounts.list_tokens()]
     if principal.user is None:
         return []
