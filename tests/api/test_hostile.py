@@ -347,6 +347,28 @@ def test_stream_refuses_huge_keypoint_count(url: str) -> None:
     assert response.status_code == 413
 
 
+@pytest.mark.parametrize(
+    ("header", "words"),
+    [
+        ({"fps": 1e308, "n_keypoints": 17}, "at most 100000"),
+        ({"fps": 1e-300, "n_keypoints": 17}, None),  # accepted: any rate above 0 is a rate
+        ({"fps": 30, "n_keypoints": 1.5}, "whole number"),
+        ({"fps": 30, "n_keypoints": 17, "rate": 30}, "only the keys"),
+    ],
+)
+def test_stream_header_is_checked_before_any_frame(
+    url: str, header: dict[str, float], words: str | None
+) -> None:
+    ws_url = url.replace("http", "ws") + "/api/v1/stream/filter"
+    with connect(ws_url) as socket:
+        socket.send(json.dumps(header))
+        answer = json.loads(socket.recv(timeout=60))
+    if words is None:
+        assert "error" not in answer, answer
+    else:
+        assert words in answer["error"], answer
+
+
 def test_stream_refuses_huge_frame(url: str) -> None:
     ws_url = url.replace("http", "ws") + "/api/v1/stream/filter"
     frame = json.dumps({"positions": [[0.0, 0.0, 0.0]] * 200_000})

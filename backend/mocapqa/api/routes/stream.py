@@ -20,6 +20,7 @@ from starlette.concurrency import run_in_threadpool
 from mocapqa.api.http_guards import RateWindow, origin_allowed
 from mocapqa.config import Settings
 from mocapqa.errors import MocapQAError, RateLimitError, TooLargeError
+from mocapqa.io.formats import MAX_FPS
 from mocapqa.pipeline.filtering import StreamSession
 
 __all__ = ["router"]
@@ -51,6 +52,9 @@ def _receive_limit(text: str, max_bytes: int) -> Any:
     return json.loads(text)
 
 
+_HEADER_KEYS = frozenset({"fps", "n_keypoints", "length_unit", "preset"})
+
+
 def _session(first: Any, settings: Settings) -> StreamSession:
     if not isinstance(first, dict):
         raise TypeError(f"Expected a JSON object first, got {type(first).__name__}")
@@ -60,8 +64,16 @@ def _session(first: Any, settings: Settings) -> StreamSession:
             f"Expected n_keypoints from 1 to {settings.stream_max_keypoints} (setting "
             f"stream_max_keypoints), got {n_keypoints:g}"
         )
+    if n_keypoints != int(n_keypoints):
+        raise TypeError(f"Expected a whole number for 'n_keypoints', got {n_keypoints:g}")
+    fps = _number(first, "fps")
+    if not 0 < fps <= MAX_FPS:
+        raise ValueError(f"Expected 'fps' above 0 and at most {MAX_FPS:g}, got {fps:g}")
+    extra = sorted(set(first) - _HEADER_KEYS)
+    if extra:
+        raise TypeError(f"Expected only the keys {sorted(_HEADER_KEYS)} first, got {extra}")
     return StreamSession(
-        _number(first, "fps"),
+        fps,
         int(n_keypoints),
         _text(first, "length_unit", "unknown"),
         _text(first, "preset", "default"),
