@@ -139,14 +139,22 @@ def read_mapping_text() -> dict[str, str]:
     return dict(tomllib.loads(MAPPING_TOML))
 
 
-def test_limits_build_takes_a_mapping_and_stores_it_with_the_rig(
-    odd_walk: Path, mapping_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    from mocapqa.limits.storage import load_model
-
+@pytest.fixture
+def odd_folder(odd_walk: Path, tmp_path: Path) -> Path:
+    """A folder holding the renamed walk, as ``limits build`` reads takes."""
     folder = tmp_path / "takes"
     folder.mkdir()
     (folder / "odd_walk.bvh").symlink_to(odd_walk)
+    return folder
+
+
+def test_limits_build_takes_a_mapping_and_stores_it_with_the_rig(
+    odd_walk: Path, odd_folder: Path, mapping_file: Path, tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
+    from mocapqa.limits.storage import load_model
+
+    folder = odd_folder
     without, with_mapping = tmp_path / "without.npz", tmp_path / "with.npz"
     build = ["limits", "build", str(folder), "--no-networks", "--all-takes"]
     assert main([*build, "-o", str(without)]) == 0
@@ -165,11 +173,9 @@ def test_limits_build_takes_a_mapping_and_stores_it_with_the_rig(
 
 
 def test_limits_build_refuses_a_mapping_it_cannot_use(
-    odd_walk: Path, mapping_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    odd_folder: Path, mapping_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    folder = tmp_path / "takes"
-    folder.mkdir()
-    (folder / "odd_walk.bvh").symlink_to(odd_walk)
+    folder = odd_folder
     out = ["-o", str(tmp_path / "m.npz"), "--no-networks", "--all-takes"]
     # A per-rig model matches its joints by name.
     per_rig = ["limits", "build", str(folder), *out, "--rig", "cmu", "--mapping", str(mapping_file)]
