@@ -271,9 +271,12 @@ def test_tar_import_reports_links(client: TestClient, corpus_dir: Path) -> None:
         files=[
             ("files", ("bad.tar.gz", b"not a tar at all")),
             ("files", ("walk.bvh", bandai_walk)),
+            ("files", ("readme.txt", b"notes beside the takes")),
         ],
     )
     assert garbage.status_code == 201, garbage.text
+    # A loose text file is skipped like an archive member of its kind, not a failed take.
+    assert garbage.json()["skipped"] == [{"name": "readme.txt", "reason": "not a motion file"}]
     failed = {f["name"]: f["error"] for f in garbage.json()["failed"]}
     assert "readable .tar.gz" in failed["bad.tar.gz"]
     assert [c["name"] for c in garbage.json()["created"]] == ["walk.bvh"]

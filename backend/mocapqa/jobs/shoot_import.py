@@ -127,7 +127,12 @@ def import_uploads(
 
     for source, name in uploads:
         if archive_kind(name) is None:
-            ingest(source, name)
+            # The rule of an archive's members, for files sent one by one (a folder chosen in
+            # the browser): a notes.txt beside the takes is skipped, not a failed take.
+            if _is_motion_name(name):
+                ingest(source, name)
+            else:
+                report.skipped.append({"name": name, "reason": "not a motion file"})
             continue
         scratch = Path(tempfile.mkdtemp(prefix="archive-", dir=files.root / "incoming"))
         try:
