@@ -63,7 +63,20 @@ export function createTimebar({ nFrames, marks, onJump, onRange }) {
   const outHandle = h("span", { class: "tb-handle tb-out", title: "out point (O): drag to move" });
   const loop = h("div", { class: "tb-loop", id: "loop-band", hidden: true }, inHandle, outHandle);
   const cursor = h("div", { class: "tb-cursor" });
-  const bar = h("div", { class: "timebar", id: "timebar", title: "click: go to a frame · drag: set the loop range" }, markEls, gaps, loop, cursor);
+  // A slider to the keyboard and to screen readers: ←/→ step (the take view's keys), Home/End
+  // go to the first/last frame, Page Up/Down move a tenth of the take.
+  const bar = h("div", {
+    class: "timebar", id: "timebar", title: "click: go to a frame · drag: set the loop range", tabindex: "0",
+    role: "slider", "aria-label": "time bar", "aria-valuemin": "0", "aria-valuemax": String(Math.max(0, nFrames - 1)), "aria-valuenow": "0",
+  }, markEls, gaps, loop, cursor);
+  let now = 0;
+  bar.addEventListener("keydown", (e) => {
+    const step = Math.max(1, Math.round(nFrames / 10));
+    const target = { Home: 0, End: nFrames - 1, PageUp: now - step, PageDown: now + step }[e.key];
+    if (target === undefined) return;
+    e.preventDefault();
+    onJump(Math.max(0, Math.min(nFrames - 1, target)));
+  });
   let range = null, drag = null;
 
   const frameOf = (e) => { const r = bar.getBoundingClientRect(); return frameAtX(e.clientX - r.left, r.width, nFrames); };
@@ -91,7 +104,12 @@ export function createTimebar({ nFrames, marks, onJump, onRange }) {
 
   return {
     el: bar,
-    setFrame(f) { cursor.style.left = `${(100 * (f + 0.5)) / Math.max(1, nFrames)}%`; },
+    setFrame(f) {
+      now = f;
+      cursor.style.left = `${(100 * (f + 0.5)) / Math.max(1, nFrames)}%`;
+      bar.setAttribute("aria-valuenow", String(f));
+      bar.setAttribute("aria-valuetext", `frame ${f} of ${nFrames}`);
+    },
     /** Show the loop range ([a, b] or null) and whether playback loops over it. */
     setRange(next, looping) {
       range = next;

@@ -488,3 +488,28 @@ def test_a_short_window_unpins_the_player_bar(
     p.set_viewport_size({"width": 1280, "height": 900})
     p.wait_for_function(f"({position})() === 'sticky'")
     p.wait_for_function("() => document.documentElement.scrollWidth <= window.innerWidth")
+
+
+def test_the_time_bar_is_a_slider_the_keyboard_reaches(
+    live_server: str, knees: dict[str, Any], page: Page
+) -> None:
+    """Tab reaches the time bar; Home/End go to the ends, Page Down a tenth further, the arrows
+    step; a screen reader hears the frame."""
+    p = page.page
+    page.open_take(live_server, knees)
+    n_frames = int(p.get_attribute("#timebar", "aria-valuemax")) + 1
+    value = "() => document.getElementById('timebar').getAttribute('aria-valuenow')"
+    p.focus("#timebar")
+    assert p.get_attribute("#timebar", "role") == "slider"
+    assert p.get_attribute("#timebar", "tabindex") == "0"
+    p.keyboard.press("End")
+    p.wait_for_function(f"() => ({value})() === '{n_frames - 1}'")
+    assert page.frame() == n_frames - 1
+    p.keyboard.press("Home")
+    p.wait_for_function(f"() => ({value})() === '0'")
+    p.keyboard.press("PageDown")
+    step = int(n_frames / 10 + 0.5)  # as Math.round
+    p.wait_for_function(f"() => ({value})() === '{step}'")
+    p.keyboard.press("ArrowRight")
+    assert page.frame() == step + 1
+    assert p.get_attribute("#timebar", "aria-valuetext") == f"frame {step + 1} of {n_frames}"
