@@ -709,6 +709,9 @@ def test_compare_matches_findings_and_diffs_options(
     spins = sum(f["kind"] == "spin" for f in knees["result"]["findings"])
     assert spins > 0
     assert f"limb spins (reported, not corrected)\t{spins}\t{spins}" in table
+    # How many intervals each run applied, and by which choice.
+    applied = sum(f["kind"] == "twist" and f["applied"] for f in knees["result"]["findings"])
+    assert f"twist intervals applied\t{applied} (confident)" in table
     assert p.evaluate("() => document.getElementById('compare-twist').data.length") == 4
     # Both runs side by side in 3D, one camera: a drag in A's view turns B's too.
     assert p.locator("#compare-3d canvas").count() == 1  # one canvas draws both runs
