@@ -280,6 +280,27 @@ def test_chunked_upload_over_the_limit_stops_at_the_limit(url: str, settings: Se
     assert stored(settings, url) == (0, [])
 
 
+def test_a_chunked_json_body_over_the_limit_names_the_limit(url: str) -> None:
+    """A body sent without Content-Length is counted as it arrives; the 413 names the limit
+    as it does for a Content-Length over it (it said only "Content Too Large")."""
+
+    def body() -> Iterator[bytes]:
+        yield b'{"name": "'
+        for _ in range(3):
+            yield b"x" * (1 << 20)
+        yield b'"}'
+
+    response = httpx.post(
+        f"{url}/api/v1/shoots",
+        content=body(),
+        headers={"Content-Type": "application/json"},
+        timeout=120,
+    )
+    assert response.status_code == 413, response.text
+    assert response.json()["error"] == "TooLargeError"
+    assert "max_request_kb" in response.json()["detail"]
+
+
 @pytest.mark.parametrize(
     "path",
     [

@@ -171,6 +171,15 @@ async def _handle_http(request: Request, error: Exception) -> JSONResponse:
     if refused is not None:
         return _invalid([{"field": refused[0], "message": refused[1]}])
     body = error_body("HTTPError", str(error.detail))
+    limit = request.scope.get("starlette.max_body_size")
+    if error.status_code == 413 and isinstance(limit, int):
+        # The body limit caught a body sent without a length (chunked) while it was read:
+        # answer as a Content-Length over the limit is answered, naming the limit.
+        body = error_body(
+            "TooLargeError",
+            f"Expected a request body of at most {limit} bytes (settings max_upload_mb, "
+            "max_request_kb), got more",
+        )
     headers = dict(error.headers or {})
     if error.status_code == 405:
         headers["Allow"] = ", ".join(_allowed_methods(request)) or headers.get("Allow", "")
