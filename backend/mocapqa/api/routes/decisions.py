@@ -10,6 +10,7 @@ from fastapi.responses import Response
 from mocapqa.api.auth import Principal, audit, require
 from mocapqa.api.decision_schemas import DecisionIn, DecisionOut, DecisionsOut
 from mocapqa.api.deps import ClientDep, ServicesDep
+from mocapqa.api.disposition import attachment, download_stem
 from mocapqa.api.errors import responses
 from mocapqa.core.text import display_name
 from mocapqa.errors import NotFoundError
@@ -106,9 +107,8 @@ def download_decided(run: DoneRunDep, services: ServicesDep, decisions: Decision
         decisions.latest(str(run["id"])),
         services.settings.read_limits,
     )
-    stem = str(take["file_name"]).rsplit(".", 1)[0]
     return Response(
         decided_bvh(motion),
         media_type="text/plain",
-        headers={"Content-Disposition": f'attachment; filename="{stem}.decided.bvh"'},
+        headers=attachment(f"{download_stem(take)}.decided.bvh"),
     )

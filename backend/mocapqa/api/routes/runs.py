@@ -10,6 +10,7 @@ from fastapi.responses import FileResponse, Response
 
 from mocapqa.api.auth import Principal, audit, require
 from mocapqa.api.deps import ClientDep, Services, ServicesDep, TakeDep, require_run_slot
+from mocapqa.api.disposition import attachment, download_stem
 from mocapqa.api.errors import responses
 from mocapqa.api.frame_windows import read_window, window_json, window_packed
 from mocapqa.api.schemas import AnalysisOptionsIn, RunOut
@@ -149,11 +150,8 @@ def download_html_report(run_id: str, services: ServicesDep) -> Response:
     run = services.repository.require_done(run_id)
     take = services.repository.get_take(str(run["take_id"]))
     body = html_report(services.files, run_id, take, services.renderer)
-    stem = str(take["file_name"]).rsplit(".", 1)[0]
     return Response(
-        body,
-        media_type="text/html",
-        headers={"Content-Disposition": f'attachment; filename="{stem}.report.html"'},
+        body, media_type="text/html", headers=attachment(f"{download_stem(take)}.report.html")
     )
 
 
@@ -175,5 +173,6 @@ def download(
     if not path.is_file():
         raise NotFoundError(f"Expected a {kind} output for run {run_id}, got none for this take")
     take = services.repository.get_take(str(run["take_id"]))
-    stem = str(take["file_name"]).rsplit(".", 1)[0]
-    return FileResponse(path, media_type=media_type, filename=f"{stem}.{suffix}")
+    return FileResponse(
+        path, media_type=media_type, headers=attachment(f"{download_stem(take)}.{suffix}")
+    )

@@ -14,6 +14,7 @@ from fastapi.responses import StreamingResponse
 
 from mocapqa.api.auth import Principal, audit, require, require_owner
 from mocapqa.api.deps import ClientDep, ServicesDep
+from mocapqa.api.disposition import attachment
 from mocapqa.api.errors import responses
 from mocapqa.api.shoot_schemas import (
     HeatmapOut,
@@ -287,8 +288,7 @@ def export_summary(
     (what the dashboard's export links send)."""
     store = _store(services)
     shoot = store.get(shoot_id)
-    stem = "".join(c if c.isalnum() or c in "-_" else "_" for c in shoot["name"])
-    disposition = {"Content-Disposition": f'attachment; filename="{stem}.summary.{kind}"'}
+    disposition = attachment(f"{shoot['name']}.summary.{kind}")
     if kind == "json":
         rows = list(_export_rows(store, shoot_id, filters, sort, order == "desc"))
         about = {"shoot": shoot["name"], "filters": filters.chosen(), "sort": sort, "order": order}
