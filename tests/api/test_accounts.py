@@ -435,3 +435,20 @@ def test_unknown_fields_and_admin_only_listings_are_refused_not_ignored(
     # Everyone's tokens are an admin's listing: a viewer asking gets 403, not their own list.
     assert client.get("/api/v1/tokens?everyone=true", headers=headers["viewer"]).status_code == 403
     assert client.get("/api/v1/tokens?everyone=true", headers=headers["admin"]).status_code == 200
+
+
+def test_names_that_only_look_alike_are_one_name(
+    team: tuple[TestClient, dict[str, dict[str, str]]],
+) -> None:
+    client, headers = team
+    accounts: Accounts = client.app.state.accounts  # type: ignore[attr-defined]
+    # "ADMIN" beside "admin" would read as one person in the audit log.
+    with pytest.raises(ConflictError, match="exists as 'admin'"):
+        accounts.add_user("ADMIN", Role.VIEWER, PASSWORD)
+    # A shoot name typed composed and decomposed is one name.
+    composed = client.post("/api/v1/shoots", json={"name": "Ünï"}, headers=headers["admin"])
+    assert composed.status_code == 201
+    decomposed = client.post(
+        "/api/v1/shoots", json={"name": "U\u0308ni\u0308"}, headers=headers["admin"]
+    )
+    assert decomposed.status_code == 409

@@ -141,8 +141,15 @@ class Accounts:
                 f"or digit), got {name!r}"
             )
         with self.engine.begin() as conn:
-            if conn.execute(select(users.c.id).where(users.c.name == name)).first():
-                raise ConflictError(f"Expected a new user name, got {name!r}, which exists")
+            # Names differing only in case ("ADMIN", "admin") would read as one person in the
+            # audit log and the review history: one of them is refused.
+            taken = conn.execute(
+                select(users.c.name).where(func.lower(users.c.name) == name.lower())
+            ).first()
+            if taken:
+                raise ConflictError(
+                    f"Expected a new user name, got {name!r}, which exists as {taken[0]!r}"
+                )
             conn.execute(
                 insert(users).values(
                     name=name,

@@ -6,6 +6,7 @@ table sorts and filters on indexed columns without walking every run.
 
 from __future__ import annotations
 
+import unicodedata
 from collections.abc import Iterator
 from datetime import UTC, datetime
 from typing import Any
@@ -570,8 +571,10 @@ class ShootStore:
 
 def _checked_name(name: str) -> str:
     """The name without control and format characters (as take names, ``display_name``),
-    its runs of white space made one space."""
-    clean = " ".join(display_name(str(name), max_length=len(str(name))).split())
+    its runs of white space made one space, in Unicode's composed form (NFC), so that "Ünï"
+    typed on two systems is one name, not two shoots that look alike."""
+    text = unicodedata.normalize("NFC", str(name))
+    clean = " ".join(display_name(text, max_length=len(text)).split())
     if not clean or len(clean) > 255:
         raise InputError(f"Expected a shoot name of 1–255 characters, got {name!r}")
     return clean
