@@ -452,3 +452,11 @@ def test_names_that_only_look_alike_are_one_name(
         "/api/v1/shoots", json={"name": "U\u0308ni\u0308"}, headers=headers["admin"]
     )
     assert decomposed.status_code == 409
+
+
+def test_a_shoot_asked_for_by_a_decomposed_name_is_found(tmp_path: Path) -> None:
+    from mocapqa.store.repository import Repository
+
+    store = ShootStore(Repository(f"sqlite:///{tmp_path / 'db.sqlite3'}").engine)
+    made = store.ensure("Ünï")
+    assert store.ensure("U\u0308ni\u0308")["id"] == made["id"]

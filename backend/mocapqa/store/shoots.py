@@ -156,8 +156,9 @@ class ShootStore:
 
     def ensure(self, name: str) -> dict[str, Any]:
         """The shoot of that name, created when missing."""
+        clean = _checked_name(name)  # the form it is stored in
         with self.engine.connect() as conn:
-            found = conn.execute(select(shoots.c.id).where(shoots.c.name == name)).scalar()
+            found = conn.execute(select(shoots.c.id).where(shoots.c.name == clean)).scalar()
         if found is not None:
             return self.get(str(found))
         try:
