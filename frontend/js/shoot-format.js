@@ -133,7 +133,7 @@ export function progressSummary(progress) {
 /** An import's answer in three lists of lines: kept, skipped (with reason), failed (with error). */
 export function importLines(result) {
   return {
-    kept: (result.created || []).map((c) => c.name),
+    kept: (result.created || []).map((c) => (c.duplicate_of ? `${c.name} (same content as ${c.duplicate_of}, already in the shoot)` : c.name)),
     skipped: (result.skipped || []).map((s) => `${s.name}: ${s.reason}`),
     failed: (result.failed || []).map((f) => `${f.name}: ${f.error}`),
   };

@@ -275,6 +275,10 @@ def test_tar_import_reports_links(client: TestClient, corpus_dir: Path) -> None:
         ],
     )
     assert garbage.status_code == 201, garbage.text
+    # The same walk again: kept (a reviewer may want both) and said to be a copy.
+    again = client.post(f"{API}/shoots/{sid}/takes", files=[("files", ("copy.bvh", bandai_walk))])
+    assert again.json()["created"][0]["duplicate_of"] == "walk.bvh"
+    assert "duplicate_of" not in garbage.json()["created"][0]
     # A loose text file is skipped like an archive member of its kind, not a failed take.
     assert garbage.json()["skipped"] == [{"name": "readme.txt", "reason": "not a motion file"}]
     failed = {f["name"]: f["error"] for f in garbage.json()["failed"]}

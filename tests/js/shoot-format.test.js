@@ -89,6 +89,11 @@ test("importLines lists kept names, skip reasons and errors", () => {
   assert.deepEqual(lines, { kept: ["a.bvh"], skipped: ["x.zip:notes.txt: not a motion file"], failed: ["b.bvh: line 3: bad"] });
 });
 
+test("importLines says when a kept take has the content of one already in the shoot", () => {
+  const lines = importLines({ created: [{ name: "copy.bvh", take_id: "3", run_id: "4", duplicate_of: "walk.bvh" }] });
+  assert.deepEqual(lines.kept, ["copy.bvh (same content as walk.bvh, already in the shoot)"]);
+});
+
 test("decisionForKey maps A/F/R in either case and nothing else", () => {
   assert.equal(decisionForKey("a"), "approved");
   assert.equal(decisionForKey("F"), "needs_fix");

@@ -123,7 +123,11 @@ def import_uploads(
         except MocapQAError as e:
             report.failed.append({"name": label or name, "error": str(e)})
         else:
-            report.created.append({"name": name, "take_id": take_id, "run_id": run_id})
+            created = {"name": name, "take_id": take_id, "run_id": run_id}
+            same = repository.same_content(take_id)
+            if same is not None:  # kept (a reviewer may want both), but said
+                created["duplicate_of"] = same
+            report.created.append(created)
 
     for source, name in uploads:
         if archive_kind(name) is None:

@@ -141,6 +141,23 @@ class Repository:
             raise
         return take_id, run_id
 
+    def same_content(self, take_id: str) -> str | None:
+        """The name of another take of the same shoot with byte-identical content (the same
+        file imported twice), or None (also for a take outside a shoot)."""
+        with self.engine.connect() as conn:
+            row = conn.execute(
+                select(takes.c.shoot_id, takes.c.sha256).where(takes.c.id == take_id)
+            ).first()
+            if row is None or row[0] is None:
+                return None
+            other = conn.execute(
+                select(takes.c.name)
+                .where(takes.c.shoot_id == row[0], takes.c.sha256 == row[1], takes.c.id != take_id)
+                .order_by(takes.c.created_at)
+                .limit(1)
+            ).scalar()
+        return None if other is None else str(other)
+
     def get_take(self, take_id: str) -> dict[str, Any]:
         """One take with its latest run and review fields.
 
