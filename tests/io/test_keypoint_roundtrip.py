@@ -118,3 +118,13 @@ def test_npy_wrong_shape_and_garbage_are_parse_errors(tmp_path: Path) -> None:
         parse_keypoint_npy((tmp_path / "flat.npy").read_bytes(), "flat.npy", fps=30)
     with pytest.raises(ParseError, match="Expected a NumPy file"):
         parse_keypoint_npy(b"\x93NUMPY garbage", "bad.npy", fps=30)
+
+
+@pytest.mark.parametrize("dtype", [np.complex128, np.bool_])
+def test_npy_of_no_real_numbers_is_refused_naming_the_dtype(dtype: type) -> None:
+    import io
+
+    buffer = io.BytesIO()
+    np.save(buffer, np.ones((4, 2, 3), dtype=dtype), allow_pickle=False)
+    with pytest.raises(ParseError, match="real numbers, got dtype"):
+        parse_keypoint_npy(buffer.getvalue(), "odd.npy", fps=30.0)

@@ -47,6 +47,12 @@ def _split(
         raise ParseError(
             f"Expected an array of shape (F, K, 2|3|4), got {array.shape}", path, field=field
         )
+    # Real numbers only: a complex array would lose its imaginary part in the cast, a boolean
+    # one read as 0/1 coordinates.
+    if array.dtype.kind not in "iuf":
+        raise ParseError(
+            f"Expected an array of real numbers, got dtype {array.dtype}", path, field=field
+        )
     try:
         values = np.asarray(array, dtype=np.float64)
     except (TypeError, ValueError) as e:
