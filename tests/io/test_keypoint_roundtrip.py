@@ -128,3 +128,10 @@ def test_npy_of_no_real_numbers_is_refused_naming_the_dtype(dtype: type) -> None
     np.save(buffer, np.ones((4, 2, 3), dtype=dtype), allow_pickle=False)
     with pytest.raises(ParseError, match="real numbers, got dtype"):
         parse_keypoint_npy(buffer.getvalue(), "odd.npy", fps=30.0)
+
+
+def test_a_csv_with_a_byte_order_mark_reads_as_without_one() -> None:
+    # Spreadsheets save UTF-8 CSVs with a BOM; decoded elsewhere first, it stayed on "frame".
+    text = "\ufeffframe,keypoint,x,y,z\n0,a,1,2,3\n1,a,1,2,3\n"
+    for data in (text, text.encode("utf-8")):
+        assert parse_keypoint_csv(data, "bom.csv", fps=30.0).n_frames == 2

@@ -84,7 +84,7 @@ def decode_text(data: bytes | str, path: str | Path) -> str:
         On NUL bytes or bytes that are not UTF-8, with the line where they occur.
     """
     if isinstance(data, str):
-        text = data
+        text = data.removeprefix("\ufeff")  # text read elsewhere may still start with a BOM
     else:
         try:
             text = data.decode("utf-8-sig")
