@@ -297,3 +297,14 @@ def test_keypoints_no_take_holds_are_refused_at_the_upload(
     assert response.status_code == 422, response.text
     assert field in (response.json().get("field") or response.json()["detail"])
     no_takes(signed_in)
+
+
+def test_a_zip_of_takes_sent_as_one_take_says_where_archives_go(signed_in: TestClient) -> None:
+    """An .npz is a zip file, so a .zip of takes was read as one and refused for a missing
+    'positions' array."""
+    response = signed_in.post(
+        "/api/v1/takes", files={"file": ("takes.zip", deflated_zip({"a.bvh": SMALL_BVH}))}
+    )
+    assert response.status_code == 422
+    assert "import archives of takes into a shoot" in response.json()["detail"]
+    no_takes(signed_in)

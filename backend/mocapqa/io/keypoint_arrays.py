@@ -162,6 +162,13 @@ def parse_keypoint_npz(
         with archive:
             key = "positions" if "positions" in archive.files else "keypoints"
             if key not in archive.files:
+                if not path.lower().endswith(".npz"):
+                    # An .npz is a zip file: a .zip of takes lands here when sent as one take.
+                    raise ParseError(
+                        "Expected one take, got a zip archive: import archives of takes into a "
+                        "shoot (POST /shoots/{id}/takes, or the shoot view)",
+                        path,
+                    )
                 raise ParseError("Expected a 'positions' array", path, field="positions")
             positions, confidence, n_dims = _split(archive[key], path, key)
             if "confidence" in archive.files:
