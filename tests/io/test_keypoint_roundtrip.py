@@ -135,3 +135,14 @@ def test_a_csv_with_a_byte_order_mark_reads_as_without_one() -> None:
     text = "\ufeffframe,keypoint,x,y,z\n0,a,1,2,3\n1,a,1,2,3\n"
     for data in (text, text.encode("utf-8")):
         assert parse_keypoint_csv(data, "bom.csv", fps=30.0).n_frames == 2
+
+
+def test_truncated_headers_say_what_is_missing() -> None:
+    from mocapqa.io.bvh import parse_bvh
+    from mocapqa.io.trc import parse_trc
+
+    with pytest.raises(ParseError, match="'HIERARCHY' section before 'MOTION', got 'MOTION' first"):
+        parse_bvh("MOTION\nFrames: 1\nFrame Time: 0.033\n0 0 0\n", "x.bvh")
+    # It said "Expected a TRC file starting 'PathFileType', got 'PathFileType...'".
+    with pytest.raises(ParseError, match="TRC header of 3 lines and a marker row, got 1 line"):
+        parse_trc("PathFileType\t4\t(X/Y/Z)\tx.trc\n", "x.trc")

@@ -189,6 +189,12 @@ def parse_bvh(
         last_line = text.count("\n", 0, len(text.rstrip())) + 1
         raise ParseError("Expected a 'MOTION' section, got end of file", path, last_line)
     motion_line = text.count("\n", 0, match.start())  # 0-based index of the MOTION line
+    if not text[: match.start()].strip():
+        raise ParseError(
+            "Expected a 'HIERARCHY' section before 'MOTION', got 'MOTION' first",
+            path,
+            motion_line + 1,
+        )
     hierarchy = parse_hierarchy(
         text[: match.start()].split("\n"), path, "end of hierarchy (truncated file?)"
     )

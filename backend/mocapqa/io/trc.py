@@ -132,9 +132,15 @@ def parse_trc(data: bytes | str, path: str | Path = "<trc>") -> KeypointSequence
     """
     path = str(path)
     lines = decode_text(data, path).splitlines()
-    if len(lines) < 4 or not lines[0].lstrip().startswith("PathFileType"):
+    if not lines or not lines[0].lstrip().startswith("PathFileType"):
         first = lines[0][:40] if lines else ""
         raise ParseError(f"Expected a TRC file starting 'PathFileType', got {first!r}", path, 1)
+    if len(lines) < 4:
+        raise ParseError(
+            f"Expected a TRC header of 3 lines and a marker row, got {len(lines)} line(s)",
+            path,
+            len(lines),
+        )
     header = _header_values(lines, path)
     fps = float_from_text(header["DataRate"], path, 3, "DataRate")
     if not (math.isfinite(fps) and fps > 0):
