@@ -175,7 +175,8 @@ def resolve_fps(
         if default_fps is None:
             raise ParseError(
                 f"Expected a frame rate: {format_name} input without a time column or fps "
-                "field needs the fps argument (for example --fps 30)",
+                "field needs the fps argument (the upload's fps field, or --fps 30 on the "
+                "command line)",
                 path,
                 field="fps",
             )
