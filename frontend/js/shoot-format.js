@@ -106,6 +106,9 @@ export const TAKE_COLUMNS = [
 
 /** One cell's text. */
 export function formatCell(key, row) {
+  // An analysed take without a score is one no check could read (its rig's roles were not
+  // found): say so, rather than a dash that reads as "not yet".
+  if (key === "score" && row.status === "done" && row.score == null) return "not checked";
   const column = TAKE_COLUMNS.find((c) => c.key === key);
   return column ? column.format(row[key]) : String(row[key] ?? "–");
 }

@@ -305,3 +305,9 @@ test("exportQuery sends the table's filters, sort and order, never its page", ()
   assert.equal(exportQuery(state), "sort=name&order=desc&rig=cmu&has_findings=true");
   assert.equal(exportQuery(TABLE_DEFAULTS), "sort=score&order=asc");
 });
+
+test("an analysed take without a score reads 'not checked', a queued one a dash", () => {
+  assert.equal(formatCell("score", { status: "done", score: null }), "not checked");
+  assert.equal(formatCell("score", { status: "queued", score: null }), "–");
+  assert.equal(formatCell("score", { status: "done", score: 97.25 }), "97.3");
+});
