@@ -110,7 +110,14 @@ export async function takeView(main, takeId, params, onTeardown) {
   const bridgedRuns = result.series.filter && result.series.filter.bridged_runs;
   if (bridgedRuns) timebar.setGaps(bridgedRuns);
   const rerunSlot = h("div", {});
-  main.append(help, list.panel, timelines, review, stepsPanel(result), downloadsPanel(run, result), rerunSlot);
+  // A take no check could read is said above its (empty) findings, not only under Steps.
+  const unchecked = Object.entries(result.steps).filter(([, st]) => st.state === "no_roles" || st.state === "no_model");
+  const uncheckedNote = unchecked.length
+    ? h("p", { class: "notice", id: "not-checked" }, h("b", {}, "Not checked: "),
+      unchecked.map(([name, st]) => `${name}: ${st.message}`).join(" · "),
+      unchecked.some(([, st]) => st.state === "no_roles") ? " — name the rig's joints in \u201cRig roles (mapping)\u201d below and re-run." : "")
+    : null;
+  main.append(help, uncheckedNote ?? "", list.panel, timelines, review, stepsPanel(result), downloadsPanel(run, result), rerunSlot);
   // The mapping editor selects the joint it names in the 3D views, as a click on the joint does.
   const onJoint = (name) => { if (!jointIndex.has(name)) return; store.set({ joint: name }); focusCharts(); render(); remember(); };
   formLists.then(([filters, described]) => rerunSlot.replaceWith(rerunPanel(take, run, filters, described, { summary: result.summary, onJoint })));

@@ -74,3 +74,23 @@ def test_missing_roles_are_named_by_hand_and_the_rerun_uses_them(
     summary = httpx.get(f"{live_server}/api/v1/runs/{run_id}/result").json()["summary"]
     assert sorted(summary["missing_roles"]) == ["left_lower_leg", "right_lower_leg"]
     assert summary["roles"]["left_forearm"] == "SegA"
+
+
+def test_a_rig_no_check_could_read_says_so_above_its_findings(
+    live_server: str, corpus_dir: Path, page: Page, tmp_path: Path
+) -> None:
+    """Every joint renamed to a number: nothing was checked, and the take view says so at the
+    top, pointing at the mapping editor, instead of an innocent "No findings"."""
+    text = (corpus_dir / "bvh" / "cmu" / "cmu_12_01_walk.bvh").read_text()
+    names = re.findall(r"\b(?:ROOT|JOINT) (\S+)", text)
+    for k, name in enumerate(names):
+        text = re.sub(rf"\b(ROOT|JOINT) {re.escape(name)}\b", rf"\g<1> j{k}", text)
+    path = tmp_path / "anonymous.bvh"
+    path.write_text(text)
+    take = upload(live_server, path)
+    assert take["result"]["steps"]["twist"]["state"] == "no_roles"
+    page.open_take(live_server, take)
+    note = page.page.inner_text("#not-checked")
+    assert note.startswith("Not checked:")
+    assert "no limb chain found" in note
+    assert "Rig roles (mapping)" in note
