@@ -4,16 +4,21 @@ import * as api from "./api.js";
 import { h } from "./dom.js";
 import { MARGIN } from "./charts.js";
 import { compareViews } from "./compare3d.js";
-import { fmt, matchFindings, optionsDiff } from "./format.js";
+import { fmt, matchFindings, optionsDiff, runOptionsLabel } from "./format.js";
 import { loadPlotly, untabbableModebar } from "./plotly.js";
 
+// Each choice starts the view again: an older call still waiting for its answers must not
+// draw after a newer one (two comparisons stacked on the page).
+let drawing = 0;
+
 export async function compareView(main, params, onTeardown = () => {}) {
+  const mine = ++drawing;
   const page = await api.listTakes({ limit: 500 });
+  const takes = await Promise.all(page.items.map((t) => api.getTake(t.id)));
+  if (mine !== drawing) return;
   const options = [];
-  for (const t of page.items) {
-    const take = await api.getTake(t.id);
-    take.runs.forEach((r, i) => options.push([r.id, `${t.name} · run ${i + 1} (${r.status})`]));
-  }
+  takes.forEach((take, k) => take.runs.forEach((r, i) => options.push([r.id,
+    `${page.items[k].name} (${String(take.id).slice(0, 6)}) · run ${i + 1} (${r.status}) · ${runOptionsLabel(r)}`])));
   const pick = (name) => h("select", { id: `compare-${name}`, onchange: (e) => {
     const next = new URLSearchParams(params); next.set(name, e.target.value); location.hash = `#/compare?${next}`; } },
     h("option", { value: "" }, "choose…"), options.map(([v, l]) => h("option", { value: v, selected: v === params.get(name) }, l)));
@@ -23,7 +28,7 @@ export async function compareView(main, params, onTeardown = () => {}) {
   main.replaceChildren(h("h1", {}, "Compare two takes or runs"), h("div", { class: "controls" }, labelled("a"), labelled("b")));
   const ids = [params.get("a"), params.get("b")].filter(Boolean);
   const results = await Promise.all(ids.map(async (id) => ({ run: await api.getRun(id), result: await api.getResult(id).catch(() => null) })));
-  if (!results.length) return;
+  if (!results.length || mine !== drawing) return;
   const metric = (label, get) => h("tr", {}, h("td", {}, label), results.map((r) => h("td", {}, r.result ? get(r.result, r.run) : "–")));
   const maxOffset = (res) => {
     const s = res.series.twist && res.series.twist.summaries;
@@ -50,6 +55,7 @@ export async function compareView(main, params, onTeardown = () => {}) {
       : h("p", { class: "muted", id: "compare-options" }, "Same options."));
   const label = (r) => options.find(([v]) => v === r.run.id)?.[1] || r.run.id;
   await compareViews(main, results[0], results[1], results.map(label), onTeardown);
+  if (mine !== drawing) return;
   const matched = matchFindings(a.findings, b.findings);
   const span = (f) => `${f.start_frame}–${f.end_frame}`;
   const rows = [
@@ -69,6 +75,7 @@ export async function compareView(main, params, onTeardown = () => {}) {
   const chart = h("div", { id: "compare-twist", class: "chart" });
   main.append(h("h2", {}, "Twist θP and removed offset, A solid, B dashed"), h("div", { class: "controls" }, "joint ", joint), h("div", { class: "panel" }, chart));
   const Plotly = await loadPlotly();
+  if (mine !== drawing) return;
   const draw = () => {
     const x = chainsA.find((c) => c.joint === joint.value), y = chainsB.get(joint.value);
     const line = (series, frames, name, dash, color, yaxis) => ({ type: "scatter", mode: "lines", x: frames, y: series, name, yaxis, line: { dash, color, width: 1.4 } });

@@ -58,11 +58,15 @@ export function intervalDecisions(run, result, take = null) {
       return button;
     });
     const corrected = decision ? decision === "accept" : f.applied;
+    // Redrawn under the keyboard's focus: the same button keeps it (screen readers and Tab
+    // carry on from there instead of the page's start).
+    const focused = cell.contains(document.activeElement) ? document.activeElement.dataset?.decision : null;
     cell.replaceChildren(
       h("span", { class: "applied muted", title: "the run's twist_apply choice, in its corrected BVH" }, f.applied ? "run: applied" : "run: not applied"), " · ",
       decision ? badge(LABELS[decision], BADGE[decision]) : h("span", { class: "muted" }, "undecided"),
       h("span", { class: "outcome muted", title: "what the reviewed download does with this interval" }, corrected ? " → corrected" : " → left as recorded"), " ",
       ...buttons);
+    if (focused) buttons.find((b) => b.dataset.decision === focused)?.focus();
   };
 
   async function decide(id, decision) {

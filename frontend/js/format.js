@@ -40,6 +40,16 @@ export function stepsRan(run) {
   return ran.length ? ran.join("+") : "no step ran";
 }
 
+/** What tells two runs of a take apart in a list: the steps that ran, the twist choice when it
+ * is not the default, the filter ("twist+limits · apply all · quat-pd"). */
+export function runOptionsLabel(run) {
+  const parts = [stepsRan(run)];
+  const apply = run.options && run.options.twist_apply;
+  if (apply && apply !== "confident") parts.push(`apply ${apply}`);
+  if (run.options && run.options.filter_method) parts.push(run.options.filter_method);
+  return parts.filter(Boolean).join(" · ");
+}
+
 /** Run checks a take of this kind can run (twist and limits need joint rotations). */
 export const checksFor = (kind) => (kind === "motion" ? ["twist", "limits", "filter"] : ["filter"]);
 

@@ -1,7 +1,7 @@
 // The review panel: a decision with notes; saving updates the panel in place (the player, its
 // frame and the camera stay as they are).
 import * as api from "./api.js";
-import { badge, h, REVIEW } from "./dom.js";
+import { badge, h, REVIEW, toast } from "./dom.js";
 
 export function reviewPanel(take) {
   const panel = h("div", { class: "panel", id: "review-panel" });
@@ -18,7 +18,9 @@ export function reviewPanel(take) {
       const fresh = await api.getTake(take.id);
       showHistory(fresh.reviews);
       message.textContent = "saved"; message.className = "muted";
-    } catch (e) { message.textContent = e.message; message.className = "error"; }
+      // A/F/R save from anywhere on the page: say what was recorded where it can be seen.
+      toast(`review saved: ${REVIEW[status.value]}`);
+    } catch (e) { message.textContent = e.message; message.className = "error"; toast(e.message); }
   } }, "save review");
   showHistory(take.reviews);
   /** Record a decision from the keyboard (A/F/R): set it and save. */

@@ -2,7 +2,7 @@
 import * as api from "./api.js";
 import * as charts from "./charts.js";
 import { badge, h } from "./dom.js";
-import { fmt, nextFinding, seconds, stepsRan } from "./format.js";
+import { fmt, nextFinding, runOptionsLabel, seconds } from "./format.js";
 import { filterFromParams, filterParams, findingAt, jointsOf, kindsOf, loopOfFinding } from "./findings.js";
 import { findingsList } from "./findings-list.js";
 import { createTimebar, parseRange, withIn, withOut } from "./timebar.js";
@@ -257,7 +257,8 @@ export async function takeView(main, takeId, params, onTeardown) {
     const typing = target instanceof HTMLElement && (target.matches("input, textarea, select, [contenteditable]") || target.isContentEditable);
     if (typing || e.ctrlKey || e.metaKey || e.altKey) return;
     // Space plays or pauses on its key-down (a focused play button would wait for the key-up).
-    if (e.key === " " && (target === playButton || !target.matches("button, a, [tabindex]"))) { e.preventDefault(); if (!e.repeat) togglePlay(); }
+    // The time bar (a slider) plays too: it is where a reviewer's focus rests between findings.
+    if (e.key === " " && (target === playButton || target.id === "timebar" || !target.matches("button, a, [tabindex]"))) { e.preventDefault(); if (!e.repeat) togglePlay(); }
     else if (e.key === "ArrowRight" || e.key === "ArrowLeft") {
       e.preventDefault();
       if (player.playing) togglePlay();
@@ -268,6 +269,8 @@ export async function takeView(main, takeId, params, onTeardown) {
       if (reached) {
         if (player.playing) togglePlay();
         list.mark(reached);
+        // The row reached in sight (the list may be far below the views).
+        document.querySelector("#findings tr.finding.current")?.scrollIntoView({ block: "nearest" });
         // The finding reached is the one opened: its joint selected, Y/X act on it if twist.
         decided.opened(reached); store.set({ joint: reached.joint }); focusCharts();
         // Y/X then act on the finding reached, not on a row focused before.
@@ -354,7 +357,7 @@ export async function takeView(main, takeId, params, onTeardown) {
 function runPicker(take, run) {
   const select = h("select", { id: "run-pick", "aria-label": "run", onchange: (e) => { location.hash = api.takeLink(take.id, e.target.value); } },
     take.runs.map((r, i) => h("option", { value: r.id, selected: r.id === run.id },
-      `run ${i + 1} · ${r.status} · ${stepsRan(r)}${r.options.filter_method ? ` · ${r.options.filter_method}` : ""}`)));
+      `run ${i + 1} · ${r.status} · ${runOptionsLabel(r)}`)));
   return h("div", { class: "controls" }, "Run ", select,
     run.server_time_s != null ? h("span", { class: "muted" }, `server time ${fmt(run.server_time_s, 2)} s`) : null,
     h("a", { href: `#/compare?a=${run.id}` }, "compare…"));

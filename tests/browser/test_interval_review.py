@@ -92,6 +92,13 @@ def test_accept_and_reject_intervals_persist_and_the_download_has_them(
     assert served == expected.content
     corrected = httpx.get(f"{live_server}/api/v1/runs/{knees['run']}/download/bvh", timeout=60)
     assert served != corrected.content  # the decisions changed the run's own choice
+    # A decision made from the keyboard keeps the focus on its button (it was redrawn away).
+    p.focus(f"#findings tr[data-interval='{second}'] button.decide-accept")
+    p.keyboard.press("Enter")
+    p.wait_for_function(
+        "(id) => document.activeElement?.matches(`tr[data-interval='${id}'] button.decide-accept`)",
+        arg=second,
+    )
 
 
 def test_limb_spins_are_listed_with_their_read_out_and_nothing_to_accept(

@@ -513,3 +513,8 @@ def test_the_time_bar_is_a_slider_the_keyboard_reaches(
     p.keyboard.press("ArrowRight")
     assert page.frame() == step + 1
     assert p.get_attribute("#timebar", "aria-valuetext") == f"frame {step + 1} of {n_frames}"
+    # Space on the bar plays and pauses, as it does on the page.
+    p.keyboard.press("Space")
+    p.wait_for_function("() => document.getElementById('play').textContent.endsWith('pause')")
+    p.keyboard.press("Space")
+    p.wait_for_function("() => document.getElementById('play').textContent.endsWith('play')")

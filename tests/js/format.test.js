@@ -63,3 +63,11 @@ test("the options diff lists only what differs, as readable values", () => {
     ["filter_params.beta", "1", "2"],
   ]);
 });
+
+test("runOptionsLabel tells two runs of a take apart by what differs", () => {
+  const done = (options, steps) => ({ status: "done", options, summary: { steps } });
+  const ran = { twist: "done", limits: "done", filter: "skipped" };
+  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "confident" }, ran)), "twist+limits");
+  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "all" }, ran)), "twist+limits · apply all");
+  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits", "filter"], twist_apply: "none", filter_method: "quat-pd" }, { ...ran, filter: "done" })), "twist+limits+filter · apply none · quat-pd");
+});
