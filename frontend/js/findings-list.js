@@ -83,7 +83,11 @@ export function findingsList(findings, decided, onOpen, initial = null, onFilter
     const bodies = grouped
       ? groupByJoint(shown, key, dir).map((g) => h("tbody", { class: "group", "data-joint": g.joint }, groupHead(g), collapsed.has(g.joint) ? null : g.rows.map(row)))
       : [h("tbody", {}, sortFindings(shown, key, dir).map(row))];
-    table.replaceChildren(head, ...bodies);
+    // Filters that keep nothing say so (a bare header read as a broken table).
+    const none = findings.length && !shown.length
+      ? [h("tbody", {}, h("tr", { id: "findings-none" }, h("td", { colspan: span, class: "muted" }, "No finding matches the filters.")))]
+      : [];
+    table.replaceChildren(head, ...bodies, ...none);
   }
 
   /** Mark `f` as the current finding: its row highlighted, its group opened. */

@@ -69,7 +69,9 @@ export async function takeView(main, takeId, params, onTeardown) {
   const rawDiv = h("div", { id: "view-raw", class: "view3d" });
   const corrDiv = h("div", { id: "view-corrected", class: "view3d" });
   const rawTitle = h("h3", { class: "view-title" }, "raw");
-  const corrTitle = h("h3", { class: "view-title" }, "corrected");
+  // Keypoints are filtered, not corrected: the right-hand view says which it shows.
+  const outcome = result.kind === "keypoints" ? "filtered" : "corrected";
+  const corrTitle = h("h3", { class: "view-title" }, outcome);
   const rawPanel = h("div", { class: "col panel", id: "panel-raw" }, rawTitle, rawDiv);
   const presets = ["front", "side", "top"].map((name) => h("button", { id: `camera-${name}`, class: "small" }, name));
   const closeButton = h("button", { id: "camera-close", class: "small", "aria-pressed": "false", title: "frame the selected joint (or the current finding's joint) close (C)" }, "close-in");
@@ -166,7 +168,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     frameLabel.textContent = `frame ${f} / ${nFrames - 1} · ${seconds(f, fps)} · ${frame.flagged.size} flagged joint(s)`;
     jointLabel.textContent = store.state.joint ? `selected: ${store.state.joint}` : "click a joint to select it";
     rawTitle.textContent = `raw — frame ${frame.shown}`;
-    corrTitle.textContent = store.state.overlay ? `corrected (solid) and raw (ghost) — frame ${frame.shown}` : `corrected — frame ${frame.shown}`;
+    corrTitle.textContent = store.state.overlay ? `${outcome} (solid) and raw (ghost) — frame ${frame.shown}` : `${outcome} — frame ${frame.shown}`;
     scrubber.value = f;
     timebar.setFrame(f);
     if (timeline) timeline.setFrame(f);

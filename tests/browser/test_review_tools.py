@@ -109,7 +109,10 @@ def test_findings_grouped_by_joint_filtered_and_walked(
     assert all(abs(float(r["value"].split()[0])) >= 20 for r in shown)
     assert len(shown) == sum(f["value"] is not None and abs(f["value"]) >= 20 for f in findings)
     p.fill("#filter-min", "")
+    p.fill("#filter-text", "no such joint")
+    assert p.inner_text("#findings-none") == "No finding matches the filters."
     p.fill("#filter-text", "calf")
+    assert p.locator("#findings-none").count() == 0
     assert rows(page)
     assert all("calf" in r["joint"].lower() for r in rows(page))
     shot(page, "findings-filtered")
