@@ -137,6 +137,8 @@ export function rerunPanel(take, run, filters, described, context = {}) {
         if (bad) bad.setAttribute("aria-invalid", "true");
       }
       message.textContent = built.errors.join(" · "); message.className = "error";
+      // The first field at fault takes the focus, so the keyboard is where the fix goes.
+      document.querySelector("#rerun-panel [aria-invalid='true']")?.focus();
       return;
     }
     try {
@@ -144,7 +146,17 @@ export function rerunPanel(take, run, filters, described, context = {}) {
       location.hash = api.takeLink(take.id, created.id);
     } catch (e) { message.textContent = e.message; message.className = "error"; }
   } }, "re-run");
-  return h("div", { class: "panel", id: "rerun-panel" }, h("h2", {}, "Re-run with other options (earlier runs are kept)"),
+  const panel = h("div", { class: "panel", id: "rerun-panel" }, h("h2", {}, "Re-run with other options (earlier runs are kept)"),
     h("div", { class: "controls" }, h("label", {}, "preset ", presetPick)),
     h("div", { class: "option-groups" }, groups, roles ? roles.box : null), h("div", { class: "controls" }, start, message));
+  // A change to the form answers an earlier refusal: its message and marks go (they named
+  // fields that may be gone, e.g. after choosing a preset).
+  const clear = () => {
+    if (message.className !== "error") return;
+    message.textContent = ""; message.className = "muted";
+    for (const el of panel.querySelectorAll("[aria-invalid]")) el.removeAttribute("aria-invalid");
+  };
+  panel.addEventListener("change", clear);
+  panel.addEventListener("input", clear);
+  return panel;
 }

@@ -388,14 +388,18 @@ def test_options_form_grouped_with_units_presets_and_checks(
     assert "cutoff_hz: expected a number" in message
     assert "max_points: expected at least 10" in message
     assert cutoff.get_attribute("aria-invalid") == "true"
+    # The keyboard is taken to the first field at fault.
+    assert p.evaluate("() => document.activeElement.dataset.param") == "cutoff_hz"
     shot(page, "options-form")
     time.sleep(0.5)
     runs_after = len(
         httpx.get(f"{live_server}/api/v1/takes/{knees['id']}", timeout=30).json()["runs"]
     )
     assert runs_after == runs_before
-    # Fixed, the run starts with exactly those options.
+    # Fixed, the run starts with exactly those options; the first change clears the refusal.
     p.select_option("#run-preset", "twist only")
+    assert p.inner_text("#rerun-message") == ""
+    assert cutoff.count() == 0 or cutoff.get_attribute("aria-invalid") is None
     p.select_option("#filter-method", "butterworth")
     panel.locator("[data-param='cutoff_hz']").fill("4")
     p.fill("#option-max_points", "300")
