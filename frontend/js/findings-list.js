@@ -103,7 +103,9 @@ export function findingsList(findings, decided, onOpen, initial = null, onFilter
   }
 
   render();
-  const panel = h("div", { class: "panel", id: "findings-panel" }, title,
+  // Every row and its buttons are Tab stops: a way past them to the take's review.
+  const skip = h("button", { class: "small", id: "skip-to-review", onclick: () => document.getElementById("review-status")?.focus() }, "skip to the review ↓");
+  const panel = h("div", { class: "panel", id: "findings-panel" }, title, findings.length ? skip : null,
     findings.length ? [
       h("div", { class: "controls findings-filters" },
         kindBoxes.map((b) => h("label", {}, b, ` ${b.value}`)),

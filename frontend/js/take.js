@@ -84,7 +84,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   const overlayBox = h("input", { type: "checkbox", id: "overlay" });
   const viewsRow = h("div", { class: "row view-row", id: "views" }, rawPanel, h("div", { class: "col panel" }, corrTitle, corrDiv));
   main.append(
-    runPicker(take, run),
+    runPicker(take, run, () => store.state.frame),
     h("div", { class: "controls view-options" }, "camera ", presets, closeButton, followButton,
       h("label", {}, triadsBox, " joint axes"), h("label", {}, overlayBox, " overlay (raw as ghost)"),
       h("span", { class: "muted", id: "view-legend" }, oriented ? "bones are drawn in their parent joint's frame; the orange side marks the roll"
@@ -356,8 +356,10 @@ export async function takeView(main, takeId, params, onTeardown) {
 
 /** The first, light overview: the skeletons do not wait for the full one. */
 
-function runPicker(take, run) {
-  const select = h("select", { id: "run-pick", "aria-label": "run", onchange: (e) => { location.hash = api.takeLink(take.id, e.target.value); } },
+/** The run list; another run opens at the frame shown now (`frameNow()`), as a reviewer
+ * comparing runs expects, rather than at frame 0. */
+function runPicker(take, run, frameNow) {
+  const select = h("select", { id: "run-pick", "aria-label": "run", onchange: (e) => { location.hash = `${api.takeLink(take.id, e.target.value)}&frame=${frameNow()}`; } },
     take.runs.map((r, i) => h("option", { value: r.id, selected: r.id === run.id },
       `run ${i + 1} · ${r.status} · ${runOptionsLabel(r)}`)));
   return h("div", { class: "controls" }, "Run ", select,

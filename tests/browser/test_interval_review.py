@@ -8,7 +8,7 @@ from typing import Any
 
 import httpx
 import pytest
-from tests.browser.test_workstation import ARTIFACTS, KNEES_TAKE, Page, upload
+from tests.browser.test_workstation import ARTIFACTS, KNEES_TAKE, Page, scrub, upload
 
 pytestmark = pytest.mark.browser
 
@@ -196,6 +196,14 @@ def test_a_re_run_says_which_run_holds_the_decisions(
     notice = p.inner_text("#decisions-elsewhere")
     assert "Run 1 holds 1 decision" in notice
     assert "this run has none yet" in notice
+    # Another run opens at the frame shown, not at frame 0.
+    scrub(page, 120)
+    p.select_option("#run-pick", take["run"])
+    p.wait_for_function(f"() => location.hash.includes('run={take['run']}&frame=120')")
+    p.wait_for_selector("main[data-ready='1']", timeout=60_000)
+    assert page.frame() == 120
+    page.open_take(live_server, {"id": take["id"], "run": rerun["id"]})
+    p.wait_for_selector("#decisions-elsewhere:not([hidden])", timeout=30_000)
     p.click("#decisions-elsewhere-link")
     p.wait_for_function(f"() => location.hash.includes('run={take['run']}')")
     p.wait_for_selector("main[data-ready='1'] #decision-history li", timeout=60_000)

@@ -520,6 +520,11 @@ def test_the_time_bar_is_a_slider_the_keyboard_reaches(
     p.keyboard.press("ArrowRight")
     assert page.frame() == step + 1
     assert p.get_attribute("#timebar", "aria-valuetext") == f"frame {step + 1} of {n_frames}"
+    # The findings' skip button reaches the review past every row's Tab stops.
+    p.focus("#skip-to-review")
+    p.keyboard.press("Enter")
+    assert p.evaluate("() => document.activeElement.id") == "review-status"
+    p.focus("#timebar")
     # Space on the bar plays and pauses, as it does on the page.
     p.keyboard.press("Space")
     p.wait_for_function("() => document.getElementById('play').textContent.endsWith('pause')")
