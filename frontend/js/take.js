@@ -103,9 +103,11 @@ export async function takeView(main, takeId, params, onTeardown) {
   const linkedFilter = filterFromParams(params, kindsOf(result.findings), jointsOf(result.findings));
   let filterQuery = filterParams(linkedFilter, kindsOf(result.findings));
   const list = findingsList(result.findings, decided, (f) => { decided.opened(f); store.set({ joint: f.joint }); focusCharts(); jump(f.start_frame); viewsRow.scrollIntoView({ block: "start" }); },
-    linkedFilter, (query) => { filterQuery = query; remember(); });
+    linkedFilter, (query) => { filterQuery = query; remember(); timebar.setMarks(marksOf(list.shown)); });
+  // The time bar marks the findings the list's filters keep.
+  const marksOf = (findings) => [...findings].sort(byKind).map((f) => ({ start: f.start_frame, end: f.end_frame, color: findingColor(f), label: `${f.kind} · ${f.joint} · ${f.start_frame}–${f.end_frame}` }));
   const timebar = createTimebar({
-    nFrames, marks: [...result.findings].sort(byKind).map((f) => ({ start: f.start_frame, end: f.end_frame, color: findingColor(f), label: `${f.kind} · ${f.joint} · ${f.start_frame}–${f.end_frame}` })),
+    nFrames, marks: marksOf(list.shown),
     onJump: (f) => { if (player.playing) togglePlay(); jump(f); }, onRange: (r) => setRange(r),
   });
   document.getElementById("player").append(timebar.el);

@@ -52,12 +52,13 @@ export function runsOf(frames, flags) {
  */
 export function createTimebar({ nFrames, marks, onJump, onRange }) {
   const place = (el, a, b) => { const [left, width] = spanOf(a, b, nFrames); el.style.left = `${left}%`; el.style.width = `${width}%`; };
-  const markEls = marks.map((m) => {
+  const markOf = (m) => {
     const el = h("div", { class: "tb-mark", title: m.label });
     el.style.background = m.color;
     place(el, m.start, m.end);
     return el;
-  });
+  };
+  const markBox = h("div", { class: "tb-marks" }, marks.map(markOf));
   const gaps = h("div", { class: "tb-gaps" });
   const inHandle = h("span", { class: "tb-handle tb-in", title: "in point (I): drag to move" });
   const outHandle = h("span", { class: "tb-handle tb-out", title: "out point (O): drag to move" });
@@ -68,7 +69,7 @@ export function createTimebar({ nFrames, marks, onJump, onRange }) {
   const bar = h("div", {
     class: "timebar", id: "timebar", title: "click: go to a frame · drag: set the loop range", tabindex: "0",
     role: "slider", "aria-label": "time bar", "aria-valuemin": "0", "aria-valuemax": String(Math.max(0, nFrames - 1)), "aria-valuenow": "0",
-  }, markEls, gaps, loop, cursor);
+  }, markBox, gaps, loop, cursor);
   let now = 0;
   bar.addEventListener("keydown", (e) => {
     const step = Math.max(1, Math.round(nFrames / 10));
@@ -117,6 +118,8 @@ export function createTimebar({ nFrames, marks, onJump, onRange }) {
       loop.classList.toggle("looping", Boolean(looping));
       if (next) place(loop, next[0], next[1]);
     },
+    /** The findings marked: [{start, end, color, label}, …] (those the list's filters keep). */
+    setMarks(next) { markBox.replaceChildren(...next.map(markOf)); },
     /** Bridged gaps: [[start, end], …] frames drawn hatched. */
     setGaps(runs) {
       gaps.replaceChildren(...runs.map(([a, b]) => { const el = h("div", { class: "tb-gap", title: `bridged gap: frames ${a}–${b}` }); place(el, a, b); return el; }));

@@ -140,9 +140,13 @@ def test_findings_grouped_by_joint_filtered_and_walked(
     p.keyboard.press("p")
     back = [r for r in rows(page) if r["current"]]
     assert (back[0]["start"], back[0]["joint"], back[0]["kind"]) == visited[-2]
-    # With only the twist kind kept, N and P stop at twist findings only.
+    # With only the twist kind kept, N and P stop at twist findings only, and the time bar
+    # marks only those.
+    marks = "() => document.querySelectorAll('#timebar .tb-mark').length"
+    assert p.evaluate(marks) == len(findings)
     p.uncheck("#filter-kind-limits")
     p.uncheck("#filter-kind-spin")
+    assert p.evaluate(marks) == sum(f["kind"] == "twist" for f in findings)
     p.evaluate("() => document.activeElement.blur()")
     scrub(page, 0)
     twist_starts = sorted({f["start_frame"] for f in findings if f["kind"] == "twist"})
