@@ -41,6 +41,7 @@ __all__ = [
     "file_fields",
     "form_sent_for_json",
     "multipart_refusal",
+    "takes_many",
 ]
 
 FORM_TYPES = ("multipart/form-data", "application/x-www-form-urlencoded")
@@ -49,11 +50,11 @@ _ECHO_CHARS = 100
 """Most characters of a client-given part name echoed in an error."""
 
 
-def _takes_many(annotation: Any) -> bool:
+def takes_many(annotation: Any) -> bool:
     """Whether a field's annotation is a list (or other sequence), optional or not."""
     origin = get_origin(annotation)
     if origin in (Union, types.UnionType):
-        return any(_takes_many(arg) for arg in get_args(annotation) if arg is not type(None))
+        return any(takes_many(arg) for arg in get_args(annotation) if arg is not type(None))
     return origin in (list, tuple, set, frozenset, Sequence)
 
 
@@ -117,9 +118,7 @@ async def check_form_parts(connection: HTTPConnection) -> None:
     if not isinstance(connection, Request) or not _reads_form(route):
         return
     request = connection
-    declared = {
-        p.alias: _takes_many(p.field_info.annotation) for p in _body_params(route.dependant)
-    }
+    declared = {p.alias: takes_many(p.field_info.annotation) for p in _body_params(route.dependant)}
     problems = _form_problems(await request.form(), declared)
     if problems:
         raise RequestValidationError(
