@@ -452,6 +452,22 @@ def test_names_that_only_look_alike_are_one_name(
         "/api/v1/shoots", json={"name": "U\u0308ni\u0308"}, headers=headers["admin"]
     )
     assert decomposed.status_code == 409
+    # So is one typed in another case, non-ASCII letters included (SQLite's lower() is ASCII).
+    cased = client.post("/api/v1/shoots", json={"name": "üNÏ"}, headers=headers["admin"])
+    assert cased.status_code == 409
+    assert "exists as 'Ünï'" in cased.json()["detail"]
+    other = client.post("/api/v1/shoots", json={"name": "Day 2"}, headers=headers["admin"])
+    assert other.status_code == 201
+    renamed = client.patch(
+        f"/api/v1/shoots/{other.json()['id']}", json={"name": "ünï"}, headers=headers["admin"]
+    )
+    assert renamed.status_code == 409
+    # A shoot may change the case of its own name.
+    recased = client.patch(
+        f"/api/v1/shoots/{other.json()['id']}", json={"name": "DAY 2"}, headers=headers["admin"]
+    )
+    assert recased.status_code == 200
+    assert recased.json()["name"] == "DAY 2"
 
 
 def test_a_shoot_asked_for_by_a_decomposed_name_is_found(tmp_path: Path) -> None:
@@ -460,3 +476,5 @@ def test_a_shoot_asked_for_by_a_decomposed_name_is_found(tmp_path: Path) -> None
     store = ShootStore(Repository(f"sqlite:///{tmp_path / 'db.sqlite3'}").engine)
     made = store.ensure("Ünï")
     assert store.ensure("U\u0308ni\u0308")["id"] == made["id"]
+    assert store.ensure("üNÏ")["id"] == made["id"]
+    assert store.ensure("üNÏ")["name"] == "Ünï"

@@ -11,7 +11,7 @@ from collections.abc import Iterator
 from datetime import UTC, datetime
 from typing import Any
 
-from sqlalchemy import Engine, and_, delete, func, insert, or_, select, update
+from sqlalchemy import Connection, Engine, and_, delete, func, insert, or_, select, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.sql.elements import ColumnElement
 
@@ -149,18 +149,20 @@ class ShootStore:
         row = {"id": new_id(), "name": clean, "created_at": utc_now(), "owner_id": owner_id}
         try:
             with self.engine.begin() as conn:
+                _refuse_taken(conn, clean)
                 conn.execute(insert(shoots).values(**row))
         except IntegrityError as e:
             raise ConflictError(f"Expected a new shoot name, got {clean!r} (taken)") from e
         return self.get(str(row["id"]))
 
     def ensure(self, name: str) -> dict[str, Any]:
-        """The shoot of that name, created when missing."""
+        """The shoot of that name (or of a name differing only in case), created when
+        missing."""
         clean = _checked_name(name)  # the form it is stored in
         with self.engine.connect() as conn:
-            found = conn.execute(select(shoots.c.id).where(shoots.c.name == clean)).scalar()
+            found = _same_name(conn, clean)
         if found is not None:
-            return self.get(str(found))
+            return self.get(found[0])
         try:
             return self.create(name)
         except ConflictError:  # created meanwhile by another process
@@ -172,6 +174,7 @@ class ShootStore:
         self.get(shoot_id)
         try:
             with self.engine.begin() as conn:
+                _refuse_taken(conn, clean, shoot_id)
                 conn.execute(update(shoots).where(shoots.c.id == shoot_id).values(name=clean))
         except IntegrityError as e:
             raise ConflictError(f"Expected a new shoot name, got {clean!r} (taken)") from e
@@ -568,6 +571,32 @@ class ShootStore:
             # From the same counts (one query), so "finished" never contradicts them.
             "finished": counts["queued"] + counts["running"] == 0,
         }
+
+
+def _same_name(
+    conn: Connection, clean: str, other_than: str | None = None
+) -> tuple[str, str] | None:
+    """``(id, name)`` of a shoot whose name equals ``clean`` but for case ("Day 1" and
+    "day 1"), other than shoot ``other_than``; None when there is none.
+
+    Compared in Python (``str.casefold``), not with SQL ``lower``, which SQLite applies to
+    ASCII letters only; shoots are few enough to list.
+    """
+    key = clean.casefold()
+    for shoot_id, stored in conn.execute(select(shoots.c.id, shoots.c.name)):
+        if stored.casefold() == key and shoot_id != other_than:
+            return str(shoot_id), str(stored)
+    return None
+
+
+def _refuse_taken(conn: Connection, clean: str, other_than: str | None = None) -> None:
+    """:class:`ConflictError` when another shoot has the name, up to case: two shoots whose
+    names differ only in case read as one in the shoot list and the review history."""
+    found = _same_name(conn, clean, other_than)
+    if found is not None:
+        raise ConflictError(
+            f"Expected a new shoot name, got {clean!r}, which exists as {found[1]!r}"
+        )
 
 
 def _checked_name(name: str) -> str:
