@@ -375,7 +375,7 @@ def test_options_form_grouped_with_units_presets_and_checks(
         "bs => bs.filter(b => b.checked).map(b => b.value)"
     )
     assert ticked == ["twist"]
-    p.select_option("#run-preset", "twist, apply none (decide each interval)")
+    p.select_option("#run-preset", "full check, no twist interval applied (decide each)")
     assert p.input_value("#option-twist_apply") == "none"
     # The filter's parameters come from the registry, each with its unit.
     p.select_option("#filter-method", "butterworth")

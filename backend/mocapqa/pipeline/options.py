@@ -326,8 +326,8 @@ def check_mapping(mapping: object) -> dict[str, str]:
 RUN_PRESETS: dict[str, AnalysisOptions] = {
     "full check": AnalysisOptions(),
     "twist only": AnalysisOptions(checks=("twist",)),
-    "twist, apply none (decide each interval)": AnalysisOptions(twist_apply="none"),
-    "twist, apply all": AnalysisOptions(twist_apply="all"),
+    "full check, no twist interval applied (decide each)": AnalysisOptions(twist_apply="none"),
+    "full check, every twist interval applied": AnalysisOptions(twist_apply="all"),
     "limits only": AnalysisOptions(checks=("limits",)),
     "filter only": AnalysisOptions(checks=("filter",)),
 }
