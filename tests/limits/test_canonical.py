@@ -164,6 +164,33 @@ def test_the_hands_axial_rotation_reads_alike_on_three_rigs(corpus_dir: Path) ->
             assert abs(np.median(tau)) < 20, (relative, side, np.median(tau))
 
 
+def test_the_wrists_rest_near_neutral_on_three_rigs(corpus_dir: Path) -> None:
+    # The hand's long axis continues the forearm on every rig. Pointed at the knuckles where a
+    # rig has them (Character Creator), the shipped model read 002_03's right wrist 56° flexed
+    # and 24° deviated, CMU's walk 7.5°, while Bandai and CMU hands, without knuckles, read 0.
+    model = load_model(next(p for p in default_model_paths() if p.stem == "canonical"))
+    for relative in (
+        "bvh/cmu/cmu_12_01_walk.bvh",
+        "bvh/cmu/iclone/002_03.bvh",
+        "bvh/bandai/dataset-1_walk_normal_001.bvh",
+    ):
+        report = check_limits(read_bvh(corpus_dir / relative), model)
+        for side in ("left", "right"):
+            flexion = report.params_deg[:, report.roles.index(f"{side}_hand"), 0]
+            assert abs(np.median(flexion)) < 5, (relative, side, np.median(flexion))
+
+
+def test_a_hand_mapped_onto_a_bone_of_no_length_is_framed_from_its_forearm(cmu: Motion) -> None:
+    # CMU's finger bases sit at the hand (zero OFFSET): mapped as the hands, their long axis
+    # comes from the forearm joint, not from the zero bone to their parent.
+    mapping = {"left_hand": "LeftFingerBase", "right_hand": "RightFingerBase"}
+    frames = rig_frames([cmu], mapping)
+    assert np.isfinite(frames.frames).all()
+    # A forearm mapped onto its own hand has no long axis: a clear error, not a crash.
+    with pytest.raises(InputError, match="bone of non-zero length"):
+        rig_frames([cmu], {"left_forearm": "LeftHand", "left_hand": "LeftFingerBase"})
+
+
 def test_an_unseen_rig_s_hands_are_not_flagged_by_a_model_of_the_other_rigs(
     corpus_dir: Path,
 ) -> None:

@@ -8,9 +8,11 @@ anatomical frame to the joint's local frame, so that ``A_j = R_j C_j`` (``R_j`` 
 world rotation) is the segment's anatomical frame:
 
 * ``y`` — the long axis, from the joint to the next role joint down the limb (upper arm →
-  forearm, ..., foot → toe); a hand (or a foot without a toe) points to the mean of its
-  children's OFFSETs (the knuckles), or, when they are all zero (CMU, Bandai), along its
-  parent's bone as seen from its own frame on average over the frames;
+  forearm, ..., foot → toe); a foot without a toe points to the mean of its children's
+  OFFSETs and End Sites; a hand, on every rig, continues its parent's bone as seen from its
+  own frame on average over the frames (its mean pose is a straight wrist), because CMU and
+  Bandai hands have no knuckle offsets to point at and pointing at them where they exist
+  read one rig's wrists 10–14° flexed against the others;
 * ``x`` — the flexion axis, the normal of the limb plane: ``y × u`` with ``u`` the neighbouring
   segment (upper arm and upper leg: the forearm / lower leg; forearm, lower leg and foot: their
   parent segment; clavicle: the body's up axis); a hand, whose wrist hardly bends, takes the
@@ -225,8 +227,8 @@ def _median_direction(
 
 
 def _end_axis(skeleton: Skeleton, joint: int) -> FloatArray | None:
-    """Long axis of a segment without a next role joint (a hand): toward the mean of its
-    children and End Sites (the knuckles); None when they all sit at zero offset.
+    """Long axis of a segment without a next role joint (a foot without a toe): toward the
+    mean of its children and End Sites; None when they all sit at zero offset.
 
     A sum, not the longest child, so two children of equal length cannot swap places.
     """
@@ -326,19 +328,42 @@ def canonical_frames(
     cache: dict[int, FloatArray] = {}
     long_axes: dict[int, FloatArray] = {}
 
+    def mean_direction(joint: int, vectors: FloatArray) -> FloatArray | None:
+        """The mean direction of world vectors ``(F, 3)`` seen from the joint's frame; None
+        when they are all (nearly) zero, a bone of no length."""
+        if np.median(np.linalg.norm(vectors, axis=-1)) < 1e-6:
+            return None
+        mean = np.mean(_unit(_local(quats[:, joint], vectors)), axis=0)
+        return _unit(mean) if np.linalg.norm(mean) > 1e-6 else None
+
     def long_axis(side: str, role: str, joint: int) -> FloatArray:
         distal = rig.joint(side, _DISTAL_ROLE[role]) if role in _DISTAL_ROLE else None  # type: ignore[arg-type]
-        if distal is None:
+        if distal is not None:
+            axis = mean_direction(joint, positions[:, distal] - positions[:, joint])
+        elif role == "hand":
+            # A hand continues its forearm's bone (from the forearm joint, so that a helper
+            # bone of no length between them does not matter), seen from its own frame, on
+            # average over the frames: CMU and Bandai hands have no knuckle offsets, and
+            # pointing the others at theirs read the Character Creator wrist 10-14 degrees
+            # flexed against those rigs. The knuckles only stand in for a hand at its forearm.
+            forearm = rig.joint(side, "forearm")  # type: ignore[arg-type]
+            anchor = int(skeleton.parents[joint]) if forearm is None else forearm
+            axis = mean_direction(joint, positions[:, joint] - positions[:, anchor])
+            if axis is None:
+                axis = _end_axis(skeleton, joint)
+        else:
+            # A foot without a toe points to its End Site, or else continues its parent's bone.
             axis = _end_axis(skeleton, joint)
-            if axis is not None:
-                return axis
-            # No child offsets (CMU and Bandai hands): the segment continues its parent's
-            # bone, seen from its own frame, on average over the frames.
-            parent = int(skeleton.parents[joint])
-            direction = _local(quats[:, joint], positions[:, joint] - positions[:, parent])
-            return _unit(np.mean(_unit(direction), axis=0))
-        direction = _local(quats[:, joint], positions[:, distal] - positions[:, joint])
-        return _unit(np.mean(_unit(direction), axis=0))
+            if axis is None:
+                parent = int(skeleton.parents[joint])
+                axis = mean_direction(joint, positions[:, joint] - positions[:, parent])
+        if axis is None:
+            raise InputError(
+                f"Expected the {side} {role.replace('_', ' ')} ({skeleton.names[joint]!r}) to "
+                f"have a bone of non-zero length toward the next joint of its limb; its long "
+                f"axis cannot be found (check the role mapping)"
+            )
+        return axis
 
     def world_long(side: str, role: str, joint: int) -> FloatArray:
         if joint not in long_axes:
