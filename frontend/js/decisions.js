@@ -61,11 +61,13 @@ export function intervalDecisions(run, result, take = null) {
     // Redrawn under the keyboard's focus: the same button keeps it (screen readers and Tab
     // carry on from there instead of the page's start).
     const focused = cell.contains(document.activeElement) ? document.activeElement.dataset?.decision : null;
-    cell.replaceChildren(
-      h("span", { class: "applied muted", title: "the run's twist_apply choice, in its corrected BVH" }, f.applied ? "run: applied" : "run: not applied"), " · ",
-      decision ? badge(LABELS[decision], BADGE[decision]) : h("span", { class: "muted" }, "undecided"),
-      h("span", { class: "outcome muted", title: "what the reviewed download does with this interval" }, corrected ? " → corrected" : " → left as recorded"), " ",
-      ...buttons);
+    // The read-out wraps on the left; the buttons keep to the cell's right, side by side.
+    cell.replaceChildren(h("div", { class: "decision-cell" },
+      h("span", { class: "decision-state" },
+        h("span", { class: "applied muted", title: "the run's twist_apply choice, in its corrected BVH" }, f.applied ? "run: applied" : "run: not applied"), " · ",
+        decision ? badge(LABELS[decision], BADGE[decision]) : h("span", { class: "muted" }, "undecided"),
+        h("span", { class: "outcome muted", title: "what the reviewed download does with this interval" }, corrected ? " → corrected" : " → left as recorded")),
+      h("span", { class: "decision-buttons" }, ...buttons)));
     if (focused) buttons.find((b) => b.dataset.decision === focused)?.focus();
   };
 

@@ -264,8 +264,10 @@ export function frameTake(frameSets, pad = 0.08) {
 }
 
 /**
- * The size of the box that follows the body: the largest extent of the body in any frame, and
- * the floor and ceiling over the take (scene coordinates).
+ * The size of the box that follows the body: the largest extent of the body in any frame, the
+ * floor and ceiling over the take, and the radius of the sphere that holds every point of every
+ * frame about the body's target: that frame's centre (centreOf) across the floor, half-way
+ * between floor and ceiling in height (scene coordinates).
  */
 export function bodyBox(frameSets, pad = 0.15) {
   let extent = 0, floor = Infinity, ceiling = -Infinity;
@@ -280,8 +282,26 @@ export function bodyBox(frameSets, pad = 0.15) {
     extent = Math.max(extent, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
     floor = Math.min(floor, lo[2]); ceiling = Math.max(ceiling, hi[2]);
   }
-  if (!Number.isFinite(floor)) return { half: 1, floor: 0, ceiling: 2 };
-  return { half: (extent || 1) * (0.5 + pad), floor, ceiling };
+  if (!Number.isFinite(floor)) return { half: 1, floor: 0, ceiling: 2, radius: 1 };
+  const middle = (floor + ceiling) / 2;
+  let radius = 0;
+  for (const frames of frameSets) for (const points of frames) {
+    const c = centreOf(points);
+    if (!c) continue;
+    for (const p of points) if (present(p)) { const s = toScene(p); radius = Math.max(radius, Math.hypot(s[0] - c[0], s[1] - c[1], s[2] - middle)); }
+  }
+  return { half: (extent || 1) * (0.5 + pad), floor, ceiling, radius };
+}
+
+/**
+ * How the camera frames the whole body (focus "body"): its target's height half-way between
+ * the take's floor and ceiling, and its distance, at which the sphere of `box.radius` about the
+ * target (every point of every frame) fits a camera of vertical field of view `fovDeg` with
+ * `margin` of the radius to spare, whichever way the camera turns about the target (views wider
+ * than tall, as the take view's, have at least that field across). `box` is a bodyBox.
+ */
+export function bodyFraming(box, fovDeg, margin = 0.08) {
+  return { height: (box.floor + box.ceiling) / 2, distance: ((box.radius || 1) * (1 + margin)) / Math.sin((fovDeg * Math.PI) / 360) };
 }
 
 /** The centre of the present points (scene coordinates), or null when none is present. */

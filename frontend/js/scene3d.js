@@ -17,6 +17,7 @@ const AXES = ["#d62728", "#2ca02c", "#1f77b4"].map((c) => new THREE.Color(c));
 
 const LIGHT_AMBIENT = 1.6, LIGHT_DIRECT = 1.6; // intensities of a white ambient and directional light
 const LIGHT = [1, 2, 3].map((v) => v / Math.hypot(1, 2, 3)); // toward the directional light
+const FOV = 35; // the camera's vertical field of view, degrees
 
 function viewScene(bonesCount, nPoints, nJoints, oriented) {
   const scene = new THREE.Scene();
@@ -78,8 +79,10 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   const box = geo.bodyBox([overview.raw, overview.corrected], 0.1);
   const floorY = box.floor;
   const size = 2 * box.half;
-  const orbit = { ...geo.PRESETS.front, distance: size * 1.5, target: [0, floorY + size * 0.4, 0] };
-  const camera = new THREE.PerspectiveCamera(35, 1, size / 100, size * 200);
+  // The whole body in view, every keypoint with a margin (the head too, seen from above).
+  const framing = geo.bodyFraming(box, FOV);
+  const orbit = { ...geo.PRESETS.front, distance: framing.distance, target: [0, framing.height, 0] };
+  const camera = new THREE.PerspectiveCamera(FOV, 1, size / 100, size * 200);
   // The one canvas: absolutely placed in the row that holds both panels, over the union of the
   // shown views; it takes no pointer events (each view's own element does) and is transparent
   // between the views, where the panels' borders and gap show through.
@@ -309,8 +312,8 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
     setFocus(mode) {
       const resting = [focus, mode].includes("joint") && focus !== mode; // into or out of close-in
       focus = mode;
-      if (resting) orbit.distance = geo.focusDistance(mode, size);
-      if (mode === "body" && frame) orbit.target[1] = floorY + size * 0.4;
+      if (resting) orbit.distance = mode === "joint" ? geo.focusDistance(mode, size) : framing.distance;
+      if (mode === "body" && frame) orbit.target[1] = framing.height;
       if (frame) show(frame); else requestRender();
     },
     get focus() { return focus; },

@@ -91,7 +91,7 @@ export async function takeView(main, takeId, params, onTeardown) {
         : "keypoints fade with their detection confidence; purple: bridged by the filter (hatched on the time bar)")),
     viewsRow,
     h("div", { class: "panel player", id: "player" },
-      h("div", { class: "controls" }, playButton, "speed ", speed, scrubber, frameLabel, jointLabel),
+      h("div", { class: "controls" }, playButton, "speed ", speed, frameLabel, jointLabel, scrubber),
       h("div", { class: "controls" }, loopButton, loopFindingButton, clearLoopButton, loopLabel)),
   );
   const help = h("p", { class: "muted", id: "keys-help" },

@@ -75,6 +75,30 @@ def test_accept_and_reject_intervals_persist_and_the_download_has_them(
     p.locator("#findings").locator("xpath=..").screenshot(
         path=str(ARTIFACTS / "decisions-accept-reject.png")
     )
+    # In a narrow window the read-outs (accepted, rejected, undecided) wrap, but each row's
+    # Accept and Reject stay side by side, equally wide, in line with every other row's.
+    p.set_viewport_size({"width": 800, "height": 1000})
+    boxes = p.evaluate(
+        "() => [...document.querySelectorAll('#findings tr[data-interval] td.decision')].map((c) =>"
+        " ['accept', 'reject'].map((d) => { const b = c.querySelector(`button.decide-${d}`)"
+        ".getBoundingClientRect(); return [b.left, b.top, b.width, b.height]; }))"
+    )
+    assert len(boxes) >= 2
+    for k in (0, 1):  # the Accepts line up, and the Rejects
+        lefts = [row[k][0] for row in boxes]
+        assert max(lefts) - min(lefts) < 1
+    for accept, reject in boxes:
+        assert accept[2] == pytest.approx(reject[2], abs=0.5)  # equally wide
+        assert accept[1] == pytest.approx(reject[1], abs=0.5)  # on one line
+        assert accept[0] + accept[2] <= reject[0]
+    # ... and the table fits the window (the canvas and charts follow the resize a frame later).
+    assert p.evaluate(
+        "() => document.getElementById('findings').getBoundingClientRect().right <= innerWidth"
+    )
+    p.locator("#findings").locator("xpath=..").screenshot(
+        path=str(ARTIFACTS / "decisions-accept-reject-800px.png")
+    )
+    p.set_viewport_size({"width": 1400, "height": 1000})
 
     # After a reload the decisions are still there (they come from the server).
     page.open_take(live_server, knees)

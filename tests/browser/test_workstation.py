@@ -416,6 +416,16 @@ def test_narrow_window_and_a_keypoint_take(
     assert views[0]["y"] == views[1]["y"]
     assert views[0]["x"] < views[1]["x"]
     assert all(v["y"] + v["height"] <= play["y"] for v in views)
+    # The scrubber spans the player bar, as the time bar under it does (not squeezed beside
+    # the read-outs, nor pushing them onto a line of their own).
+    player, scrubber = p.locator("#player").bounding_box(), p.locator("#scrubber").bounding_box()
+    timebar = p.locator("#timebar").bounding_box()
+    assert scrubber["width"] >= 0.95 * timebar["width"]
+    assert player["x"] <= scrubber["x"]
+    assert scrubber["x"] + scrubber["width"] <= player["x"] + player["width"]
+    read_outs = [p.locator(sel).bounding_box() for sel in ("#play", "#frame-label", "#joint-label")]
+    middles = [b["y"] + b["height"] / 2 for b in read_outs]
+    assert max(middles) - min(middles) < 2  # on one line
     p.screenshot(path=str(ARTIFACTS / "workstation-take-900px.png"))
     # A TRC take: the re-run form offers only the filter; the run picker names what ran.
     narrow.open_take(live_server, takes["trc"])
@@ -425,6 +435,18 @@ def test_narrow_window_and_a_keypoint_take(
     assert offered == ["filter"]
     # Pose2Sim's markers are joined by the bones of their layout, not drawn as loose dots.
     assert p.evaluate("() => window.mocapqaViews.lines") >= 20
+    # Every keypoint (the head's too) is drawn inside both views, clear of their edges.
+    margins = p.evaluate(
+        "() => ['raw', 'corrected'].flatMap((name) => { const v = window.mocapqaViews;"
+        " const d = document.getElementById(name === 'raw' ? 'view-raw' : 'view-corrected');"
+        " const r = d.getBoundingClientRect(); const out = [];"
+        " for (let j = 0; j < v.points; j++) { const [x, y] = v.screenOf(name, j);"
+        " if (Number.isFinite(y))"
+        " out.push(Math.min(x - r.left, r.right - x, y - r.top, r.bottom - y)); }"
+        " return out; })"
+    )
+    assert len(margins) >= 20
+    assert min(margins) >= 5, margins
     assert "twist" not in p.inner_text("#run-pick")
     p.screenshot(path=str(ARTIFACTS / "workstation-keypoints.png"), full_page=True)
     narrow.close()

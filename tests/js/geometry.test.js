@@ -73,6 +73,55 @@ test("the follow box keeps its size, sits on the floor and re-centres only on dr
   assert.equal(geo.drifted([0.5, 0, 1], ranges), true);
 });
 
+// Where a point lands on a square view (normalised: ±1 at the edges) of a camera at `eye`
+// looking at `target`, Y up, of vertical field of view `fovDeg`.
+function onScreen(point, eye, target, fovDeg) {
+  const sub = (a, b) => a.map((v, k) => v - b[k]);
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const unit = (a) => a.map((v) => v / Math.hypot(...a));
+  const crossOf = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  const forward = unit(sub(target, eye));
+  const right = unit(crossOf(forward, [0, 1, 0]));
+  const up = crossOf(right, forward);
+  const q = sub(point, eye), depth = dot(q, forward), t = Math.tan((fovDeg * Math.PI) / 360);
+  return [dot(q, right) / (depth * t), dot(q, up) / (depth * t)];
+}
+
+test("the body's framing keeps every point in view with a margin, the head too, from any side", () => {
+  // A keypoint take of a standing figure (Y up, metres): the head's top 1.8 m over the floor,
+  // leaning toward the camera, one arm reaching forward; a second frame a step to the side.
+  const pose = [[0, 0, 0.12], [0.15, 0, -0.05], [0, 1.0, 0], [-0.2, 1.45, 0.05], [0.2, 1.45, 0.05],
+    [0.1, 1.8, 0.15], [0.05, 1.62, 0.2], [-0.3, 1.2, 0.6], [0.3, 1.0, 0.1]];
+  const frames = [pose, pose.map(([x, y, z]) => [x + 0.4, y, z])];
+  const box = geo.bodyBox([frames], 0.1);
+  const fov = 35;
+  const { height, distance } = geo.bodyFraming(box, fov);
+  assert.ok(Math.abs(height - 0.9) < 1e-9); // half-way between the floor and the head's top
+  for (const points of frames) {
+    const centre = geo.centreOf(points);
+    const target = geo.focusTarget("body", points, -1, null, [0, height, 0]);
+    assert.deepEqual(target, [centre[0], height, -centre[1]]);
+    for (const preset of Object.values(geo.PRESETS)) for (const turn of [0, 0.5, 1, 1.5, 2, 2.5, 3]) {
+      const eye = geo.orbitPosition(target, preset.azimuth + turn, preset.elevation, distance);
+      for (const p of points) {
+        const [x, y] = onScreen(p, eye, target, fov);
+        assert.ok(Math.abs(x) < 0.95 && Math.abs(y) < 0.95, `${p} at ${[x, y]} (${turn} rad round)`);
+      }
+    }
+  }
+  // Not so far that the figure is lost: seen from the front it spans most of the view's height.
+  const front = geo.focusTarget("body", pose, -1, null, [0, height, 0]);
+  const eye = geo.orbitPosition(front, 0, geo.PRESETS.front.elevation, distance);
+  const ys = pose.map((p) => onScreen(p, eye, front, fov)[1]);
+  assert.ok(Math.max(...ys) - Math.min(...ys) > 1.4);
+});
+
+test("an empty take is framed as a body 2 units tall", () => {
+  const box = geo.bodyBox([[[null, [NaN, 0, 0]]]]);
+  assert.equal(geo.bodyFraming(box, 35).height, 1);
+  assert.ok(geo.bodyFraming(box, 35).distance > 1 / Math.sin((17.5 * Math.PI) / 180));
+});
+
 test("frameTake holds every frame and keeps the floor at the lowest point", () => {
   const { ranges } = geo.frameTake([[[[0, 0, 0], [1, 2, 3]]]], 0);
   assert.deepEqual(ranges, [[0, 1], [-3, 0], [0, 2]]);
