@@ -263,7 +263,13 @@ def test_info_in_a_fresh_process_loads_only_what_it_needs(cmu_walk: Path, corpus
     assert codes == [0, 0]
     assert not arrow_after_small
     assert arrow_after_large
-    assert cli == ["mocapqa.cli.app", "mocapqa.cli.info", "mocapqa.cli.main", "mocapqa.cli.roles"]
+    assert cli == [
+        "mocapqa.cli.app",
+        "mocapqa.cli.info",
+        "mocapqa.cli.main",
+        "mocapqa.cli.reading",
+        "mocapqa.cli.roles",
+    ]
 
 
 def test_timed_works_take_turns_of_consecutive_runs() -> None:
@@ -274,3 +280,34 @@ def test_timed_works_take_turns_of_consecutive_runs() -> None:
     assert calls == ["a", "b"] + (["a"] * 2 + ["b"] * 2) * 3
     assert [len(turn) for turn in times["a"]] == [2, 2, 2]
     assert all(seconds >= 0.0 for turn in times["b"] for seconds in turn)
+
+
+def test_the_commands_that_read_a_take_keep_the_reading_limits(
+    cmu_walk: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # The server's limits, from the same settings: refused from the header, naming the setting,
+    # before the frames are read; raised by the same variable.
+    monkeypatch.setenv("MOCAPQA_MAX_FRAME_POINTS", "10000")  # the walk: 524 frames × 31 joints
+    small = tmp_path / "small.npz"
+    np.savez(small, positions=np.zeros((400, 33, 3)))  # 13,200 frame-points
+    for args in (
+        ["info", str(cmu_walk)],
+        ["convert", str(small), "-o", str(tmp_path / "out.csv"), "--fps", "30"],
+        ["detect", str(cmu_walk)],
+        ["limits", "check", str(cmu_walk)],
+        ["report", str(cmu_walk), "-o", str(tmp_path / "r.html")],
+    ):
+        assert main(args) != 0, args
+        err = capsys.readouterr().err
+        assert "max_frame_points" in err, (args, err)
+        assert "Traceback" not in err
+    assert not (tmp_path / "out.csv").exists()
+    assert not (tmp_path / "r.html").exists()
+    monkeypatch.setenv("MOCAPQA_MAX_FRAME_POINTS", "20000")
+    assert main(["info", str(cmu_walk), "--json"]) == 0
+    # A twist command given a keypoint file says so.
+    assert main(["detect", str(small)]) != 0
+    assert "Expected a BVH take, got a npz file" in capsys.readouterr().err

@@ -12,6 +12,7 @@ from rich.console import Console
 from rich.table import Table
 
 from mocapqa.cli.app import app, bench_app
+from mocapqa.cli.reading import read_input
 from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
 from mocapqa.errors import InputError
 
@@ -49,12 +50,12 @@ def filter_command(
     from mocapqa.filters.apply import filter_keypoints, filter_motion
     from mocapqa.filters.registry import FILTERS
     from mocapqa.io.bvh_write import write_bvh
-    from mocapqa.io.formats import read_take, require_frames, write_keypoints
+    from mocapqa.io.formats import require_frames, write_keypoints
     from mocapqa.metrics.smoothness import lag_frames, mean_abs_jerk
 
     overrides = parse_overrides(param or [])
     roles = load_mapping(mapping)
-    take = read_take(input_path, fps=fps)
+    take = read_input(input_path, fps=fps)
     require_frames(take, input_path)
     summary: dict[str, Any]
     if roles is not None and not isinstance(take, Motion):

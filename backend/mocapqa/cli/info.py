@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal
 import typer
 
 from mocapqa.cli.app import app
+from mocapqa.cli.reading import read_input
 from mocapqa.cli.roles import (
     MappingOption,
     RootTranslationOption,
@@ -164,13 +165,13 @@ def info_command(
 ) -> None:
     """Show what a take holds: frames, rate, joints or keypoints, units, rig roles."""
     from mocapqa.core.motion import Motion
-    from mocapqa.io.formats import detect_format, read_take
+    from mocapqa.io.formats import detect_format
 
     if fps is not None and not fps > 0:
         raise InputError(f"Expected --fps > 0, got {fps}")
     roles = load_mapping(mapping)
     format_name = detect_format(file)
-    take = read_take(file, fps=fps, number_reader="auto", root_translation=root_translation)
+    take = read_input(file, fps=fps, number_reader="auto", root_translation=root_translation)
     if isinstance(take, Motion):
         summary = motion_summary(take, roles, root_translation)
         missing_roles(take.skeleton, roles)
@@ -197,7 +198,7 @@ def convert_command(
     """Convert a take: BVH to BVH, keypoints between TRC, CSV, NPY, NPZ and JSON."""
     from mocapqa.core.motion import Motion
     from mocapqa.io.bvh_write import write_bvh
-    from mocapqa.io.formats import KEYPOINT_WRITE_FORMATS, read_take, write_keypoints
+    from mocapqa.io.formats import KEYPOINT_WRITE_FORMATS, write_keypoints
 
     if fps is not None and not fps > 0:
         raise InputError(f"Expected --fps > 0, got {fps}")
@@ -205,7 +206,7 @@ def convert_command(
         raise InputError(f"Expected --precision between 0 and 15, got {precision}")
     suffix = output.suffix.lower().lstrip(".")
     roles = load_mapping(mapping)
-    take = read_take(source, fps=fps, number_reader="auto")
+    take = read_input(source, fps=fps, number_reader="auto")
     if isinstance(take, Motion):
         missing_roles(take.skeleton, roles)
         if suffix != "bvh":

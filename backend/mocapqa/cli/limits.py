@@ -11,6 +11,7 @@ from rich.console import Console
 from rich.table import Table
 
 from mocapqa.cli.app import limits_app
+from mocapqa.cli.reading import read_input_bvh
 from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
 from mocapqa.errors import InputError
 
@@ -268,13 +269,12 @@ def limits_check(
     A rig the canonical model has not seen is framed from the take itself, leaving out the
     frames of the twist intervals the twist detector finds on it (as the pipeline does).
     """
-    from mocapqa.io.bvh import read_bvh
     from mocapqa.io.formats import require_frames
     from mocapqa.limits.analysis import check_limits
     from mocapqa.twist.analysis import analyze_twist
 
     roles = load_mapping(mapping)
-    motion = read_bvh(path)
+    motion = read_input_bvh(path)
     require_frames(motion, path)
     missing = missing_roles(motion.skeleton, roles)
     model = _chosen_model(model_path, motion) if model_path is not None else None
@@ -414,7 +414,6 @@ def _framed_from(
 ) -> LimitsModel:
     """``model`` (default: the shipped one) with the frames of ``motion``'s rig estimated over
     the takes of that rig under ``folder`` (with the roles of ``mapping``)."""
-    from mocapqa.io.bvh import read_bvh
     from mocapqa.limits.build import with_rig_frames
     from mocapqa.limits.canonical import rig_key
     from mocapqa.limits.storage import load_default_model
@@ -426,7 +425,9 @@ def _framed_from(
             "rig's own model (pass --model with a canonical model)"
         )
     key = rig_key(motion)
-    takes = [(p.name, m) for p in sorted(folder.rglob("*.bvh")) if rig_key(m := read_bvh(p)) == key]
+    takes = [
+        (p.name, m) for p in sorted(folder.rglob("*.bvh")) if rig_key(m := read_input_bvh(p)) == key
+    ]
     if not takes:
         raise InputError(f"Expected BVH takes of the checked take's rig under {folder}, got none")
     return with_rig_frames(model, [m for _, m in takes], [n for n, _ in takes], mapping)

@@ -16,6 +16,7 @@ from rich.progress import Progress
 from rich.table import Table
 
 from mocapqa.cli.app import app, bench_app
+from mocapqa.cli.reading import read_input
 from mocapqa.cli.report import TakeRun, analyze_take, build_take_report, sheet_tiles
 from mocapqa.cli.roles import (
     MappingOption,
@@ -51,10 +52,10 @@ def raw_run(
 ) -> TakeRun:
     """A take read without analysis: corrected is the raw take, no findings."""
     from mocapqa.core.motion import Motion
-    from mocapqa.io.formats import read_take, require_frames
+    from mocapqa.io.formats import require_frames
     from mocapqa.render.scene import track_from_keypoints, track_from_motion
 
-    take = read_take(path, root_translation=root_translation)
+    take = read_input(path, root_translation=root_translation)
     require_frames(take, path)
     summary: dict[str, object] = {"fps": 0.0}
     if isinstance(take, Motion):

@@ -24,6 +24,7 @@ from rich.console import Console
 from rich.progress import Progress
 
 from mocapqa.cli.app import app
+from mocapqa.cli.reading import read_input
 from mocapqa.cli.roles import (
     MappingOption,
     RootTranslationOption,
@@ -97,12 +98,12 @@ def analyze_take(
     from mocapqa.core.keypoints import KeypointSequence
     from mocapqa.core.motion import Motion
     from mocapqa.io.bvh_root import explain_root_translation
-    from mocapqa.io.formats import read_take, require_frames
+    from mocapqa.io.formats import require_frames
     from mocapqa.pipeline.analyze import analyze
     from mocapqa.pipeline.options import AnalysisOptions
     from mocapqa.render.scene import track_from_points
 
-    take = read_take(path, root_translation=root_translation)
+    take = read_input(path, root_translation=root_translation)
     require_frames(take, path)
     result = analyze(take, AnalysisOptions.from_json(options), progress)
     if isinstance(take, Motion):

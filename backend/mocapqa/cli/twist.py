@@ -14,6 +14,7 @@ from rich.progress import Progress
 from rich.table import Table
 
 from mocapqa.cli.app import app, bench_app
+from mocapqa.cli.reading import read_input_bvh
 from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
 
 if TYPE_CHECKING:
@@ -69,7 +70,6 @@ def refine(
     Every interval found is listed in the report with its confidence and whether it was
     applied; the written take is the input with exactly the applied intervals' levels removed.
     """
-    from mocapqa.io.bvh import read_bvh
     from mocapqa.io.bvh_write import write_bvh
     from mocapqa.io.formats import require_frames
     from mocapqa.twist.analysis import analyze_twist
@@ -77,7 +77,7 @@ def refine(
 
     _check_method(method)
     roles = load_mapping(mapping)
-    motion = read_bvh(input_path)
+    motion = read_input_bvh(input_path)
     require_frames(motion, input_path)
     missing = missing_roles(motion.skeleton, roles)
     analysis = analyze_twist(motion, method, roles, apply=apply)
@@ -106,14 +106,13 @@ def detect(
     mapping: MappingOption = None,
 ) -> None:
     """Report axial twist error intervals (and which refine would apply) without writing."""
-    from mocapqa.io.bvh import read_bvh
     from mocapqa.io.formats import require_frames
     from mocapqa.twist.analysis import analyze_twist
     from mocapqa.twist.spin import find_limb_spins
 
     _check_method(method)
     roles = load_mapping(mapping)
-    motion = read_bvh(input_path)
+    motion = read_input_bvh(input_path)
     require_frames(motion, input_path)
     missing = missing_roles(motion.skeleton, roles)
     analysis = analyze_twist(motion, method, roles, apply=apply)
