@@ -95,7 +95,7 @@ def test_a_mapping_naming_an_unknown_joint_exits_3(
     bad = tmp_path / "bad.json"
     bad.write_text('{"left_toe": "NoSuchJoint"}', encoding="utf-8")
     assert main(["detect", str(odd_walk), "--mapping", str(bad)]) == 3
-    assert "Expected a joint of this skeleton, got 'NoSuchJoint'" in capsys.readouterr().err
+    assert "to be a joint of this skeleton, got 'NoSuchJoint'" in capsys.readouterr().err
 
 
 def test_mapping_files_in_json_and_toml_either_way_round(tmp_path: Path) -> None:
@@ -104,6 +104,25 @@ def test_mapping_files_in_json_and_toml_either_way_round(tmp_path: Path) -> None
     as_toml = tmp_path / "rig.toml"
     as_toml.write_text('left_toe = "LeftDigits"\n', encoding="utf-8")
     assert read_mapping(as_json) == read_mapping(as_toml) == {"left_toe": "LeftDigits"}
+
+
+@pytest.mark.parametrize(
+    ("text", "pattern"),
+    [
+        # JSON keeps the last of a key given twice: one of the two roles was dropped unseen.
+        ('{"left_upper_arm": "LeftArm", "left_upper_arm": "RightArm"}', "'left_upper_arm' twice"),
+        ('{"left_upper_arm": {"joint": "LeftArm"}}', "for 'left_upper_arm', got dict"),
+        ('{"left_upper_arm": "LeftArm", "right_upper_arm": "LeftArm"}', "one role per joint"),
+    ],
+)
+def test_a_mapping_file_that_contradicts_itself_names_the_fault(
+    text: str, pattern: str, tmp_path: Path
+) -> None:
+    path = tmp_path / "rig.json"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(InputError, match=pattern) as raised:
+        read_mapping(path)
+    assert "rig.json" in str(raised.value)
 
 
 def test_run_options_carry_the_mapping() -> None:

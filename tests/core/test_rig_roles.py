@@ -178,9 +178,29 @@ def test_a_mapping_overrides_the_guess() -> None:
     ("mapping", "pattern"),
     [
         ({"upperarm_l": "left_elbow"}, r"Expected a role in .*got 'upperarm_l': 'left_elbow'"),
-        ({"no_such_joint": "left_hand"}, r"Expected a joint of this skeleton, got 'no_such_joint'"),
+        ({"no_such_joint": "left_hand"}, r"left_hand to be a joint of this skeleton, got 'no_such"),
+        # Each of these was read without a word: one role kept, the other dropped.
+        (
+            {"left_upper_arm": "upperarm_l", "right_upper_arm": "upperarm_l"},
+            r"one role per joint, got 'upperarm_l' for left_upper_arm and right_upper_arm",
+        ),
+        (
+            {"left_upper_arm": "hand_l", "left_forearm": "upperarm_l"},
+            r"left_forearm \('upperarm_l'\) below the left_upper_arm \('hand_l'\)",
+        ),
+        ({"left_upper_arm": "pelvis"}, r"below the left_clavicle .*\(map left_clavicle too\)"),
     ],
 )
 def test_a_bad_mapping_is_an_input_error(mapping: dict[str, str], pattern: str) -> None:
     with pytest.raises(InputError, match=pattern):
         find_roles(unreal_skeleton(), mapping)
+
+
+def test_a_joint_the_mapping_gives_a_role_loses_the_role_found_by_name() -> None:
+    skeleton = unreal_skeleton()
+    # lowerarm_l is the forearm by name; mapped as the hand, it is the hand only (before, both
+    # roles held it, and the hand, not below itself, was dropped without a word).
+    rig = find_roles(skeleton, {"left_hand": "lowerarm_l"})
+    assert rig.roles["left_hand"] == skeleton.index("lowerarm_l")
+    assert "left_forearm" in rig.unmapped
+    assert rig.roles["left_upper_arm"] == skeleton.index("upperarm_l")

@@ -203,12 +203,20 @@ def normalise_mapping(mapping: Mapping[str, str]) -> dict[str, str]:
     Raises
     ------
     InputError
-        If neither all keys nor all values are role keys, or a value is not a string.
+        If neither all keys nor all values are role keys, a value is not a string, or one
+        joint is named for two roles.
     """
     if not all(isinstance(k, str) and isinstance(v, str) for k, v in mapping.items()):
         raise InputError("Expected a mapping of role keys to joint names (strings)")
     valid = set(ROLE_KEYS)
     if all(k in valid for k in mapping):
+        roles_of: dict[str, str] = {}
+        for key, joint in mapping.items():
+            if joint in roles_of:
+                raise InputError(
+                    f"Expected one role per joint, got {joint!r} for {roles_of[joint]} and {key}"
+                )
+            roles_of[joint] = key
         return dict(mapping)
     if all(v in valid for v in mapping.values()):
         inverted: dict[str, str] = {}
@@ -256,24 +264,45 @@ def find_roles(skeleton: Skeleton, mapping: Mapping[str, str] | None = None) -> 
             ]
             for level, joint in _limb_roles(skeleton, candidates, tokens).items():
                 roles[role_key(side, limb_roles[level])] = joint
+    mapped: set[str] = set()
     if mapping:
         for key, joint_name in normalise_mapping(mapping).items():
             try:
-                roles[key] = skeleton.index(joint_name)
+                joint = skeleton.index(joint_name)
             except KeyError:
-                raise InputError(f"Expected a joint of this skeleton, got {joint_name!r}") from None
-    # Keep only roles whose limb order holds (each a descendant of the previous one).
+                raise InputError(
+                    f"Expected the mapping's joint for {key} to be a joint of this skeleton, "
+                    f"got {joint_name!r}"
+                ) from None
+            # A joint the mapping gives a role loses any role found for it by name.
+            for other in [k for k, j in roles.items() if j == joint and k != key]:
+                del roles[other]
+            roles[key] = joint
+            mapped.add(key)
+    # Keep only roles whose limb order holds (each a descendant of the previous one). A role
+    # found by name that breaks it is dropped; one the mapping gave is an error, not dropped
+    # silently: the mapping says something about the rig that cannot be.
     for side in SIDES:
         for limb_roles, _ in _LIMBS:
-            previous: int | None = None
+            previous: str | None = None
             for role in limb_roles:
                 key = role_key(side, role)
                 if key not in roles:
                     continue
-                if previous is not None and not _is_descendant(skeleton, roles[key], previous):
+                if previous is not None and not _is_descendant(
+                    skeleton, roles[key], roles[previous]
+                ):
+                    if key in mapped:
+                        raise InputError(
+                            f"Expected the mapping's joint for {key} "
+                            f"({skeleton.names[roles[key]]!r}) below the {previous} "
+                            f"({skeleton.names[roles[previous]]!r}) in the hierarchy, got a "
+                            f"joint that is not its descendant"
+                            + ("" if previous in mapped else f" (map {previous} too)")
+                        )
                     del roles[key]
                     continue
-                previous = roles[key]
+                previous = key
     unmapped = tuple(key for key in ROLE_KEYS if key not in roles)
     return RigMap(roles=roles, unmapped=unmapped)
 

@@ -24,6 +24,16 @@ from mocapqa.errors import InputError, ParseError
 __all__ = ["read_mapping"]
 
 
+def _refuse_repeated_keys(pairs: list[tuple[str, object]]) -> dict[str, object]:
+    """A JSON object's members as a dict; ValueError naming a key given twice."""
+    table: dict[str, object] = {}
+    for key, value in pairs:
+        if key in table:
+            raise ValueError(f"Expected each key once, got {key!r} twice")
+        table[key] = value
+    return table
+
+
 def read_mapping(path: Path) -> dict[str, str]:
     """Read a rig mapping file (JSON, or TOML for a ``.toml`` file).
 
@@ -50,17 +60,24 @@ def read_mapping(path: Path) -> dict[str, str]:
             raise ParseError(f"Expected TOML, got {e}", path) from e
     else:
         try:
-            data = json.loads(text)
+            data = json.loads(text, object_pairs_hook=_refuse_repeated_keys)
         except json.JSONDecodeError as e:
             raise ParseError(f"Expected JSON, got {e.msg}", path, e.lineno) from e
-    if not isinstance(data, dict) or not all(
-        isinstance(k, str) and isinstance(v, str) for k, v in data.items()
-    ):
+        except ValueError as e:  # a key given twice: the last would silently win
+            raise ParseError(str(e), path) from e
+    if not isinstance(data, dict):
         raise ParseError(
             'Expected a table of role → joint name, e.g. {"left_upper_arm": "LeftArm"}, '
             f"got {type(data).__name__}",
             path,
         )
+    for key, value in data.items():
+        if not isinstance(value, str):
+            raise ParseError(
+                f"Expected a joint name (a string) for {key!r}, got {type(value).__name__}",
+                path,
+                field=key,
+            )
     try:
         return normalise_mapping(data)
     except InputError as e:
