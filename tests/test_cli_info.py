@@ -311,3 +311,32 @@ def test_the_commands_that_read_a_take_keep_the_reading_limits(
     # A twist command given a keypoint file says so.
     assert main(["detect", str(small)]) != 0
     assert "Expected a BVH take, got a npz file" in capsys.readouterr().err
+
+
+def test_info_and_convert_refuse_hostile_numbers_without_a_traceback(
+    tmp_path: Path, corpus_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    csv = tmp_path / "kp.csv"
+    assert main(["convert", str(corpus_dir / TRC), "-o", str(csv)]) == 0
+    lines = csv.read_text(encoding="utf-8").splitlines()
+    cells = lines[1].split(",")
+    cells[3] = "1e308"  # the first x: read, and written out by convert
+    lines[1] = ",".join(cells)
+    huge = tmp_path / "kp_inf.csv"
+    huge.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    garbage = tmp_path / "kp_garbage.npy"
+    garbage.write_bytes(b"\x93NUMPY\x01\x00\x20\x00{'descr': '<f8', 'shape': (1, \"\"\"     \n")
+    capsys.readouterr()
+    cases = [
+        (["info", str(huge)], "within ±1,000,000,000, got 1e+308"),
+        (["convert", str(huge), "-o", str(tmp_path / "out.trc")], "within ±1,000,000,000"),
+        (["info", str(garbage), "--fps", "30"], "kp_garbage.npy: Expected a NumPy array header"),
+        (["info", str(csv), "--fps", "inf"], "Expected --fps > 0, finite and at most 100000"),
+        (["convert", str(csv), "-o", str(tmp_path / "o.csv"), "--fps", "nan"], "finite"),
+    ]
+    for argv, message in cases:
+        assert main(argv) == 3, argv
+        err = capsys.readouterr().err
+        assert message in err, err
+        assert "Traceback" not in err
+    assert not (tmp_path / "out.trc").exists()

@@ -236,6 +236,28 @@ def test_zip_import_keeps_good_members(client: TestClient, corpus_dir: Path) -> 
     assert progress["status_counts"]["done"] == 2, (progress, client.get(f"{API}/takes").json())
 
 
+def test_import_skips_keypoint_csv_sidecars(client: TestClient) -> None:
+    """A ``.meta.json`` beside its CSV is the CSV's metadata, not a take (batches skip it too)."""
+    sid = _shoot(client, "sidecars")["id"]
+    meta = b'{"fps": 30.0, "length_unit": "m"}'
+    response = client.post(
+        f"{API}/shoots/{sid}/takes",
+        files=[
+            ("files", ("day.zip", _zip([("day/kp.csv.meta.json", meta)]))),
+            ("files", ("walk.CSV.meta.json", meta)),
+        ],
+    )
+    assert response.status_code == 201, response.text
+    report = response.json()
+    assert report["created"] == []
+    assert report["failed"] == []
+    assert [s["name"] for s in report["skipped"]] == [
+        "day.zip:day/kp.csv.meta.json",
+        "walk.CSV.meta.json",
+    ]
+    assert all("sidecar" in s["reason"] for s in report["skipped"])
+
+
 def test_tar_import_reports_links(client: TestClient, corpus_dir: Path) -> None:
     sid = _shoot(client, "tarred")["id"]
     buffer = io.BytesIO()

@@ -90,3 +90,32 @@ def test_adaptive_filter_rejects_bad_shapes_and_parameters() -> None:
         f.update(np.zeros((2, 3)), np.ones(2))
     with pytest.raises(InputError, match="Expected `weighting`"):
         dataclasses.replace(AdaptiveParams(), weighting="vote")  # type: ignore[arg-type]
+
+
+def test_a_window_longer_than_the_take_costs_the_take_not_the_window() -> None:
+    rng = np.random.default_rng(7)
+    x = np.cumsum(rng.normal(size=(20, 3, 3)), axis=0)
+    p = dataclasses.replace(
+        FILTERS["adaptive"].preset("note", CM), weighting="rules", window_s=60.0
+    )
+    fps = 1000.0  # a 60 s window is 60,000 frames; the take has 20
+    batch = adaptive_filter(x, fps, p)
+    # Streaming, which cannot know the take's length, keeps the whole window: same output.
+    f = AdaptiveFilter(p, 3, fps)
+    assert f.state.n_window == 60_000
+    outs = [f.update(x[t]) for t in range(20)]
+    np.testing.assert_array_equal(np.array([o[0] for o in outs]), batch.values)
+    np.testing.assert_array_equal(np.array([o[1] for o in outs]), batch.weights)
+    capped = AdaptiveFilter(p, 3, fps, max_frames=20)
+    assert capped.state.n_window == 60_000
+    assert max(len(a) for a in (capped.state._speeds, capped.state._accels)) == 20
+
+
+def test_parameters_out_of_range_are_refused_naming_the_range() -> None:
+    for name, value in [("window_s", float("inf")), ("window_s", 1e9), ("lead_s", -1.0)]:
+        with pytest.raises(InputError, match=f"Expected `{name}` 0"):
+            dataclasses.replace(AdaptiveParams(), **{name: value})
+    with pytest.raises(InputError, match="Expected `confidence_threshold` 0 to 1, got nan"):
+        AdaptiveParams(confidence_threshold=float("nan"))
+    # The bounds themselves are valid.
+    AdaptiveParams(window_s=60.0, lead_s=0.0, innovation_power=10.0, jitter_threshold=1.0)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -11,7 +12,7 @@ import pytest
 
 from mocapqa.cli.main import main
 from mocapqa.core.keypoints import KeypointSequence
-from mocapqa.errors import InputError
+from mocapqa.errors import InputError, OptionError
 from mocapqa.filters.apply import data_scale, filter_keypoints, filter_motion
 from mocapqa.filters.registry import FILTERS, DataScale
 from mocapqa.io.bvh import read_bvh
@@ -154,3 +155,81 @@ def test_cli_filters_a_bvh_and_refuses_bad_parameters(corpus_dir: Path, tmp_path
     bad = ["filter", str(corpus_dir / BANDAI), "-o", str(out), "--param", "natural_frequency_hz=9"]
     assert main(bad) == 3
     assert main([*bad[:4], "--param", "oops"]) == 3
+
+
+@pytest.mark.parametrize(
+    ("method", "param", "value", "message"),
+    [
+        ("adaptive", "window_s", "inf", "0.0001 to 60 s"),  # was an OverflowError
+        ("adaptive", "window_s", "1e9", "0.0001 to 60 s"),  # was a MemoryError
+        ("adaptive", "confidence_threshold", "nan", "0 to 1"),  # was accepted
+        ("adaptive", "innovation_power", "100", "at most 10"),  # was all-NaN output
+        ("adaptive", "kalman.process_noise", "1e400", "1e-24 to 1e+24"),
+        ("adaptive", "kalman.gate_sigma", "1e300", "0 to 1000"),  # was an OverflowError
+        ("one-euro", "min_cutoff_hz", "inf", "0.001 to 10000 Hz"),  # was all-NaN output
+        ("one-euro", "beta", "inf", "0 to 1e+20"),
+        ("kalman", "measurement_noise", "inf", "1e-24 to 1e+24"),
+        ("kalman", "process_noise", "1e400", "1e-24 to 1e+24"),
+        ("ema", "time_constant_s", "-inf", "0.0001 to 60 s"),
+        ("butterworth", "cutoff_hz", "nan", "0.001 to 10000 Hz"),
+    ],
+)
+def test_every_filter_parameter_is_finite_and_in_its_range(
+    trc: KeypointSequence, method: str, param: str, value: str, message: str
+) -> None:
+    with pytest.raises(OptionError, match=re.escape(message)) as raised:
+        filter_keypoints(trc, method, "default", {param: value})
+    assert raised.value.field == param
+    # The same override as a number (the API's JSON) is refused the same way.
+    with pytest.raises(OptionError, match=re.escape(message)):
+        filter_keypoints(trc, method, "default", {param: float(value)})
+
+
+def test_rotation_filter_parameters_are_in_their_range(corpus_dir: Path) -> None:
+    motion = read_bvh(corpus_dir / BANDAI)
+    with pytest.raises(OptionError, match=r"`natural_frequency_hz` 0\.001 to 10000 Hz, got inf"):
+        filter_motion(motion, "quat-pd", {"natural_frequency_hz": "inf"})
+    with pytest.raises(OptionError, match="`beta`"):
+        filter_motion(motion, "quat-one-euro", {"beta": "nan"})
+
+
+@pytest.mark.parametrize("extent", [1e-8, 1.0, 1e9])
+def test_presets_stay_in_range_for_any_unit_and_the_bounds_filter_finitely(
+    trc: KeypointSequence, extent: float
+) -> None:
+    # Data of unknown unit and any size: the presets convert to its scale within the ranges,
+    # and the extreme values of the ranges still give finite output.
+    scale = extent / float(np.nanmax(np.abs(trc.positions)))
+    seq = dataclasses.replace(trc, positions=trc.positions * scale, length_unit="unknown")
+    for method in ("adaptive", "kalman", "one-euro", "ema", "butterworth"):
+        for preset in FILTERS[method].presets:
+            assert np.isfinite(filter_keypoints(seq, method, preset).sequence.positions).all()
+    for noise in ("1e-24", "1e24"):
+        extremes = {
+            "kalman.measurement_noise": noise, "kalman.process_noise": noise,
+            "innovation_power": "10", "kalman.gate_sigma": "1000",
+        }  # fmt: skip
+        out = filter_keypoints(seq, "adaptive", "default", extremes).sequence.positions
+        assert np.isfinite(out).all()
+
+
+def test_cli_filter_refuses_out_of_range_parameters_naming_them(
+    corpus_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out.trc"
+    argv = ["filter", str(corpus_dir / BALANCING), "-o", str(out)]
+    for extra in (
+        ["--param", "window_s=inf"],
+        ["--param", "window_s=1e9"],
+        ["--method", "one-euro", "--param", "beta=inf"],
+        ["--method", "kalman", "--param", "measurement_noise=inf"],
+        ["--param", "confidence_threshold=nan"],
+        ["--fps", "inf"],
+    ):
+        assert main([*argv, *extra]) == 3, extra
+        err = capsys.readouterr().err
+        assert "Traceback" not in err
+        assert extra[-1].split("=")[0] in err or "--fps" in err, err
+    assert not out.exists()
+    assert main([*argv, "--fps", "inf"]) == 3
+    assert "Expected --fps > 0, finite" in capsys.readouterr().err

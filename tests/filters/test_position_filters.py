@@ -109,7 +109,7 @@ def test_butterworth_interpolates_gaps_and_keeps_empty_channels_marked() -> None
 def test_invalid_parameters_are_refused() -> None:
     with pytest.raises(InputError, match="Expected `process_noise`"):
         KalmanParams(process_noise=0.0)
-    with pytest.raises(InputError, match="Expected `time_constant_s` > 0"):
+    with pytest.raises(InputError, match=r"Expected `time_constant_s` 0\.0001 to 60 s"):
         EmaParams(time_constant_s=-1.0)
     with pytest.raises(InputError, match="Nyquist"):
         butterworth_filter(np.zeros((20, 1)), 10.0, ButterworthParams(6.0))

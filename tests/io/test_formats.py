@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -12,6 +13,7 @@ from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import ParseError, UnsupportedFormatError
 from mocapqa.io.formats import KEYPOINT_FORMATS, detect_format, read_take, write_keypoints
+from mocapqa.io.keypoint_layouts import MEDIAPIPE_33_NAMES as MP
 
 TRIAL = "keypoints/pose2sim/S00_P00_T01_BalancingTrial"
 MEDIAPIPE = "keypoints/mediapipe"
@@ -103,3 +105,71 @@ def test_write_format_overrides_the_extension(tmp_path: Path) -> None:
     again = read_take(tmp_path / "out.txt")
     assert isinstance(again, KeypointSequence)
     assert again.length_unit == "m"
+
+
+def _huge_value_takes(folder: Path, corpus_dir: Path) -> dict[str, Path]:
+    """A take of every keypoint format with one coordinate of 1e308 (the rest ordinary)."""
+    positions = np.arange(2 * 2 * 3, dtype=float).reshape(2, 2, 3) / 10
+    positions[1, 1, 0] = 0.123456  # written as text, then replaced by 1e308
+    seq = KeypointSequence(("a", "b"), positions, np.ones((2, 2)), 30.0, length_unit="m")
+    paths: dict[str, Path] = {}
+    for kind in ("csv", "json", "trc"):
+        path = folder / f"take.{kind}"
+        write_keypoints(path, seq)
+        text = path.read_text(encoding="utf-8")
+        assert text.count("0.123456") == 1, kind
+        path.write_text(text.replace("0.123456", "1e308"), encoding="utf-8")
+        paths[kind] = path
+    huge = positions.copy()
+    huge[1, 1, 0] = 1e308
+    np.save(folder / "take.npy", huge)
+    np.savez(folder / "take.npz", positions=huge, fps=np.float64(30))
+    paths["npy"], paths["npz"] = folder / "take.npy", folder / "take.npz"
+    openpose = folder / "openpose"
+    openpose.mkdir()
+    frame = json.loads((DATA / "openpose_body25_frame.json").read_text(encoding="utf-8"))
+    frame["people"][0]["pose_keypoints_2d"][0] = 1e308
+    (openpose / "cam.0000.json").write_text(json.dumps(frame), encoding="utf-8")
+    paths["openpose"] = openpose
+    landmarks = [{"x": 1e308 if i == 3 else 0.1, "y": i, "z": 0.5} for i in range(33)]
+    (folder / "mp.json").write_text(json.dumps([landmarks]), encoding="utf-8")
+    paths["mediapipe-json"] = folder / "mp.json"
+    rows = "".join(f"0,{name},{'1e308' if i == 3 else 0.1},0.2,0.3\n" for i, name in enumerate(MP))
+    (folder / "mp.csv").write_text("frame_number,landmark,x,y,z\n" + rows, encoding="utf-8")
+    paths["mediapipe-csv"] = folder / "mp.csv"
+    pbtxt = (corpus_dir / MEDIAPIPE / "google_mediapipe_testdata/pose_landmarks.pbtxt").read_text()
+    (folder / "mp.pbtxt").write_text(pbtxt.replace("x: 0.46507242", "x: 1e308", 1))
+    paths["mediapipe-pbtxt"] = folder / "mp.pbtxt"
+    return paths
+
+
+def test_every_keypoint_reader_refuses_coordinates_beyond_1e9(
+    tmp_path: Path, corpus_dir: Path
+) -> None:
+    # The BVH reader and the filters refused 1e308; the keypoint readers read it, and convert
+    # wrote it out.
+    paths = _huge_value_takes(tmp_path, corpus_dir)
+    assert set(paths) == set(KEYPOINT_FORMATS)
+    for kind, path in paths.items():
+        assert detect_format(path) == kind
+        with pytest.raises(ParseError, match=r"within ±1,000,000,000, got 1e\+308") as caught:
+            read_take(path, fps=30.0)
+        assert caught.value.field == "positions", kind
+        assert caught.value.path == str(path) or path.name in str(caught.value), kind
+
+
+@pytest.mark.parametrize("kind", ["json", "mediapipe-json", "openpose"])
+def test_json_readers_name_the_nesting_they_parse(tmp_path: Path, kind: str) -> None:
+    from mocapqa.io.keypoint_input import JSON_PARSE_DEPTH
+    from mocapqa.io.keypoint_json import parse_keypoint_json
+    from mocapqa.io.mediapipe import parse_mediapipe_json
+    from mocapqa.io.openpose import parse_openpose_frame
+
+    deep = "[" * 5000 + "]" * 5000  # RecursionError in json.loads without the check
+    parse = {
+        "json": lambda: parse_keypoint_json(deep, "deep.json", fps=30.0),
+        "mediapipe-json": lambda: parse_mediapipe_json(deep, "deep.json", fps=30.0),
+        "openpose": lambda: parse_openpose_frame(deep, "deep.json"),
+    }[kind]
+    with pytest.raises(ParseError, match=f"nested at most {JSON_PARSE_DEPTH} deep"):
+        parse()

@@ -4,6 +4,8 @@ analysed and written without recursion when the limits allow it."""
 from __future__ import annotations
 
 import io
+import pickle
+import re
 import zipfile
 from pathlib import Path
 
@@ -11,7 +13,7 @@ import numpy as np
 import pytest
 from tests.api.test_hostile import bvh_text
 
-from mocapqa.errors import TooLargeError
+from mocapqa.errors import ParseError, TooLargeError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.io.bvh_write import format_bvh
 from mocapqa.io.formats import read_take
@@ -129,3 +131,83 @@ def test_sparse_frame_numbers_are_refused_by_the_readers_before_the_arrays() -> 
     assert parse_mediapipe_csv(landmarks, "m.csv", limits=ReadLimits(max_frame_points=9 * 33))
     with pytest.raises(TooLargeError, match=r"^m.csv: .*got 9 × 33"):
         parse_mediapipe_csv(landmarks, "m.csv", limits=ReadLimits(max_frame_points=9 * 33 - 1))
+
+
+def _npy_with_header(text_from: str, text_to: str) -> bytes:
+    """A valid (10, 21, 4) ``.npy`` whose header's ``text_from`` became ``text_to`` (same
+    header length, padded with spaces: the data that follows is the real 6,720 bytes)."""
+    buffer = io.BytesIO()
+    np.save(buffer, np.zeros((10, 21, 4)))
+    data = buffer.getvalue()
+    size = int.from_bytes(data[8:10], "little")
+    header = data[10 : 10 + size].decode("latin1").replace(text_from, text_to).rstrip()
+    assert len(header) < size
+    return data[:10] + (header.ljust(size - 1) + "\n").encode("latin1") + data[10 + size :]
+
+
+@pytest.mark.parametrize("limits", [None, ReadLimits()])
+def test_npy_header_claiming_a_huge_shape_is_refused_before_allocating(
+    tmp_path: Path, limits: ReadLimits | None
+) -> None:
+    # 100,000,000 × 21 × 4 float64 is 62.6 GiB: NumPy allocated it before reading the data.
+    path = tmp_path / "kp_shapelie.npy"
+    path.write_bytes(_npy_with_header("(10, 21, 4)", "(100000000, 21, 4)"))
+    error = ParseError if limits is None else TooLargeError
+    with pytest.raises(error, match=r"kp_shapelie\.npy") as caught:
+        read_take(path, fps=30.0, limits=limits)
+    assert ("holds, got a header declaring 67200000000" in str(caught.value)) is (limits is None)
+
+
+@pytest.mark.parametrize(
+    ("header", "message"),
+    [
+        # The tokenizer's error (NumPy retries a header as Python 2's) escaped as a traceback.
+        ("'shape': (10, 21, 4), }", '\'shape\': (10, 21, 4 """'),
+        ("(10, 21, 4)", "(-10, 21, 4)"),
+        ("(10, 21, 4)", "(1, 1, 100000000000000000000000000000)"),
+        ("'<f8'", "'|O'"),
+    ],
+)
+def test_malformed_npy_headers_are_parse_errors_naming_the_file(
+    tmp_path: Path, header: str, message: str
+) -> None:
+    path = tmp_path / "bad.npy"
+    path.write_bytes(_npy_with_header(header, message))
+    for limits in (None, ReadLimits()):
+        with pytest.raises((ParseError, TooLargeError), match=r"bad\.npy: Expected") as caught:
+            read_take(path, fps=30.0, limits=limits)
+        assert "allow_pickle" not in str(caught.value)
+        assert "Traceback" not in str(caught.value)
+
+
+def test_numpy_files_of_objects_or_pickles_get_our_message_not_numpys(tmp_path: Path) -> None:
+    objects = tmp_path / "objects.npy"
+    np.save(objects, np.array([[[1, 2, 3]]], dtype=object), allow_pickle=True)
+    archive = tmp_path / "objects.npz"
+    np.savez(archive, positions=np.array([[[1, 2, 3]]], dtype=object))
+    pickled = tmp_path / "pickled.npy"
+    pickled.write_bytes(pickle.dumps([1, 2, 3]))
+    for path in (objects, archive, pickled):
+        with pytest.raises(ParseError, match=re.escape(path.name)) as caught:
+            read_take(path, fps=30.0)
+        assert "allow_pickle" not in str(caught.value)
+        assert "unsafe" not in str(caught.value)
+    with pytest.raises(ParseError, match="array of Python objects"):
+        read_take(objects, fps=30.0)
+
+
+def test_npz_member_headers_are_checked_before_loading(tmp_path: Path) -> None:
+    # A stored member whose header claims 2,000,000 × 33 × 4 (2.1 GB) over 6,720 bytes.
+    lying = _npy_with_header("(10, 21, 4)", "(2000000, 33, 4)")
+    path = tmp_path / "lie.npz"
+    with zipfile.ZipFile(path, "w") as archive:
+        archive.writestr("positions.npy", lying)
+    with pytest.raises(ParseError, match=r"field 'positions'.* declaring 2112000000"):
+        read_take(path, fps=30.0)
+    with pytest.raises(TooLargeError, match=r"max_frame_points.* 2000000 × 33"):
+        read_take(path, fps=30.0, limits=ReadLimits())
+    raw = tmp_path / "raw.npz"
+    with zipfile.ZipFile(raw, "w") as archive:
+        archive.writestr("positions", b"not an array")  # AttributeError in the reader
+    with pytest.raises(ParseError, match="field 'positions': Expected a NumPy array"):
+        read_take(raw, fps=30.0)

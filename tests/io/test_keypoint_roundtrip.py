@@ -116,7 +116,7 @@ def test_npy_wrong_shape_and_garbage_are_parse_errors(tmp_path: Path) -> None:
     np.save(tmp_path / "flat.npy", np.zeros((4, 3)))
     with pytest.raises(ParseError, match=r"Expected an array of shape \(F, K, 2\|3\|4\)"):
         parse_keypoint_npy((tmp_path / "flat.npy").read_bytes(), "flat.npy", fps=30)
-    with pytest.raises(ParseError, match="Expected a NumPy file"):
+    with pytest.raises(ParseError, match="Expected a NumPy array header"):
         parse_keypoint_npy(b"\x93NUMPY garbage", "bad.npy", fps=30)
 
 

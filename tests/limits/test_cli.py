@@ -184,3 +184,32 @@ def test_build_tries_the_hidden_sizes_asked_for(corpus_dir: Path, tmp_path: Path
     sizes = {j.scores.hidden_size for j in load_model(model).joints if j.scores is not None}
     assert sizes == {3}
     assert main([*args, "--hidden", "0"]) == 3  # refused before any take is read
+
+
+def test_build_and_check_refuse_bad_numbers_before_working(
+    corpus_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    corpus = tmp_path / "corpus"
+    corpus.mkdir()
+    take = corpus_dir / "bvh" / "bandai" / "dataset-1_kick_normal_001.bvh"
+    (corpus / take.name).symlink_to(take)
+    model = tmp_path / "model.npz"
+    # 1e-6 divides 360: the build asked for 921 PiB.
+    build = ["limits", "build", str(corpus), "-o", str(model), "--no-networks"]
+    assert main([*build, "--bin-deg", "1e-6"]) == 3
+    assert "Expected `bin_deg` from 0.5 to 360 degrees, got 1e-06" in capsys.readouterr().err
+    assert main([*build, "--workers", "-1"]) == 2  # a usage error, as Typer reports it
+    assert "'--workers': -1 is not in the range x>=0" in capsys.readouterr().err
+    assert not model.exists()
+    missing = tmp_path / "missing_dir"
+    assert main(["limits", "check", str(take), "--frame-from", str(missing)]) == 3
+    err = capsys.readouterr().err
+    assert "--frame-from" in err
+    assert "got a path that does not exist" in err
+
+
+def test_batch_refuses_a_negative_worker_count(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["batch", str(tmp_path), "--workers", "-1"]) == 2
+    assert "'--workers': -1 is not in the range x>=0" in capsys.readouterr().err

@@ -10,6 +10,7 @@ import pytest
 
 from mocapqa.errors import InputError, ShapeError
 from mocapqa.limits.occupancy import (
+    MIN_BIN_DEG,
     OccupancyParams,
     build_occupancy,
     evaluate,
@@ -184,3 +185,12 @@ def test_the_lookups_agree_with_evaluate_on_any_leading_shape() -> None:
     np.testing.assert_array_equal(np.hypot(swing, twist) > 0, ~valid)
     np.testing.assert_allclose(np.hypot(excess[:, 0], excess[:, 1]), swing, atol=1e-9)
     np.testing.assert_allclose(np.abs(excess[:, 2]), twist, atol=1e-9)
+
+
+def test_bin_size_has_a_lower_bound_that_keeps_the_paper_setting() -> None:
+    # 1e-6 divides 360 (3.6e8 bins a side): building it asked for 921 PiB.
+    for tiny in (1e-6, 0.25, float("nan"), 0.0, -1.0):
+        with pytest.raises(InputError, match=r"Expected `bin_deg` from 0\.5 to 360 degrees"):
+            OccupancyParams(bin_deg=tiny)
+    for valid in (MIN_BIN_DEG, 1.0, 15.0, 360.0):
+        assert OccupancyParams(bin_deg=valid).n_bins == round(360 / valid)

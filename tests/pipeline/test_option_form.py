@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import pytest
 
-from mocapqa.errors import InputError
+from mocapqa.errors import InputError, OptionError
 from mocapqa.pipeline.options import (
     CHECKS,
     MAX_POINTS_RANGE,
@@ -45,3 +46,39 @@ def test_presets_are_valid_options_and_the_bounds_are_enforced() -> None:
     low, high = MAX_POINTS_RANGE
     with pytest.raises(InputError, match=rf"^max_points: Expected {low} to {high}"):
         AnalysisOptions(max_points=high + 1)
+
+
+@pytest.mark.parametrize(
+    ("method", "params", "field", "message"),
+    [
+        # Strings are converted by the filter: "inf" and "nan" got through the JSON check.
+        ("adaptive", {"window_s": "inf"}, "filter_params.window_s", "0.0001 to 60 s"),
+        (
+            "adaptive",
+            {"confidence_threshold": "nan"},
+            "filter_params.confidence_threshold",
+            "0 to 1",
+        ),
+        (
+            "adaptive",
+            {"kalman.process_noise": "1e400"},
+            "filter_params.kalman.process_noise",
+            "1e+24",
+        ),
+        ("kalman", {"measurement_noise": 1e30}, "filter_params.measurement_noise", "1e+24"),
+        ("one-euro", {"beta": "inf"}, "filter_params.beta", "0 to 1e+20"),
+        ("adaptive", {"innovation_power": 50}, "filter_params.innovation_power", "at most 10"),
+    ],
+)
+def test_run_options_refuse_filter_parameters_out_of_their_range(
+    method: str, params: dict[str, object], field: str, message: str
+) -> None:
+    with pytest.raises(OptionError, match=re.escape(message)) as raised:
+        AnalysisOptions.from_json({"filter_method": method, "filter_params": params})
+    assert raised.value.field == field
+    assert str(raised.value).count(field) == 1
+
+
+def test_run_options_take_the_bounds_of_the_ranges() -> None:
+    params = {"window_s": 60.0, "lead_s": 0, "kalman.bridge_decay_s": 0.0, "innovation_power": 10}
+    AnalysisOptions.from_json({"filter_method": "adaptive", "filter_params": params})

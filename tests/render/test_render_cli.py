@@ -37,3 +37,29 @@ def test_render_command_rejects_a_bad_interval(corpus_dir: Path, tmp_path: Path)
          "-o", str(tmp_path / "x.gif")]
     )  # fmt: skip
     assert code == 3
+
+
+@pytest.mark.parametrize(("width", "height"), [("8193", "16"), ("100000", "100000"), ("15", "480")])
+def test_render_refuses_an_image_size_out_of_range_before_reading(
+    corpus_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], width: str, height: str
+) -> None:
+    # 100,000 × 100,000 px aborted VTK (exit 134); 8,193 × 16 rendered.
+    out = tmp_path / "r.png"
+    code = main(
+        ["render", str(corpus_dir / KICK), "--frame", "0", "--no-analyze",
+         "--width", width, "--height", height, "-o", str(out)]
+    )  # fmt: skip
+    assert code == 3
+    err = capsys.readouterr().err
+    assert "--width/--height: Expected an image width and height of 16 to 8192 px" in err
+    assert not out.exists()
+
+
+def test_still_options_bound_the_image_size() -> None:
+    from mocapqa.errors import ShapeError
+    from mocapqa.render.still import MAX_SIDE_PX, MIN_SIDE_PX, StillOptions
+
+    StillOptions(width_px=MAX_SIDE_PX, height_px=MIN_SIDE_PX)
+    for size in ((MAX_SIDE_PX + 1, 480), (640, 100_000), (MIN_SIDE_PX - 1, 480)):
+        with pytest.raises(ShapeError, match="16 to 8192 px"):
+            StillOptions(width_px=size[0], height_px=size[1])

@@ -15,16 +15,21 @@ import json
 import logging
 import os
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from mocapqa.cli.app import app
 
+if TYPE_CHECKING:
+    from rich.console import Console
+
 __all__ = ["DASK_LOGGERS", "batch"]
 
 DASK_LOGGERS = ("distributed", "distributed.client")
 """Dask's client-side loggers (each has its own level and handler)."""
+MAX_FAILED_LINES = 50
+"""Failed takes listed one per line on stderr at the end of a batch; the rest are counted."""
 
 
 def _quiet_dask_logging() -> None:
@@ -66,7 +71,7 @@ def batch(
         typer.Option(help="Dask scheduler address (default: $MOCAPQA_DASK_SCHEDULER or local)."),
     ] = None,
     workers: Annotated[
-        int, typer.Option(help="Worker processes of the local cluster (0: one per core).")
+        int, typer.Option(min=0, help="Worker processes of the local cluster (0: one per core).")
     ] = 0,
     options: Annotated[str | None, typer.Option(help="Run options as JSON.")] = None,
     output: Annotated[
@@ -77,7 +82,8 @@ def batch(
 
     Takes whose content, options and mocapqa version already have a done run are skipped, so
     an interrupted batch finishes when run again. Exit code 0 when no take failed, 2 when
-    some did, 8 when the Dask scheduler cannot be reached or is lost.
+    some did, 8 when the Dask scheduler cannot be reached or is lost. Each failed take is
+    listed on stderr with its reason (the first 50; the full list is in --output).
     """
     from rich.console import Console
     from rich.progress import (
@@ -89,9 +95,10 @@ def batch(
         TimeRemainingColumn,
     )
 
+    from mocapqa.cli.outputs import FolderReads, check_outputs
     from mocapqa.config import get_settings
     from mocapqa.errors import ClusterError
-    from mocapqa.jobs.batch import run_batch
+    from mocapqa.jobs.batch import MOTION_SUFFIXES, run_batch
     from mocapqa.jobs.batch_output import ResultWriter
     from mocapqa.jobs.engine import Engine
     from mocapqa.limits.catalog import ModelCatalog
@@ -100,6 +107,8 @@ def batch(
     from mocapqa.store.shoots import ShootStore
 
     _quiet_dask_logging()
+    read = [FolderReads(p, MOTION_SUFFIXES, recursive=True) if p.is_dir() else p for p in paths]
+    check_outputs({"--output": output}, read)
     run_options = _options(options)
     settings = get_settings()
     if run_options.limits_model is not None:  # refused before any take is read
@@ -126,6 +135,7 @@ def batch(
     )
     task = progress.add_task("batch", total=None, tally="", rate="")
     state = {"done": 0, "failed": 0, "skipped": 0, "frames": 0, "started": 0.0}
+    failed: list[tuple[str, str]] = []  # (source, reason) of the first MAX_FAILED_LINES
 
     def on_total(total: int) -> None:
         import time
@@ -137,6 +147,9 @@ def batch(
         import time
 
         state[row["status"]] += 1
+        if row["status"] == "failed" and len(failed) < MAX_FAILED_LINES:
+            reason = " ".join(str(row.get("error") or "no reason given").split("\n"))
+            failed.append((str(row["source"]), reason))
         if row["status"] == "done":
             state["frames"] += int(row.get("n_frames") or 0)
         elapsed = max(time.perf_counter() - state["started"], 1e-9)
@@ -178,5 +191,16 @@ def batch(
         f"{counts.skipped} skipped; {counts.frames} frames"
         + (f"; results in {output}" if output is not None else "")
     )
+    _print_failed(console, failed, counts.failed)
     if counts.failed:
         raise typer.Exit(2)
+
+
+def _print_failed(console: Console, failed: list[tuple[str, str]], n_failed: int) -> None:
+    """One line per failed take (``failed: SOURCE: REASON``), then how many more failed."""
+    from rich.markup import escape
+
+    for source, reason in failed:
+        console.print(f"failed: {escape(source)}: {escape(reason)}", soft_wrap=True)
+    if n_failed > len(failed):
+        console.print(f"… and {n_failed - len(failed)} more failed", soft_wrap=True)

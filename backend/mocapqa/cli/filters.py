@@ -12,6 +12,7 @@ from rich.console import Console
 from rich.table import Table
 
 from mocapqa.cli.app import app, bench_app
+from mocapqa.cli.outputs import check_outputs, require_suffix, take_input
 from mocapqa.cli.reading import read_input
 from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
 from mocapqa.errors import InputError
@@ -42,24 +43,43 @@ def filter_command(
         list[str] | None, typer.Option(help="Override, NAME=VALUE (repeatable).")
     ] = None,
     report: Annotated[Path | None, typer.Option(help="Write a JSON report here.")] = None,
-    fps: Annotated[float | None, typer.Option(help="Frame rate for formats without one.")] = None,
+    fps: Annotated[
+        float | None,
+        typer.Option(help="Frames per second, for formats that do not store it (NPY, CSV, ...)."),
+    ] = None,
     mapping: MappingOption = None,
 ) -> None:
     """Filter a keypoint file or the rotations of a BVH take."""
     from mocapqa.core.motion import Motion
     from mocapqa.filters.apply import filter_keypoints, filter_motion
     from mocapqa.filters.registry import FILTERS
+    from mocapqa.io.atomic import write_text
     from mocapqa.io.bvh_write import write_bvh
-    from mocapqa.io.formats import require_frames, write_keypoints
+    from mocapqa.io.formats import (
+        KEYPOINT_WRITE_FORMATS,
+        check_fps,
+        require_frames,
+        write_keypoints,
+    )
     from mocapqa.metrics.smoothness import lag_frames, mean_abs_jerk
 
+    if fps is not None:
+        check_fps(fps, "--fps")
     overrides = parse_overrides(param or [])
+    check_outputs(
+        {"-o": output, "--report": report}, [take_input(input_path), mapping], sidecars=True
+    )
     roles = load_mapping(mapping)
     take = read_input(input_path, fps=fps)
     require_frames(take, input_path)
     summary: dict[str, Any]
     if roles is not None and not isinstance(take, Motion):
         raise InputError("Expected --mapping only for BVH input, got a keypoint take")
+    if isinstance(take, Motion):
+        require_suffix("-o", output, (".bvh",), "a BVH input's filtered take")
+    else:
+        formats = tuple(f".{kind}" for kind in KEYPOINT_WRITE_FORMATS)
+        require_suffix("-o", output, formats, "filtered keypoints")
     if isinstance(take, Motion):
         missing_roles(take.skeleton, roles)
         method = method or "quat-pd"
@@ -88,7 +108,7 @@ def filter_command(
             )
         summary["per_keypoint"] = per_key
     if report is not None:
-        report.write_text(json.dumps(summary, indent=1, default=str, allow_nan=True))
+        write_text(report, json.dumps(summary, indent=1, default=str, allow_nan=True))
     console.print(f"filtered {input_path} with {method} → {output}")
 
 

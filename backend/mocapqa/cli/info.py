@@ -165,10 +165,10 @@ def info_command(
 ) -> None:
     """Show what a take holds: frames, rate, joints or keypoints, units, rig roles."""
     from mocapqa.core.motion import Motion
-    from mocapqa.io.formats import detect_format
+    from mocapqa.io.formats import check_fps, detect_format
 
-    if fps is not None and not fps > 0:
-        raise InputError(f"Expected --fps > 0, got {fps}")
+    if fps is not None:
+        check_fps(fps, "--fps")
     roles = load_mapping(mapping)
     format_name = detect_format(file)
     take = read_input(file, fps=fps, number_reader="auto", root_translation=root_translation)
@@ -196,15 +196,17 @@ def convert_command(
     mapping: MappingOption = None,
 ) -> None:
     """Convert a take: BVH to BVH, keypoints between TRC, CSV, NPY, NPZ and JSON."""
+    from mocapqa.cli.outputs import check_outputs, take_input
     from mocapqa.core.motion import Motion
     from mocapqa.io.bvh_write import write_bvh
-    from mocapqa.io.formats import KEYPOINT_WRITE_FORMATS, write_keypoints
+    from mocapqa.io.formats import KEYPOINT_WRITE_FORMATS, check_fps, write_keypoints
 
-    if fps is not None and not fps > 0:
-        raise InputError(f"Expected --fps > 0, got {fps}")
+    if fps is not None:
+        check_fps(fps, "--fps")
     if not 0 <= precision <= 15:
         raise InputError(f"Expected --precision between 0 and 15, got {precision}")
     suffix = output.suffix.lower().lstrip(".")
+    check_outputs({"-o": output}, [take_input(source), mapping], sidecars=True)
     roles = load_mapping(mapping)
     take = read_input(source, fps=fps, number_reader="auto")
     if isinstance(take, Motion):

@@ -11,6 +11,7 @@ from rich.console import Console
 from rich.table import Table
 
 from mocapqa.cli.app import limits_app
+from mocapqa.cli.outputs import FolderReads, check_outputs, require_suffix
 from mocapqa.cli.reading import read_input_bvh
 from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
 from mocapqa.errors import InputError
@@ -96,8 +97,9 @@ def limits_build(
     workers: Annotated[
         int,
         typer.Option(
+            min=0,
             help="Read and chart the takes on a local Dask cluster of N worker processes "
-            "(0: in this process, the default)."
+            "(0: in this process, the default).",
         ),
     ] = 0,
     mapping: MappingOption = None,
@@ -123,6 +125,8 @@ def limits_build(
     from mocapqa.core.rig import require_mapped
     from mocapqa.limits.build import build_canonical_model, build_model
 
+    require_suffix("-o", output, (".npz",), "a limits model")
+    check_outputs({"-o": output}, [FolderReads(corpus_dir, (".bvh",), recursive=True), mapping])
     roles = load_mapping(mapping)
     if roles and rig is not None:
         raise InputError(
@@ -175,10 +179,11 @@ def _log_role(line: str) -> None:
 
 
 def _write_model(model: LimitsModel, output: Path) -> None:
-    from mocapqa.limits.storage import save_model
+    from mocapqa.io.atomic import write_bytes
+    from mocapqa.limits.storage import model_bytes
 
     output.parent.mkdir(parents=True, exist_ok=True)
-    save_model(model, output)
+    write_bytes(output, model_bytes(model))
     console.print(
         f"wrote {output}: rig {model.rig_family}, {len(model.joints)} joints, "
         f"{len(model.takes)} takes, {model.n_frames} frames, "
@@ -273,6 +278,9 @@ def limits_check(
     from mocapqa.limits.analysis import check_limits
     from mocapqa.twist.analysis import analyze_twist
 
+    if frame_from is not None and not frame_from.is_dir():
+        what = "a file" if frame_from.exists() else "a path that does not exist"
+        raise InputError(f"--frame-from {frame_from}: Expected a folder of BVH takes, got {what}")
     roles = load_mapping(mapping)
     motion = read_input_bvh(path)
     require_frames(motion, path)
@@ -376,8 +384,11 @@ def limits_show(
     import matplotlib.pyplot as plt
     import numpy as np
 
+    from mocapqa.io.atomic import atomic_path
     from mocapqa.limits.storage import load_model
 
+    require_suffix("-o", output, (".png",), "a PNG image")
+    check_outputs({"-o": output}, [model_path])
     model = load_model(model_path)
     limits = model.joint(joint)
     occupancy = limits.occupancy
@@ -404,8 +415,11 @@ def limits_show(
         f"{occupancy.bin_deg:g}° bins, {limits.n_samples} frames"
     )
     output.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(output, dpi=80)
-    plt.close(figure)
+    try:
+        with atomic_path(output) as temporary:
+            figure.savefig(temporary, dpi=80, format="png")
+    finally:
+        plt.close(figure)
     console.print(f"wrote {output}")
 
 

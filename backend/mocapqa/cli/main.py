@@ -69,9 +69,9 @@ def main(argv: list[str] | None = None) -> int:
         return _report(e)
     except OSError as e:
         # Readers turn their OSErrors into ParseErrors, so this is an output that cannot be
-        # written (a missing folder, no permission, a full disk). Writers write a temporary
-        # file first; the message names the output.
-        path = str(e.filename).removesuffix(".tmp") if e.filename else "?"
+        # written (a missing folder, no permission, a full disk, ``ulimit -f``). Writers go
+        # through mocapqa.io.atomic, which names the output (not its temporary) as filename.
+        path = str(e.filename) if e.filename else "an output file"
         got = e.strerror or type(e).__name__
         return _report(InputError(f"Expected a writable output path, got {got}: {path}"))
     return 0

@@ -16,6 +16,7 @@ from rich.progress import Progress
 from rich.table import Table
 
 from mocapqa.cli.app import app, bench_app
+from mocapqa.cli.outputs import check_outputs, require_suffix, take_input
 from mocapqa.cli.reading import read_input
 from mocapqa.cli.report import TakeRun, analyze_take, build_take_report, sheet_tiles
 from mocapqa.cli.roles import (
@@ -25,7 +26,7 @@ from mocapqa.cli.roles import (
     missing_roles,
     warn_missing,
 )
-from mocapqa.errors import InputError, NotFoundError
+from mocapqa.errors import InputError, NotFoundError, OptionError, ShapeError
 
 __all__ = ["bench_render", "flagged_at", "parse_interval", "raw_run", "render"]
 
@@ -99,15 +100,21 @@ def render(
     up_axis: Annotated[
         str | None, typer.Option(help="Override the detected up axis (+y, -y, +z, ...).")
     ] = None,
-    width: Annotated[int, typer.Option(help="Width of one view, px.")] = 640,
-    height: Annotated[int, typer.Option(help="Height of one view, px.")] = 480,
+    width: Annotated[int, typer.Option(help="Width of one view, px (16 to 8192).")] = 640,
+    height: Annotated[int, typer.Option(help="Height of one view, px (16 to 8192).")] = 480,
     mapping: MappingOption = None,
     root_translation: RootTranslationOption = "auto",
 ) -> None:
     """Render a still (--frame), a clip (--interval) or a contact sheet (--contact-sheet)."""
+    from mocapqa.io.atomic import write_bytes
+    from mocapqa.render.clip import CLIP_FORMATS
     from mocapqa.render.service import RenderService
     from mocapqa.render.still import StillOptions
 
+    try:  # checked before the take is read
+        options = StillOptions(width_px=width, height_px=height)
+    except ShapeError as e:
+        raise OptionError("--width/--height", str(e)) from e
     chosen = sum([frame is not None, interval is not None, contact_sheet])
     if chosen != 1:
         raise InputError(
@@ -115,6 +122,13 @@ def render(
         )
     if not input_path.exists():
         raise NotFoundError(f"Expected an existing take file, got {input_path}")
+    if interval is not None:
+        clip = tuple(f".{kind}" for kind in CLIP_FORMATS)
+        require_suffix("-o", output, clip, "a clip (--interval)")
+    else:
+        what = "a still (--frame)" if frame is not None else "a contact sheet"
+        require_suffix("-o", output, (".png",), what)
+    check_outputs({"-o": output}, [take_input(input_path), mapping])
     with Progress(console=console, transient=True) as bar, RenderService() as service:
         task = bar.add_task("reading", total=100)
 
@@ -138,7 +152,6 @@ def render(
             task, completed=100 * done / total, description=f"rendering {done}/{total}"
         )
         if frame is not None:
-            options = StillOptions(width_px=width, height_px=height)
             flags = flagged_at(run, frame) if 0 <= frame < run.raw.n_frames else None
             step(0, "rendering")
             if compare:
@@ -160,7 +173,7 @@ def render(
                     f"Expected flagged intervals for a contact sheet, got none in {input_path}"
                 )
             data = service.contact_sheet(run.raw, tiles, run.corrected, progress=tick)
-    output.write_bytes(data)
+    write_bytes(output, data)
     console.print(f"{output} ({len(data) / 1e3:.0f} kB)")
 
 

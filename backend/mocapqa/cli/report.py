@@ -24,6 +24,7 @@ from rich.console import Console
 from rich.progress import Progress
 
 from mocapqa.cli.app import app
+from mocapqa.cli.outputs import check_outputs, require_suffix, take_input
 from mocapqa.cli.reading import read_input
 from mocapqa.cli.roles import (
     MappingOption,
@@ -255,10 +256,16 @@ def report(
     root_translation: RootTranslationOption = "auto",
 ) -> None:
     """Write a self-contained HTML QA report: summary, findings, timelines, contact sheet."""
+    from mocapqa.io.atomic import write_bytes, write_text
     from mocapqa.render.service import RenderService
 
     if not input_path.exists():
         raise NotFoundError(f"Expected an existing take file, got {input_path}")
+    require_suffix("-o", output, (".html", ".htm"), "an HTML report")
+    if pdf is not None:
+        require_suffix("--pdf", pdf, (".pdf",), "a PDF report")
+    stored = [run / "report.json", run / "points.npz"] if run is not None else []
+    check_outputs({"-o": output, "--pdf": pdf}, [take_input(input_path), options, mapping, *stored])
     option_values = None
     if options is not None:
         try:
@@ -279,12 +286,16 @@ def report(
         html = build_take_report(
             input_path, service, run, option_values, progress, root_translation
         )
-    output.write_text(html, encoding="utf-8")
+    write_text(output, html)
     console.print(f"report → {output} ({len(html) / 1e6:.1f} MB)")
     if pdf is not None:
-        # Chromium needs the HTML as a file; a copy keeps the user's output untouched.
+        # Chromium needs the HTML as a file; a copy keeps the user's output untouched. It
+        # prints to the scratch folder, and a printed PDF replaces the output whole.
         with tempfile.TemporaryDirectory() as folder:
             page = Path(folder) / "report.html"
             shutil.copyfile(output, page)
-            reason = print_pdf(page, pdf)
+            printed = Path(folder) / "report.pdf"
+            reason = print_pdf(page, printed)
+            if reason is None:
+                write_bytes(pdf, printed.read_bytes())
         console.print(reason if reason else f"PDF → {pdf}")

@@ -14,6 +14,7 @@ from rich.progress import Progress
 from rich.table import Table
 
 from mocapqa.cli.app import app, bench_app
+from mocapqa.cli.outputs import check_outputs, require_suffix
 from mocapqa.cli.reading import read_input_bvh
 from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
 
@@ -70,12 +71,15 @@ def refine(
     Every interval found is listed in the report with its confidence and whether it was
     applied; the written take is the input with exactly the applied intervals' levels removed.
     """
+    from mocapqa.io.atomic import write_text
     from mocapqa.io.bvh_write import write_bvh
     from mocapqa.io.formats import require_frames
     from mocapqa.twist.analysis import analyze_twist
     from mocapqa.twist.spin import find_limb_spins
 
     _check_method(method)
+    require_suffix("-o", output, (".bvh",), "a BVH take")
+    check_outputs({"-o": output, "--report": report}, [input_path, mapping])
     roles = load_mapping(mapping)
     motion = read_input_bvh(input_path)
     require_frames(motion, input_path)
@@ -84,8 +88,7 @@ def refine(
     spins = find_limb_spins(motion, mapping=roles)
     write_bvh(output, analysis.refined)
     if report is not None:
-        text = json.dumps(_report(analysis, input_path, missing, spins), indent=2)
-        report.write_text(text, encoding="utf-8")
+        write_text(report, json.dumps(_report(analysis, input_path, missing, spins), indent=2))
     console = Console(highlight=False)
     applied = [i for i in analysis.intervals if i.applied]
     frames = sum(i.end_frame - i.start_frame + 1 for i in applied)

@@ -37,6 +37,15 @@ from mocapqa.filters.ema import EmaFilter, EmaParams
 from mocapqa.filters.kalman import KalmanFilter, KalmanParams
 from mocapqa.filters.motion_state import MotionStateTracker
 from mocapqa.filters.one_euro import OneEuroFilter, OneEuroParams
+from mocapqa.filters.ranges import (
+    DURATION,
+    DURATION_OR_OFF,
+    NON_NEGATIVE,
+    POWER,
+    UNIT_INTERVAL,
+    bounded,
+    check_ranges,
+)
 
 __all__ = [
     "WEIGHT_NAMES",
@@ -67,7 +76,8 @@ class AdaptiveParams:
     weighting : {"rules", "innovation"}
         How weights are chosen (see the module docstring).
     window_s : float
-        Motion-state window (rules) or innovation averaging time constant, seconds.
+        Motion-state window (rules) or innovation averaging time constant, seconds (0.0001
+        to 60).
     slow_speed, fast_speed : float
         Speed thresholds of the rules, unit/s of the data.
     jitter_threshold : float
@@ -75,12 +85,12 @@ class AdaptiveParams:
     confidence_threshold : float
         Confidence below which the rules favour the Kalman filter.
     innovation_power : float
-        Exponent of the innovation weighting (> 0).
+        Exponent of the innovation weighting (> 0 and at most 10).
     share_bridges : bool
         Feed the Kalman estimate to the other filters where it bridged a sample.
     lead_s : float
-        Innovation mode only: add ``lead_s`` × the Kalman velocity to the blend, seconds. It
-        offsets the lag of the smoothing members at the cost of some noise.
+        Innovation mode only: add ``lead_s`` × the Kalman velocity to the blend, seconds (0 to
+        60). It offsets the lag of the smoothing members at the cost of some noise.
     body_prior : bool
         Innovation mode only: while a keypoint is bridged its velocity relaxes (with the Kalman
         ``bridge_decay_s``) toward the mean velocity of all keypoints instead of toward zero.
@@ -90,17 +100,18 @@ class AdaptiveParams:
     one_euro: OneEuroParams = field(default_factory=OneEuroParams)
     ema: EmaParams = field(default_factory=EmaParams)
     weighting: Literal["rules", "innovation"] = "rules"
-    window_s: float = 5 / 30
-    slow_speed: float = 0.1
-    fast_speed: float = 1.0
-    jitter_threshold: float = 0.5
-    confidence_threshold: float = 0.5
-    innovation_power: float = 1.0
+    window_s: float = bounded(5 / 30, DURATION)
+    slow_speed: float = bounded(0.1, NON_NEGATIVE)
+    fast_speed: float = bounded(1.0, NON_NEGATIVE)
+    jitter_threshold: float = bounded(0.5, UNIT_INTERVAL)
+    confidence_threshold: float = bounded(0.5, UNIT_INTERVAL)
+    innovation_power: float = bounded(1.0, POWER)
     share_bridges: bool = False
-    lead_s: float = 0.0
+    lead_s: float = bounded(0.0, DURATION_OR_OFF)
     body_prior: bool = False
 
     def __post_init__(self) -> None:
+        check_ranges(self)
         if self.weighting not in ("rules", "innovation"):
             raise InputError(
                 f"Expected `weighting` 'rules' or 'innovation', got {self.weighting!r}"
@@ -195,9 +206,15 @@ class AdaptiveFilter:
         Number of keypoints ``K``.
     fps : float
         Frames per second.
+    max_frames : int, optional
+        Most frames that will be filtered, when known (a batch): a motion-state window longer
+        than the take then costs memory for the take's frames only (see
+        :class:`~mocapqa.filters.motion_state.MotionStateTracker`).
     """
 
-    def __init__(self, params: AdaptiveParams, n_keypoints: int, fps: float) -> None:
+    def __init__(
+        self, params: AdaptiveParams, n_keypoints: int, fps: float, max_frames: int | None = None
+    ) -> None:
         if not fps > 0:
             raise InputError(f"Expected `fps` > 0, got {fps}")
         n = 3 * n_keypoints
@@ -207,7 +224,7 @@ class AdaptiveFilter:
         self.kalman = KalmanFilter(params.kalman, n, fps)
         self.one_euro = OneEuroFilter(params.one_euro, n, fps)
         self.ema = EmaFilter(params.ema, n, fps)
-        self.state = MotionStateTracker(n_keypoints, fps, params.window_s)
+        self.state = MotionStateTracker(n_keypoints, fps, params.window_s, max_frames)
         self.innovation = params.weighting == "innovation"
         """Whether the compiled innovation-weighted kernel runs (else the note's rules)."""
         # Kernel state: equal starting weights; the floor (1 % of r) keeps weights finite.
@@ -310,7 +327,7 @@ def adaptive_filter(
     n, k, _ = positions.shape
     if confidence is not None:
         check_shape(np.asarray(confidence), "confidence", (n, k))
-    f = AdaptiveFilter(params, k, fps)
+    f = AdaptiveFilter(params, k, fps, max_frames=n)
     if f.innovation:
         conf = np.ones((n, k)) if confidence is None else np.asarray(confidence, np.float64)
         flat = np.ascontiguousarray(positions.reshape(n, 3 * k))

@@ -22,7 +22,7 @@ import numpy as np
 from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
-from mocapqa.errors import InputError
+from mocapqa.errors import InputError, OptionError
 from mocapqa.filters.adaptive import WEIGHT_NAMES, adaptive_filter
 from mocapqa.filters.butterworth import butterworth_filter, butterworth_quats
 from mocapqa.filters.ema import ema_filter
@@ -111,26 +111,38 @@ def apply_overrides(params: Any, overrides: dict[str, Any]) -> Any:
     """A copy of the dataclass ``params`` with dotted-name ``overrides`` applied.
 
     Values may be strings (from the command line); they are converted to the field's type.
+    Each parameter dataclass checks its values when made (the ranges of
+    :mod:`mocapqa.filters.ranges`).
 
     Raises
     ------
-    InputError
-        On an unknown name or an unconvertible value.
+    OptionError
+        On an unknown name, an unconvertible value or one outside the parameter's range; its
+        ``field`` is the dotted name (``kalman.process_noise``).
     """
     for key, value in overrides.items():
-        head, _, rest = key.partition(".")
-        names = [f.name for f in dataclasses.fields(params)]
-        if head not in names:
-            raise InputError(f"Expected a parameter in {names}, got {key!r}")
-        current = getattr(params, head)
-        if rest:
-            if not dataclasses.is_dataclass(current):
-                raise InputError(f"Expected a parameter in {names}, got {key!r}")
-            new = apply_overrides(current, {rest: value})
-        else:
-            new = _coerce(value, current, key) if isinstance(value, str) else value
-        params = dataclasses.replace(params, **{head: new})
+        try:
+            params = _override(params, key, value)
+        except OptionError:
+            raise
+        except InputError as e:
+            raise OptionError(key, str(e)) from e
     return params
+
+
+def _override(params: Any, key: str, value: Any) -> Any:
+    head, _, rest = key.partition(".")
+    names = [f.name for f in dataclasses.fields(params)]
+    if head not in names:
+        raise InputError(f"Expected a parameter in {names}, got {key!r}")
+    current = getattr(params, head)
+    if rest:
+        if not dataclasses.is_dataclass(current):
+            raise InputError(f"Expected a parameter in {names}, got {key!r}")
+        new = _override(current, rest, value)
+    else:
+        new = _coerce(value, current, key) if isinstance(value, str) else value
+    return dataclasses.replace(params, **{head: new})
 
 
 def resolve_params(

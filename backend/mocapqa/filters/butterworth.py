@@ -18,6 +18,7 @@ import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray, check_shape
 from mocapqa.errors import InputError
+from mocapqa.filters.ranges import FREQUENCY, ORDER, bounded, check_ranges
 from mocapqa.kinematics.quaternion import unwrap
 
 __all__ = ["ButterworthParams", "butterworth_filter", "butterworth_quats"]
@@ -35,10 +36,11 @@ class ButterworthParams:
         Filter order per pass (1–8).
     """
 
-    cutoff_hz: float = 6.0
-    order: int = 4
+    cutoff_hz: float = bounded(6.0, FREQUENCY)
+    order: int = bounded(4, ORDER)
 
     def __post_init__(self) -> None:
+        check_ranges(self)
         if not (self.cutoff_hz > 0 and 1 <= self.order <= 8):
             raise InputError(
                 f"Expected `cutoff_hz` > 0 and `order` in 1..8, got {self.cutoff_hz} and "

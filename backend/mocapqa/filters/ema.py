@@ -17,6 +17,7 @@ import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.errors import InputError
+from mocapqa.filters.ranges import BELOW_ONE, DURATION, bounded, check_ranges
 from mocapqa.filters.streaming import channel_count, run_streaming
 
 __all__ = ["EmaFilter", "EmaParams", "ema_filter", "time_constant_from_alpha"]
@@ -34,10 +35,11 @@ class EmaParams:
         Samples with a confidence at or below this are treated as missing.
     """
 
-    time_constant_s: float = 0.0934
-    min_confidence: float = 0.0
+    time_constant_s: float = bounded(0.0934, DURATION)
+    min_confidence: float = bounded(0.0, BELOW_ONE)
 
     def __post_init__(self) -> None:
+        check_ranges(self)
         if not self.time_constant_s > 0:
             raise InputError(f"Expected `time_constant_s` > 0, got {self.time_constant_s}")
 

@@ -27,6 +27,14 @@ import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.errors import InputError
+from mocapqa.filters.ranges import (
+    BELOW_ONE,
+    DURATION_OR_OFF,
+    NOISE,
+    SIGMA,
+    bounded,
+    check_ranges,
+)
 
 __all__ = ["KalmanFilter", "KalmanParams", "KalmanResult", "kalman_filter"]
 
@@ -56,15 +64,16 @@ class KalmanParams:
         it constant (pure constant-velocity prediction).
     """
 
-    process_noise: float = 1e-2
-    measurement_noise: float = 3e-5
+    process_noise: float = bounded(1e-2, NOISE)
+    measurement_noise: float = bounded(3e-5, NOISE)
     confidence_weighted: bool = False
-    gate_sigma: float = 0.0
-    min_confidence: float = 0.0
-    reacquire_s: float = 0.1
-    bridge_decay_s: float = 0.0
+    gate_sigma: float = bounded(0.0, SIGMA)
+    min_confidence: float = bounded(0.0, BELOW_ONE)
+    reacquire_s: float = bounded(0.1, DURATION_OR_OFF)
+    bridge_decay_s: float = bounded(0.0, DURATION_OR_OFF)
 
     def __post_init__(self) -> None:
+        check_ranges(self)
         if not (self.process_noise > 0 and self.measurement_noise > 0):
             raise InputError(
                 "Expected `process_noise` and `measurement_noise` > 0, got "

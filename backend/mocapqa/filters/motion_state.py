@@ -65,18 +65,32 @@ class MotionStateTracker:
         Frames per second.
     window_s : float
         Window length in seconds.
+    max_frames : int, optional
+        Most frames that will be given to :meth:`update` (a batch knows its take's length).
+        A window longer than that keeps only ``max_frames`` rows: the rows never written hold
+        zeros, which add nothing to the window's sums, so the states are the same while the
+        memory follows the take, not the window.
+
+    Notes
+    -----
+    Each state averages over the whole window, ``n − 1`` speeds and ``n − 2`` accelerations
+    and reversals, counting the slots not written yet as 0 (the note's start-up).
     """
 
-    def __init__(self, n_keypoints: int, fps: float, window_s: float) -> None:
+    def __init__(
+        self, n_keypoints: int, fps: float, window_s: float, max_frames: int | None = None
+    ) -> None:
         self.fps = fps
         n = window_frames(window_s, fps)
         self.n_window = n
+        cap = n if max_frames is None else max(1, max_frames)
         self._held = np.full((n_keypoints, 3), np.nan)
         self._step = np.zeros((n_keypoints, 3))
         self._speed = np.zeros(n_keypoints)
-        self._speeds = np.zeros((n - 1, n_keypoints))
-        self._accels = np.zeros((n - 2, n_keypoints))
-        self._reversals = np.zeros((n - 2, n_keypoints))
+        self._n_speeds, self._n_accels = n - 1, n - 2
+        self._speeds = np.zeros((min(n - 1, cap), n_keypoints))
+        self._accels = np.zeros((min(n - 2, cap), n_keypoints))
+        self._reversals = np.zeros((min(n - 2, cap), n_keypoints))
         self._i = 0
         self._j = 0
 
@@ -95,9 +109,10 @@ class MotionStateTracker:
         self._held = held
         self._step = step
         self._speed = speed
+        # Sums over the rows kept, divided by the window's length: the mean over the window.
         return MotionState(
-            speed=self._speeds.mean(axis=0),
-            acceleration=self._accels.mean(axis=0),
-            jitter=self._reversals.mean(axis=0),
+            speed=self._speeds.sum(axis=0) / self._n_speeds,
+            acceleration=self._accels.sum(axis=0) / self._n_accels,
+            jitter=self._reversals.sum(axis=0) / self._n_accels,
             confidence=np.asarray(confidence, dtype=np.float64),
         )

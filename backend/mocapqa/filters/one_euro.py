@@ -25,6 +25,7 @@ import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.errors import InputError
+from mocapqa.filters.ranges import BELOW_ONE, FREQUENCY, NON_NEGATIVE, bounded, check_ranges
 from mocapqa.filters.streaming import channel_count, run_streaming
 
 __all__ = ["OneEuroFilter", "OneEuroParams", "one_euro_filter", "smoothing_factor"]
@@ -46,12 +47,13 @@ class OneEuroParams:
         Samples with a confidence at or below this are treated as missing.
     """
 
-    min_cutoff_hz: float = 1.0
-    beta: float = 0.007
-    d_cutoff_hz: float = 1.0
-    min_confidence: float = 0.0
+    min_cutoff_hz: float = bounded(1.0, FREQUENCY)
+    beta: float = bounded(0.007, NON_NEGATIVE)
+    d_cutoff_hz: float = bounded(1.0, FREQUENCY)
+    min_confidence: float = bounded(0.0, BELOW_ONE)
 
     def __post_init__(self) -> None:
+        check_ranges(self)
         if not (self.min_cutoff_hz > 0 and self.d_cutoff_hz > 0 and self.beta >= 0):
             raise InputError(
                 "Expected `min_cutoff_hz` > 0, `d_cutoff_hz` > 0 and `beta` >= 0, got "

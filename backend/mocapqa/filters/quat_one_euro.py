@@ -23,6 +23,7 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray, check_shape
 from mocapqa.errors import InputError
+from mocapqa.filters.ranges import FREQUENCY, NON_NEGATIVE, bounded, check_ranges
 from mocapqa.kinematics.quaternion import exp_map, log_map, multiply, unwrap
 
 __all__ = ["QuatOneEuroFilter", "QuatOneEuroParams", "quat_one_euro_filter"]
@@ -42,11 +43,12 @@ class QuatOneEuroParams:
         Cutoff of the angular-velocity low-pass, Hz.
     """
 
-    min_cutoff_hz: float = 1.5
-    beta: float = 0.5
-    d_cutoff_hz: float = 1.0
+    min_cutoff_hz: float = bounded(1.5, FREQUENCY)
+    beta: float = bounded(0.5, NON_NEGATIVE)
+    d_cutoff_hz: float = bounded(1.0, FREQUENCY)
 
     def __post_init__(self) -> None:
+        check_ranges(self)
         if not (self.min_cutoff_hz > 0 and self.d_cutoff_hz > 0 and self.beta >= 0):
             raise InputError(
                 "Expected `min_cutoff_hz` > 0, `d_cutoff_hz` > 0 and `beta` >= 0, got "

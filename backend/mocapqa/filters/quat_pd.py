@@ -36,6 +36,7 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray, check_shape
 from mocapqa.errors import InputError
+from mocapqa.filters.ranges import FREQUENCY, POSITIVE, UNIT_INTERVAL, bounded, check_ranges
 from mocapqa.kinematics.quaternion import unwrap
 
 __all__ = [
@@ -65,13 +66,14 @@ class QuatPDParams:
         What to do with gains the frame rate cannot integrate stably.
     """
 
-    natural_frequency_hz: float = 2.5
-    damping_ratio: float = 1.0
-    accel_gain: float = 0.0
+    natural_frequency_hz: float = bounded(2.5, FREQUENCY)
+    damping_ratio: float = bounded(1.0, POSITIVE)
+    accel_gain: float = bounded(0.0, UNIT_INTERVAL)
     integration: Literal["exact", "approximate"] = "exact"
     on_unstable: Literal["refuse", "clamp"] = "refuse"
 
     def __post_init__(self) -> None:
+        check_ranges(self)
         if not (self.natural_frequency_hz > 0 and self.damping_ratio > 0):
             raise InputError(
                 "Expected `natural_frequency_hz` > 0 and `damping_ratio` > 0, got "

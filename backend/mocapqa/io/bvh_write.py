@@ -9,7 +9,7 @@ Conventions
   was read with (``euler_hint_deg``) and they describe the same rotation, those numbers are
   written verbatim; elsewhere the equivalent triple nearest to them is chosen, so nothing
   jumps by 360° or flips to the second Euler solution.
-* Files are written to a temporary name and renamed into place.
+* Files are written to a temporary name and renamed into place (:mod:`mocapqa.io.atomic`).
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ import numpy.typing as npt
 
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import POSITION_CHANNELS, Motion
+from mocapqa.io.atomic import write_text
 from mocapqa.kinematics.euler import euler_from_quats, quats_from_euler
 
 __all__ = ["channel_values", "format_bvh", "frame_lines", "write_bvh"]
@@ -194,8 +195,15 @@ def channel_values(motion: Motion) -> FloatArray:
 
 
 def write_bvh(path: str | Path, motion: Motion, precision: int = 6) -> None:
-    """Write a motion as BVH (written to a temporary name, then renamed into place)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(format_bvh(motion, precision), encoding="utf-8", newline="\n")
-    tmp.replace(path)
+    """Write a motion as BVH, whole or not at all (:mod:`mocapqa.io.atomic`).
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination file.
+    motion : Motion
+        The take.
+    precision : int, default 6
+        Decimal places of channel values.
+    """
+    write_text(path, format_bvh(motion, precision))

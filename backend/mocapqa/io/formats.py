@@ -16,17 +16,15 @@ from __future__ import annotations
 
 import codecs
 import json
+import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Literal
 
-import numpy as np
-
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
-from mocapqa.errors import ParseError, UnsupportedFormatError
+from mocapqa.errors import InputError, ParseError, UnsupportedFormatError
 from mocapqa.io.bvh import NumberReader, read_bvh
-from mocapqa.io.bvh_frames import MAX_MAGNITUDE
 from mocapqa.io.guards import ReadLimits, check_take_input, check_take_size
 from mocapqa.io.keypoint_arrays import (
     read_keypoint_npy,
@@ -35,6 +33,7 @@ from mocapqa.io.keypoint_arrays import (
     write_keypoint_npz,
 )
 from mocapqa.io.keypoint_csv import read_keypoint_csv, write_keypoint_csv
+from mocapqa.io.keypoint_input import check_coordinates
 from mocapqa.io.keypoint_json import read_keypoint_json, write_keypoint_json
 from mocapqa.io.mediapipe import read_mediapipe_csv, read_mediapipe_json, read_mediapipe_pbtxt
 from mocapqa.io.openpose import openpose_frame_files, read_openpose
@@ -45,6 +44,7 @@ __all__ = [
     "KEYPOINT_WRITE_FORMATS",
     "MAX_FPS",
     "TAKE_FORMATS",
+    "check_fps",
     "detect_format",
     "read_take",
     "require_frames",
@@ -265,14 +265,37 @@ MAX_FPS = 100_000.0
 from a file): far above any capture system, low enough that per-second rates stay finite."""
 
 
+def check_fps(fps: float, name: str = "fps") -> None:
+    """Refuse a frame rate the user gives (``--fps``, an upload's ``fps``) that is not finite,
+    above 0 and at most :data:`MAX_FPS`.
+
+    Parameters
+    ----------
+    fps : float
+        The rate, frames per second.
+    name : str
+        The option or field named in the message.
+
+    Raises
+    ------
+    InputError
+        E.g. ``Expected --fps > 0, finite and at most 100000 frames per second, got inf``.
+    """
+    if not (math.isfinite(fps) and 0 < fps <= MAX_FPS):
+        raise InputError(
+            f"Expected {name} > 0, finite and at most {MAX_FPS:g} frames per second, got {fps:g}"
+        )
+
+
 def require_frames(take: Motion | KeypointSequence, path: str | Path) -> None:
     """Refuse a take without frames (a BVH's ``Frames: 0``): nothing to analyse or draw.
 
     Readers accept such a take, so ``mocapqa info`` and ``convert`` work on a rig-only BVH;
     everything that analyses, filters or renders a take calls this first.
 
-    Also refuses a keypoint take without keypoints, with a coordinate beyond ±1e9 or a frame
-    rate over 100,000 fps (the limits a BVH's reader and ``--fps`` already keep).
+    Also refuses a keypoint take without keypoints, with a coordinate beyond ±1e9 (which the
+    readers refuse already; a sequence made in code may hold one) or a frame rate over
+    100,000 fps (the limits a BVH's reader and ``--fps`` already keep).
 
     Raises
     ------
@@ -284,17 +307,9 @@ def require_frames(take: Motion | KeypointSequence, path: str | Path) -> None:
         field = "Frames" if isinstance(take, Motion) else None
         raise ParseError("Expected at least one frame, got 0", path, field=field)
     if isinstance(take, KeypointSequence):
-        # The keypoint readers keep any finite number: refuse what no take holds, as the BVH
-        # reader does (MAX_MAGNITUDE), before a filter squares it into infinity.
         if take.n_keypoints == 0:
             raise ParseError("Expected at least one keypoint, got 0", path, field="keypoints")
-        largest = float(np.nanmax(np.abs(take.positions), initial=0.0))
-        if largest > MAX_MAGNITUDE:
-            raise ParseError(
-                f"Expected coordinates within ±{MAX_MAGNITUDE:g}, got {largest:g}",
-                path,
-                field="positions",
-            )
+        check_coordinates(take.positions, path, take.names, take.frame_numbers)
         if take.fps > MAX_FPS:
             raise ParseError(
                 f"Expected fps at most {MAX_FPS:g}, got {take.fps:g}", path, field="fps"

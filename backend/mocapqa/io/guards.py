@@ -21,7 +21,9 @@ The limits are parameters (:class:`ReadLimits`); the server builds them from its
 from __future__ import annotations
 
 import codecs
+import math
 import re
+import tokenize
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,12 +36,15 @@ from mocapqa.errors import ParseError, TooLargeError
 __all__ = [
     "JSON_FORMATS",
     "TEXT_FORMATS",
+    "NpyHeader",
     "ReadLimits",
     "check_frame_points",
     "check_json_depth",
     "check_line_length",
     "check_take_input",
     "check_take_size",
+    "json_nesting",
+    "read_npy_header",
 ]
 
 TEXT_FORMATS = frozenset(
@@ -118,11 +123,37 @@ def check_line_length(path: Path, max_line_bytes: int) -> None:
             line, run = line + int(newlines.size), tail
 
 
-def check_json_depth(path: Path, max_depth: int) -> None:
-    """Refuse a JSON file nested deeper than ``max_depth``, without parsing it.
+def json_nesting(data: bytes, depth: int = 0) -> tuple[int, int]:
+    """The deepest nesting of arrays and objects in ``data``, and the nesting at its end.
 
-    Brackets are counted in 1 MB chunks with NumPy; brackets inside strings count too, so
-    the estimate errs on the side of refusing (keypoint names hold no brackets).
+    Brackets are counted with NumPy, 1 MB at a time, without parsing; brackets inside strings
+    count too, so the estimate errs on the side of refusing (keypoint names hold no brackets).
+
+    Parameters
+    ----------
+    data : bytes
+        JSON text, or a piece of it.
+    depth : int
+        The nesting at the start of ``data`` (the previous piece's end).
+
+    Returns
+    -------
+    deepest, end : int
+    """
+    deepest = depth
+    view = memoryview(data)
+    for start in range(0, len(data), _CHUNK):
+        steps = _OPEN[np.frombuffer(view[start : start + _CHUNK], dtype=np.uint8)]
+        if not steps.any():
+            continue
+        levels = depth + np.cumsum(steps, dtype=np.int64)
+        deepest, depth = max(deepest, int(levels.max())), int(levels[-1])
+    return deepest, depth
+
+
+def check_json_depth(path: Path, max_depth: int) -> None:
+    """Refuse a JSON file nested deeper than ``max_depth``, without parsing it
+    (:func:`json_nesting` over 1 MB chunks).
 
     Raises
     ------
@@ -132,29 +163,94 @@ def check_json_depth(path: Path, max_depth: int) -> None:
     depth = 0
     with path.open("rb") as handle:
         while chunk := handle.read(_CHUNK):
-            steps = _OPEN[np.frombuffer(chunk, dtype=np.uint8)]
-            if not steps.any():
-                continue
-            levels = depth + np.cumsum(steps, dtype=np.int64)
-            if int(levels.max()) > max_depth:
+            deepest, depth = json_nesting(chunk, depth)
+            if deepest > max_depth:
                 raise TooLargeError(
                     f"{path.name}: Expected JSON nested at most {max_depth} deep "
                     "(setting max_json_depth), got deeper"
                 )
-            depth = int(levels[-1])
 
 
-def _frame_points(shape: tuple[int, ...], itemsize: int, path: Path, limits: ReadLimits) -> int:
-    frame_points = int(shape[0]) * int(shape[1]) if len(shape) >= 2 else 0
+def _frame_points(header: NpyHeader, path: Path, limits: ReadLimits) -> int:
+    shape = header.shape
+    frame_points = shape[0] * shape[1] if len(shape) >= 2 else 0
     if frame_points > limits.max_frame_points:
         raise TooLargeError(
             f"{path.name}: Expected at most {limits.max_frame_points} frames × points "
             f"(setting max_frame_points), got {shape[0]} × {shape[1]}"
         )
-    return int(np.prod(shape, dtype=np.int64)) * itemsize
+    return header.n_bytes
 
 
-def _npy_header(handle: IO[bytes], path: Path) -> tuple[tuple[int, ...], int]:
+@dataclass(frozen=True, slots=True)
+class NpyHeader:
+    """What a ``.npy`` header declares.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        The array's shape (no dimension negative).
+    dtype : numpy.dtype
+        Its element type (never one holding Python objects).
+    offset : int
+        Bytes from the start of the ``.npy`` to its data.
+    """
+
+    shape: tuple[int, ...]
+    dtype: np.dtype
+    offset: int
+
+    @property
+    def n_bytes(self) -> int:
+        """Bytes of data the header declares (Python integers: no overflow)."""
+        return math.prod(self.shape) * int(self.dtype.itemsize)
+
+
+# What NumPy's header reader raises on a malformed header: besides ValueError, the tokenizer's
+# error (a header it retries as Python 2's), SyntaxError and RecursionError from the literal.
+_HEADER_ERRORS = (
+    ValueError,
+    OSError,
+    EOFError,
+    SyntaxError,
+    TypeError,
+    RecursionError,
+    MemoryError,
+    tokenize.TokenError,
+)
+
+
+def _header_problem(error: BaseException) -> str:
+    """What was wrong with a header, in our words (NumPy's suggest loading it unsafely)."""
+    text = str(error).splitlines()[0] if str(error) else ""
+    if text.startswith("Header info length"):
+        return "a header longer than 10,000 bytes"
+    if isinstance(error, ValueError | OSError | EOFError) and "allow_pickle" not in text:
+        return text[:160] or type(error).__name__
+    return "a header that is not a dictionary of shape, dtype and order"
+
+
+def read_npy_header(handle: IO[bytes], path: str | Path) -> NpyHeader:
+    """Read the header of the ``.npy`` at ``handle``'s position, without its data.
+
+    Parameters
+    ----------
+    handle : binary file
+        Positioned at the magic string; left at the start of the data.
+    path : str or Path
+        The file named in messages.
+
+    Returns
+    -------
+    NpyHeader
+
+    Raises
+    ------
+    ParseError
+        On a missing magic string or a malformed header (naming the file), a negative
+        dimension, or an array of Python objects (never read: that would need pickle).
+    """
+    start = handle.tell()
     try:
         version = np.lib.format.read_magic(handle)
         read_header = (
@@ -163,17 +259,26 @@ def _npy_header(handle: IO[bytes], path: Path) -> tuple[tuple[int, ...], int]:
             else np.lib.format.read_array_header_2_0
         )
         shape, _, dtype = read_header(handle, max_header_size=10_000)
-    except (ValueError, OSError, EOFError) as e:
-        raise ParseError(f"Expected a NumPy array header, got unreadable data ({e})", path) from e
-    return tuple(int(n) for n in shape), int(dtype.itemsize)
+    except _HEADER_ERRORS as e:
+        raise ParseError(
+            f"Expected a NumPy array header, got unreadable data ({_header_problem(e)})", path
+        ) from e
+    if any(n < 0 for n in shape):
+        raise ParseError(f"Expected an array shape without negative sizes, got {shape}", path)
+    if dtype.hasobject:
+        raise ParseError(
+            f"Expected an array of numbers, got an array of Python objects ({dtype}), "
+            "which is not read",
+            path,
+        )
+    return NpyHeader(tuple(int(n) for n in shape), dtype, handle.tell() - start)
 
 
 def _check_arrays(path: Path, kind: str, limits: ReadLimits) -> None:
     total = 0
     if kind == "npy":
         with path.open("rb") as handle:
-            shape, itemsize = _npy_header(handle, path)
-        total = _frame_points(shape, itemsize, path, limits)
+            total = _frame_points(read_npy_header(handle, path), path, limits)
     else:
         try:
             with zipfile.ZipFile(path) as archive:
@@ -187,8 +292,7 @@ def _check_arrays(path: Path, kind: str, limits: ReadLimits) -> None:
                 for member in members:
                     if member.filename.endswith(".npy"):
                         with archive.open(member) as handle:
-                            shape, itemsize = _npy_header(handle, path)
-                        total += _frame_points(shape, itemsize, path, limits)
+                            total += _frame_points(read_npy_header(handle, path), path, limits)
         except (zipfile.BadZipFile, OSError, EOFError, ValueError) as e:
             raise ParseError(f"Expected a readable .npz archive, got {e}", path) from e
     if total > limits.max_unpacked_bytes:

@@ -8,6 +8,9 @@ Conventions
 * ``.npz`` holds ``positions`` (or ``keypoints``) as above and may carry ``confidence``
   ``(F, K)``, ``names`` ``(K,)``, ``fps``, ``unit`` and ``n_dims``; the writer stores all of them.
 * Arrays are loaded with ``allow_pickle=False``. NaN is missing; infinity is an error.
+* Every array header is read first (:func:`mocapqa.io.guards.read_npy_header`): an array of
+  Python objects is refused, and so is a header declaring more data than the file (or the
+  ``.npz`` member) holds, before NumPy allocates what the header declares.
 """
 
 from __future__ import annotations
@@ -22,6 +25,8 @@ from numpy.typing import NDArray
 
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import ParseError
+from mocapqa.io.atomic import atomic_path
+from mocapqa.io.guards import read_npy_header
 from mocapqa.io.keypoint_input import (
     build_keypoint_sequence,
     read_file_bytes,
@@ -43,6 +48,8 @@ __all__ = [
 def _split(
     array: NDArray[Any], path: str, field: str
 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, int]:
+    if not isinstance(array, np.ndarray):  # an .npz member without the .npy format
+        raise ParseError("Expected a NumPy array, got other data", path, field=field)
     if array.ndim != 3 or array.shape[2] not in (2, 3, 4):
         raise ParseError(
             f"Expected an array of shape (F, K, 2|3|4), got {array.shape}", path, field=field
@@ -67,7 +74,43 @@ def _split(
     return positions, confidence, n_dims
 
 
+def _check_declared(declared: int, held: int, path: str, member: str | None = None) -> None:
+    if declared > held:
+        raise ParseError(
+            f"Expected at most the {held} bytes of data the file holds, got a header "
+            f"declaring {declared} (a truncated file, or a header that lies)",
+            path,
+            field=member,
+        )
+
+
+def _check_headers(data: bytes, path: str) -> None:
+    """Read every array header of ``.npy`` or ``.npz`` bytes before NumPy loads them."""
+    if data.startswith(b"\x93NUMPY"):
+        handle = io.BytesIO(data)
+        header = read_npy_header(handle, path)
+        _check_declared(header.n_bytes, len(data) - header.offset, path)
+        return
+    if not data.startswith(b"PK"):
+        raise ParseError(
+            "Expected a NumPy file (a .npy starting with \\x93NUMPY, or an .npz zip archive), "
+            "got other data",
+            path,
+        )
+    try:
+        with zipfile.ZipFile(io.BytesIO(data)) as archive:
+            for member in archive.infolist():
+                if member.filename.endswith(".npy"):
+                    with archive.open(member) as stream:
+                        header = read_npy_header(stream, path)
+                    key = member.filename.removesuffix(".npy")
+                    _check_declared(header.n_bytes, member.file_size - header.offset, path, key)
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, ValueError) as e:
+        raise ParseError(f"Expected a readable .npz archive, got {e}", path) from e
+
+
 def _load(data: bytes, path: str) -> Any:
+    _check_headers(data, path)
     try:
         return np.load(io.BytesIO(data), allow_pickle=False)
     except (ValueError, OSError, EOFError, zipfile.BadZipFile, KeyError) as e:
@@ -120,6 +163,8 @@ def parse_keypoint_npy(
 
 def _scalar(archive: Any, key: str, path: str) -> Any:
     value = archive[key]
+    if not isinstance(value, np.ndarray):
+        raise ParseError("Expected a NumPy scalar, got other data", path, field=key)
     if value.ndim != 0:
         raise ParseError(f"Expected a scalar, got shape {value.shape}", path, field=key)
     return value.item()
@@ -225,7 +270,7 @@ def write_keypoint_npy(path: str | Path, seq: KeypointSequence) -> None:
         The data.
     """
     stacked = np.concatenate([seq.positions, seq.confidence[..., None]], axis=-1)
-    with Path(path).open("wb") as handle:
+    with atomic_path(path) as temporary, temporary.open("wb") as handle:
         np.save(handle, stacked, allow_pickle=False)
 
 
@@ -239,7 +284,7 @@ def write_keypoint_npz(path: str | Path, seq: KeypointSequence) -> None:
     seq : KeypointSequence
         The data.
     """
-    with Path(path).open("wb") as handle:
+    with atomic_path(path) as temporary, temporary.open("wb") as handle:
         np.savez(
             handle,
             positions=seq.positions,

@@ -36,6 +36,7 @@ import numpy as np
 
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import ParseError
+from mocapqa.io.atomic import atomic_path
 from mocapqa.io.guards import ReadLimits, check_take_size
 from mocapqa.io.keypoint_input import (
     build_keypoint_sequence,
@@ -52,6 +53,7 @@ __all__ = [
     "csv_sidecar",
     "csv_sidecar_path",
     "format_keypoint_csv",
+    "is_csv_sidecar",
     "parse_keypoint_csv",
     "read_keypoint_csv",
     "write_keypoint_csv",
@@ -85,6 +87,12 @@ def csv_sidecar_path(path: str | Path) -> Path:
     """The metadata sidecar of a long keypoint CSV: ``walk.csv`` → ``walk.csv.meta.json``."""
     path = Path(path)
     return path.with_name(path.name + ".meta.json")
+
+
+def is_csv_sidecar(name: str | Path) -> bool:
+    """Whether a file name is a keypoint CSV's metadata sidecar (``*.csv.meta.json``, any
+    case): read with its CSV, never a take of its own (batches and shoot imports skip it)."""
+    return Path(name).name.lower().endswith(".csv.meta.json")
 
 
 def _read_sidecar(path: str | Path) -> dict[str, Any] | None:
@@ -314,7 +322,8 @@ def csv_sidecar(seq: KeypointSequence) -> dict[str, Any]:
 def write_keypoint_csv(path: str | Path, seq: KeypointSequence) -> None:
     """Write a sequence as a long keypoint CSV file and its ``.meta.json`` sidecar.
 
-    Each is written under a temporary name, then renamed into place.
+    Both are written to temporary files first and renamed into place only when both were
+    written (:mod:`mocapqa.io.atomic`); a failure leaves the old pair as it was.
 
     Parameters
     ----------
@@ -324,10 +333,7 @@ def write_keypoint_csv(path: str | Path, seq: KeypointSequence) -> None:
         The data.
     """
     path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(format_keypoint_csv(seq), encoding="utf-8", newline="\n")
-    tmp.replace(path)
     sidecar = csv_sidecar_path(path)
-    tmp = sidecar.with_name(sidecar.name + ".tmp")
-    tmp.write_text(json.dumps(csv_sidecar(seq), indent=1), encoding="utf-8")
-    tmp.replace(sidecar)
+    with atomic_path(path) as table, atomic_path(sidecar) as meta:
+        table.write_text(format_keypoint_csv(seq), encoding="utf-8", newline="\n")
+        meta.write_text(json.dumps(csv_sidecar(seq), indent=1), encoding="utf-8")

@@ -6,6 +6,9 @@ Conventions
   the 1-based line or the field; a :class:`~mocapqa.errors.ShapeError` raised while building
   the :class:`~mocapqa.core.keypoints.KeypointSequence` is wrapped the same way.
 * Number text follows Python's ``float``: ``nan`` means missing; infinity is rejected.
+* Coordinates lie within ±:data:`~mocapqa.io.bvh_frames.MAX_MAGNITUDE` (1e9), the bound the BVH
+  reader keeps: every reader builds its sequence with :func:`build_keypoint_sequence`, which
+  refuses a larger one (:func:`check_coordinates`) before a filter squares it into infinity.
 * The frame rate is resolved in one place: a caller's ``fps`` wins, then the file's, then a
   reader-specific default that is recorded in ``KeypointSequence.assumptions``, or an error
   when the format has no default.
@@ -13,22 +16,29 @@ Conventions
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from mocapqa.core.arrays import FloatArray, IntArray
 from mocapqa.core.keypoints import LENGTH_UNITS, KeypointSequence
 from mocapqa.errors import ParseError, ShapeError
+from mocapqa.io.bvh_frames import MAX_MAGNITUDE
+from mocapqa.io.guards import json_nesting
 
 __all__ = [
     "FPS_SNAP_TOLERANCE",
+    "JSON_PARSE_DEPTH",
     "MAX_FILE_BYTES",
     "STANDARD_FPS",
     "build_keypoint_sequence",
+    "check_coordinates",
     "decode_text",
     "float_from_text",
+    "parse_json",
     "read_file_bytes",
     "resolve_fps",
     "resolve_length_unit",
@@ -95,6 +105,46 @@ def decode_text(data: bytes | str, path: str | Path) -> str:
         line = text[: text.index("\x00")].count("\n") + 1
         raise ParseError("Expected a text file, got binary data (NUL bytes)", path, line)
     return text
+
+
+JSON_PARSE_DEPTH = 512
+"""Deepest nesting of arrays and objects the JSON readers parse, whatever the reading limits
+(the server's ``max_json_depth``, 64, refuses deeper files first): Python's parser recurses
+once per level and fails near its recursion limit of 1,000 calls."""
+
+
+def parse_json(data: bytes | str, path: str | Path) -> Any:
+    """Parse a JSON document of a keypoint format (see :func:`decode_text` for the text).
+
+    Parameters
+    ----------
+    data : bytes or str
+        The file's content.
+    path : str or Path
+        The file name used in messages.
+
+    Returns
+    -------
+    object
+        The document.
+
+    Raises
+    ------
+    ParseError
+        On text that is not UTF-8, invalid JSON (with its line), or a document nested deeper
+        than :data:`JSON_PARSE_DEPTH`.
+    """
+    text = decode_text(data, path)
+    deepest, _ = json_nesting(data if isinstance(data, bytes) else text.encode("utf-8"))
+    too_deep = f"Expected JSON nested at most {JSON_PARSE_DEPTH} deep, got deeper"
+    if deepest > JSON_PARSE_DEPTH:
+        raise ParseError(too_deep, path)
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as e:
+        raise ParseError(f"Expected valid JSON, got {e.msg}", path, e.lineno) from e
+    except RecursionError as e:  # a backstop: deep in a caller's stack, fewer levels parse
+        raise ParseError(too_deep, path) from e
 
 
 def float_from_text(
@@ -183,7 +233,7 @@ def resolve_fps(
         fps = default_fps
         assumptions.append(f"fps {default_fps:g} assumed: {format_name} stores no frame rate")
     if not (math.isfinite(fps) and fps > 0):
-        raise ParseError(f"Expected fps > 0, got {fps}", path, field="fps")
+        raise ParseError(f"Expected a finite fps > 0, got {fps}", path, field="fps")
     return float(fps)
 
 
@@ -274,6 +324,53 @@ def resolve_length_unit(
     return default_unit
 
 
+def check_coordinates(
+    positions: FloatArray,
+    path: str | Path,
+    names: tuple[str, ...] | None = None,
+    frame_numbers: IntArray | None = None,
+) -> None:
+    """Refuse coordinates beyond ±:data:`~mocapqa.io.bvh_frames.MAX_MAGNITUDE` (NaN is missing).
+
+    Parameters
+    ----------
+    positions : ndarray, shape (F, K, 3)
+        Coordinates.
+    path : str or Path
+        The file named in the message.
+    names : tuple of str, optional
+        Keypoint names, to name the first coordinate out of range.
+    frame_numbers : ndarray of int, shape (F,), optional
+        The source's frame numbers, to name its frame (else the 0-based frame index).
+
+    Raises
+    ------
+    ParseError
+        Naming the file, the field ``positions``, the value, its frame and keypoint.
+    """
+    values = np.asarray(positions, dtype=np.float64)
+    if values.size == 0:
+        return
+    # Two reductions without a temporary |values| array (the take may be large).
+    if np.nanmax(values, initial=-np.inf) <= MAX_MAGNITUDE and (
+        np.nanmin(values, initial=np.inf) >= -MAX_MAGNITUDE
+    ):
+        return
+    where = tuple(int(i) for i in np.argwhere(np.abs(values) > MAX_MAGNITUDE)[0])
+    frame = where[0]
+    if frame_numbers is not None and len(frame_numbers) == len(values):
+        frame = int(frame_numbers[frame])
+    point = f"keypoint {where[1]}"
+    if names is not None and len(names) == values.shape[1]:
+        point = f"keypoint {names[where[1]]!r}"
+    raise ParseError(
+        f"Expected coordinates within ±{int(MAX_MAGNITUDE):,}, got {values[where]:g} "
+        f"(frame {frame}, {point})",
+        path,
+        field="positions",
+    )
+
+
 def build_keypoint_sequence(
     path: str | Path,
     names: tuple[str, ...],
@@ -321,8 +418,10 @@ def build_keypoint_sequence(
     Raises
     ------
     ParseError
-        When the data do not make a valid sequence (duplicate names, confidence outside [0, 1]).
+        When the data do not make a valid sequence (duplicate names, confidence outside [0, 1]),
+        or a coordinate lies beyond ±1e9 (:func:`check_coordinates`).
     """
+    check_coordinates(positions, path, tuple(names), frame_numbers)
     try:
         return KeypointSequence(
             names=tuple(names),

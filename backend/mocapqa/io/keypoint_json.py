@@ -24,9 +24,10 @@ import numpy as np
 
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import ParseError
+from mocapqa.io.atomic import write_text
 from mocapqa.io.keypoint_input import (
     build_keypoint_sequence,
-    decode_text,
+    parse_json,
     read_file_bytes,
     resolve_fps,
     resolve_length_unit,
@@ -93,12 +94,7 @@ def parse_keypoint_json(
         On invalid JSON (with its line) or a wrong structure (with the field).
     """
     path = str(path)
-    try:
-        document = json.loads(decode_text(data, path))
-    except json.JSONDecodeError as e:
-        raise ParseError(f"Expected valid JSON, got {e.msg}", path, e.lineno) from e
-    except RecursionError as e:
-        raise ParseError("Expected JSON nested less deeply", path) from e
+    document = parse_json(data, path)
     if not isinstance(document, dict):
         raise ParseError("Expected a JSON object", path)
     names = document.get("keypoints")
@@ -176,7 +172,7 @@ def format_keypoint_json(seq: KeypointSequence) -> str:
 
 
 def write_keypoint_json(path: str | Path, seq: KeypointSequence) -> None:
-    """Write a sequence as generic keypoint JSON (temporary name, then renamed into place).
+    """Write a sequence as generic keypoint JSON, whole or not at all (:mod:`mocapqa.io.atomic`).
 
     Parameters
     ----------
@@ -185,7 +181,4 @@ def write_keypoint_json(path: str | Path, seq: KeypointSequence) -> None:
     seq : KeypointSequence
         The data.
     """
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(format_keypoint_json(seq), encoding="utf-8", newline="\n")
-    tmp.replace(path)
+    write_text(path, format_keypoint_json(seq))

@@ -20,7 +20,6 @@ Conventions
 
 from __future__ import annotations
 
-import json
 import math
 import re
 from pathlib import Path
@@ -35,6 +34,7 @@ from mocapqa.io.keypoint_input import (
     build_keypoint_sequence,
     decode_text,
     float_from_text,
+    parse_json,
     read_file_bytes,
     resolve_fps,
     resolve_length_unit,
@@ -236,10 +236,7 @@ def parse_mediapipe_json(
         On invalid JSON (line) or a wrong structure (field).
     """
     path = str(path)
-    try:
-        document = json.loads(decode_text(data, path))
-    except json.JSONDecodeError as e:
-        raise ParseError(f"Expected valid JSON, got {e.msg}", path, e.lineno) from e
+    document = parse_json(data, path)
     frames, file_fps = _frames_of(document, path)
     if not frames:
         raise ParseError("Expected at least one frame, got none", path, field="frames")

@@ -22,7 +22,6 @@ Conventions
 
 from __future__ import annotations
 
-import json
 import math
 import re
 from pathlib import Path
@@ -35,7 +34,7 @@ from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import ParseError
 from mocapqa.io.keypoint_input import (
     build_keypoint_sequence,
-    decode_text,
+    parse_json,
     read_file_bytes,
     resolve_fps,
 )
@@ -143,11 +142,7 @@ def parse_openpose_frame(
     ParseError
         On invalid JSON (with its line) or a wrong structure (with the field).
     """
-    text = decode_text(data, path)
-    try:
-        document: Any = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise ParseError(f"Expected valid JSON, got {e.msg}", path, e.lineno) from e
+    document: Any = parse_json(data, path)
     if not isinstance(document, dict) or not isinstance(document.get("people"), list):
         raise ParseError("Expected an object with a 'people' list", path, field="people")
     people: list[Any] = document["people"]

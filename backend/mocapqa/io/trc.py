@@ -32,6 +32,7 @@ import numpy as np
 
 from mocapqa.core.keypoints import LENGTH_UNITS, KeypointSequence
 from mocapqa.errors import ParseError
+from mocapqa.io.atomic import write_text
 from mocapqa.io.keypoint_input import (
     build_keypoint_sequence,
     decode_text,
@@ -239,7 +240,7 @@ def format_trc(seq: KeypointSequence, file_name: str = "keypoints.trc") -> str:
 
 
 def write_trc(path: str | Path, seq: KeypointSequence) -> None:
-    """Write a sequence as a TRC file (written to a temporary name, then renamed into place).
+    """Write a sequence as a TRC file, whole or not at all (:mod:`mocapqa.io.atomic`).
 
     Parameters
     ----------
@@ -249,6 +250,4 @@ def write_trc(path: str | Path, seq: KeypointSequence) -> None:
         The data. Confidence is not stored; 2D data are written with their zero Z.
     """
     path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(format_trc(seq, path.name), encoding="utf-8", newline="\n")
-    tmp.replace(path)
+    write_text(path, format_trc(seq, path.name))

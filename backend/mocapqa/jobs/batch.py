@@ -17,10 +17,11 @@ import os
 import time
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
-from pathlib import Path
+from pathlib import Path, PurePath
 from typing import TYPE_CHECKING, Any
 
 from mocapqa.errors import InputError, MocapQAError
+from mocapqa.io.keypoint_csv import is_csv_sidecar
 from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.take_task import analyse_path, content_sha256
 from mocapqa.store.repository import new_id
@@ -29,10 +30,31 @@ from mocapqa.store.shoots import ShootStore
 if TYPE_CHECKING:
     from mocapqa.pipeline.options import AnalysisOptions
 
-__all__ = ["CHUNK_TAKES", "MOTION_SUFFIXES", "BatchCounts", "chunk_size", "discover", "run_batch"]
+__all__ = [
+    "CHUNK_TAKES",
+    "MOTION_SUFFIXES",
+    "BatchCounts",
+    "chunk_size",
+    "discover",
+    "run_batch",
+    "skip_reason",
+]
 
 MOTION_SUFFIXES = (".bvh", ".trc", ".csv", ".json", ".npy", ".npz", ".pbtxt")
 """File suffixes a batch analyses; other files under a folder are ignored."""
+SIDECAR_REASON = "a keypoint CSV's .meta.json sidecar (read with its CSV), not a take"
+
+
+def skip_reason(name: str | Path) -> str | None:
+    """Why a file (by name) is not a take, or None when it is one: a suffix not in
+    :data:`MOTION_SUFFIXES`, or a keypoint CSV's ``.meta.json`` sidecar. Batches and shoot
+    imports share this rule."""
+    if is_csv_sidecar(name):
+        return SIDECAR_REASON
+    if PurePath(name).suffix.lower() not in MOTION_SUFFIXES:
+        return "not a motion file"
+    return None
+
 
 CHUNK_TAKES = 4
 """Takes per Dask task in a large batch. A task costs the client, scheduler and worker about
@@ -76,9 +98,10 @@ def _is_frame_folder(folder: Path, names: list[str]) -> bool:
 def discover(paths: Iterable[Path]) -> Iterator[tuple[Path, str | None]]:
     """Every take under ``paths``, in a stable order, with a reason when it is skipped.
 
-    A file named on the command line is a take when its suffix is in :data:`MOTION_SUFFIXES`
-    (else it is skipped, with the reason); under a folder, such files are takes and other
-    files are ignored. A folder of OpenPose JSON frames is one take.
+    A file named on the command line is a take when :func:`skip_reason` finds none (else it
+    is skipped, with the reason); under a folder, such files are takes and other files
+    (a keypoint CSV's ``.meta.json`` sidecar among them) are ignored. A folder of OpenPose
+    JSON frames is one take.
 
     Raises
     ------
@@ -89,8 +112,7 @@ def discover(paths: Iterable[Path]) -> Iterator[tuple[Path, str | None]]:
         if not path.exists():
             raise InputError(f"Expected an existing file or folder, got nothing at {path}")
         if path.is_file():
-            ok = path.suffix.lower() in MOTION_SUFFIXES
-            yield path, None if ok else "not a motion file"
+            yield path, skip_reason(path)
             continue
         for folder, dirs, names in os.walk(path):
             dirs.sort()
@@ -99,7 +121,7 @@ def discover(paths: Iterable[Path]) -> Iterator[tuple[Path, str | None]]:
                 yield here, None
                 names = [n for n in names if not n.endswith(".json")]
             for name in sorted(names):
-                if Path(name).suffix.lower() in MOTION_SUFFIXES:
+                if skip_reason(name) is None:
                     yield here / name, None
 
 

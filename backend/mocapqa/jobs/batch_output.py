@@ -2,7 +2,10 @@
 
 One row per file: ``source``, ``status`` (done | failed | skipped), ``error``, ``take_id`` and
 the QA summary columns (``docs/qa-summary.md``). Parquet is written in row groups of
-:data:`ROW_GROUP` rows, so memory stays bounded whatever the corpus size.
+:data:`ROW_GROUP` rows, so memory stays bounded whatever the corpus size. Rows stream to a
+temporary file beside the output, renamed into place on :meth:`ResultWriter.close`
+(:mod:`mocapqa.io.atomic`): a table that cannot be finished (a full disk) leaves an existing
+file as it was, and a device, FIFO or folder is refused up front.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from mocapqa.errors import InputError
+from mocapqa.io.atomic import PendingFile, output_target, with_output_path
 
 __all__ = ["COLUMNS", "OUTPUT_FORMATS", "ROW_GROUP", "ResultWriter"]
 
@@ -47,7 +51,8 @@ class ResultWriter:
     Raises
     ------
     InputError
-        For a suffix other than ``.csv``, ``.jsonl`` or ``.parquet``.
+        For a suffix other than ``.csv``, ``.jsonl`` or ``.parquet``, or an output that
+        exists and is not a regular file.
     """
 
     def __init__(self, path: Path) -> None:
@@ -58,6 +63,9 @@ class ResultWriter:
                 f"Expected an output ending in {', '.join(OUTPUT_FORMATS)}, got {self.path.name!r}"
             )
         self.path.parent.mkdir(parents=True, exist_ok=True)
+        output_target(self.path)  # refused before the batch starts, not at its end
+        self._file: PendingFile | None = None  # created on the first flush
+        self._closed = False
         self._pending: list[dict[str, Any]] = []
         self._text: TextIO | None = None
         self._csv: Any = None
@@ -72,16 +80,30 @@ class ResultWriter:
             self.flush()
 
     def flush(self) -> None:
-        """Write the queued rows."""
-        if self.format == "parquet":
-            self._flush_parquet()
-        else:
-            self._flush_text()
+        """Write the queued rows.
+
+        Raises
+        ------
+        OSError
+            When they cannot be written (its ``filename`` is the output, not the temporary).
+        """
+        try:
+            if self.format == "parquet":
+                self._flush_parquet()
+            else:
+                self._flush_text()
+        except OSError as e:
+            raise with_output_path(e, self.path) from e
         self._pending = []
+
+    def _temporary(self) -> Path:
+        if self._file is None:
+            self._file = PendingFile(self.path)
+        return self._file.temporary
 
     def _flush_text(self) -> None:
         if self._text is None:
-            self._text = self.path.open("w", newline="", encoding="utf-8")
+            self._text = self._temporary().open("w", newline="", encoding="utf-8")
             if self.format == "csv":
                 self._csv = csv.DictWriter(self._text, [name for name, _ in COLUMNS])
                 self._csv.writeheader()
@@ -98,18 +120,44 @@ class ResultWriter:
 
         schema = pa.schema([(name, pa.type_for_alias(kind)) for name, kind in COLUMNS])
         if self._parquet is None:
-            self._parquet = pq.ParquetWriter(self.path, schema)
+            self._parquet = pq.ParquetWriter(self._temporary(), schema)
         if self._pending:
             table = pa.Table.from_pylist(self._pending, schema=schema)
             self._parquet.write_table(table)
 
     def close(self) -> None:
-        """Flush and close the file (an empty table still gets its header or schema)."""
-        self.flush()
-        if self._text is not None:
-            self._text.close()
-        if self._parquet is not None:
-            self._parquet.close()
+        """Flush, close and rename the file into place (an empty table still gets its header
+        or schema).
+
+        Raises
+        ------
+        OSError
+            When the table cannot be finished (its ``filename`` is the output); the
+            temporary file is removed and an existing output is left as it was.
+        """
+        if self._closed:
+            return
+        self._closed = True
+        error: BaseException | None = None
+        try:
+            self.flush()
+        except BaseException as e:
+            error = e
+        for handle in (self._text, self._parquet):
+            try:
+                if handle is not None:
+                    handle.close()
+            except BaseException as e:
+                error = error or e
+        self._text = self._parquet = None
+        if error is not None:
+            if self._file is not None:
+                self._file.discard()
+            if isinstance(error, OSError):
+                raise with_output_path(error, self.path) from error
+            raise error
+        if self._file is not None:
+            self._file.commit()
 
     def __enter__(self) -> ResultWriter:
         return self

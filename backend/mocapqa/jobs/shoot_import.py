@@ -16,7 +16,7 @@ from typing import Any, BinaryIO
 
 from mocapqa.errors import InputError, MocapQAError, NotFoundError, TooLargeError
 from mocapqa.jobs.archive import archive_kind, unpack
-from mocapqa.jobs.batch import MOTION_SUFFIXES
+from mocapqa.jobs.batch import skip_reason
 from mocapqa.jobs.intake import CHUNK_BYTES, MAX_NAME_CHARS, ingest_take
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.pipeline.loading import ReadLimits
@@ -77,8 +77,9 @@ def _label(archive: str, member: str) -> str:
     return label if len(label) <= limit else f"{label[: limit - 1]}…"
 
 
-def _is_motion_name(name: str) -> bool:
-    return PurePosixPath(name.replace("\\", "/")).suffix.lower() in MOTION_SUFFIXES
+def _skip_reason(name: str) -> str | None:
+    """Why an uploaded file or archive member is not a take (the batch's rule), or None."""
+    return skip_reason(PurePosixPath(name.replace("\\", "/")).name)
 
 
 def import_uploads(
@@ -133,10 +134,11 @@ def import_uploads(
         if archive_kind(name) is None:
             # The rule of an archive's members, for files sent one by one (a folder chosen in
             # the browser): a notes.txt beside the takes is skipped, not a failed take.
-            if _is_motion_name(name):
+            reason = _skip_reason(name)
+            if reason is None:
                 ingest(source, name)
             else:
-                report.skipped.append({"name": name, "reason": "not a motion file"})
+                report.skipped.append({"name": name, "reason": reason})
             continue
         scratch = Path(tempfile.mkdtemp(prefix="archive-", dir=files.root / "incoming"))
         try:
@@ -157,8 +159,8 @@ def import_uploads(
                 label = _label(name, member.name)
                 if member.path is None:
                     report.failed.append({"name": label, "error": str(member.problem)})
-                elif not _is_motion_name(member.name):
-                    report.skipped.append({"name": label, "reason": "not a motion file"})
+                elif (reason := _skip_reason(member.name)) is not None:
+                    report.skipped.append({"name": label, "reason": reason})
                 else:
                     with member.path.open("rb") as handle:
                         base = PurePosixPath(member.name.replace("\\", "/")).name

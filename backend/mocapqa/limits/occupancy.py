@@ -38,6 +38,7 @@ from mocapqa.errors import InputError, ShapeError
 from mocapqa.limits.intervals import circular_intervals, dilate, smooth, wrap
 
 __all__ = [
+    "MIN_BIN_DEG",
     "OccupancyMap",
     "OccupancyParams",
     "build_occupancy",
@@ -50,6 +51,12 @@ __all__ = [
 ]
 
 
+MIN_BIN_DEG = 0.5
+"""Smallest swing-plane bin, degrees: 720 × 720 bins per joint, half the paper's 1°. The map
+holds N² bins per joint and its smoothing and nearest-bin transform cost more, so a bin of
+10⁻⁶° (3.6 × 10⁸ bins a side) would ask for petabytes."""
+
+
 @dataclass(frozen=True, slots=True)
 class OccupancyParams:
     """Parameters of the lookup map.
@@ -57,7 +64,8 @@ class OccupancyParams:
     Parameters
     ----------
     bin_deg : float
-        Side of a swing-plane bin in degrees; 360 must be a whole multiple of it (paper: 1).
+        Side of a swing-plane bin in degrees, at least :data:`MIN_BIN_DEG` (0.5); 360 must be
+        a whole multiple of it (paper: 1).
     dilation_bins : int
         Rings of neighbouring bins added to the occupied set after smoothing (paper: 0).
     tau_margin_deg : float
@@ -76,9 +84,13 @@ class OccupancyParams:
     interpolate: bool = False
 
     def __post_init__(self) -> None:
-        n = 360.0 / self.bin_deg if self.bin_deg > 0 else 0.0
-        if not (self.bin_deg > 0 and abs(n - round(n)) < 1e-9):
-            raise InputError(f"Expected `bin_deg` dividing 360, got {self.bin_deg}")
+        if not MIN_BIN_DEG <= self.bin_deg <= 360.0:  # NaN too
+            raise InputError(
+                f"Expected `bin_deg` from {MIN_BIN_DEG:g} to 360 degrees, got {self.bin_deg:g}"
+            )
+        n = 360.0 / self.bin_deg
+        if abs(n - round(n)) >= 1e-9:
+            raise InputError(f"Expected `bin_deg` dividing 360, got {self.bin_deg:g}")
         if self.dilation_bins < 0 or self.tau_margin_deg < 0:
             raise InputError(
                 "Expected `dilation_bins` >= 0 and `tau_margin_deg` >= 0, got "

@@ -12,7 +12,6 @@ take.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -21,7 +20,7 @@ from mocapqa.core.keypoints import LENGTH_UNITS, KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError, ParseError, TooLargeError
 from mocapqa.io.bvh_root import ROOT_TRANSLATIONS, explain_root_translation
-from mocapqa.io.formats import MAX_FPS, detect_format, read_take, write_keypoints
+from mocapqa.io.formats import check_fps, detect_format, read_take, write_keypoints
 from mocapqa.io.guards import ReadLimits
 from mocapqa.kinematics.bindpose import leading_bind_pose
 
@@ -64,8 +63,8 @@ class ReadOptions:
     root_translation: Literal["auto", "add", "replace"] = "auto"
 
     def __post_init__(self) -> None:
-        if self.fps is not None and not (math.isfinite(self.fps) and 0 < self.fps <= MAX_FPS):
-            raise InputError(f"Expected fps in (0, {MAX_FPS:g}], got {self.fps}")
+        if self.fps is not None:
+            check_fps(self.fps)
         if self.length_unit is not None and self.length_unit not in LENGTH_UNITS:
             raise InputError(f"Expected length_unit in {LENGTH_UNITS}, got {self.length_unit!r}")
         if self.root_translation not in ROOT_TRANSLATIONS:

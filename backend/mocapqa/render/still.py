@@ -20,6 +20,8 @@ from mocapqa.render.engine import FIXED_COLOR, FLAG_COLOR, CanvasPool, ImageArra
 from mocapqa.render.scene import CameraView, SkeletonTrack, check_same_shape, frame_camera
 
 __all__ = [
+    "MAX_SIDE_PX",
+    "MIN_SIDE_PX",
     "StillOptions",
     "check_frame",
     "flags_at",
@@ -29,6 +31,13 @@ __all__ = [
 ]
 
 
+MIN_SIDE_PX = 16
+"""Smallest side of one view, pixels."""
+MAX_SIDE_PX = 8192
+"""Largest side of one view, pixels: an 8192 × 8192 view side by side (16384 px wide) takes
+20 s and 7 GB; 100,000 px aborted VTK."""
+
+
 @dataclass(frozen=True, slots=True)
 class StillOptions:
     """Image size and viewpoint of stills.
@@ -36,7 +45,8 @@ class StillOptions:
     Parameters
     ----------
     width_px, height_px : int
-        Size of one view in pixels (side by side doubles the width).
+        Size of one view in pixels, :data:`MIN_SIDE_PX` to :data:`MAX_SIDE_PX` (side by side
+        doubles the width).
     azimuth_deg, elevation_deg : float
         Viewing direction, degrees.
     """
@@ -47,9 +57,13 @@ class StillOptions:
     elevation_deg: float = 15.0
 
     def __post_init__(self) -> None:
-        if self.width_px < 16 or self.height_px < 16:
+        if not (
+            MIN_SIDE_PX <= self.width_px <= MAX_SIDE_PX
+            and MIN_SIDE_PX <= self.height_px <= MAX_SIDE_PX
+        ):
             raise ShapeError(
-                f"Expected an image of at least 16×16 px, got {self.width_px}×{self.height_px}"
+                f"Expected an image width and height of {MIN_SIDE_PX} to {MAX_SIDE_PX} px, "
+                f"got {self.width_px}×{self.height_px}"
             )
 
 

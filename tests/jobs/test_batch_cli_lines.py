@@ -1,0 +1,138 @@
+"""``mocapqa batch`` says which takes failed, leaves keypoint CSV sidecars alone, and writes its
+results table whole or not at all."""
+
+from __future__ import annotations
+
+import errno
+import os
+import re
+import stat
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from mocapqa.cli.batch import MAX_FAILED_LINES
+from mocapqa.cli.main import main
+from mocapqa.errors import InputError
+from mocapqa.jobs.batch import BatchCounts, discover
+from mocapqa.jobs.batch_output import ResultWriter
+
+TRC = "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d/S00_P00_T01_BalancingTrial_0-100.trc"
+
+
+def test_discovery_skips_a_keypoint_csv_sidecar(
+    corpus_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    folder = tmp_path / "takes"
+    folder.mkdir()
+    assert main(["convert", str(corpus_dir / TRC), "-o", str(folder / "kp.csv")]) == 0
+    sidecar = folder / "kp.csv.meta.json"
+    assert sidecar.is_file()
+    (folder / "take.json").write_text("{}", encoding="utf-8")
+    found = list(discover([folder]))
+    assert found == [(folder / "kp.csv", None), (folder / "take.json", None)]
+    # Named on the command line, it is listed as skipped with the reason.
+    [(path, reason)] = list(discover([sidecar]))
+    assert path == sidecar
+    assert reason is not None
+    assert "sidecar" in reason
+
+
+def _fake_batch(rows: list[dict[str, Any]]) -> Callable[..., BatchCounts]:
+    def run_batch(
+        paths: list[Path], shoots: Any, options: Any, on_row: Callable[[dict[str, Any]], None],
+        **kwargs: Any,
+    ) -> BatchCounts:  # fmt: skip
+        counts = BatchCounts(total=len(rows))
+        for row in rows:
+            counts.add(row)
+            on_row(row)
+        return counts
+
+    return run_batch
+
+
+def test_without_output_each_failed_take_is_one_stderr_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setenv("MOCAPQA_DATA_DIR", str(tmp_path / "data"))
+    rows = [{"source": "/takes/good.bvh", "status": "done", "n_frames": 10}]
+    rows += [
+        {"source": f"/takes/bad{k:02d}.bvh", "status": "failed", "error": f"line {k}: broken"}
+        for k in range(MAX_FAILED_LINES + 3)
+    ]
+    monkeypatch.setattr("mocapqa.jobs.batch.run_batch", _fake_batch(rows))
+    code = main(["batch", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    lines = [line for line in err.splitlines() if line.startswith("failed: ")]
+    assert len(lines) == MAX_FAILED_LINES
+    assert lines[0] == "failed: /takes/bad00.bvh: line 0: broken"
+    assert lines[-1] == "failed: /takes/bad49.bvh: line 49: broken"
+    assert "… and 3 more failed" in err
+    assert "good.bvh" not in err
+    assert re.search(r"54 file\(s\): 1 done, 53 failed", err), err
+
+
+def test_batch_of_a_folder_with_a_converted_csv_fails_only_the_bad_take(
+    corpus_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
+    """The hostile pass: ``convert kp.trc -o DIR/kp.csv`` then ``batch DIR`` listed the
+    sidecar as a failed take, and said only "0 done, 3 failed"."""
+    monkeypatch.setenv("MOCAPQA_DATA_DIR", str(tmp_path / "data"))
+    folder = tmp_path / "takes"
+    folder.mkdir()
+    assert main(["convert", str(corpus_dir / TRC), "-o", str(folder / "kp.csv")]) == 0
+    broken = folder / "broken.bvh"
+    broken.write_text("HIERARCHY\nJOINT Hips\nMOTION\n", encoding="utf-8")
+    capsys.readouterr()
+    code = main(["batch", str(folder), "--workers", "1"])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert "2 file(s): 1 done, 1 failed" in err, err
+    failed = [line for line in err.splitlines() if line.startswith("failed: ")]
+    assert len(failed) == 1, err
+    assert failed[0].startswith(f"failed: {broken}: "), err
+    assert "Expected 'ROOT'" in failed[0], err
+    assert "meta.json" not in err
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".jsonl", ".parquet"])
+def test_the_results_table_is_replaced_whole_or_not_at_all(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, suffix: str
+) -> None:
+    out = tmp_path / f"results{suffix}"
+    out.write_bytes(b"an earlier table")
+    with ResultWriter(out) as writer:
+        writer.write({"source": "a.bvh", "status": "done"})
+        assert out.read_bytes() == b"an earlier table"  # rows go to a temporary meanwhile
+    assert out.read_bytes() != b"an earlier table"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [out.name]
+
+    # A disk that fills up on the last rows: the earlier table stays, no temporary is left.
+    out.write_bytes(b"an earlier table")
+    writer = ResultWriter(out)
+    writer.write({"source": "a.bvh", "status": "done"})
+    writer.flush()
+    writer.write({"source": "b.bvh", "status": "done"})
+    monkeypatch.setattr(writer, f"_flush_{'parquet' if suffix == '.parquet' else 'text'}", _full)
+    with pytest.raises(OSError, match="No space left") as caught:
+        writer.close()
+    assert caught.value.filename == str(out)
+    assert out.read_bytes() == b"an earlier table"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [out.name]
+
+
+def _full() -> None:
+    raise OSError(errno.ENOSPC, "No space left on device")
+
+
+def test_the_results_table_refuses_a_fifo(tmp_path: Path) -> None:
+    fifo = tmp_path / "results.csv"
+    os.mkfifo(fifo)
+    with pytest.raises(InputError, match="FIFO"):
+        ResultWriter(fifo)
+    assert stat.S_ISFIFO(fifo.lstat().st_mode)
