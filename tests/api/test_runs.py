@@ -188,6 +188,17 @@ def test_filter_registry_lists_parameters_with_units(client: TestClient) -> None
     one_euro = {p["name"]: p for p in filters["one-euro"]["parameters"]}
     assert one_euro["min_cutoff_hz"]["unit"] == "Hz"
     assert "keypoints" in filters["adaptive"]["applies_to"]
+    # The declared ranges, so the re-run form refuses a value before sending it.
+    assert (one_euro["min_cutoff_hz"]["minimum"], one_euro["min_cutoff_hz"]["maximum"]) == (
+        0.001,
+        10_000.0,
+    )
+    ema = {p["name"]: p for p in filters["ema"]["parameters"]}
+    assert ema["time_constant_s"]["maximum"] == 60.0
+    for entry in filters.values():
+        for parameter in entry["parameters"]:
+            if parameter["type"] == "float":
+                assert parameter["minimum"] is not None, (entry["name"], parameter["name"])
 
 
 def test_stream_filters_frames_and_returns_weights(client: TestClient) -> None:

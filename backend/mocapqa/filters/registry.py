@@ -34,6 +34,7 @@ from mocapqa.filters.kalman import KalmanParams
 from mocapqa.filters.one_euro import OneEuroParams
 from mocapqa.filters.quat_one_euro import QuatOneEuroParams
 from mocapqa.filters.quat_pd import QuatPDParams
+from mocapqa.filters.ranges import range_of
 
 __all__ = [
     "FILTERS",
@@ -71,12 +72,16 @@ class DataScale:
 
 @dataclass(frozen=True, slots=True)
 class ParamInfo:
-    """One parameter for a UI form: dotted ``name``, ``default``, ``unit`` and ``type``."""
+    """One parameter for a UI form: dotted ``name``, ``default``, ``unit``, ``type`` and the
+    declared range's bounds (:mod:`mocapqa.filters.ranges`; None where none is declared), so a
+    form can refuse a value before it is sent."""
 
     name: str
     default: Any
     unit: str
     type: str
+    minimum: float | None = None
+    maximum: float | None = None
 
 
 _UNITS = {
@@ -106,8 +111,16 @@ def _flatten(entry: str, params: Any, prefix: str = "") -> list[ParamInfo]:
         if dataclasses.is_dataclass(value):
             out += _flatten(entry, value, f"{prefix}{f.name}.")
         else:
+            bounds = range_of(params, f.name)
             out.append(
-                ParamInfo(prefix + f.name, value, _unit(entry, f.name), type(value).__name__)
+                ParamInfo(
+                    prefix + f.name,
+                    value,
+                    _unit(entry, f.name),
+                    type(value).__name__,
+                    None if bounds is None else bounds.low,
+                    None if bounds is None else bounds.high,
+                )
             )
     return out
 
