@@ -3,8 +3,10 @@
 // values and the options of a new run out. No DOM.
 
 /**
- * One typed-in value checked against its field ({name, type, minimum?, maximum?}):
- * {value} (undefined for an empty text: the default) or {error} naming the field.
+ * One typed-in value checked against its field ({name, type, minimum?, maximum?,
+ * minimum_excluded?, maximum_excluded?}; an excluded bound is not itself allowed, as GET
+ * /filters serves a range "> 0"): {value} (undefined for an empty text: the default) or {error}
+ * naming the field.
  */
 export function checkValue(field, text) {
   const raw = String(text ?? "").trim();
@@ -17,7 +19,9 @@ export function checkValue(field, text) {
   const value = Number(raw);
   if (!Number.isFinite(value)) return { error: `${field.name}: expected a number, got "${raw}"` };
   if (field.type === "int" && !Number.isInteger(value)) return { error: `${field.name}: expected a whole number, got ${raw}` };
+  if (field.minimum != null && field.minimum_excluded && value <= field.minimum) return { error: `${field.name}: expected more than ${field.minimum}, got ${raw}` };
   if (field.minimum != null && value < field.minimum) return { error: `${field.name}: expected at least ${field.minimum}, got ${raw}` };
+  if (field.maximum != null && field.maximum_excluded && value >= field.maximum) return { error: `${field.name}: expected less than ${field.maximum}, got ${raw}` };
   if (field.maximum != null && value > field.maximum) return { error: `${field.name}: expected at most ${field.maximum}, got ${raw}` };
   return { value };
 }

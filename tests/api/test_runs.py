@@ -195,6 +195,11 @@ def test_filter_registry_lists_parameters_with_units(client: TestClient) -> None
     )
     ema = {p["name"]: p for p in filters["ema"]["parameters"]}
     assert ema["time_constant_s"]["maximum"] == 60.0
+    kalman = {p["name"]: p for p in filters["kalman"]["parameters"]}
+    # min_confidence is below 1: the bound is served as excluded, as the server refuses it.
+    assert kalman["min_confidence"]["maximum"] == 1.0
+    assert kalman["min_confidence"]["maximum_excluded"] is True
+    assert kalman["min_confidence"]["minimum_excluded"] is False
     for entry in filters.values():
         for parameter in entry["parameters"]:
             if parameter["type"] == "float":

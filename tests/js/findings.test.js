@@ -108,6 +108,12 @@ test("the re-run form checks values against their fields and builds the options"
   assert.match(form.checkValue(cutoff, "Infinity").error, /expected a number/);
   assert.match(form.checkValue(order, "2.5").error, /^order: expected a whole number/);
   assert.match(form.checkValue(order, "9").error, /^order: expected at most 8/);
+  // A bound GET /filters marks excluded ("> 0", "< 1") is refused itself.
+  const confidence = { name: "min_confidence", type: "float", minimum: 0, maximum: 1, maximum_excluded: true };
+  assert.match(form.checkValue(confidence, "1").error, /^min_confidence: expected less than 1, got 1/);
+  assert.deepEqual(form.checkValue(confidence, "0"), { value: 0 });
+  const damping = { name: "damping_ratio", type: "float", minimum: 0, minimum_excluded: true, maximum: 10 };
+  assert.match(form.checkValue(damping, "0").error, /expected more than 0/);
   assert.deepEqual(form.checkValue({ name: "on", type: "bool" }, "false"), { value: false });
   assert.match(form.checkValue({ name: "on", type: "bool" }, "yes").error, /true or false/);
   const fields = { max_points: { name: "max_points", type: "int", minimum: 10, maximum: 100000 } };

@@ -189,6 +189,10 @@ def test_a_hand_mapped_onto_a_bone_of_no_length_is_framed_from_its_forearm(cmu: 
     # A forearm mapped onto its own hand has no long axis: a clear error, not a crash.
     with pytest.raises(InputError, match="bone of non-zero length"):
         rig_frames([cmu], {"left_forearm": "LeftHand", "left_hand": "LeftFingerBase"})
+    # A leg role on an arm joint leaves no body frame: an error naming the mapping, where it
+    # was an "internal error" of the run (scipy's non-positive determinant).
+    with pytest.raises(InputError, match="check the role mapping"):
+        rig_frames([cmu], {"left_upper_leg": "LeftArm"})
 
 
 def test_an_unseen_rig_s_hands_are_not_flagged_by_a_model_of_the_other_rigs(

@@ -68,6 +68,9 @@ def test_presets_are_valid_options_and_the_bounds_are_enforced() -> None:
         ("kalman", {"measurement_noise": 1e30}, "filter_params.measurement_noise", "1e+24"),
         ("one-euro", {"beta": "inf"}, "filter_params.beta", "0 to 1e+20"),
         ("adaptive", {"innovation_power": 50}, "filter_params.innovation_power", "at most 10"),
+        # An int past a float's range overflowed math.isfinite: a 500 from the API.
+        ("ema", {"time_constant_s": 10**400}, "filter_params.time_constant_s", "0.0001 to 60 s"),
+        ("butterworth", {"order": -(10**400)}, "filter_params.order", "order"),
     ],
 )
 def test_run_options_refuse_filter_parameters_out_of_their_range(
@@ -82,3 +85,13 @@ def test_run_options_refuse_filter_parameters_out_of_their_range(
 def test_run_options_take_the_bounds_of_the_ranges() -> None:
     params = {"window_s": 60.0, "lead_s": 0, "kalman.bridge_decay_s": 0.0, "innovation_power": 10}
     AnalysisOptions.from_json({"filter_method": "adaptive", "filter_params": params})
+
+
+def test_an_apply_list_past_its_cap_is_refused_when_asked_for() -> None:
+    # 100,000 ids (a 590 KB string) were stored and queued, and failed when the run started.
+    with pytest.raises(OptionError, match="at most 10,000 interval ids") as raised:
+        AnalysisOptions.from_json({"twist_apply": ",".join(str(i) for i in range(100_000))})
+    assert raised.value.field == "twist_apply"
+    with pytest.raises(OptionError, match="at most 10,000 interval ids"):
+        AnalysisOptions.from_json({"twist_apply": ",".join(["0"] * 40_001)})  # 80,001 characters
+    AnalysisOptions.from_json({"twist_apply": ",".join(str(i) for i in range(10_000))})

@@ -67,7 +67,10 @@ class Range:
     def __contains__(self, value: object) -> bool:
         if isinstance(value, bool) or not isinstance(value, int | float):
             return False
-        if not math.isfinite(value):
+        try:  # an int beyond a float's range (10**309) overflows here: not in any range
+            if not math.isfinite(value):
+                return False
+        except OverflowError:
             return False
         above = value > self.low if self.low_open else value >= self.low
         below = value < self.high if self.high_open else value <= self.high
@@ -127,6 +130,13 @@ def range_of(params: Any, name: str) -> Range | None:
     return None
 
 
+def _shown(value: object) -> str:
+    """A refused value for a message: a huge integer by its size, not its 400 digits."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**16:
+        return f"an integer of {len(str(abs(value)))} digits"
+    return repr(value)
+
+
 def check_ranges(params: Any) -> None:
     """Refuse a parameter dataclass with a number outside its declared range.
 
@@ -147,4 +157,4 @@ def check_ranges(params: Any) -> None:
             continue
         value = getattr(params, f.name)
         if value not in allowed:
-            raise InputError(f"Expected `{f.name}` {allowed.describe()}, got {value!r}")
+            raise InputError(f"Expected `{f.name}` {allowed.describe()}, got {_shown(value)}")

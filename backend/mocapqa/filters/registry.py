@@ -73,8 +73,9 @@ class DataScale:
 @dataclass(frozen=True, slots=True)
 class ParamInfo:
     """One parameter for a UI form: dotted ``name``, ``default``, ``unit``, ``type`` and the
-    declared range's bounds (:mod:`mocapqa.filters.ranges`; None where none is declared), so a
-    form can refuse a value before it is sent."""
+    declared range's bounds (:mod:`mocapqa.filters.ranges`; None where none is declared; a
+    bound ``*_excluded`` is not itself allowed), so a form can refuse a value before it is
+    sent."""
 
     name: str
     default: Any
@@ -82,6 +83,8 @@ class ParamInfo:
     type: str
     minimum: float | None = None
     maximum: float | None = None
+    minimum_excluded: bool = False
+    maximum_excluded: bool = False
 
 
 _UNITS = {
@@ -120,6 +123,8 @@ def _flatten(entry: str, params: Any, prefix: str = "") -> list[ParamInfo]:
                     type(value).__name__,
                     None if bounds is None else bounds.low,
                     None if bounds is None else bounds.high,
+                    bounds is not None and bounds.low_open,
+                    bounds is not None and bounds.high_open,
                 )
             )
     return out

@@ -188,6 +188,12 @@ def _local(world_quats: FloatArray, vectors: FloatArray) -> FloatArray:
     return rotate(conjugate(world_quats), vectors)
 
 
+def _parallel(x: FloatArray, y: FloatArray) -> bool:
+    """Whether two directions are (nearly) parallel, or one has no length: no frame has them
+    as its ``x`` and ``y``."""
+    return bool(np.linalg.norm(np.cross(_unit(x), _unit(y))) < 1e-6)
+
+
 def _frame_quat(x: FloatArray, y: FloatArray) -> FloatArray:
     """Quaternion of the frame with columns ``(x⊥, y, x⊥ × y)``, ``y`` taken exactly."""
     y = _unit(y)
@@ -401,8 +407,16 @@ def canonical_frames(
         else:
             normals = _local(quats[:, joint], np.cross(along, partner))
         flexion, bend = _median_direction(normals, long_axes[joint], sign_ref, skip)
-        if bend < _MIN_BEND_SIN2:
+        if bend < _MIN_BEND_SIN2 or _parallel(flexion, long_axes[joint]):
             flexion = sign_ref
+        if _parallel(flexion, long_axes[joint]):
+            # A segment along the body's left-right axis on average (a mapping that names an
+            # arm joint for a leg role): no flexion axis can be found for it.
+            raise InputError(
+                f"Expected the {side} {role.replace('_', ' ')} ({skeleton.names[joint]!r}) to "
+                "run across the body's left-right axis, got a segment along it; its flexion "
+                "axis cannot be found (check the role mapping)"
+            )
         cache[joint] = _frame_quat(flexion, long_axes[joint])
         return cache[joint]
 
@@ -421,6 +435,14 @@ def canonical_frames(
             left_w, up_w = body[role in _ARM_ROLES]
             left_l = np.mean(_local(quats[:, parent], left_w), axis=0)
             up_l = np.mean(_local(quats[:, parent], up_w), axis=0)
+            if _parallel(left_l, up_l):
+                # Hips or shoulders stacked along the up axis (a mapping that names an arm
+                # joint for a leg role): no body frame.
+                raise InputError(
+                    "Expected the body's left-right axis (hips, shoulders) across its up axis "
+                    f"(hips to shoulders), got the two along each other, framing "
+                    f"{skeleton.names[joint]!r} (check the role mapping)"
+                )
             # Legs hang: their body frame's long axis points down, so standing is near identity.
             parent_frames.append(_frame_quat(left_l, up_l if role in _ARM_ROLES else -up_l))
         roles.append(role_key(side, role))

@@ -23,7 +23,7 @@ from mocapqa.twist.angles import ChainGeometry
 from mocapqa.twist.confidence import APPLY_THRESHOLD, has_evidence
 from mocapqa.twist.detect import DetectedInterval
 
-__all__ = ["APPLY_CHOICES", "TwistInterval", "choose_intervals", "parse_apply"]
+__all__ = ["APPLY_CHOICES", "MAX_APPLY_IDS", "TwistInterval", "choose_intervals", "parse_apply"]
 
 APPLY_CHOICES = ("confident", "all", "none")
 """Which intervals a refinement applies, besides an explicit list of interval ids:
@@ -32,6 +32,10 @@ minimum-evidence rule, the default), ``all`` or ``none``."""
 
 
 _IDS = re.compile(r"[0-9]+(,[0-9]+)*")
+
+
+MAX_APPLY_IDS = 10_000
+"""Most interval ids an ``apply`` list may name (a take has far fewer intervals)."""
 
 
 def parse_apply(value: str | frozenset[int]) -> str | frozenset[int]:
@@ -47,12 +51,18 @@ def parse_apply(value: str | frozenset[int]) -> str | frozenset[int]:
     text = str(value).strip()
     if text in APPLY_CHOICES:
         return text
+    if len(text) > 8 * MAX_APPLY_IDS:  # before splitting: a 590 KB list was stored and queued
+        raise InputError(
+            f"Expected at most {MAX_APPLY_IDS:,} interval ids, got {len(text):,} characters"
+        )
     # ASCII digits only: int() would also read "1_0" as 10 and other scripts' digits.
     ids = (
         frozenset(int(v) for v in text.split(","))
         if _IDS.fullmatch(text.replace(" ", ""))
         else frozenset({-1})
     )
+    if len(ids) > MAX_APPLY_IDS:
+        raise InputError(f"Expected at most {MAX_APPLY_IDS:,} interval ids, got {len(ids):,}")
     if not ids or min(ids) < 0:
         raise InputError(
             f"Expected apply to be one of {list(APPLY_CHOICES)} or interval ids like '0,3', "
