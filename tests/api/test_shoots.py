@@ -256,6 +256,8 @@ def test_import_skips_keypoint_csv_sidecars(client: TestClient) -> None:
         "walk.CSV.meta.json",
     ]
     assert all("sidecar" in s["reason"] for s in report["skipped"])
+    # An import stores each file as a take of its own: the sidecar is not read, and says so.
+    assert all("not read by an import" in s["reason"] for s in report["skipped"])
 
 
 def test_tar_import_reports_links(client: TestClient, corpus_dir: Path) -> None:

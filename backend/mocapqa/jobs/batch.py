@@ -33,6 +33,7 @@ if TYPE_CHECKING:
 __all__ = [
     "CHUNK_TAKES",
     "MOTION_SUFFIXES",
+    "SIDECAR_REASON",
     "BatchCounts",
     "chunk_size",
     "discover",

@@ -16,7 +16,7 @@ from typing import Any, BinaryIO
 
 from mocapqa.errors import InputError, MocapQAError, NotFoundError, TooLargeError
 from mocapqa.jobs.archive import archive_kind, unpack
-from mocapqa.jobs.batch import skip_reason
+from mocapqa.jobs.batch import SIDECAR_REASON, skip_reason
 from mocapqa.jobs.intake import CHUNK_BYTES, MAX_NAME_CHARS, ingest_take
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.pipeline.loading import ReadLimits
@@ -77,9 +77,18 @@ def _label(archive: str, member: str) -> str:
     return label if len(label) <= limit else f"{label[: limit - 1]}…"
 
 
+IMPORT_SIDECAR_REASON = (
+    "a keypoint CSV's .meta.json sidecar: not read by an import (the CSV's rate comes from its "
+    "time column, its unit is 'unknown'); upload the CSV alone with fps and length_unit"
+)
+"""The skip reason of a sidecar in an import: unlike a batch of local files, an import stores
+each file as a take of its own, so the sidecar never reaches its CSV's reader."""
+
+
 def _skip_reason(name: str) -> str | None:
     """Why an uploaded file or archive member is not a take (the batch's rule), or None."""
-    return skip_reason(PurePosixPath(name.replace("\\", "/")).name)
+    reason = skip_reason(PurePosixPath(name.replace("\\", "/")).name)
+    return IMPORT_SIDECAR_REASON if reason == SIDECAR_REASON else reason
 
 
 def import_uploads(
