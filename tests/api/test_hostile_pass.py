@@ -260,6 +260,18 @@ def test_a_mapping_to_a_joint_the_take_lacks_is_422_before_queueing(
         headers=alice[1],
     )
     assert accepted.status_code == 201, accepted.text
+    # A mapping against the hierarchy (the upper arm above its clavicle) is refused here too,
+    # from the hierarchy recorded at upload, instead of a run that fails when it starts.
+    inverted = client.post(
+        f"/api/v1/takes/{take['id']}/runs",
+        json={"mapping": {"left_clavicle": "Spine", "left_upper_arm": "Hips"}},
+        headers=alice[1],
+    )
+    assert inverted.status_code == 422, inverted.text
+    assert inverted.json()["field"] == "mapping"
+    assert "not its descendant" in inverted.json()["detail"]
+    detail = client.get(f"/api/v1/takes/{take['id']}", headers=alice[1]).json()
+    assert len(detail["runs"]) == 2
 
 
 def test_shoot_names_lose_invisible_characters_as_take_names_do(

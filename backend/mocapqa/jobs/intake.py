@@ -32,6 +32,7 @@ __all__ = [
     "CHUNK_BYTES",
     "MAX_NAME_CHARS",
     "ingest_take",
+    "joint_parents_of",
     "joints_of",
     "name_too_long",
     "reading_of",
@@ -68,6 +69,17 @@ def joints_of(files: FileStore, take_id: str) -> list[str] | None:
     takes stored before the names were recorded)."""
     joints = (reading_of(files, take_id) or {}).get("joints")
     return [str(j) for j in joints] if isinstance(joints, list) else None
+
+
+def joint_parents_of(files: FileStore, take_id: str) -> list[int] | None:
+    """A BVH take's parent index per joint as recorded when it was read (None for keypoint
+    takes and takes stored before the hierarchy was recorded)."""
+    parents = (reading_of(files, take_id) or {}).get("joint_parents")
+    if not isinstance(parents, list) or not all(
+        isinstance(p, int) and not isinstance(p, bool) for p in parents
+    ):
+        return None
+    return [int(p) for p in parents]
 
 
 def safe_file_name(name: str) -> str:

@@ -100,8 +100,9 @@ def reading_facts(take: Motion | KeypointSequence, read: ReadOptions) -> dict[st
         ``read_options`` (as chosen), ``fps``, ``length_unit`` and, for keypoints,
         ``assumptions`` (frame rate, unit, layout or frame numbers the file did not state);
         for a BVH, ``root_translation``, ``root_translation_reason``, ``bind_pose_frames``
-        (:func:`mocapqa.kinematics.bindpose.leading_bind_pose`) and ``joints`` (the joint names, by
-        which a run's ``mapping`` option is checked before it is queued).
+        (:func:`mocapqa.kinematics.bindpose.leading_bind_pose`), ``joints`` and ``joint_parents``
+        (the joint names and the hierarchy, by which a run's ``mapping`` option is checked before
+        it is queued).
     """
     facts: dict[str, Any] = {"read_options": read.to_json(), "fps": take.fps}
     if isinstance(take, Motion):
@@ -110,6 +111,7 @@ def reading_facts(take: Motion | KeypointSequence, read: ReadOptions) -> dict[st
         facts["root_translation_reason"] = explain_root_translation(take, read.root_translation)
         facts["bind_pose_frames"] = leading_bind_pose(take.quats)
         facts["joints"] = list(take.skeleton.names)
+        facts["joint_parents"] = [int(p) for p in take.skeleton.parents]
     else:
         facts["length_unit"] = take.length_unit
         facts["source_format"] = take.source_format

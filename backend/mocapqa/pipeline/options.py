@@ -208,14 +208,18 @@ class AnalysisOptions:
                 f"Expected no preset or 'default' for a motion take, got {self.filter_preset!r}",
             )
 
-    def check_joints(self, joints: Sequence[str] | None) -> None:
+    def check_joints(
+        self, joints: Sequence[str] | None, parents: Sequence[int] | None = None
+    ) -> None:
         """Refuse a ``mapping`` naming a joint the take does not have (``joints``: the BVH's
-        joint names, None when not recorded: the run then finds out).
+        joint names, None when not recorded: the run then finds out) or, given the hierarchy
+        (``parents``, the parent index per joint), one that contradicts it (a mapped joint
+        not below the limb's previous role, :func:`mocapqa.core.rig.find_roles`).
 
         Raises
         ------
         OptionError
-            Naming the role, e.g. ``mapping.left_upper_arm``.
+            Naming the role, e.g. ``mapping.left_upper_arm``, or ``mapping``.
         """
         if joints is None:
             return
@@ -226,6 +230,24 @@ class AnalysisOptions:
                     f"mapping.{role}",
                     f"Expected a joint of this take ({len(known)} joints), got {joint!r}",
                 )
+        if not self.mapping or parents is None or len(parents) != len(joints):
+            return
+        import numpy as np
+
+        from mocapqa.core.motion import Skeleton
+        from mocapqa.core.rig import find_roles
+        from mocapqa.errors import ShapeError
+
+        try:  # the roles depend on names and hierarchy only, so no offsets are needed
+            skeleton = Skeleton(
+                tuple(joints), np.asarray(parents), np.zeros((len(joints), 3)), ((),) * len(joints)
+            )
+        except ShapeError:  # a record this code did not write: the run finds out
+            return
+        try:
+            find_roles(skeleton, self.mapping)
+        except InputError as e:
+            raise OptionError("mapping", str(e)) from e
 
     def to_json(self) -> dict[str, Any]:
         """The options as a JSON-ready dict."""

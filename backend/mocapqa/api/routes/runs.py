@@ -16,7 +16,7 @@ from mocapqa.api.frame_windows import read_window, window_json, window_packed
 from mocapqa.api.schemas import AnalysisOptionsIn, RunOut
 from mocapqa.api.views import run_out
 from mocapqa.errors import NotFoundError
-from mocapqa.jobs.intake import joints_of
+from mocapqa.jobs.intake import joint_parents_of, joints_of
 from mocapqa.jobs.rendered import html_report
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.roles import Action
@@ -52,7 +52,10 @@ def start_run(
     """
     parsed = AnalysisOptions.from_json((options or AnalysisOptionsIn()).model_dump())
     parsed.check_take_kind(str(take["kind"]), float(take["fps"]) if take.get("fps") else None)
-    parsed.check_joints(joints_of(services.files, str(take["id"])))
+    take_id = str(take["id"])
+    parsed.check_joints(
+        joints_of(services.files, take_id), joint_parents_of(services.files, take_id)
+    )
     require_run_slot(services, client)
     run_id = services.repository.add_run(str(take["id"]), parsed.to_json())
     services.runner.submit(run_id, client=client)
