@@ -117,6 +117,30 @@ def test_nul_in_a_query_is_422_naming_it(
     assert client.get(f"/api/v1/shoots/{shoot['id']}", headers=alice[1]).status_code == 200
 
 
+def test_a_json_key_sent_twice_is_422_naming_it(
+    client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    """Python's JSON parser keeps the last of a repeated key: ``{"name": "x", "name": "y"}``
+    made a shoot "y"; nested objects (run options' ``filter_params``) too."""
+    headers = {**alice[1], "content-type": "application/json"}
+    response = client.post("/api/v1/shoots", content=b'{"name": "x", "name": "y"}', headers=headers)
+    assert response.status_code == 422, response.text
+    assert response.json()["field"] == "body.name"
+    assert "twice" in response.json()["detail"]
+    assert client.get("/api/v1/shoots", headers=alice[1]).json() == []
+    take = upload(client, alice[1])
+    nested = (
+        b'{"filter_method": "ema", "filter_params": {"time_constant_s": 1, "time_constant_s": 2}}'
+    )
+    response = client.post(f"/api/v1/takes/{take['id']}/runs", content=nested, headers=headers)
+    assert response.status_code == 422, response.text
+    assert response.json()["field"] == "body.time_constant_s"
+    # The same key in two objects is two keys; invalid JSON is FastAPI's own 422.
+    made = client.post("/api/v1/shoots", content=b'{"name": "z"}', headers=headers)
+    assert made.status_code == 201, made.text
+    assert client.post("/api/v1/shoots", content=b'{"name": ', headers=headers).status_code == 422
+
+
 def test_a_query_parameter_read_once_and_sent_twice_is_422_naming_it(
     client: TestClient, alice: tuple[int, dict[str, str]]
 ) -> None:

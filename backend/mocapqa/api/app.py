@@ -31,7 +31,7 @@ from mocapqa.api.errors import install_error_handlers
 from mocapqa.api.form_parts import check_form_parts
 from mocapqa.api.http_guards import install_http_guards
 from mocapqa.api.index_page import STATIC_URL, index_page
-from mocapqa.api.query_repeats import check_query_repeats
+from mocapqa.api.query_repeats import check_json_repeats, check_query_repeats
 from mocapqa.api.routes import (
     decisions,
     filters,
@@ -168,8 +168,12 @@ def create_app(
         description="Motion-capture QA: twist errors, joint limits and keypoint filtering.",
         lifespan=lifespan,
         # Every route: a form route refuses the parts it would not read (api/form_parts.py),
-        # and a query parameter read once may be sent once (api/query_repeats.py).
-        dependencies=[Depends(check_form_parts), Depends(check_query_repeats)],
+        # and a query parameter or JSON key read once may be sent once (api/query_repeats.py).
+        dependencies=[
+            Depends(check_form_parts),
+            Depends(check_query_repeats),
+            Depends(check_json_repeats),
+        ],
     )
     app.state.services = services
     app.state.accounts = accounts

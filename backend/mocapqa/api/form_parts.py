@@ -41,6 +41,7 @@ __all__ = [
     "file_fields",
     "form_sent_for_json",
     "multipart_refusal",
+    "reads_form",
     "takes_many",
 ]
 
@@ -66,7 +67,7 @@ def _body_params(dependant: Any) -> list[Any]:
     return found
 
 
-def _reads_form(route: Any) -> bool | None:
+def reads_form(route: Any) -> bool | None:
     """True when the route reads a form body, False for a JSON body, None for no body."""
     body = getattr(route, "body_field", None)
     if body is None or getattr(route, "dependant", None) is None:
@@ -76,7 +77,7 @@ def _reads_form(route: Any) -> bool | None:
 
 def file_fields(route: Any) -> list[str]:
     """The names of the route's file fields (``File()``), in declaration order."""
-    if not _reads_form(route):
+    if not reads_form(route):
         return []
     return [p.alias for p in _body_params(route.dependant) if isinstance(p.field_info, params.File)]
 
@@ -115,7 +116,7 @@ async def check_form_parts(connection: HTTPConnection) -> None:
     RequestValidationError
     """
     route: Any = connection.scope.get("route")
-    if not isinstance(connection, Request) or not _reads_form(route):
+    if not isinstance(connection, Request) or not reads_form(route):
         return
     request = connection
     declared = {p.alias: takes_many(p.field_info.annotation) for p in _body_params(route.dependant)}
@@ -131,7 +132,7 @@ async def form_sent_for_json(request: Request) -> list[tuple[str, str]]:
     reads JSON (run options sent as a form), or [] when the body is not a form. For the
     validation handler, after the route's other dependencies (401 and 403 come first)."""
     kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
-    if kind not in FORM_TYPES or _reads_form(request.scope.get("route")) is not False:
+    if kind not in FORM_TYPES or reads_form(request.scope.get("route")) is not False:
         return []
     # The body FastAPI already read, parsed as a form; a multipart body the parser refuses
     # raises its 400 here, which the outer handler answers as multipart_refusal says.

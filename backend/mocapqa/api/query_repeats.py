@@ -1,23 +1,77 @@
-"""Query parameters sent more than once where the route reads one value.
+"""Query parameters and JSON keys sent more than once where the route reads one value.
 
-Starlette keeps the last of a repeated query parameter (``?limit=5&limit=100000``), so what a
+Starlette keeps the last of a repeated query parameter (``?limit=5&limit=100000``), and
+Python's JSON parser the last of a repeated key (``{"name": "a", "name": "b"}``), so what a
 client meant, and what a proxy or log in front of the server saw, could differ from what the
-route used. :func:`check_query_repeats` (a dependency of every route) refuses such a request
-with a 422 naming ``query.NAME``, as FastAPI names a query field; a parameter declared as a
-list takes every value.
+route used. :func:`check_query_repeats` refuses such a query with a 422 naming
+``query.NAME``, as FastAPI names a query field (a parameter declared as a list takes every
+value); :func:`check_json_repeats` a JSON body with a key given twice in one object, naming
+``body.KEY``. Both are dependencies of every route.
 """
 
 from __future__ import annotations
 
+import json
 from collections import Counter
 from typing import Any
 
 from fastapi.exceptions import RequestValidationError
-from starlette.requests import HTTPConnection
+from starlette.requests import HTTPConnection, Request
 
-from mocapqa.api.form_parts import takes_many
+from mocapqa.api.form_parts import reads_form, takes_many
 
-__all__ = ["check_query_repeats"]
+__all__ = ["check_json_repeats", "check_query_repeats"]
+
+
+class _RepeatedKeyError(ValueError):
+    """A JSON object with a key given twice."""
+
+    def __init__(self, key: str) -> None:
+        super().__init__(key)
+        self.key = key
+
+
+def _refuse_repeats(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    table: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in table:
+            raise _RepeatedKeyError(key)
+        table[key] = value
+    return table
+
+
+async def check_json_repeats(connection: HTTPConnection) -> None:
+    """Refuse (422 naming ``body.KEY``) a JSON body with a key given twice in one object; a
+    body that is not valid JSON is left to FastAPI's own 422.
+
+    Raises
+    ------
+    RequestValidationError
+    """
+    if (
+        not isinstance(connection, Request)
+        or reads_form(connection.scope.get("route")) is not False
+    ):
+        return
+    kind = connection.headers.get("content-type", "").split(";")[0].strip().lower()
+    if not kind.endswith("json"):
+        return
+    body = await connection.body()  # cached: the route reads the same bytes
+    try:
+        json.loads(body, object_pairs_hook=_refuse_repeats)
+    except _RepeatedKeyError as e:
+        shown = e.key if len(e.key) <= 100 else f"{e.key[:100]}…"
+        raise RequestValidationError(
+            [
+                {
+                    "loc": ("body", shown),
+                    "msg": f"Expected each key once, got {shown!r} twice",
+                    "type": "value_error",
+                }
+            ]
+        ) from None
+    except (ValueError, RecursionError):  # not JSON: FastAPI answers it
+        return
 
 
 def _query_params(dependant: Any) -> list[Any]:
