@@ -19,25 +19,9 @@ from fastapi.exceptions import RequestValidationError
 from starlette.requests import HTTPConnection, Request
 
 from mocapqa.api.form_parts import reads_form, takes_many
+from mocapqa.core.json_keys import RepeatedKeyError, unique_keys
 
 __all__ = ["check_json_repeats", "check_query_repeats"]
-
-
-class _RepeatedKeyError(ValueError):
-    """A JSON object with a key given twice."""
-
-    def __init__(self, key: str) -> None:
-        super().__init__(key)
-        self.key = key
-
-
-def _refuse_repeats(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    table: dict[str, Any] = {}
-    for key, value in pairs:
-        if key in table:
-            raise _RepeatedKeyError(key)
-        table[key] = value
-    return table
 
 
 async def check_json_repeats(connection: HTTPConnection) -> None:
@@ -58,8 +42,8 @@ async def check_json_repeats(connection: HTTPConnection) -> None:
         return
     body = await connection.body()  # cached: the route reads the same bytes
     try:
-        json.loads(body, object_pairs_hook=_refuse_repeats)
-    except _RepeatedKeyError as e:
+        json.loads(body, object_pairs_hook=unique_keys)
+    except RepeatedKeyError as e:
         shown = e.key if len(e.key) <= 100 else f"{e.key[:100]}…"
         raise RequestValidationError(
             [

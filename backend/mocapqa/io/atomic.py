@@ -18,6 +18,7 @@ PDF, rendered PNG/GIF/MP4, a limits model, the batch results table) goes through
 
 from __future__ import annotations
 
+import contextlib
 import os
 import secrets
 import stat
@@ -174,12 +175,9 @@ class PendingFile:
     def discard(self) -> None:
         """Remove the temporary file; the target is left as it was."""
         self._open = False
-        try:
-            self.temporary.unlink()
-        except FileNotFoundError:
-            pass
-        except OSError:
-            pass  # nothing more can be done; the caller's error is the one to report
+        # Nothing more can be done if this fails; the caller's error is the one to report.
+        with contextlib.suppress(OSError):
+            self.temporary.unlink(missing_ok=True)
 
 
 @contextmanager

@@ -18,20 +18,11 @@ import json
 import tomllib
 from pathlib import Path
 
+from mocapqa.core.json_keys import RepeatedKeyError, unique_keys
 from mocapqa.core.rig import normalise_mapping
 from mocapqa.errors import InputError, ParseError
 
 __all__ = ["read_mapping"]
-
-
-def _refuse_repeated_keys(pairs: list[tuple[str, object]]) -> dict[str, object]:
-    """A JSON object's members as a dict; ValueError naming a key given twice."""
-    table: dict[str, object] = {}
-    for key, value in pairs:
-        if key in table:
-            raise ValueError(f"Expected each key once, got {key!r} twice")
-        table[key] = value
-    return table
 
 
 def read_mapping(path: Path) -> dict[str, str]:
@@ -60,10 +51,10 @@ def read_mapping(path: Path) -> dict[str, str]:
             raise ParseError(f"Expected TOML, got {e}", path) from e
     else:
         try:
-            data = json.loads(text, object_pairs_hook=_refuse_repeated_keys)
+            data = json.loads(text, object_pairs_hook=unique_keys)
         except json.JSONDecodeError as e:
             raise ParseError(f"Expected JSON, got {e.msg}", path, e.lineno) from e
-        except ValueError as e:  # a key given twice: the last would silently win
+        except RepeatedKeyError as e:  # the last would silently win
             raise ParseError(str(e), path) from e
     if not isinstance(data, dict):
         raise ParseError(
