@@ -3,13 +3,18 @@
 Every file or archive member becomes a take of the shoot when it reads; members that are not
 motion files are listed as skipped, members that fail (unsafe names, links, unreadable or
 malformed content) are listed with their error, and the rest are kept. Limits on the archive
-as a whole (size, member count, unpacked size) reject it entirely, before extracting.
+as a whole (size, member count, unpacked size) reject it entirely, before extracting; a member
+larger than the upload limit is cut while it is unpacked and listed as failed. An archive's
+declared unpacked size is added to the request's hold of the user's staging allowance
+(:mod:`mocapqa.jobs.staging`) before it is unpacked, and given back once its members are
+stored.
 """
 
 from __future__ import annotations
 
 import shutil
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Any, BinaryIO
@@ -19,6 +24,7 @@ from mocapqa.jobs.archive import archive_kind, unpack
 from mocapqa.jobs.batch import SIDECAR_REASON, skip_reason
 from mocapqa.jobs.intake import CHUNK_BYTES, MAX_NAME_CHARS, ingest_take
 from mocapqa.jobs.runner import JobRunner
+from mocapqa.jobs.staging import StagingHold
 from mocapqa.pipeline.loading import ReadLimits
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
@@ -33,7 +39,7 @@ class ImportLimits:
     Parameters
     ----------
     max_upload_bytes : int
-        Largest file or archive received.
+        Largest file or archive received, and archive member unpacked.
     max_members : int
         Most members of an archive.
     max_unpacked_bytes : int
@@ -77,6 +83,18 @@ def _label(archive: str, member: str) -> str:
     return label if len(label) <= limit else f"{label[: limit - 1]}…"
 
 
+def _holder(staging: StagingHold | None, name: str, held: list[int]) -> Callable[[int], None]:
+    """An archive's ``before_extract``: its declared unpacked size held in ``staging`` (which
+    may refuse it), and noted in ``held`` to be given back."""
+
+    def hold(declared: int) -> None:
+        if staging is not None:
+            staging.reserve(declared, f" ({declared} unpacked from {name!r})")
+            held[0] = declared
+
+    return hold
+
+
 IMPORT_SIDECAR_REASON = (
     "a keypoint CSV's .meta.json sidecar: not read by an import (the CSV's rate comes from its "
     "time column, its unit is 'unknown'); upload the CSV alone with fps and length_unit"
@@ -100,15 +118,21 @@ def import_uploads(
     limits: ImportLimits,
     client: str = "local",
     owner_id: int | None = None,
+    staging: StagingHold | None = None,
 ) -> ImportReport:
     """Import uploaded files (takes or archives of takes) into a shoot; analyses start, in
     ``client``'s line of the runner's fair queue (and counted in its queued runs). Each take
     is stored owned by ``owner_id``, so takes made before a limit stops the import keep theirs.
+    Each archive's declared unpacked size is held in ``staging`` (the request's hold of its
+    user's allowance in ``incoming/``) while it is unpacked and stored.
 
     Raises
     ------
     TooLargeError
-        When an archive passes a limit (earlier uploads of the same request are kept).
+        When an archive passes a limit (earlier uploads of the same request are kept), or
+        would take the request past the staging allowance alone.
+    RateLimitError
+        When an archive would take the user's requests past the staging allowance.
     NotFoundError
         When the shoot is deleted while the import runs (the take being stored is removed).
     """
@@ -150,6 +174,7 @@ def import_uploads(
                 report.skipped.append({"name": name, "reason": reason})
             continue
         scratch = Path(tempfile.mkdtemp(prefix="archive-", dir=files.root / "incoming"))
+        held = [0]
         try:
             received = scratch / "archive"
             _receive(source, received, name, limits.max_upload_bytes)
@@ -157,7 +182,13 @@ def import_uploads(
             members.mkdir()
             try:
                 unpacked = unpack(
-                    received, name, members, limits.max_members, limits.max_unpacked_bytes
+                    received,
+                    name,
+                    members,
+                    limits.max_members,
+                    limits.max_unpacked_bytes,
+                    max_member_bytes=limits.max_upload_bytes,
+                    before_extract=_holder(staging, name, held),
                 )
             except TooLargeError:
                 raise
@@ -177,4 +208,6 @@ def import_uploads(
                     member.path.unlink(missing_ok=True)
         finally:
             shutil.rmtree(scratch, ignore_errors=True)
+            if staging is not None:
+                staging.release(held[0])
     return report
