@@ -89,3 +89,17 @@ def test_first_loopback_start_makes_an_admin_and_a_link(tmp_path: Path) -> None:
         path = link.split("8123", 1)[1]
         assert client.get(path, follow_redirects=False).headers["location"] == "/"
         assert client.get("/api/v1/me").json()["name"] == "admin"
+
+
+def test_a_token_for_a_disabled_user_is_refused(tmp_path: Path) -> None:
+    """It was printed (exit 0) but never signed in: disabling revokes a user's tokens and
+    refuses new sign-ins."""
+    data = tmp_path / "store"
+    assert mocapqa(data, "users", "add", "gone", "--role", "reviewer").returncode == 0
+    assert mocapqa(data, "users", "disable", "gone").returncode == 0
+    made = mocapqa(data, "tokens", "create", "--user", "gone")
+    assert made.returncode != 0
+    assert "Expected an enabled user" in made.stderr, made.stderr
+    assert "disabled" in made.stderr
+    assert "mqa_" not in made.stdout
+    assert mocapqa(data, "tokens", "create", "--user", "nobody").returncode != 0

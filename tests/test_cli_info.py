@@ -102,7 +102,7 @@ def test_info_reports_missing_keypoints(
     ("args", "code", "pattern"),
     [
         (["info", "nowhere.bvh"], 3, "Expected an existing file"),
-        (["info", "{walk}", "--fps", "0"], 3, "Expected --fps > 0"),
+        (["info", "{walk}", "--fps", "0"], 3, "Expected --fps finite, at least 0.1"),
         (["info", "{broken}"], 3, "line 2: Expected 'ROOT'"),
         (["info", "{walk}", "--mapping", "{bad_json}"], 3, "line 2: Expected JSON"),
         (["info", "{walk}", "--mapping", "{bad_role}"], 3, "Expected a role in"),
@@ -331,7 +331,10 @@ def test_info_and_convert_refuse_hostile_numbers_without_a_traceback(
         (["info", str(huge)], "within ±1,000,000,000, got 1e+308"),
         (["convert", str(huge), "-o", str(tmp_path / "out.trc")], "within ±1,000,000,000"),
         (["info", str(garbage), "--fps", "30"], "kp_garbage.npy: Expected a NumPy array header"),
-        (["info", str(csv), "--fps", "inf"], "Expected --fps > 0, finite and at most 100000"),
+        (
+            ["info", str(csv), "--fps", "inf"],
+            "Expected --fps finite, at least 0.1 and at most 100000",
+        ),
         (["convert", str(csv), "-o", str(tmp_path / "o.csv"), "--fps", "nan"], "finite"),
     ]
     for argv, message in cases:

@@ -105,6 +105,9 @@ def test_openapi_documents_every_status_each_route_answers(client: TestClient) -
                 assert 404 in documented, path
             if method in ("POST", "DELETE"):
                 assert 403 in documented, path
+            if method in ("POST", "PUT", "PATCH", "DELETE"):
+                # Every request body is bounded (max_request_kb, max_upload_mb): 413 over it.
+                assert 413 in documented, (method, path)
     upload = spec["paths"]["/api/v1/takes"]["post"]["responses"]
     assert {"413", "415", "429"} <= set(upload)
     run_status = spec["components"]["schemas"]["RunOut"]["properties"]["status"]

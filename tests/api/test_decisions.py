@@ -187,3 +187,29 @@ def test_deleting_the_take_removes_its_decisions(
     assert len(store.history(run_id)) == 1
     assert client.delete(f"/api/v1/takes/{knees_run['take_id']}").status_code == 204
     assert store.history(run_id) == []
+
+
+def test_a_decision_records_the_client_address_of_a_signed_in_reviewer(
+    client: TestClient, knees_run: dict[str, Any]
+) -> None:
+    """The history's ``client`` read ``user:3`` (the run-quota key) for a signed-in reviewer;
+    docs/api.md says it is the client's address, as the audit log records it."""
+    from datetime import timedelta
+
+    from mocapqa.store.roles import Role
+
+    accounts = client.app.state.accounts  # type: ignore[attr-defined]
+    user = accounts.add_user("ana", Role.REVIEWER)
+    token = accounts.issue(user.id, "api", timedelta(days=1)).token
+    response = client.post(
+        f"/api/v1/runs/{knees_run['id']}/intervals/0/decisions",
+        json={"decision": "accept"},
+        headers={"Authorization": f"Bearer {token}"},
+    )
+    assert response.status_code == 201, response.text
+    assert response.json()["client"] == "testclient"
+    assert response.json()["reviewer"] == "ana"
+    history = client.get(
+        f"/api/v1/runs/{knees_run['id']}/decisions", headers={"Authorization": f"Bearer {token}"}
+    ).json()["history"]
+    assert [h["client"] for h in history] == ["testclient"]

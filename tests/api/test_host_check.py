@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import pytest
+from starlette.responses import PlainTextResponse
+from starlette.testclient import TestClient
+from starlette.types import Receive, Scope, Send
 
 from mocapqa.api.host_check import HostCheck, host_name, normal_host
 
@@ -63,3 +66,26 @@ def test_host_check_matches_ipv6_names_and_domains() -> None:
 def test_host_patterns_other_than_a_leading_star_dot_are_refused(entry: str) -> None:
     with pytest.raises(ValueError, match=r"\*\.example\.org"):
         HostCheck(_app, [entry])
+
+
+async def _ok(scope: Scope, receive: Receive, send: Send) -> None:
+    await PlainTextResponse("ok")(scope, receive, send)
+
+
+@pytest.mark.parametrize(
+    "hosts",
+    [
+        ["testserver", "testserver"],  # both allowed: still two answers to "which server?"
+        ["testserver", "evil.example"],  # the first was used, the second never checked
+        ["evil.example", "testserver"],
+    ],
+)
+def test_two_host_headers_are_400(hosts: list[str]) -> None:
+    """Two ``Host`` headers in one request were accepted, the first used: a proxy or log in
+    front of the server may have read the other."""
+    client = TestClient(HostCheck(_ok, ["testserver"]))
+    response = client.get("/", headers=[("host", host) for host in hosts])
+    assert response.status_code == 400, response.text
+    assert response.json()["error"] == "HostError"
+    assert f"one Host header, got {len(hosts)}" in response.json()["detail"]
+    assert client.get("/", headers=[("host", "testserver")]).status_code == 200

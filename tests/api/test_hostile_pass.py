@@ -336,6 +336,53 @@ def test_a_json_body_that_cannot_be_decoded_names_the_body(
     assert words in answer["detail"]
 
 
+@pytest.mark.parametrize(
+    ("origin", "status"),
+    [
+        ("https://testserver", 403),  # the server answers http: another origin
+        ("HTTPS://testserver", 403),
+        ("ftp://testserver", 403),
+        ("http://testserver", 201),
+        ("HTTP://TestServer", 201),
+    ],
+)
+def test_an_origin_of_another_scheme_is_cross_site(
+    origin: str, status: int, client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    """``Origin: https://host`` was accepted on an http server: the check compared the host
+    alone, while an origin is scheme, host and port (a page on https://host is another site to
+    http://host)."""
+    headers = {**alice[1], "Origin": origin}
+    response = client.post("/api/v1/shoots", json={"name": "day one"}, headers=headers)
+    assert response.status_code == status, response.text
+    if status == 403:
+        assert response.json()["error"] == "ForbiddenError"
+        assert client.get("/api/v1/shoots", headers=alice[1]).json() == []
+
+
+@pytest.mark.parametrize(
+    ("origin", "opens"), [("https://testserver", False), ("http://testserver", True)]
+)
+def test_a_stream_from_an_origin_of_another_scheme_is_refused(
+    origin: str, opens: bool, client: TestClient, alice: tuple[int, dict[str, str]]
+) -> None:
+    """The stream answers ws:// (the page's http://); an https:// page is another site."""
+    from starlette.websockets import WebSocketDisconnect
+
+    headers = {**alice[1], "Origin": origin}
+    if opens:
+        with client.websocket_connect("/api/v1/stream/filter", headers=headers) as socket:
+            socket.send_json({"fps": 30, "n_keypoints": 2})
+            assert socket.receive_json()["ready"] is True
+        return
+    with (
+        pytest.raises(WebSocketDisconnect) as refused,
+        client.websocket_connect("/api/v1/stream/filter", headers=headers),
+    ):
+        pass
+    assert refused.value.code == 1008
+
+
 def raw_request(url: str, head: str, wait_s: float = 120.0) -> tuple[int, dict[str, Any]]:
     """Send only a request's head on a socket and read the answer: a server waiting for the
     body would never answer (the read then times out after ``wait_s``, a generous bound)."""

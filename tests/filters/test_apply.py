@@ -232,4 +232,4 @@ def test_cli_filter_refuses_out_of_range_parameters_naming_them(
         assert extra[-1].split("=")[0] in err or "--fps" in err, err
     assert not out.exists()
     assert main([*argv, "--fps", "inf"]) == 3
-    assert "Expected --fps > 0, finite" in capsys.readouterr().err
+    assert "Expected --fps finite, at least 0.1" in capsys.readouterr().err

@@ -95,3 +95,21 @@ def test_an_apply_list_past_its_cap_is_refused_when_asked_for() -> None:
     with pytest.raises(OptionError, match="at most 10,000 interval ids"):
         AnalysisOptions.from_json({"twist_apply": ",".join(["0"] * 40_001)})  # 80,001 characters
     AnalysisOptions.from_json({"twist_apply": ",".join(str(i) for i in range(10_000))})
+
+
+@pytest.mark.parametrize(
+    ("checks", "message"),
+    [
+        (["twist"] * 100_000, "Expected each of ['twist', 'limits', 'filter'] at most once"),
+        (["limits", "filter", "limits"], "got 'limits' 2 times"),
+        (["spin"] * 100_000 + ["twist"], "got ['spin']"),
+    ],
+)
+def test_checks_are_known_names_each_at_most_once(checks: list[str], message: str) -> None:
+    """A list of 100,000 checks was stored with the run as sent (a batch options file or a
+    stored run's options read back alike)."""
+    with pytest.raises(OptionError, match=re.escape(message)) as raised:
+        AnalysisOptions.from_json({"checks": checks})
+    assert raised.value.field == "checks"
+    assert len(str(raised.value)) < 200
+    assert AnalysisOptions.from_json({"checks": ["filter", "twist"]}).checks == ("filter", "twist")

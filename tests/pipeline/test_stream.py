@@ -58,3 +58,27 @@ def test_stream_refuses_unknown_units_and_presets() -> None:
     session = StreamSession(30.0, 4, "px")
     with pytest.raises(InputError, match="Expected metric units"):
         session.filter(np.full((4, 3), np.nan), None)
+
+
+@pytest.mark.parametrize("fps", [1e-300, 0.05, 100_001.0, float("inf"), float("nan")])
+def test_stream_refuses_a_frame_rate_out_of_bounds(fps: float) -> None:
+    """1e-300 fps was a session whose first frame overflowed the Kalman filter's dt⁴."""
+    with pytest.raises(InputError, match=r"at least 0\.1 and at most 100000"):
+        StreamSession(fps, 4, "m")
+
+
+@pytest.mark.parametrize("unit", ["m", "unknown"])
+def test_stream_refuses_coordinates_and_confidences_out_of_bounds(unit: str) -> None:
+    """Positions of 1e308 were a ZeroDivisionError (the body size of a first frame) or
+    infinity out of the filter."""
+    session = StreamSession(30.0, 2, unit)
+    with pytest.raises(InputError, match="within ±1,000,000,000"):
+        session.filter(np.full((2, 3), 1e308), None)
+    with pytest.raises(InputError, match="within ±1,000,000,000"):
+        session.filter(np.array([[np.inf, 0, 0], [1, 2, 3]]), None)
+    with pytest.raises(InputError, match="from 0 to 1"):
+        session.filter(np.zeros((2, 3)), np.array([2.0, 1.0]))
+    assert session.frame == 0
+    filtered, _ = session.filter(np.array([[1e9, -1e9, 0], [np.nan, 2, 3]]), np.array([1, 0.0]))
+    assert session.frame == 1
+    assert np.isfinite(filtered[0]).all()

@@ -31,7 +31,7 @@ class DecisionOut(BaseModel):
     decision: Decision
     note: str
     reviewer: str
-    client: str
+    client: str = Field(description="The address the decision was sent from (as in the audit log)")
     created_at: datetime
 
 

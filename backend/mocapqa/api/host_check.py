@@ -4,8 +4,10 @@ Like Starlette's ``TrustedHostMiddleware`` (``*`` allows any host, ``*.example.o
 domain's), with IPv6 handled as addresses: ``Host: [::1]:8000`` and ``Host: [0:0::1]`` both
 name the allowed entry ``::1`` (or ``[::1]``; entries may be written with or without
 brackets), while a bracketed host that is not an IPv6 address (``[evil]``), an unbracketed
-IPv6 address (``::1``, which a client must bracket) and a malformed port are refused. The
-answer is the API's error body (JSON), on HTTP requests and WebSocket handshakes alike.
+IPv6 address (``::1``, which a client must bracket) and a malformed port are refused, and so
+is a request with two ``Host`` headers, allowed or not (a proxy or log in front of the server
+may have read the other one). The answer is the API's error body (JSON), on HTTP requests and
+WebSocket handshakes alike.
 """
 
 from __future__ import annotations
@@ -58,7 +60,8 @@ def host_name(header: str | None) -> str | None:
 
 
 class HostCheck:
-    """ASGI middleware refusing (400) a request whose ``Host`` is not allowed.
+    """ASGI middleware refusing (400) a request whose ``Host`` is not allowed, or that has
+    more than one.
 
     Parameters
     ----------
@@ -92,13 +95,17 @@ class HostCheck:
         if scope["type"] not in ("http", "websocket"):
             await self.app(scope, receive, send)
             return
-        header = Headers(scope=scope).get("host")
-        if self.allows(header):
+        hosts = Headers(scope=scope).getlist("host")
+        header = hosts[0] if hosts else None
+        if len(hosts) > 1:
+            # Which one names the server? A proxy or log in front may have read the other.
+            detail = f"Expected one Host header, got {len(hosts)}"
+        elif self.allows(header):
             await self.app(scope, receive, send)
             return
-        shown = (header or "")[:100]
-        body = error_body(
-            "HostError",
-            f"Expected a Host header naming this server (setting allowed_hosts), got {shown!r}",
-        )
-        await JSONResponse(body, status_code=400)(scope, receive, send)
+        else:
+            shown = (header or "")[:100]
+            detail = (
+                f"Expected a Host header naming this server (setting allowed_hosts), got {shown!r}"
+            )
+        await JSONResponse(error_body("HostError", detail), status_code=400)(scope, receive, send)

@@ -8,8 +8,16 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from mocapqa.api.request_model import RequestModel
+from mocapqa.core.rig import ROLE_KEYS
 from mocapqa.errors import InputError
-from mocapqa.pipeline.options import CHECKS, MAX_POINTS_RANGE, Check, TwistMethod, check_mapping
+from mocapqa.pipeline.options import (
+    CHECKS,
+    MAX_POINTS_RANGE,
+    Check,
+    TwistMethod,
+    check_checks,
+    check_mapping,
+)
 from mocapqa.store.repository import ReviewStatus, RunStatus
 
 __all__ = [
@@ -59,7 +67,12 @@ class AnalysisOptionsIn(RequestModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    checks: list[Check] = Field(list(CHECKS))
+    checks: list[Check] = Field(
+        list(CHECKS),
+        max_length=len(CHECKS),
+        json_schema_extra={"uniqueItems": True},
+        description="The checks to run, each at most once",
+    )
     twist_method: TwistMethod = "robust"
     twist_apply: str = Field(
         "confident",
@@ -72,9 +85,19 @@ class AnalysisOptionsIn(RequestModel):
     max_points: int = Field(2000, ge=MAX_POINTS_RANGE[0], le=MAX_POINTS_RANGE[1])
     mapping: dict[str, str] = Field(
         default_factory=dict,
+        max_length=len(ROLE_KEYS),
         description='Rig roles by hand, role key → joint name ({"left_upper_arm": "LeftArm"}); '
         "roles not named are found from the joint names and the skeleton's structure.",
     )
+
+    @field_validator("checks")
+    @classmethod
+    def _checks_once(cls, value: list[Check]) -> list[Check]:
+        try:
+            check_checks(value)
+        except InputError as e:
+            raise ValueError(str(e)) from e
+        return value
 
     @field_validator("mapping")
     @classmethod

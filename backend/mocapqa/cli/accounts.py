@@ -113,11 +113,21 @@ def tokens_create(
     expires_days: Annotated[int, typer.Option("--expires-days", min=1, max=3650)] = 90,
     name: Annotated[str, typer.Option("--name", help="What the token is for.")] = "",
 ) -> None:
-    """Create a personal token; it is printed once, as the last line of stdout."""
+    """Create a personal token; it is printed once, as the last line of stdout.
+
+    A disabled user gets none (exit 5, nothing printed on stdout): its tokens do not sign in.
+    """
     from datetime import timedelta
+
+    from mocapqa.errors import ConflictError
 
     accounts = _accounts()
     owner = accounts.get_user(user)
+    if owner.disabled:
+        raise ConflictError(
+            f"Expected an enabled user to own the token, got {owner.name!r}, which is disabled "
+            "(a disabled user's tokens do not sign in)"
+        )
     issued = accounts.issue(owner.id, "api", timedelta(days=expires_days), name)
     accounts.record("token_create", None, _CLI, issued.id, f"user={owner.name}")
     typer.echo(f"token {issued.id} for {owner.name}, expires {issued.expires_at:%Y-%m-%d}")

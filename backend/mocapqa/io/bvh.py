@@ -8,7 +8,7 @@ Conventions
   CRLF/LF/CR/mixed line endings, UTF-8 or UTF-16 with a byte order mark, trailing spaces,
   exponents, ``-0`` and ``.0083333``.
 * Refuses what no take holds: a Frame Time outside :data:`MIN_FRAME_TIME_S` to
-  :data:`MAX_FRAME_TIME_S`, values beyond :data:`~mocapqa.io.bvh_frames.MAX_MAGNITUDE`, more
+  :data:`MAX_FRAME_TIME_S`, values beyond :data:`~mocapqa.core.bounds.MAX_MAGNITUDE`, more
   than :data:`~mocapqa.io.bvh_hierarchy.MAX_JOINTS` joints.
 * Rotation channels are intrinsic in channel order (see :mod:`mocapqa.kinematics.euler`) and are
   converted to local quaternions ``(F, J, 4)``; the angles read are kept as the motion's
@@ -32,6 +32,7 @@ from typing import Literal
 import numpy as np
 
 from mocapqa.core.arrays import FloatArray
+from mocapqa.core.bounds import MAX_FPS, MIN_FPS
 from mocapqa.core.motion import POSITION_CHANNELS, Motion, Skeleton
 from mocapqa.errors import ParseError
 from mocapqa.io.bvh_frames import frames_by_arrow, frames_by_line, quoted
@@ -52,10 +53,12 @@ BvhParseError = ParseError
 """Alias of :class:`~mocapqa.errors.ParseError`, the error every malformed BVH raises."""
 NumberReader = Literal["arrow", "python", "auto"]
 """How the frame block's numbers are read (see :func:`parse_bvh`)."""
-MIN_FRAME_TIME_S = 1e-5
-"""Shortest Frame Time accepted: 100,000 fps, ten times the fastest motion-capture cameras."""
-MAX_FRAME_TIME_S = 10.0
-"""Longest Frame Time accepted (0.1 fps); a larger one is most often a frame rate."""
+MIN_FRAME_TIME_S = 1 / MAX_FPS
+"""Shortest Frame Time accepted, 1e-5 s (:data:`~mocapqa.core.bounds.MAX_FPS`, 100,000 fps):
+ten times the fastest motion-capture cameras."""
+MAX_FRAME_TIME_S = 1 / MIN_FPS
+"""Longest Frame Time accepted, 10 s (:data:`~mocapqa.core.bounds.MIN_FPS`, 0.1 fps); a larger
+one is most often a frame rate."""
 AUTO_ARROW_BYTES = 1_000_000
 """Frame blocks from this size are read by Arrow under ``number_reader="auto"``.
 

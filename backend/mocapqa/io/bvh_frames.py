@@ -21,17 +21,11 @@ from typing import Any
 import numpy as np
 
 from mocapqa.core.arrays import FloatArray
+from mocapqa.core.bounds import MAX_MAGNITUDE
 from mocapqa.errors import ParseError
 
-__all__ = ["MAX_MAGNITUDE", "frames_by_arrow", "frames_by_line", "quoted"]
+__all__ = ["frames_by_arrow", "frames_by_line", "quoted"]
 
-MAX_MAGNITUDE = 1e9
-"""Largest |value| of a channel or OFFSET, in file units or degrees.
-
-Far beyond any real take (a kilometre in micrometres, 2.8 million turns), and far enough
-below the float range that sums along a 1000-joint chain, squares and third differences at
-100,000 fps stay finite: a file with 1e308 in it is refused here, not turned into NaN later.
-"""
 
 _QUOTED_CHARS = 40
 

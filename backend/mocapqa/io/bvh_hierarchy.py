@@ -20,9 +20,10 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from mocapqa.core.bounds import MAX_MAGNITUDE
 from mocapqa.core.motion import POSITION_CHANNELS, ROTATION_CHANNELS, EndSite
 from mocapqa.errors import ParseError
-from mocapqa.io.bvh_frames import MAX_MAGNITUDE, quoted
+from mocapqa.io.bvh_frames import quoted
 
 __all__ = ["MAX_JOINTS", "MAX_NAME_CHARS", "Hierarchy", "parse_hierarchy"]
 

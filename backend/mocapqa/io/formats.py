@@ -21,6 +21,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Literal
 
+from mocapqa.core.bounds import MAX_FPS, MIN_FPS
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError, ParseError, UnsupportedFormatError
@@ -42,7 +43,6 @@ from mocapqa.io.trc import read_trc, write_trc
 __all__ = [
     "KEYPOINT_FORMATS",
     "KEYPOINT_WRITE_FORMATS",
-    "MAX_FPS",
     "TAKE_FORMATS",
     "check_fps",
     "detect_format",
@@ -260,14 +260,10 @@ def read_take(
     return take
 
 
-MAX_FPS = 100_000.0
-"""Highest frame rate a take may have, frames per second (a rate given with ``--fps`` or read
-from a file): far above any capture system, low enough that per-second rates stay finite."""
-
-
 def check_fps(fps: float, name: str = "fps") -> None:
-    """Refuse a frame rate the user gives (``--fps``, an upload's ``fps``) that is not finite,
-    above 0 and at most :data:`MAX_FPS`.
+    """Refuse a frame rate the user gives (``--fps``, an upload's ``fps``, a live stream's)
+    that is not finite, from :data:`~mocapqa.core.bounds.MIN_FPS` to
+    :data:`~mocapqa.core.bounds.MAX_FPS`.
 
     Parameters
     ----------
@@ -279,11 +275,13 @@ def check_fps(fps: float, name: str = "fps") -> None:
     Raises
     ------
     InputError
-        E.g. ``Expected --fps > 0, finite and at most 100000 frames per second, got inf``.
+        E.g. ``Expected --fps finite, at least 0.1 and at most 100000 frames per second, got
+        inf``.
     """
-    if not (math.isfinite(fps) and 0 < fps <= MAX_FPS):
+    if not (math.isfinite(fps) and MIN_FPS <= fps <= MAX_FPS):
         raise InputError(
-            f"Expected {name} > 0, finite and at most {MAX_FPS:g} frames per second, got {fps:g}"
+            f"Expected {name} finite, at least {MIN_FPS:g} and at most {MAX_FPS:g} frames per "
+            f"second, got {fps:g}"
         )
 
 
@@ -294,8 +292,10 @@ def require_frames(take: Motion | KeypointSequence, path: str | Path) -> None:
     everything that analyses, filters or renders a take calls this first.
 
     Also refuses a keypoint take without keypoints, with a coordinate beyond ±1e9 (which the
-    readers refuse already; a sequence made in code may hold one) or a frame rate over
-    100,000 fps (the limits a BVH's reader and ``--fps`` already keep).
+    readers refuse already; a sequence made in code may hold one) or a frame rate below 0.1
+    or over 100,000 fps (:mod:`mocapqa.core.bounds`: the limits a BVH's reader and ``--fps``
+    already keep; a keypoint file's own rate, such as a JSON ``fps`` of 1e-300, meets them
+    here).
 
     Raises
     ------
@@ -310,9 +310,11 @@ def require_frames(take: Motion | KeypointSequence, path: str | Path) -> None:
         if take.n_keypoints == 0:
             raise ParseError("Expected at least one keypoint, got 0", path, field="keypoints")
         check_coordinates(take.positions, path, take.names, take.frame_numbers)
-        if take.fps > MAX_FPS:
+        if not MIN_FPS <= take.fps <= MAX_FPS:
             raise ParseError(
-                f"Expected fps at most {MAX_FPS:g}, got {take.fps:g}", path, field="fps"
+                f"Expected fps at least {MIN_FPS:g} and at most {MAX_FPS:g}, got {take.fps:g}",
+                path,
+                field="fps",
             )
 
 

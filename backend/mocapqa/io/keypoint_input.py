@@ -6,7 +6,7 @@ Conventions
   the 1-based line or the field; a :class:`~mocapqa.errors.ShapeError` raised while building
   the :class:`~mocapqa.core.keypoints.KeypointSequence` is wrapped the same way.
 * Number text follows Python's ``float``: ``nan`` means missing; infinity is rejected.
-* Coordinates lie within ±:data:`~mocapqa.io.bvh_frames.MAX_MAGNITUDE` (1e9), the bound the BVH
+* Coordinates lie within ±:data:`~mocapqa.core.bounds.MAX_MAGNITUDE` (1e9), the bound the BVH
   reader keeps: every reader builds its sequence with :func:`build_keypoint_sequence`, which
   refuses a larger one (:func:`check_coordinates`) before a filter squares it into infinity.
 * The frame rate is resolved in one place: a caller's ``fps`` wins, then the file's, then a
@@ -24,9 +24,9 @@ from typing import Any
 import numpy as np
 
 from mocapqa.core.arrays import FloatArray, IntArray
+from mocapqa.core.bounds import MAX_MAGNITUDE
 from mocapqa.core.keypoints import LENGTH_UNITS, KeypointSequence
 from mocapqa.errors import ParseError, ShapeError
-from mocapqa.io.bvh_frames import MAX_MAGNITUDE
 from mocapqa.io.guards import json_nesting
 
 __all__ = [
@@ -330,7 +330,7 @@ def check_coordinates(
     names: tuple[str, ...] | None = None,
     frame_numbers: IntArray | None = None,
 ) -> None:
-    """Refuse coordinates beyond ±:data:`~mocapqa.io.bvh_frames.MAX_MAGNITUDE` (NaN is missing).
+    """Refuse coordinates beyond ±:data:`~mocapqa.core.bounds.MAX_MAGNITUDE` (NaN is missing).
 
     Parameters
     ----------

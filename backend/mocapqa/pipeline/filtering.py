@@ -17,11 +17,13 @@ from typing import Any
 import numpy as np
 
 from mocapqa.core.arrays import FloatArray
+from mocapqa.core.bounds import MAX_MAGNITUDE
 from mocapqa.core.keypoints import LENGTH_UNITS
 from mocapqa.errors import InputError
 from mocapqa.filters.adaptive import AdaptiveFilter
 from mocapqa.filters.apply import data_scale
 from mocapqa.filters.registry import FILTERS, DataScale
+from mocapqa.io.formats import check_fps
 
 __all__ = ["StreamSession", "filter_catalog"]
 
@@ -81,7 +83,8 @@ class StreamSession:
     Raises
     ------
     InputError
-        On a bad frame rate, keypoint count, unit or preset.
+        On a bad frame rate (not finite, or not from :data:`~mocapqa.core.bounds.MIN_FPS` to
+        :data:`~mocapqa.core.bounds.MAX_FPS`), keypoint count, unit or preset.
     """
 
     def __init__(
@@ -91,8 +94,9 @@ class StreamSession:
         length_unit: str = "unknown",
         preset: str = "default",
     ) -> None:
-        if not (math.isfinite(fps) and fps > 0) or n_keypoints < 1:
-            raise InputError(f"Expected fps > 0 and n_keypoints ≥ 1, got {fps}, {n_keypoints}")
+        check_fps(fps)
+        if n_keypoints < 1:
+            raise InputError(f"Expected n_keypoints ≥ 1, got {n_keypoints}")
         if length_unit not in LENGTH_UNITS:
             raise InputError(f"Expected a length unit in {LENGTH_UNITS}, got {length_unit!r}")
         if preset not in FILTERS["adaptive"].presets:
@@ -143,12 +147,21 @@ class StreamSession:
     def filter(self, positions: Any, confidence: Any | None) -> tuple[FloatArray, FloatArray]:
         """Filter one frame and return the arrays (unrounded).
 
+        A frame is refused, before it changes the filter, when a coordinate is infinite or
+        beyond ±:data:`~mocapqa.core.bounds.MAX_MAGNITUDE` (NaN is missing) or a confidence
+        is not from 0 to 1 (NaN counts as 0).
+
         Returns
         -------
         filtered : ndarray, shape (K, 3)
             NaN where the keypoint has had no valid sample yet.
         weights : ndarray, shape (K, 3)
             Weights of (Kalman, One Euro, EMA).
+
+        Raises
+        ------
+        InputError
+            On a frame or confidence of another shape, or a value out of its bounds.
         """
         k = self.n_keypoints
         try:
@@ -156,13 +169,36 @@ class StreamSession:
             conf = (
                 None if confidence is None else np.asarray(confidence, dtype=np.float64).reshape(k)
             )
-        except (TypeError, ValueError) as e:
+        except (TypeError, ValueError, OverflowError) as e:
             raise InputError(f"Expected positions ({k}, 3) and confidence ({k},), got {e}") from e
+        _check_frame(frame, conf)
+        if conf is not None:
+            conf = np.nan_to_num(conf, nan=0.0)
         if self._filter is None:
             self._filter = self._make_filter(frame[None])
         filtered, weights = self._filter.update(frame, conf)
         self.frame += 1
         return np.asarray(filtered, dtype=np.float64), np.asarray(weights, dtype=np.float64)
+
+
+def _check_frame(frame: FloatArray, confidence: FloatArray | None) -> None:
+    """Refuse a coordinate that is infinite or beyond ±MAX_MAGNITUDE, or a confidence not
+    from 0 to 1 (NaN is missing in both), naming the first keypoint at fault."""
+    over = np.abs(frame) > MAX_MAGNITUDE  # NaN compares False: missing
+    if over.any():
+        keypoint, axis = (int(i) for i in np.argwhere(over)[0])
+        raise InputError(
+            f"Expected coordinates within ±{int(MAX_MAGNITUDE):,} (the stream's length unit), "
+            f"got {frame[keypoint, axis]:g} at keypoint {keypoint}"
+        )
+    if confidence is not None:
+        bad = ~((confidence >= 0) & (confidence <= 1)) & ~np.isnan(confidence)
+        if bad.any():
+            keypoint = int(np.flatnonzero(bad)[0])
+            raise InputError(
+                f"Expected confidence from 0 to 1, got {confidence[keypoint]:g} at keypoint "
+                f"{keypoint}"
+            )
 
 
 def _weights_json(weights: Any) -> dict[str, Any]:

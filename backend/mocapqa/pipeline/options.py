@@ -31,6 +31,7 @@ __all__ = [
     "Check",
     "ParamValue",
     "TwistMethod",
+    "check_checks",
     "check_mapping",
     "describe_options",
 ]
@@ -70,7 +71,7 @@ class AnalysisOptions:
     Parameters
     ----------
     checks : tuple of str
-        Subset of :data:`CHECKS` to run.
+        Subset of :data:`CHECKS` to run, each named at most once.
     twist_method : str
         One of :data:`TWIST_METHODS`.
     twist_apply : str
@@ -107,9 +108,10 @@ class AnalysisOptions:
     limits_model: str | None = None
 
     def __post_init__(self) -> None:
-        unknown = [c for c in self.checks if c not in CHECKS]
-        if unknown:
-            raise OptionError("checks", f"Expected names among {list(CHECKS)}, got {unknown}")
+        try:
+            check_checks(self.checks)
+        except InputError as e:
+            raise OptionError("checks", str(e)) from e
         if self.twist_method not in TWIST_METHODS:
             raise OptionError(
                 "twist_method",
@@ -313,6 +315,29 @@ class AnalysisOptions:
             max_points=max_points,
             mapping=data.get("mapping") or {},
             limits_model=data.get("limits_model"),
+        )
+
+
+def check_checks(checks: Sequence[str]) -> None:
+    """Refuse a ``checks`` option naming a check not in :data:`CHECKS` or one more than once
+    (so at most ``len(CHECKS)`` names). The one check of the option, used by
+    :class:`AnalysisOptions` and the API's request model.
+
+    Raises
+    ------
+    InputError
+        E.g. ``Expected each of ['twist', 'limits', 'filter'] at most once, got 'twist'
+        100000 times``.
+    """
+    unknown = sorted(set(checks) - set(CHECKS))
+    if unknown:
+        shown = [c[:40] for c in unknown[:3]] + (["…"] if len(unknown) > 3 else [])
+        raise InputError(f"Expected names among {list(CHECKS)}, got {shown}")
+    twice = next((c for c in CHECKS if checks.count(c) > 1), None)
+    if twice is not None:
+        raise InputError(
+            f"Expected each of {list(CHECKS)} at most once, got {twice!r} "
+            f"{checks.count(twice)} times"
         )
 
 

@@ -7,9 +7,9 @@ from typing import Annotated, Any
 from fastapi import APIRouter, Depends, Path, Request
 from fastapi.responses import Response
 
-from mocapqa.api.auth import Principal, audit, require
+from mocapqa.api.auth import Principal, audit, client_address, require
 from mocapqa.api.decision_schemas import DecisionIn, DecisionOut, DecisionsOut
-from mocapqa.api.deps import ClientDep, ServicesDep
+from mocapqa.api.deps import ServicesDep
 from mocapqa.api.disposition import attachment, download_stem
 from mocapqa.api.errors import responses
 from mocapqa.core.text import display_name
@@ -73,10 +73,9 @@ def add_decision(
     body: DecisionIn,
     services: ServicesDep,
     decisions: DecisionsDep,
-    client: ClientDep,
 ) -> DecisionOut:
     """Accept or reject one twist interval; the newest decision per interval counts, every
-    one is kept."""
+    one is kept, with the reviewer and the client's address (as the audit log has it)."""
     run_id = str(run["id"])
     known = {int(i["id"]) for i in run_intervals(services.files, run_id)}
     if interval_id not in known:
@@ -84,8 +83,10 @@ def add_decision(
             f"Expected a twist interval id of run {run_id} ({len(known)} interval(s)), "
             f"got {interval_id}"
         )
-    # The reviewer is who is signed in; a body's ``reviewer`` is ignored.
-    row = decisions.add(run_id, interval_id, body.decision, body.note, principal.name, client)
+    # The reviewer is who is signed in; a body's ``reviewer`` is ignored. The client is the
+    # request's address (not the run-quota key, ``user:N`` for a signed-in user).
+    address = client_address(request)
+    row = decisions.add(run_id, interval_id, body.decision, body.note, principal.name, address)
     audit(request, principal, "decision", run_id, f"interval {interval_id}: {body.decision}")
     return _out(row)
 

@@ -16,6 +16,7 @@ from mocapqa.api.auth import Principal, audit, require, require_owner
 from mocapqa.api.deps import ClientDep, ServicesDep
 from mocapqa.api.disposition import attachment
 from mocapqa.api.errors import responses
+from mocapqa.api.http_guards import STAGING_STATE
 from mocapqa.api.shoot_schemas import (
     HeatmapOut,
     ImportOut,
@@ -54,7 +55,7 @@ def _store(services: ServicesDep) -> ShootStore:
 ShootSort = Literal[SORT_COLUMNS]  # type: ignore[valid-type]
 
 
-@router.post("", status_code=201, responses=responses(401, 403, 409))
+@router.post("", status_code=201, responses=responses(401, 403, 409, 413))
 def create_shoot(
     request: Request, principal: Maker, body: ShootIn, services: ServicesDep
 ) -> ShootOut:
@@ -76,7 +77,7 @@ def get_shoot(shoot_id: str, services: ServicesDep) -> ShootOut:
     return ShootOut(**_store(services).get(shoot_id))
 
 
-@router.patch("/{shoot_id}", responses=responses(401, 403, 404, 409))
+@router.patch("/{shoot_id}", responses=responses(401, 403, 404, 409, 413))
 def rename_shoot(
     request: Request, principal: Maker, shoot_id: str, body: ShootIn, services: ServicesDep
 ) -> ShootOut:
@@ -92,7 +93,7 @@ def rename_shoot(
 @router.delete(
     "/{shoot_id}",
     status_code=204,
-    responses=responses(401, 403, 404),
+    responses=responses(401, 403, 404, 413),
 )
 def delete_shoot(
     request: Request,
@@ -141,7 +142,10 @@ def import_takes(
 
     Non-motion archive members are listed as skipped, unreadable or unsafe ones (links,
     names leaving the archive) as failed with their error; the rest are kept, owned by the
-    signed-in user (who may delete them, as takes uploaded one by one).
+    signed-in user (who may delete them, as takes uploaded one by one). A member larger than
+    ``max_upload_mb`` is failed, cut while it is unpacked. An archive that would take the
+    user's requests in progress past ``max_incoming_mb_per_user`` is 429 (413 when this
+    request alone would), before it is unpacked.
     """
     _store(services).require(shoot_id)
     settings = services.settings
@@ -160,6 +164,7 @@ def import_takes(
         limits,
         client,
         principal.user_id,
+        getattr(request.state, STAGING_STATE, None),
     )
     for take in report.created:
         audit(request, principal, "upload", take["take_id"], f"{take['name']} run {take['run_id']}")
