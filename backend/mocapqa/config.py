@@ -10,10 +10,11 @@ tests and benchmarks read (``../shared/data``) is found by ``MOCAPQA_CORPUS_DIR`
 
 from __future__ import annotations
 
+import ipaddress
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from pydantic import Field
+from pydantic import Field, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 if TYPE_CHECKING:
@@ -37,6 +38,15 @@ class Settings(BaseSettings):
         The real-data corpus (for ``bench`` and ``limits build`` defaults).
     job_workers : int
         Analysis worker threads.
+    trusted_proxies : list of str
+        Addresses or networks (``10.0.0.5``, ``172.18.0.0/16``) of reverse proxies whose
+        ``X-Forwarded-For`` and ``X-Forwarded-Proto`` headers are believed. None by default:
+        the client is the address the connection comes from, whatever a header says, so a
+        forged header cannot dodge the sign-in limit or write another address into the audit
+        log (``docs/deploy.md``).
+    server_threads : int
+        Threads serving requests at once (the synchronous routes and dependencies); the
+        database pool is sized for them and the job workers.
 
     The limits below are refused with their 4xx (413, 422 or 429) before their cost is paid;
     ``docs/api.md`` lists them with the reasoning behind each default.
@@ -80,6 +90,13 @@ class Settings(BaseSettings):
     archive_max_unpacked_mb : float
         Most MB an uploaded archive may unpack to (declared sizes checked before extracting,
         written bytes while extracting).
+    max_concurrent_imports_per_user : int
+        Shoot imports one user may have in progress at once; more get 429 with
+        ``Retry-After``, before the body is read. Anonymous requests count per address.
+    max_incoming_mb_per_user : float
+        Most MB one user's uploads and imports in progress may stage in ``incoming/`` (each
+        request's announced body, and each archive's declared unpacked size before it is
+        unpacked); more get 429 with ``Retry-After``, a request over it alone 413.
     """
 
     model_config = SettingsConfigDict(env_prefix="MOCAPQA_", extra="ignore")
@@ -89,6 +106,21 @@ class Settings(BaseSettings):
     max_upload_mb: float = 200.0
     corpus_dir: Path | None = None
     job_workers: int = 2
+    server_threads: int = Field(default=40, ge=1, le=1000)
+    trusted_proxies: list[str] = Field(default_factory=list)
+
+    @field_validator("trusted_proxies")
+    @classmethod
+    def _proxy_addresses(cls, value: list[str]) -> list[str]:
+        for entry in value:
+            try:
+                ipaddress.ip_network(entry, strict=False)
+            except ValueError:
+                raise ValueError(
+                    f"Expected trusted_proxies to hold IP addresses or networks, got {entry!r}"
+                ) from None
+        return value
+
     max_request_kb: float = 1024.0
     max_unpacked_mb: float = 200.0
     max_frame_points: int = 5_000_000
@@ -120,6 +152,8 @@ class Settings(BaseSettings):
     dask_scheduler: str | None = None
     archive_max_members: int = 10_000
     archive_max_unpacked_mb: float = 2_000.0
+    max_concurrent_imports_per_user: int = 2
+    max_incoming_mb_per_user: float = 4_000.0
 
     @property
     def resolved_database_url(self) -> str:

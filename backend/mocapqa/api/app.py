@@ -19,6 +19,7 @@ from contextlib import asynccontextmanager
 from pathlib import Path
 from typing import Any
 
+import anyio.to_thread
 import plotly
 from fastapi import APIRouter, Depends, FastAPI, Request, Response
 from fastapi.middleware.gzip import GZipMiddleware
@@ -123,7 +124,9 @@ def create_app(
         lazily, so an app whose runs never draw pays nothing.
     """
     settings.data_dir.mkdir(parents=True, exist_ok=True)
-    repository = Repository(settings.resolved_database_url)
+    repository = Repository(
+        settings.resolved_database_url, threads=settings.server_threads + settings.job_workers
+    )
     files = FileStore(settings.data_dir)
     owns_renderer = renderer is None
     render_service = RenderService() if renderer is None else renderer
@@ -144,6 +147,7 @@ def create_app(
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        anyio.to_thread.current_default_thread_limiter().total_tokens = settings.server_threads
         swept = files.sweep_incoming()
         if swept:
             log.info("removed %d partial upload(s) left by a stopped server", swept)
@@ -160,6 +164,7 @@ def create_app(
                 engine.close()
             if owns_renderer:
                 render_service.close()
+            accounts.last_use.flush()
             repository.close()
 
     app = FastAPI(

@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Annotated, Any
 
 from fastapi import Depends, Request
 
 from mocapqa.api.auth import PrincipalDep, client_address, quota_key
+from mocapqa.api.http_guards import queue_full
 from mocapqa.config import Settings
-from mocapqa.errors import RateLimitError
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
@@ -23,7 +25,7 @@ __all__ = [
     "get_client",
     "get_services",
     "get_take",
-    "require_run_slot",
+    "run_places",
 ]
 
 
@@ -69,17 +71,18 @@ ClientDep = Annotated[str, Depends(get_client)]
 """Route parameter type that receives the client's key."""
 
 
-def require_run_slot(services: Services, client: str) -> None:
-    """Refuse (429) a new run from a user with ``max_queued_runs_per_user`` waiting.
+@contextmanager
+def run_places(services: Services, client: str, wanted: int = 1) -> Iterator[int]:
+    """Hold up to ``wanted`` of the client's free places in the run queue while the block
+    records and submits its runs (:meth:`JobRunner.places`); yields how many it got, at least
+    one: none free is refused (429) for a user with ``max_queued_runs_per_user`` waiting.
 
     Raises
     ------
     RateLimitError
     """
     limit = services.settings.max_queued_runs_per_user
-    if services.runner.pending(client) >= limit:
-        raise RateLimitError(
-            f"Expected at most {limit} queued runs per user (setting "
-            "max_queued_runs_per_user), got that many waiting",
-            retry_after_s=10,
-        )
+    with services.runner.places(client, wanted, limit) as granted:
+        if granted == 0:
+            raise queue_full(limit)
+        yield granted

@@ -3,9 +3,10 @@
 One ASGI middleware (:class:`RequestGuard`), so each check answers before the body is read:
 
 * **Origin**: a state-changing request (POST, PUT, PATCH, DELETE) that a browser marks as
-  coming from another site (``Sec-Fetch-Site: cross-site``, or an ``Origin`` whose host is not
-  the request's ``Host`` nor in ``cors_origins``) gets 403 — no page elsewhere can upload or
-  delete through a visitor's browser. Clients that are not browsers send neither header.
+  coming from another site (``Sec-Fetch-Site: cross-site``, or an ``Origin`` whose scheme and
+  host are not the request's scheme and ``Host`` nor in ``cors_origins``) gets 403 — no page
+  elsewhere can upload or delete through a visitor's browser. Clients that are not browsers
+  send neither header.
 * **Body size**: counted while it streams (Content-Length or chunked), with Starlette's
   :class:`~starlette.middleware.body_limit.RequestBodyLimitMiddleware`: the upload route allows
   ``max_upload_mb`` (plus the multipart envelope), a shoot import (many files or archives in
@@ -20,6 +21,13 @@ One ASGI middleware (:class:`RequestGuard`), so each check answers before the bo
   users exist) gets its 401 here, before its body is read too, and one from a user whose role
   may not upload (a viewer) its 403. An import into a shoot that does not exist gets its 404
   here as well (after the 401/403, so the answer says nothing of shoots to a stranger).
+* **Staging per user** (:mod:`mocapqa.jobs.staging`): an import beyond
+  ``max_concurrent_imports_per_user`` in progress, or an upload or import whose announced body
+  (``Content-Length``, else its body limit) would take the user's requests in progress past
+  ``max_incoming_mb_per_user`` staged in ``incoming/``, gets 429 with ``Retry-After`` before
+  its body is read (413 when it is over that alone). The request's hold is in its scope's
+  state (:data:`STAGING_STATE`), where an import adds each archive's declared unpacked size
+  before unpacking it; it is given back when the request ends.
 * **Text no store can keep**: a NUL (``%00``) in the path or in a query parameter gets 422
   naming ``path`` or ``query.NAME`` (PostgreSQL refuses NUL in text; JSON bodies get the same
   check from :class:`~mocapqa.api.request_model.RequestModel`).
@@ -49,20 +57,24 @@ from starlette.middleware.body_limit import RequestBodyLimitMiddleware
 from starlette.middleware.cors import CORSMiddleware
 from starlette.requests import HTTPConnection
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
+from uvicorn.middleware.proxy_headers import ProxyHeadersMiddleware
 
 from mocapqa.api.errors import error_body
 from mocapqa.api.host_check import HostCheck
 from mocapqa.api.request_model import unstorable_text
 from mocapqa.config import Settings
-from mocapqa.errors import ForbiddenError, NotFoundError
+from mocapqa.errors import ForbiddenError, NotFoundError, RateLimitError, TooLargeError
+from mocapqa.jobs.staging import StagingHold, StagingQuota
 
 __all__ = [
     "CONTENT_SECURITY_POLICY",
     "MULTIPART_SLACK_BYTES",
+    "STAGING_STATE",
     "RateWindow",
     "RequestGuard",
     "install_http_guards",
     "origin_allowed",
+    "queue_full",
     "unstorable_location",
 ]
 
@@ -81,14 +93,18 @@ _DOCS_PATHS = ("/docs", "/redoc")
 MULTIPART_SLACK_BYTES = 64_000
 """Allowance for the multipart envelope around an upload's file."""
 _STATE_CHANGING = frozenset({"POST", "PUT", "PATCH", "DELETE"})
+STAGING_STATE = "staging_hold"
+"""Name, in an upload's request state, of its :class:`~mocapqa.jobs.staging.StagingHold`."""
 
 
-def origin_allowed(headers: Headers, cors_origins: list[str]) -> bool:
+def origin_allowed(headers: Headers, cors_origins: list[str], scheme: str) -> bool:
     """Whether a browser request comes from this site (or an allowed one).
 
     ``Sec-Fetch-Site: cross-site`` is refused unless its ``Origin`` is in ``cors_origins``;
-    an ``Origin`` must name the request's own ``Host`` or be listed; no header at all (a
-    script, the CLI, curl) is allowed.
+    an ``Origin`` must name the request's own scheme (``scheme``: the request's, ``ws`` and
+    ``wss`` standing for ``http`` and ``https``) and ``Host``, or be listed: a page on
+    ``https://host`` is another site to ``http://host``. No header at all (a script, the CLI,
+    curl) is allowed.
     """
     origin = headers.get("origin")
     if origin and origin in cors_origins:
@@ -99,7 +115,9 @@ def origin_allowed(headers: Headers, cors_origins: list[str]) -> bool:
         return True
     if origin == "null":
         return False
-    return urlsplit(origin).netloc.lower() == headers.get("host", "").lower()
+    parts = urlsplit(origin)
+    own = {"ws": "http", "wss": "https"}.get(scheme.lower(), scheme.lower())
+    return parts.scheme.lower() == own and parts.netloc.lower() == headers.get("host", "").lower()
 
 
 def unstorable_location(scope: Scope) -> tuple[str, str] | None:
@@ -194,6 +212,10 @@ class RequestGuard:
         self.uploads = RateWindow(settings.uploads_per_minute_per_user)
         self.upload_bytes = int(settings.max_upload_mb * 1_000_000) + MULTIPART_SLACK_BYTES
         self.request_bytes = int(settings.max_request_kb * 1000)
+        self.staging = StagingQuota(
+            settings.max_concurrent_imports_per_user,
+            int(settings.max_incoming_mb_per_user * 1_000_000),
+        )
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
@@ -209,7 +231,9 @@ class RequestGuard:
         is_import = imported is not None
         is_upload = (method == "POST" and scope["path"] == self.upload_path) or is_import
         secured = self._with_headers(send, scope["path"].startswith(_DOCS_PATHS), is_upload)
-        if method in _STATE_CHANGING and not origin_allowed(headers, self.settings.cors_origins):
+        if method in _STATE_CHANGING and not origin_allowed(
+            headers, self.settings.cors_origins, scope.get("scheme", "http")
+        ):
             detail = (
                 f"Expected a request from this site, got Origin {headers.get('origin')!r}, "
                 f"Sec-Fetch-Site {headers.get('sec-fetch-site')!r}"
@@ -223,6 +247,7 @@ class RequestGuard:
             body = error_body("ValidationError", f"{field}: {message}", field=field, errors=[entry])
             await _send_json(secured, 422, body)
             return
+        hold: StagingHold | None = None
         if is_upload:
             try:
                 key = await run_in_threadpool(self.quota_key, HTTPConnection(scope))
@@ -241,21 +266,43 @@ class RequestGuard:
                 except NotFoundError as e:
                     await _send_json(secured, 404, error_body("NotFoundError", str(e)))
                     return
+            try:
+                hold = self._staging_hold(key, headers, is_import)
+            except (RateLimitError, TooLargeError) as e:
+                retry = e.retry_after_s if isinstance(e, RateLimitError) else 0
+                body = error_body(type(e).__name__, str(e))
+                await _send_json(secured, 429 if retry else 413, body, retry)
+                return
             refused = self._upload_refusal(key)
             if refused is not None:
+                hold.close()
                 await _send_json(secured, 429, refused[0], refused[1])
                 return
         limit = self.upload_bytes if is_upload else self.request_bytes
         if is_import:
             limit = self.import_bytes
-        await RequestBodyLimitMiddleware(self.app, limit)(scope, receive, secured)
+        if hold is None:
+            await RequestBodyLimitMiddleware(self.app, limit)(scope, receive, secured)
+            return
+        scope["state"] = {**scope.get("state", {}), STAGING_STATE: hold}
+        try:
+            await RequestBodyLimitMiddleware(self.app, limit)(scope, receive, secured)
+        finally:
+            hold.close()
+
+    def _staging_hold(self, key: str, headers: Headers, is_import: bool) -> StagingHold:
+        """Admit an upload's announced body (its Content-Length, else its body limit) to its
+        user's staging allowance; raises what :meth:`StagingQuota.admit` raises."""
+        limit = self.import_bytes if is_import else self.upload_bytes
+        length = headers.get("content-length", "")
+        announced = int(length) if length.isascii() and length.isdigit() else limit
+        return self.staging.admit(key, min(announced, limit), is_import)
 
     def _upload_refusal(self, key: str) -> tuple[dict[str, object], int] | None:
         limit = self.settings.max_queued_runs_per_user
         if self.pending_runs(key) >= limit:
-            detail = f"Expected at most {limit} queued runs per user (setting "
-            detail += "max_queued_runs_per_user), got that many waiting"
-            return error_body("RateLimitError", detail), 10
+            full = queue_full(limit)
+            return error_body("RateLimitError", str(full)), full.retry_after_s
         wait = self.uploads.admit(key)
         if wait > 0:
             per_minute = self.settings.uploads_per_minute_per_user
@@ -302,6 +349,16 @@ class RequestGuard:
         return secured
 
 
+def queue_full(limit: int) -> RateLimitError:
+    """The refusal of a run (or an upload, which starts one) from a user with ``limit`` runs
+    waiting: one message for the guard before the body and the routes' place in the queue."""
+    return RateLimitError(
+        f"Expected at most {limit} queued runs per user (setting max_queued_runs_per_user), "
+        "got that many waiting",
+        retry_after_s=10,
+    )
+
+
 def install_http_guards(
     app: FastAPI,
     settings: Settings,
@@ -311,8 +368,9 @@ def install_http_guards(
     import_paths: re.Pattern[str] | None = None,
     import_target: Callable[[str], None] | None = None,
 ) -> None:
-    """Add the request guard, CORS (when ``cors_origins`` is set) and the Host check, in the
-    order that makes the Host check run first. ``pending_runs`` counts a quota key's queued
+    """Add the request guard, CORS (when ``cors_origins`` is set), the Host check and, for
+    ``trusted_proxies``, uvicorn's forwarded-header middleware, in the order that makes the
+    forwarded headers apply first, then the Host check. ``pending_runs`` counts a quota key's queued
     runs, ``quota_key`` names a request's key from its headers, None for a request to refuse
     with 401 (a blocking call: it runs on a worker thread); ``import_paths`` matches the
     routes that take many files in one request (uploads with the import body limit), its
@@ -338,3 +396,7 @@ def install_http_guards(
             max_age=600,
         )
     app.add_middleware(HostCheck, allowed_hosts=settings.allowed_hosts)
+    if settings.trusted_proxies:
+        # Outermost: the address and scheme every guard, limit and audit entry sees are the
+        # ones a trusted proxy vouches for; nobody else's headers are read.
+        app.add_middleware(ProxyHeadersMiddleware, trusted_hosts=settings.trusted_proxies)

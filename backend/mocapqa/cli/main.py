@@ -27,6 +27,7 @@ COMMAND_MODULES: dict[str, tuple[str, ...]] = {
     "tokens": ("accounts",),
     "db": ("database",),
     "limits": ("limits",),
+    "bench api": ("bench_api",),
     "bench batch": ("bench_batch",),
     "bench io": ("bench_io",),
     "bench filters": ("filters",),

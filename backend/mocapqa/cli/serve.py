@@ -101,4 +101,8 @@ def serve(
         # A WebSocket message over the stream's limit is refused by the protocol (close 1009)
         # before it is assembled; the app checks the same limit again.
         ws_max_size=settings.stream_max_frame_bytes,
+        # uvicorn believes X-Forwarded-For from 127.0.0.1 by default (FORWARDED_ALLOW_IPS):
+        # any local process could then forge its address. The app reads forwarded headers
+        # only from MOCAPQA_TRUSTED_PROXIES (api/http_guards.py).
+        proxy_headers=False,
     )

@@ -8,6 +8,7 @@ is applied, whatever the run's options.
 
 from __future__ import annotations
 
+import functools
 import json
 from typing import Any
 
@@ -33,20 +34,33 @@ def run_intervals(files: FileStore, run_id: str) -> list[dict[str, Any]]:
         For a keypoint take or a run without the twist check.
     """
     path = files.existing(files.run_dir(run_id) / "report.json", "the report")
-    report = json.loads(path.read_bytes())
-    if report.get("kind") != "motion":
+    stat = path.stat()
+    kind, intervals = _report_intervals(str(path), stat.st_mtime_ns, stat.st_size)
+    if kind != "motion":
         raise ConflictError(
             f"Expected a run of a motion (BVH) take, got run {run_id} of a keypoint take: "
             "keypoint takes have no twist intervals to accept or reject"
         )
-    twist = (report.get("series") or {}).get("twist")
-    if twist is None:
+    if intervals is None:
         raise ConflictError(
             f"Expected a run with the twist check, got run {run_id} without it: start a run "
             "with 'twist' in checks"
         )
-    intervals: list[dict[str, Any]] = twist["intervals"]
-    return intervals
+    return [dict(interval) for interval in intervals]
+
+
+@functools.lru_cache(maxsize=64)
+def _report_intervals(
+    path: str, mtime_ns: int, size: int
+) -> tuple[str | None, tuple[dict[str, Any], ...] | None]:
+    """A report's take kind and twist intervals (None without the twist check), read once
+    per version of the file (its path, change time and size): a finished run's report is
+    written once, and parsing it (a few MB) was most of the cost of a decisions request."""
+    del mtime_ns, size  # the cache key only
+    with open(path, "rb") as handle:
+        report = json.loads(handle.read())
+    twist = (report.get("series") or {}).get("twist")
+    return report.get("kind"), None if twist is None else tuple(twist["intervals"])
 
 
 def with_decisions(intervals: list[dict[str, Any]], latest: dict[int, str]) -> list[dict[str, Any]]:

@@ -16,7 +16,9 @@ import json
 import logging
 import threading
 import time
+from collections.abc import Iterator
 from concurrent.futures import Future
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -176,6 +178,7 @@ class JobRunner:
         self._cancelled: set[str] = set()
         self._preloaded: dict[str, Take] = {}
         self._lock = threading.Lock()
+        self._held: dict[str, int] = {}
 
     def start(self) -> list[str]:
         """Start the workers; re-queue runs left by a stopped server (failing those already
@@ -206,9 +209,36 @@ class JobRunner:
                 self._preloaded.pop(run_id, None)
 
     def pending(self, client: str) -> int:
-        """Runs of ``client`` queued (held back included) or running."""
+        """Runs of ``client`` queued (held back included) or running, and places held for
+        runs about to be submitted (:meth:`places`)."""
         with self._lock:
-            return sum(1 for c in self._clients.values() if c == client)
+            return self._pending(client)
+
+    def _pending(self, client: str) -> int:
+        held = self._held.get(client, 0)
+        return held + sum(1 for c in self._clients.values() if c == client)
+
+    @contextmanager
+    def places(self, client: str, wanted: int, limit: int) -> Iterator[int]:
+        """Hold up to ``wanted`` of ``client``'s free places under ``limit`` pending runs
+        while the block records and submits its runs; yields how many it got (0: none free).
+
+        Checking the count and submitting later let parallel requests all pass the check
+        (36 at once got 25 places of 20); places are taken under the runner's lock instead,
+        and given back when the block ends, when its submitted runs count in their stead.
+        """
+        with self._lock:
+            granted = max(0, min(wanted, limit - self._pending(client)))
+            self._held[client] = self._held.get(client, 0) + granted
+        try:
+            yield granted
+        finally:
+            with self._lock:
+                left = self._held[client] - granted
+                if left:
+                    self._held[client] = left
+                else:
+                    del self._held[client]
 
     def in_line(self, client: str) -> int:
         """Runs of ``client`` in the workers' line: waiting for a worker or running (at most

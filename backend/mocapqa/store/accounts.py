@@ -21,6 +21,7 @@ from sqlalchemy import Engine, func, insert, select, update
 
 from mocapqa.core.text import display_name
 from mocapqa.errors import AuthenticationError, ConflictError, InputError, NotFoundError
+from mocapqa.store.last_use import LastUse
 from mocapqa.store.repository import new_id, utc_now
 from mocapqa.store.roles import Role
 from mocapqa.store.tables import audit, tokens, users
@@ -102,6 +103,28 @@ def _plain(row: Any) -> dict[str, Any]:
     return {k: _aware(v) if isinstance(v, datetime) else v for k, v in dict(row).items()}
 
 
+_USER_COLUMNS = (
+    users.c.name.label("user_name"),
+    users.c.role,
+    users.c.disabled,
+    users.c.password_hash,
+    users.c.created_at.label("user_created_at"),
+)
+"""A user's columns beside a token's in one row (both tables have ``name`` and ``created_at``)."""
+
+
+def _joined_user(row: Any) -> User:
+    """The user of a token row joined with :data:`_USER_COLUMNS`."""
+    return User(
+        id=int(row.user_id),
+        name=str(row.user_name),
+        role=Role(row.role),
+        disabled=bool(row.disabled),
+        has_password=row.password_hash is not None,
+        created_at=_aware(row.user_created_at),
+    )
+
+
 def _user(row: Any) -> User:
     return User(
         id=int(row.id),
@@ -118,6 +141,8 @@ class Accounts:
 
     def __init__(self, engine: Engine) -> None:
         self.engine = engine
+        self.last_use = LastUse(engine)
+        """Coalesced writes of credentials' ``last_used_at`` (:meth:`verify` notes)."""
 
     # users -----------------------------------------------------------------------------
     def has_users(self) -> bool:
@@ -289,7 +314,9 @@ class Accounts:
     def verify(self, token: str, kind: str, consume: bool = False) -> tuple[User, str | None]:
         """The user a credential of ``kind`` names, and its CSRF token (sessions).
 
-        ``consume`` revokes it in the same step (one-time sign-in links): of two requests
+        A read: the use is noted for :class:`~mocapqa.store.last_use.LastUse` to record, at
+        most once a minute per credential and off the request path. ``consume`` revokes the
+        credential in the same step (one-time sign-in links), a write: of two requests
         presenting the same link, only one gets the user.
 
         Raises
@@ -303,26 +330,30 @@ class Accounts:
             raise refused
         token_id, secret = match.groups()
         now = utc_now()
-        with self.engine.begin() as conn:
-            row = conn.execute(
-                select(tokens, users)
-                .join(users, users.c.id == tokens.c.user_id)
-                .where(tokens.c.id == token_id)
-            ).first()
+        query = (
+            select(tokens, *_USER_COLUMNS)
+            .join(users, users.c.id == tokens.c.user_id)
+            .where(tokens.c.id == token_id)
+        )
+        if not consume:
+            with self.engine.connect() as conn:
+                row = conn.execute(query).first()
             if row is None or not _usable(row, kind, secret, now):
                 raise refused
-            values: dict[str, Any] = {"last_used_at": now}
-            if consume:
-                values["revoked_at"] = now
+            self.last_use.note(token_id, now)
+            return _joined_user(row), row.csrf
+        with self.engine.begin() as conn:
+            row = conn.execute(query).first()
+            if row is None or not _usable(row, kind, secret, now):
+                raise refused
             used = conn.execute(
                 update(tokens)
                 .where(tokens.c.id == token_id, tokens.c.revoked_at.is_(None))
-                .values(**values)
+                .values(last_used_at=now, revoked_at=now)
             )
             if used.rowcount != 1:
                 raise refused
-            user = self.user_by_id(int(row.user_id))
-        return user, row.csrf
+        return _joined_user(row), row.csrf
 
     def user_id_of(self, token: str, kind: str) -> int | None:
         """The id of the user a valid credential of ``kind`` names, else None; reads only."""

@@ -25,6 +25,7 @@ from sqlalchemy import (
 )
 from sqlalchemy.engine import Connection
 from sqlalchemy.exc import IntegrityError
+from sqlalchemy.sql.elements import ColumnElement
 
 from mocapqa import __version__
 from mocapqa.core.text import display_name
@@ -53,6 +54,26 @@ ReviewStatus = Literal["unreviewed", "approved", "needs_fix", "rejected"]
 """A take's review decision."""
 REVIEW_STATUSES: tuple[ReviewStatus, ...] = get_args(ReviewStatus)
 """The review decisions a take can have."""
+
+
+SPARE_CONNECTIONS = 5
+"""Connections beyond one per thread: a thread may hold a second for a nested read."""
+
+
+_REVIEW_STATUS = func.coalesce(take_qa.c.review_status, "unreviewed")
+_TAKE_ROWS = (
+    select(
+        takes,
+        take_qa.c.run_id.label("latest_run_id"),
+        take_qa.c.status,
+        runs.c.summary,
+        _REVIEW_STATUS.label("review_status"),
+    )
+    .outerjoin(take_qa, take_qa.c.take_id == takes.c.id)
+    .outerjoin(runs, runs.c.id == take_qa.c.run_id)
+)
+"""A take with its latest run and review: read from its ``take_qa`` row (kept in step with
+every write, ``store/qa.py``), built once (making the statement cost more than running it)."""
 
 
 def new_id() -> str:
@@ -92,11 +113,25 @@ class Repository:
     ----------
     database_url : str
         SQLAlchemy URL (``sqlite:///...`` or ``postgresql+psycopg://...``).
+    threads : int
+        Threads that use the database at once (a server's request threads and job workers).
+        The pool keeps that many connections and :data:`SPARE_CONNECTIONS` more, so that no
+        request waits for a connection another holds, or pays for opening one (the library's
+        default of 5 kept + 10 more made 40 parallel requests queue for 30 s, and opened and
+        closed a SQLite connection, with its pragmas, on most requests). Connections are
+        opened when first needed.
     """
 
-    def __init__(self, database_url: str) -> None:
+    def __init__(self, database_url: str, threads: int = 10) -> None:
         self.database_url = database_url
-        self.engine: Engine = create_engine(database_url, pool_pre_ping=True)
+        sqlite = database_url.startswith("sqlite")
+        self.engine: Engine = create_engine(
+            database_url,
+            # A SQLite file cannot drop a connection as a server can: no ping per checkout.
+            pool_pre_ping=not sqlite,
+            pool_size=threads + SPARE_CONNECTIONS,
+            max_overflow=SPARE_CONNECTIONS,
+        )
         if self.engine.dialect.name == "sqlite":
             event.listen(self.engine, "connect", _sqlite_pragmas)
         self.upgrades = upgrade_database(self.engine)
@@ -194,60 +229,29 @@ class Repository:
         review_status: str | None = None,
         take_id: str | None = None,
     ) -> tuple[list[dict[str, Any]], int]:
-        latest_run = (
-            select(runs.c.take_id, func.max(runs.c.created_at).label("created_at"))
-            .group_by(runs.c.take_id)
-            .subquery()
-        )
-        run_row = (
-            select(
-                runs.c.take_id,
-                runs.c.id.label("latest_run_id"),
-                runs.c.status.label("status"),
-                runs.c.summary.label("summary"),
-            )
-            .join(
-                latest_run,
-                (runs.c.take_id == latest_run.c.take_id)
-                & (runs.c.created_at == latest_run.c.created_at),
-            )
-            .subquery()
-        )
-        latest_review = (
-            select(reviews.c.take_id, func.max(reviews.c.id).label("id"))
-            .group_by(reviews.c.take_id)
-            .subquery()
-        )
-        review_row = (
-            select(reviews.c.take_id, reviews.c.status.label("review_status"))
-            .join(latest_review, reviews.c.id == latest_review.c.id)
-            .subquery()
-        )
-        review_status_col = func.coalesce(review_row.c.review_status, "unreviewed")
-        query = (
-            select(
-                takes,
-                run_row.c.latest_run_id,
-                run_row.c.status,
-                run_row.c.summary,
-                review_status_col.label("review_status"),
-            )
-            .outerjoin(run_row, run_row.c.take_id == takes.c.id)
-            .outerjoin(review_row, review_row.c.take_id == takes.c.id)
-        )
+        clauses: list[ColumnElement[bool]] = []
         if take_id is not None:
-            query = query.where(takes.c.id == take_id)
+            clauses.append(takes.c.id == take_id)
         if status is not None:
-            query = query.where(run_row.c.status == status)
+            clauses.append(take_qa.c.status == status)
         if review_status is not None:
-            query = query.where(review_status_col == review_status)
+            clauses.append(_REVIEW_STATUS == review_status)  # noqa: SIM300 - an SQL expression
+        page = (
+            _TAKE_ROWS.where(*clauses)
+            .order_by(takes.c.created_at.desc(), takes.c.id)
+            .limit(limit)
+            .offset(offset)
+        )
         with self.engine.connect() as conn:
-            total = int(
-                conn.execute(select(func.count()).select_from(query.subquery())).scalar_one()
-            )
-            page = query.order_by(takes.c.created_at.desc(), takes.c.id).limit(limit).offset(offset)
             rows = [_row(r) for r in conn.execute(page).mappings()]
-        return rows, total
+            if take_id is not None:
+                return rows, len(rows)
+            total = conn.execute(
+                select(func.count())
+                .select_from(takes.outerjoin(take_qa, take_qa.c.take_id == takes.c.id))
+                .where(*clauses)
+            ).scalar_one()
+        return rows, int(total)
 
     def set_owner(self, take_id: str, owner_id: int | None) -> None:
         """Record who uploaded a take (none while the server has no users)."""

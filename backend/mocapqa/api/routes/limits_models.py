@@ -7,7 +7,7 @@ from typing import Annotated
 from fastapi import APIRouter, Depends, Request
 
 from mocapqa.api.auth import Principal, audit, require
-from mocapqa.api.deps import ClientDep, ServicesDep, require_run_slot
+from mocapqa.api.deps import ClientDep, ServicesDep, run_places
 from mocapqa.api.errors import responses
 from mocapqa.api.shoot_schemas import LimitsModelIn, LimitsModelOut, LimitsRerunsOut, ShootOut
 from mocapqa.limits.catalog import ModelCatalog
@@ -34,7 +34,7 @@ def list_limits_models(services: ServicesDep) -> list[LimitsModelOut]:
     return [LimitsModelOut(**entry.to_json()) for entry in _catalog(services).entries()]
 
 
-@router.put("/shoots/{shoot_id}/limits-model", responses=responses(401, 403, 404, 422))
+@router.put("/shoots/{shoot_id}/limits-model", responses=responses(401, 403, 404, 413, 422))
 def choose_limits_model(
     request: Request, principal: Chooser, shoot_id: str, body: LimitsModelIn, services: ServicesDep
 ) -> ShootOut:
@@ -51,7 +51,7 @@ def choose_limits_model(
     return ShootOut(**shoot)
 
 
-@router.post("/shoots/{shoot_id}/limits-reruns", responses=responses(401, 403, 404, 422, 429))
+@router.post("/shoots/{shoot_id}/limits-reruns", responses=responses(401, 403, 404, 413, 422, 429))
 def rerun_stale_limits(
     request: Request,
     principal: Chooser,
@@ -67,15 +67,14 @@ def rerun_stale_limits(
     store = ShootStore(services.repository.engine)
     model = store.limits_model(shoot_id)
     stale = stale_limits_runs(services.repository.engine, shoot_id)
-    free = services.settings.max_queued_runs_per_user - services.runner.pending(client)
-    if stale and free <= 0:
-        require_run_slot(services, client)
     queued = []
-    for take_id, used in stale[: max(free, 0)]:
-        options = AnalysisOptions.from_json({**used, "limits_model": None})
-        run_id = services.repository.add_run(take_id, options.to_json())
-        services.runner.submit(run_id, client=client)
-        queued.append({"take_id": take_id, "run_id": run_id})
+    if stale:
+        with run_places(services, client, len(stale)) as free:
+            for take_id, used in stale[:free]:
+                options = AnalysisOptions.from_json({**used, "limits_model": None})
+                run_id = services.repository.add_run(take_id, options.to_json())
+                services.runner.submit(run_id, client=client)
+                queued.append({"take_id": take_id, "run_id": run_id})
     detail = f"{len(queued)} run(s) with {model}, {len(stale) - len(queued)} left"
     audit(request, principal, "shoot_limits_reruns", shoot_id, detail)
     return LimitsRerunsOut(limits_model=model, queued=queued, remaining=len(stale) - len(queued))

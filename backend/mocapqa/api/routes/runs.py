@@ -9,7 +9,7 @@ from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import FileResponse, Response
 
 from mocapqa.api.auth import Principal, audit, require
-from mocapqa.api.deps import ClientDep, Services, ServicesDep, TakeDep, require_run_slot
+from mocapqa.api.deps import ClientDep, Services, ServicesDep, TakeDep, run_places
 from mocapqa.api.disposition import attachment, download_stem
 from mocapqa.api.errors import responses
 from mocapqa.api.frame_windows import read_window, window_json, window_packed
@@ -56,9 +56,9 @@ def start_run(
     parsed.check_joints(
         joints_of(services.files, take_id), joint_parents_of(services.files, take_id)
     )
-    require_run_slot(services, client)
-    run_id = services.repository.add_run(str(take["id"]), parsed.to_json())
-    services.runner.submit(run_id, client=client)
+    with run_places(services, client):
+        run_id = services.repository.add_run(str(take["id"]), parsed.to_json())
+        services.runner.submit(run_id, client=client)
     audit(request, principal, "run", str(take["id"]), f"run {run_id}")
     return run_out(services.repository.get_run(run_id))
 

@@ -7,10 +7,11 @@ from typing import Annotated, Literal
 from fastapi import APIRouter, Depends, File, Form, Query, Request, Response, UploadFile
 
 from mocapqa.api.auth import Principal, audit, require, require_owner
-from mocapqa.api.deps import ClientDep, ServicesDep, TakeDep, require_run_slot
+from mocapqa.api.deps import ClientDep, ServicesDep, TakeDep, run_places
 from mocapqa.api.errors import responses
 from mocapqa.api.schemas import TakeCreatedOut, TakeDetailOut, TakeOut, TakePageOut
 from mocapqa.api.views import review_out, run_out, take_fields
+from mocapqa.core.bounds import MAX_FPS, MIN_FPS
 from mocapqa.core.keypoints import LENGTH_UNITS
 from mocapqa.jobs.intake import ingest_take, reading_of
 from mocapqa.jobs.rendered import THUMBNAIL_PNG
@@ -38,7 +39,12 @@ def upload_take(
     file: Annotated[UploadFile, File()],
     fps: Annotated[
         float | None,
-        Form(gt=0, le=100_000, description="Frame rate, for formats that do not store one."),
+        Form(
+            ge=MIN_FPS,
+            le=MAX_FPS,
+            allow_inf_nan=False,
+            description="Frame rate (frames per second), for formats that do not store one.",
+        ),
     ] = None,
     length_unit: Annotated[
         LengthUnit | None,
@@ -60,22 +66,25 @@ def upload_take(
 
     Refused before the body is read: more than ``max_upload_mb`` (413), a cross-site browser
     request (403), too many uploads or queued runs from this client (429, ``Retry-After``).
-    Refused before parsing: a take beyond the read limits (413, naming the setting).
+    Refused before parsing: a take beyond the read limits (413, naming the setting). Refused
+    at the request: an ``fps`` that is not finite or not from 0.1 to 100,000 (422 naming
+    ``body.fps``, :mod:`mocapqa.core.bounds`); a file's own frame rate meets the same bounds
+    when it is read (422 naming ``fps``).
     """
-    require_run_slot(services, client)
-    max_bytes = int(services.settings.max_upload_mb * 1_000_000)
-    take_id, run_id = ingest_take(
-        file.file,
-        file.filename or "take",
-        services.repository,
-        services.files,
-        services.runner,
-        max_bytes,
-        read=ReadOptions(fps, length_unit, root_translation),
-        limits=services.settings.read_limits,
-        client=client,
-        owner_id=principal.user_id,
-    )
+    with run_places(services, client):
+        max_bytes = int(services.settings.max_upload_mb * 1_000_000)
+        take_id, run_id = ingest_take(
+            file.file,
+            file.filename or "take",
+            services.repository,
+            services.files,
+            services.runner,
+            max_bytes,
+            read=ReadOptions(fps, length_unit, root_translation),
+            limits=services.settings.read_limits,
+            client=client,
+            owner_id=principal.user_id,
+        )
     audit(request, principal, "upload", take_id, f"{file.filename or 'take'} run {run_id}")
     row = services.repository.get_take(take_id)
     reading = reading_of(services.files, take_id)
@@ -108,7 +117,7 @@ def get_take(take: TakeDep, services: ServicesDep) -> TakeDetailOut:
     )
 
 
-@router.delete("/{take_id}", status_code=204, responses=responses(401, 403, 404))
+@router.delete("/{take_id}", status_code=204, responses=responses(401, 403, 404, 413))
 def delete_take(
     request: Request,
     principal: Annotated[Principal, Depends(require(Action.DELETE_OWN))],
