@@ -15,7 +15,7 @@ from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.io.bvh import parse_bvh, read_bvh
 from mocapqa.io.bvh_write import channel_values, format_bvh
 from mocapqa.store.decisions import IntervalDecisions
-from mocapqa.twist.analysis import _refined_hint
+from mocapqa.twist.analysis import refined_hint
 from mocapqa.twist.angles import chain_geometry
 from mocapqa.twist.refine import refine_quats
 
@@ -61,7 +61,7 @@ def expected_bvh(knees: Path, intervals: list[dict[str, Any]], ids: set[int]) ->
                 offsets[start : end + 1, column[interval["joint"]]] = np.deg2rad(value)
     quats = refine_quats(raw.quats, geometries, offsets)
     changed = np.any(quats != raw.quats, axis=-1)
-    motion = replace(raw, quats=quats, euler_hint_deg=_refined_hint(raw, quats, changed))
+    motion = replace(raw, quats=quats, euler_hint_deg=refined_hint(raw, quats, changed))
     return format_bvh(motion).encode()
 
 

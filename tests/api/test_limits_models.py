@@ -150,7 +150,7 @@ def test_runs_of_a_shoot_use_its_model(team: Team, cmu_walk: Path) -> None:
 
 
 def test_takes_run_with_an_older_model_are_counted_and_run_again(
-    settings: Settings, renderer: RenderService, corpus_dir: Path, monkeypatch: pytest.MonkeyPatch
+    settings: Settings, renderer: RenderService, corpus_dir: Path
 ) -> None:
     # One queued run per user at a time, so the re-runs come in two requests.
     settings = settings.model_copy(update={"job_workers": 1, "max_queued_runs_per_user": 1})
@@ -185,8 +185,8 @@ def test_takes_run_with_an_older_model_are_counted_and_run_again(
             assert client.post(reruns, headers=headers[who]).status_code == status, who
         assert client.post(f"{API}/shoots/0000/limits-reruns", headers=admin).status_code == 404
         runner = client.app.state.services.runner  # type: ignore[attr-defined]
-        with monkeypatch.context() as patch:  # the caller's line is full: nothing is queued
-            patch.setattr(runner, "pending", lambda _client: 1)
+        key = f"user:{accounts.get_user('admin').id}"
+        with runner.places(key, 1, 1):  # the caller's line is full: nothing is queued
             full = client.post(reruns, headers=admin)
             assert full.status_code == 429, full.text
         assert client.get(f"{API}/shoots/{shoot}", headers=admin).json()["limits_stale_takes"] == 2

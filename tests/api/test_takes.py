@@ -110,7 +110,13 @@ def test_keypoint_take_is_filtered_and_downloads_read_back(
         ("picture.png", b"\x89PNG\r\n\x1a\n0000", 415, "Expected one of"),
         # The error names the file as the user sent it, not the server's temporary copy.
         ("notes.txt", b"hello", 415, "unrecognised file 'notes.txt'"),
-        ("numbers.trc", b"PathFileType\t4\t(X/Y/Z)\tx.trc\nnonsense\n", 422, ""),
+        # A TRC cut short after its header keys: the file and line, and what a TRC needs.
+        (
+            "numbers.trc",
+            b"PathFileType\t4\t(X/Y/Z)\tx.trc\nnonsense\n",
+            422,
+            "numbers.trc, line 2: Expected a TRC header of 3 lines and a marker row",
+        ),
     ],
 )
 def test_bad_uploads_are_refused_and_store_nothing(

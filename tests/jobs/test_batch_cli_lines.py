@@ -6,8 +6,8 @@ from __future__ import annotations
 import errno
 import os
 import re
+import shutil
 import stat
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -16,8 +16,9 @@ import pytest
 from mocapqa.cli.batch import MAX_FAILED_LINES
 from mocapqa.cli.main import main
 from mocapqa.errors import InputError
-from mocapqa.jobs.batch import BatchCounts, discover
+from mocapqa.jobs.batch import BatchCounts, discover, run_batch
 from mocapqa.jobs.batch_output import ResultWriter
+from mocapqa.jobs.take_task import analyse_path
 
 TRC = "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d/S00_P00_T01_BalancingTrial_0-100.trc"
 
@@ -40,40 +41,44 @@ def test_discovery_skips_a_keypoint_csv_sidecar(
     assert "sidecar" in reason
 
 
-def _fake_batch(rows: list[dict[str, Any]]) -> Callable[..., BatchCounts]:
-    def run_batch(
-        paths: list[Path], shoots: Any, options: Any, on_row: Callable[[dict[str, Any]], None],
-        **kwargs: Any,
-    ) -> BatchCounts:  # fmt: skip
-        counts = BatchCounts(total=len(rows))
-        for row in rows:
-            counts.add(row)
-            on_row(row)
-        return counts
-
-    return run_batch
+def _fails_the_bad_takes(
+    path: str, options: dict[str, Any], take_id: str, run_id: str, data_dir: str | None
+) -> dict[str, Any]:
+    """The per-take task of the batch: ``badNN.bvh`` fails with a reason naming line NN; any
+    other take is analysed and stored for real."""
+    name = Path(path).name
+    if name.startswith("bad"):
+        return {"status": "failed", "error": f"line {int(name[3:5])}: broken"}
+    return analyse_path(path, options, take_id, run_id, data_dir)
 
 
 def test_without_output_each_failed_take_is_one_stderr_line(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
-) -> None:
+    cmu_walk: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
     monkeypatch.setenv("MOCAPQA_DATA_DIR", str(tmp_path / "data"))
-    rows = [{"source": "/takes/good.bvh", "status": "done", "n_frames": 10}]
-    rows += [
-        {"source": f"/takes/bad{k:02d}.bvh", "status": "failed", "error": f"line {k}: broken"}
-        for k in range(MAX_FAILED_LINES + 3)
-    ]
-    monkeypatch.setattr("mocapqa.jobs.batch.run_batch", _fake_batch(rows))
-    code = main(["batch", str(tmp_path)])
+    folder = tmp_path / "takes"
+    folder.mkdir()
+    shutil.copyfile(cmu_walk, folder / "good.bvh")
+    for k in range(MAX_FAILED_LINES + 3):  # distinct contents: a copy would be skipped
+        (folder / f"bad{k:02d}.bvh").write_text(f"take {k}\n", encoding="utf-8")
+
+    def in_process(*args: Any, **kwargs: Any) -> BatchCounts:
+        """The real batch with its per-take task (``task=``) failing the bad takes, run in this
+        process (``engine=None``: no local cluster, rows in the order the takes are found)."""
+        return run_batch(*args, **{**kwargs, "engine": None, "task": _fails_the_bad_takes})
+
+    monkeypatch.setattr("mocapqa.jobs.batch.run_batch", in_process)
+    code = main(["batch", str(folder)])
     err = capsys.readouterr().err
     assert code == 2, err
     lines = [line for line in err.splitlines() if line.startswith("failed: ")]
     assert len(lines) == MAX_FAILED_LINES
-    assert lines[0] == "failed: /takes/bad00.bvh: line 0: broken"
-    assert lines[-1] == "failed: /takes/bad49.bvh: line 49: broken"
+    assert lines[0] == f"failed: {folder / 'bad00.bvh'}: line 0: broken"
+    assert lines[-1] == f"failed: {folder / 'bad49.bvh'}: line 49: broken"
     assert "… and 3 more failed" in err
     assert "good.bvh" not in err
-    assert re.search(r"54 file\(s\): 1 done, 53 failed", err), err
+    assert re.search(r"54 file\(s\): 1 done, 53 failed, 0 skipped; 524 frames", err), err
 
 
 def test_batch_of_a_folder_with_a_converted_csv_fails_only_the_bad_take(

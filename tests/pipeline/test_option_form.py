@@ -8,6 +8,8 @@ import re
 import pytest
 
 from mocapqa.errors import InputError, OptionError
+from mocapqa.filters.apply import resolve_params
+from mocapqa.filters.registry import DataScale
 from mocapqa.pipeline.options import (
     CHECKS,
     MAX_POINTS_RANGE,
@@ -83,8 +85,27 @@ def test_run_options_refuse_filter_parameters_out_of_their_range(
 
 
 def test_run_options_take_the_bounds_of_the_ranges() -> None:
+    """A value at either end of its range is accepted, kept as sent and reaches the filter;
+    a step past it is refused, naming the parameter and its range."""
     params = {"window_s": 60.0, "lead_s": 0, "kalman.bridge_decay_s": 0.0, "innovation_power": 10}
-    AnalysisOptions.from_json({"filter_method": "adaptive", "filter_params": params})
+    options = AnalysisOptions.from_json({"filter_method": "adaptive", "filter_params": params})
+    assert options.filter_params == params
+    assert AnalysisOptions.from_json(options.to_json()) == options
+    used = resolve_params("adaptive", "default", DataScale(), options.filter_params)
+    assert used.window_s == 60.0
+    assert used.lead_s == 0
+    assert used.kalman.bridge_decay_s == 0.0
+    assert used.innovation_power == 10
+    past = {
+        "window_s": (60.001, "0.0001 to 60 s"),
+        "lead_s": (-0.001, "0 to 60 s"),
+        "kalman.bridge_decay_s": (-0.001, "0 to 60 s"),
+        "innovation_power": (10.001, "> 0 and at most 10"),
+    }
+    for name, (value, described) in past.items():
+        with pytest.raises(OptionError, match=re.escape(described)) as raised:
+            AnalysisOptions.from_json({"filter_method": "adaptive", "filter_params": {name: value}})
+        assert raised.value.field == f"filter_params.{name}"
 
 
 def test_an_apply_list_past_its_cap_is_refused_when_asked_for() -> None:

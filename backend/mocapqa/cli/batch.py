@@ -24,7 +24,7 @@ from mocapqa.cli.app import app
 if TYPE_CHECKING:
     from rich.console import Console
 
-__all__ = ["DASK_LOGGERS", "batch"]
+__all__ = ["DASK_LOGGERS", "batch", "quiet_dask_logging"]
 
 DASK_LOGGERS = ("distributed", "distributed.client")
 """Dask's client-side loggers (each has its own level and handler)."""
@@ -32,11 +32,19 @@ MAX_FAILED_LINES = 50
 """Failed takes listed one per line on stderr at the end of a batch; the rest are counted."""
 
 
-def _quiet_dask_logging() -> None:
-    """Dask's client-side loggers at WARNING. Set in Dask's configuration, which distributed
-    reads when it is first imported — only once a take is sent to a cluster, so that a batch
-    with nothing left to analyse does not import it (0.8 CPU s of a resume, docs/batch.md) —
-    and on the loggers themselves for a process that imported it already."""
+def quiet_dask_logging() -> None:
+    """Set Dask's client-side loggers (:data:`DASK_LOGGERS`) to WARNING.
+
+    Set in Dask's configuration, which distributed reads when it is first imported — only
+    once a take is sent to a cluster, so that a batch with nothing left to analyse does not
+    import it (0.8 CPU s of a resume, docs/batch.md) — and on the loggers themselves for a
+    process that imported it already. Commands that use a Dask cluster (``mocapqa batch``,
+    ``mocapqa limits build``) call it before they start.
+
+    Notes
+    -----
+    Changes Dask's configuration (``logging``) and the loggers' levels of this process.
+    """
     import dask.config
 
     levels = {name: "warning" for name in DASK_LOGGERS}
@@ -106,7 +114,7 @@ def batch(
     from mocapqa.store.repository import Repository
     from mocapqa.store.shoots import ShootStore
 
-    _quiet_dask_logging()
+    quiet_dask_logging()
     read = [FolderReads(p, MOTION_SUFFIXES, recursive=True) if p.is_dir() else p for p in paths]
     check_outputs({"--output": output}, read)
     run_options = _options(options)

@@ -206,11 +206,11 @@ def _build_on_dask(
         TimeElapsedColumn,
     )
 
-    from mocapqa.cli.batch import _quiet_dask_logging
+    from mocapqa.cli.batch import quiet_dask_logging
     from mocapqa.jobs.engine import Engine
     from mocapqa.jobs.limits_build import build_on_engine
 
-    _quiet_dask_logging()
+    quiet_dask_logging()
     progress = Progress(
         TextColumn("[bold]limits build"),
         BarColumn(),

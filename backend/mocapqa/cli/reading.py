@@ -44,7 +44,7 @@ def read_input_bvh(path: Path, **options: Any) -> Motion:
     Raises
     ------
     InputError
-        When the file is another format.
+        When the file is another format, or does not read as a motion.
     """
     from mocapqa.core.motion import Motion
     from mocapqa.io.formats import detect_format
@@ -53,5 +53,8 @@ def read_input_bvh(path: Path, **options: Any) -> Motion:
     if kind != "bvh":
         raise InputError(f"Expected a BVH take, got a {kind} file: {path}")
     take = read_input(path, **options)
-    assert isinstance(take, Motion)  # a BVH reads as a Motion
+    if not isinstance(take, Motion):  # the BVH reader returns a Motion: a broken contract
+        raise InputError(
+            f"Expected a BVH take to read as a motion, got a {type(take).__name__}: {path}"
+        )
     return take

@@ -302,7 +302,7 @@ class JobRunner:
                 preloaded = self._preloaded.pop(run_id, None)
             reading = read_options(path.parent)
             if self.engine is not None:
-                self._execute_on_dask(run_id, run, take, path, started)
+                self._execute_on_dask(self.engine, run_id, run, take, path, started)
                 return
             motion_or_keypoints = preloaded or read_take_file(
                 path, str(take["format"]), str(take["name"]), reading, self.read_limits
@@ -338,13 +338,18 @@ class JobRunner:
             self._fail(run_id, f"internal error: {type(e).__name__}: {e}", started)
 
     def _execute_on_dask(
-        self, run_id: str, run: dict[str, Any], take: dict[str, Any], path: Any, started: float
+        self,
+        engine: Engine,
+        run_id: str,
+        run: dict[str, Any],
+        take: dict[str, Any],
+        path: Any,
+        started: float,
     ) -> None:
         from mocapqa.jobs.take_task import analyse_stored
 
-        assert self.engine is not None
         self.repository.set_progress(run_id, 10, "analysing on the Dask cluster")
-        future = self.engine.client().submit(
+        future = engine.client().submit(
             analyse_stored,
             str(path),
             str(take["format"]),
@@ -358,7 +363,7 @@ class JobRunner:
         try:
             summary = future.result()
         except Exception as e:  # a lost scheduler fails the run with its address
-            lost = self.engine.lost(e)
+            lost = engine.lost(e)
             if lost is not None:
                 raise lost from e
             raise

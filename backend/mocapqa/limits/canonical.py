@@ -50,7 +50,7 @@ from scipy.spatial.transform import Rotation
 
 from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.motion import Motion, Skeleton
-from mocapqa.core.rig import SIDES, RigMap, find_roles, mapped_roles, role_key
+from mocapqa.core.rig import SIDES, RigMap, Side, find_roles, mapped_roles, role_key
 from mocapqa.errors import InputError
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.kinematics.quaternion import conjugate, rotate
@@ -312,10 +312,14 @@ def canonical_frames(
     """
     skeleton = motion if isinstance(motion, Skeleton) else motion.skeleton
     rig = find_roles(skeleton) if rig is None else rig
-    keys = [
-        (s, r) for s in SIDES for r in MODELLED_ROLES
-        if rig.joint(s, r) is not None and all(rig.joint(s, n) is not None for n in frame_needs(r))  # type: ignore[arg-type]
-    ]  # fmt: skip
+    # Each modelled role joint by (side, role), with the roles its frame needs: the index is
+    # kept with the key, so no later look-up can come back empty.
+    keys: dict[tuple[Side, str], int] = {}
+    for s in SIDES:
+        for r in MODELLED_ROLES:
+            j = rig.joint(s, r)
+            if j is not None and all(rig.joint(s, n) is not None for n in frame_needs(r)):
+                keys[(s, r)] = j
     if not keys:
         raise InputError(
             f"Expected a skeleton with limb roles, got none among {skeleton.names[:8]}"
@@ -420,9 +424,7 @@ def canonical_frames(
         cache[joint] = _frame_quat(flexion, long_axes[joint])
         return cache[joint]
 
-    for side, role in keys:
-        joint = rig.joint(side, role)
-        assert joint is not None
+    for (side, role), joint in keys.items():
         frames.append(frame_of(side, role, joint))
         parent_role = _PARENT_ROLE.get(role)
         parent = rig.joint(side, parent_role) if parent_role else None  # type: ignore[arg-type]

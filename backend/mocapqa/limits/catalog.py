@@ -193,12 +193,16 @@ class ModelCatalog:
         """
         checked = check_model_name(name)
         if checked != DEFAULT_MODEL and self._path(checked) is None:
-            raise OptionError(
-                "limits_model",
-                f"Expected one of the limits models {self.names()}, got {checked!r}; build one "
-                "with `mocapqa limits build` and register it with `mocapqa limits register`",
-            )
+            raise self._unknown(checked)
         return checked
+
+    def _unknown(self, name: str) -> OptionError:
+        """The error for a well-formed ``name`` that is no model here, listing the known ones."""
+        return OptionError(
+            "limits_model",
+            f"Expected one of the limits models {self.names()}, got {name!r}; build one "
+            "with `mocapqa limits build` and register it with `mocapqa limits register`",
+        )
 
     def load(
         self, name: str, skeleton: Skeleton, mapping: Mapping[str, str] | None = None
@@ -216,11 +220,12 @@ class ModelCatalog:
         from mocapqa.limits.model import check_rig
         from mocapqa.limits.storage import load_default_model
 
-        self.require(name)
-        if name == DEFAULT_MODEL:
+        checked = check_model_name(name)
+        if checked == DEFAULT_MODEL:
             return load_default_model(skeleton, mapping)
-        found = self._path(name)
-        assert found is not None  # checked by require
+        found = self._path(checked)  # one look: a file unregistered meanwhile is unknown here
+        if found is None:
+            raise self._unknown(checked)
         model = _load_path(found[1])
         check_rig(model, skeleton, mapping)
         return model

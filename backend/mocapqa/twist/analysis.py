@@ -51,6 +51,7 @@ __all__ = [
     "detect_chains",
     "interval_frames",
     "parse_apply",
+    "refined_hint",
 ]
 
 Method = Literal["robust", "paper"]
@@ -333,12 +334,28 @@ def detect_chains(
     return detect_robust(dp, dc, fps, robust)
 
 
-def _refined_hint(
+def refined_hint(
     motion: Motion, refined_quats: FloatArray, changed: BoolArray
 ) -> FloatArray | None:
-    """Euler hints for writing: unchanged cells keep the read angles, changed ones follow them.
+    """Euler hints for writing a refined take: unchanged cells keep the read angles, changed
+    ones follow them.
 
-    Without read angles there is no hint: the writer then makes every joint continuous itself.
+    Parameters
+    ----------
+    motion : Motion
+        The take as read, with the Euler angles it was read with (``euler_hint_deg``).
+    refined_quats : ndarray, shape (F, J, 4)
+        The take's local rotations after refinement.
+    changed : ndarray of bool, shape (F, J)
+        True where refinement changed the rotation.
+
+    Returns
+    -------
+    ndarray, shape (F, J, 3), or None
+        Hint angles in degrees for the BVH writer: the read angles where unchanged; where
+        changed, the refined rotation as Euler angles nearest to the read angles interpolated
+        across the change. None when the take has no read angles: the writer then makes every
+        joint continuous itself.
     """
     read_hint = motion.euler_hint_deg
     if read_hint is None:
@@ -413,7 +430,7 @@ def analyze_twist(
         refined = replace(
             motion,
             quats=refined_quats,
-            euler_hint_deg=_refined_hint(motion, refined_quats, changed),
+            euler_hint_deg=refined_hint(motion, refined_quats, changed),
         )
     else:
         refined = motion

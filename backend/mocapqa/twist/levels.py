@@ -15,7 +15,7 @@ import numpy as np
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.errors import InputError
-from mocapqa.twist.analysis import _refined_hint
+from mocapqa.twist.analysis import refined_hint
 from mocapqa.twist.angles import chain_geometry
 from mocapqa.twist.refine import refine_quats
 
@@ -73,4 +73,4 @@ def remove_levels(
         return motion
     refined = refine_quats(motion.quats, geometries, offsets)
     changed = np.any(refined != motion.quats, axis=-1)
-    return replace(motion, quats=refined, euler_hint_deg=_refined_hint(motion, refined, changed))
+    return replace(motion, quats=refined, euler_hint_deg=refined_hint(motion, refined, changed))
