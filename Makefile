@@ -36,31 +36,23 @@ system-deps:
 	fi
 
 # The dashboard's JavaScript lint and unit tests (ESLint, node --test) need Node >= 20 and the
-# npm packages pinned in package-lock.json, installed from the npm registry.
-# three.js (the 3D views) and Plotly's cartesian bundle (the dashboard's charts: scatter, bar and
-# heat map; 1.5 MB against the full bundle's 4.8 MB, whose evaluation alone held the take view's
-# main thread for 3 s on a loaded 2-core machine) are served from frontend/vendor/, copied from
-# their npm packages.
-node_modules/.package-lock.json: package.json package-lock.json
-	npm ci --no-audit --no-fund
+# npm packages pinned in package-lock.json, installed from the npm registry. three.js and
+# Plotly's cartesian bundle are served from frontend/vendor/, copied from their npm packages by
+# scripts/vendor_js.py (the list the package build uses too, so a wheel carries them).
+JS_VENDOR := frontend/vendor/three/three.module.min.js
 
-frontend/vendor/three/three.module.min.js: node_modules/.package-lock.json
-	mkdir -p frontend/vendor/three
-	cp node_modules/three/build/three.module.min.js node_modules/three/build/three.core.min.js node_modules/three/LICENSE frontend/vendor/three/
+$(JS_VENDOR): package.json package-lock.json scripts/vendor_js.py
+	$(PYTHON) scripts/vendor_js.py
 
-frontend/vendor/plotly/plotly-cartesian.min.js: node_modules/.package-lock.json
-	mkdir -p frontend/vendor/plotly
-	cp node_modules/plotly.js-cartesian-dist-min/plotly-cartesian.min.js node_modules/plotly.js-cartesian-dist-min/LICENSE frontend/vendor/plotly/
-
-js-deps: frontend/vendor/three/three.module.min.js frontend/vendor/plotly/plotly-cartesian.min.js
+js-deps: $(JS_VENDOR)
 
 run: install system-deps js-deps
 	$(BIN)/mocapqa serve --host $(HOST) --port $(PORT) --demo
 
 lint: install-dev js-deps
 	npx eslint frontend/js tests/js
-	$(BIN)/ruff check backend tests scripts
-	$(BIN)/ruff format --check backend tests scripts
+	$(BIN)/ruff check backend tests scripts setup.py
+	$(BIN)/ruff format --check backend tests scripts setup.py
 	$(BIN)/lint-imports
 	$(BIN)/check-jsonschema --builtin-schema vendor.compose-spec docker-compose.yml
 	$(BIN)/hadolint Dockerfile

@@ -58,7 +58,14 @@ from mocapqa.store.repository import Repository
 from mocapqa.store.roles import Action
 from mocapqa.store.shoots import ShootStore
 
-__all__ = ["API_PREFIX", "create_app", "frontend_dir", "plotly_js_path"]
+__all__ = [
+    "API_PREFIX",
+    "VENDORED_SCRIPTS",
+    "create_app",
+    "frontend_dir",
+    "missing_vendored_scripts",
+    "plotly_js_path",
+]
 
 API_PREFIX = "/api/v1"
 """Path prefix of every API route."""
@@ -92,6 +99,16 @@ def frontend_dir() -> Path:
         if (candidate / "index.html").is_file():
             return candidate
     raise FileNotFoundError("frontend/index.html not found in the checkout or the package")
+
+
+VENDORED_SCRIPTS = ("three/three.module.min.js", "three/three.core.min.js")
+"""The files of ``frontend/vendor`` the dashboard cannot draw without (three.js: Plotly falls
+back to the copy inside its own wheel); ``scripts/vendor_js.py`` copies them."""
+
+
+def missing_vendored_scripts(frontend: Path) -> list[str]:
+    """The :data:`VENDORED_SCRIPTS` missing under ``frontend / "vendor"``."""
+    return [name for name in VENDORED_SCRIPTS if not (frontend / "vendor" / name).is_file()]
 
 
 def plotly_js_path() -> Path:

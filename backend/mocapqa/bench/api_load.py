@@ -21,6 +21,7 @@ import subprocess
 import sys
 import threading
 import time
+import urllib.request
 import uuid
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
@@ -29,13 +30,13 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
 
-import httpx
 import numpy as np
 
 __all__ = [
     "API",
     "START_BOUND_S",
     "Client",
+    "Connection",
     "LoadResult",
     "RouteFigures",
     "Sample",
@@ -142,7 +143,7 @@ def wait_until(what: str, check: Callable[[], bool], bound_s: float = START_BOUN
         try:
             if check():
                 return
-        except httpx.HTTPError:
+        except (OSError, http.client.HTTPException):
             pass
         time.sleep(0.05)
     raise TimeoutError(f"{what}: not within {bound_s} s")
@@ -156,22 +157,35 @@ class ServerProcess:
     data_dir : Path
         The server's data folder.
     environ : mapping
-        ``MOCAPQA_*`` settings for the server (the database URL, quotas, worker count).
+        ``MOCAPQA_*`` settings for the server (the database URL, quotas, worker count), and
+        any other variable to set.
+    command : sequence of str, optional
+        The ``serve`` command line without ``--port`` (default: this Python's mocapqa).
+    cwd : Path, optional
+        The server's working folder.
     """
 
-    def __init__(self, data_dir: Path, environ: Mapping[str, str]) -> None:
+    def __init__(
+        self,
+        data_dir: Path,
+        environ: Mapping[str, str],
+        command: Sequence[str] | None = None,
+        cwd: Path | None = None,
+    ) -> None:
         self.port = free_port()
         self.url = f"http://127.0.0.1:{self.port}"
         self.log_path = data_dir / "server.log"
         data_dir.mkdir(parents=True, exist_ok=True)
         env = {k: v for k, v in os.environ.items() if not k.startswith("MOCAPQA_")}
-        env.update({"MOCAPQA_DATA_DIR": str(data_dir), **environ})
-        command = [sys.executable, "-m", "mocapqa.cli.main", "serve", "--port", str(self.port)]
+        env.update({"MOCAPQA_DATA_DIR": str(data_dir), "PYTHONUNBUFFERED": "1", **environ})
+        serve = list(command or [sys.executable, "-m", "mocapqa.cli.main", "serve"])
         with self.log_path.open("wb") as log:
-            self.process = subprocess.Popen(command, env=env, stdout=log, stderr=log)
+            self.process = subprocess.Popen(
+                [*serve, "--port", str(self.port)], env=env, stdout=log, stderr=log, cwd=cwd
+            )
         wait_until(
             "server start",
-            lambda: self.process.poll() is None and httpx.get(f"{self.url}{API}/health").is_success,
+            lambda: self.process.poll() is None and _answers(f"{self.url}{API}/health"),
         )
 
     def log(self) -> str:
@@ -189,6 +203,12 @@ class ServerProcess:
                 self.process.wait(timeout=60)
 
 
+def _answers(url: str) -> bool:
+    """Whether a GET of ``url`` answers 200."""
+    with urllib.request.urlopen(url, timeout=10) as response:
+        return bool(response.status == 200)
+
+
 def short_take(bvh_text: str, frames: int) -> bytes:
     """The first ``frames`` frames of a BVH text (a small upload of a real take)."""
     head, _, motion = bvh_text.partition("MOTION")
@@ -198,9 +218,10 @@ def short_take(bvh_text: str, frames: int) -> bytes:
     return text.encode()
 
 
-class _Connection:
-    """One keep-alive HTTP/1.1 connection of the standard library's (a tenth of an httpx
-    client's CPU per request: the clients share the machine with the server they measure)."""
+class Connection:
+    """One keep-alive HTTP/1.1 connection of the standard library's, with a bearer token (a
+    tenth of an httpx client's CPU per request: the clients share the machine with the server
+    they measure)."""
 
     def __init__(self, base: str, token: str | None) -> None:
         parsed = urlsplit(base)
@@ -262,7 +283,7 @@ def _client_rounds(
     """One client's requests: ``rounds`` rounds of reads, and writes for a reviewer, with a
     pause of 0 to ``2 * think_s`` seconds (seeded by the client's index) before each."""
     samples: list[Sample] = []
-    http = _Connection(base, client.token)
+    http = Connection(base, client.token)
     pauses = np.random.default_rng(index).uniform(0.0, 2.0 * think_s, size=10 * rounds)
 
     def pause() -> None:
@@ -314,7 +335,7 @@ def _health_watch(base: str, result: LoadResult, every_s: float) -> Iterator[Non
     stop = threading.Event()
 
     def watch() -> None:
-        http = _Connection(base, None)
+        http = Connection(base, None)
         try:
             while not stop.is_set():
                 result.health.append(http.request("GET /health", "GET", "/health")[0])

@@ -82,22 +82,26 @@ def admin_token(database_url: str) -> str:
 def seed_take(base: str, token: str) -> tuple[Seed, bytes]:
     """Upload the demo take with twist errors, wait for its run; the seed and the short take
     the clients upload."""
-    import httpx
-
-    from mocapqa.bench.api_load import API, Seed, short_take, wait_until
+    from mocapqa.bench.api_load import Connection, Seed, short_take, wait_until
     from mocapqa.jobs.demo import demo_paths
 
     path = next(p for p in demo_paths() if p.name == SEED_FILE)
-    headers = {"Authorization": f"Bearer {token}"}
-    with httpx.Client(base_url=base + API, headers=headers, timeout=300) as http:
-        created = http.post("/takes", files={"file": (path.name, path.read_bytes())})
-        created.raise_for_status()
-        take_id, run_id = created.json()["id"], created.json()["run_id"]
-        wait_until(
-            "seed run",
-            lambda: http.get(f"/runs/{run_id}").json()["status"] in ("done", "failed"),
-        )
-        intervals = http.get(f"/runs/{run_id}/decisions").json()["intervals"]
+    http = Connection(base, token)
+    try:
+        _, created = http.post_file("seed", "/takes", path.name, path.read_bytes())
+        if created is None:
+            raise RuntimeError(f"the seed take {path.name} was refused")
+        take_id, run_id = created["id"], created["run_id"]
+
+        def finished() -> bool:
+            _, run = http.request("seed", "GET", f"/runs/{run_id}")
+            return run is not None and run["status"] in ("done", "failed")
+
+        wait_until("seed run", finished)
+        _, decided = http.request("seed", "GET", f"/runs/{run_id}/decisions")
+        intervals = decided["intervals"] if decided else []
+    finally:
+        http.close()
     seed = Seed(take_id, run_id, tuple(int(i["id"]) for i in intervals))
     return seed, short_take(path.read_text(), UPLOAD_FRAMES)
 

@@ -8,7 +8,7 @@ import typer
 
 from mocapqa.cli.app import app
 
-__all__ = ["FIRST_ADMIN", "is_loopback", "serve"]
+__all__ = ["FIRST_ADMIN", "is_loopback", "require_vendored_scripts", "serve"]
 
 FIRST_ADMIN = "admin"
 """Name of the admin ``serve`` creates on first start with an empty user table."""
@@ -59,6 +59,29 @@ def _sign_in(host: str, port: int) -> str | None:
         repository.close()
 
 
+def require_vendored_scripts() -> None:
+    """Refuse to serve a dashboard that cannot draw: a checkout without the vendored three.js
+    (its take page failed with "Failed to fetch dynamically imported module" and drew nothing,
+    while the server started without a word).
+
+    Raises
+    ------
+    NotFoundError
+        Naming the missing files and the command that fetches them.
+    """
+    from mocapqa.api.app import frontend_dir, missing_vendored_scripts
+    from mocapqa.errors import NotFoundError
+
+    folder = frontend_dir()
+    missing = missing_vendored_scripts(folder)
+    if missing:
+        raise NotFoundError(
+            f"Expected the dashboard's vendored scripts in {folder / 'vendor'}, got none of "
+            f"{', '.join(missing)}: run `make js-deps` in the checkout (npm), or install a "
+            "built wheel"
+        )
+
+
 @app.command()
 def serve(
     host: str = typer.Option("127.0.0.1", help="Address to listen on."),
@@ -82,6 +105,7 @@ def serve(
     from mocapqa.api.app import create_app
     from mocapqa.config import get_settings
 
+    require_vendored_scripts()
     settings = get_settings()
     if workers > 0:
         settings = settings.model_copy(update={"job_workers": workers})
