@@ -243,7 +243,15 @@ def test_stream_in_metres_matches_the_batch_default_preset(
             cells = [[None if np.isnan(v) else float(v) for v in row] for row in frame]
             socket.send_json({"positions": cells})
             streamed.append(socket.receive_json()["positions"])
-    np.testing.assert_allclose(np.asarray(streamed, dtype=np.float64), batch, atol=6e-6)
+    streamed_positions = np.asarray(streamed, dtype=np.float64)
+    # The stream is causal: it agrees with the batch filter up to the keypoint's gap. Over the
+    # gap the batch filter, which sees the frames after it, interpolates between the filtered
+    # samples on either side instead of carrying a prediction (and so differs after it).
+    others = np.arange(seq.n_keypoints) != 3
+    np.testing.assert_allclose(streamed_positions[:, others], batch[:, others], atol=6e-6)
+    np.testing.assert_allclose(streamed_positions[:5, 3], batch[:5, 3], atol=6e-6)
+    ramp = np.linspace(0.0, 1.0, 6)[1:-1, None]
+    np.testing.assert_allclose(batch[5:9, 3], batch[4, 3] + ramp * (batch[9, 3] - batch[4, 3]))
 
 
 def test_stream_refuses_a_bad_opening(client: TestClient) -> None:

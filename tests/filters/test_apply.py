@@ -6,6 +6,7 @@ import dataclasses
 import json
 import re
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -233,3 +234,112 @@ def test_cli_filter_refuses_out_of_range_parameters_naming_them(
     assert not out.exists()
     assert main([*argv, "--fps", "inf"]) == 3
     assert "Expected --fps finite, at least 0.1" in capsys.readouterr().err
+
+
+PBTXT = "keypoints/mediapipe/google_mediapipe_testdata/pose_landmarks.pbtxt"
+
+
+def _strict_json(text: str) -> Any:
+    """JSON as other tools read it: NaN and Infinity are not JSON."""
+
+    def refuse(token: str) -> None:
+        raise ValueError(f"Expected strict JSON, got {token}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+@pytest.mark.parametrize("method", ["adaptive", "kalman", "one-euro", "ema", "butterworth"])
+def test_cli_filters_a_one_frame_pbtxt_and_reports_short_take_metrics_as_unavailable(
+    corpus_dir: Path, tmp_path: Path, method: str
+) -> None:
+    # MediaPipe's golden pbtxt is one frame; lag_frames raised ValueError after the output
+    # was written.
+    source = corpus_dir / PBTXT
+    take = read_take(source)
+    assert isinstance(take, KeypointSequence)
+    assert take.n_frames == 1
+    out, report = tmp_path / "one.json", tmp_path / "one.report.json"
+    argv = ["filter", str(source), "-o", str(out), "--method", method, "--report", str(report)]
+    assert main(argv) == 0
+    back = read_take(out)
+    assert isinstance(back, KeypointSequence)
+    np.testing.assert_allclose(back.positions, take.positions, rtol=0, atol=1e-12)
+    data = _strict_json(report.read_text(encoding="utf-8"))
+    rows = data["per_keypoint"]
+    assert [r["keypoint"] for r in rows] == list(take.names)
+    for row in rows:
+        assert row["jerk_raw"] is None
+        assert row["jerk_filtered"] is None
+        assert row["lag_frames_vs_input"] is None
+    assert "not available" in " ".join(data["notes"])
+
+
+def test_cli_filter_writes_no_output_when_its_metrics_fail(
+    corpus_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import mocapqa.metrics.smoothness as smoothness
+
+    def broken(*args: Any, **kwargs: Any) -> float:
+        raise RuntimeError("metric failed")
+
+    monkeypatch.setattr(smoothness, "lag_frames", broken)
+    out = tmp_path / "out.csv"
+    with pytest.raises(RuntimeError, match="metric failed"):
+        main(["filter", str(corpus_dir / BALANCING), "-o", str(out)])
+    assert not out.exists()
+
+
+OPENPOSE_CAM01 = "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose/cam01_json"
+
+
+@pytest.fixture(scope="module")
+def openpose(corpus_dir: Path) -> KeypointSequence:
+    take = read_take(corpus_dir / OPENPOSE_CAM01)
+    assert isinstance(take, KeypointSequence)
+    return take
+
+
+def _detection_range(seq: KeypointSequence) -> tuple[np.ndarray, np.ndarray]:
+    seen = ~seq.missing[..., None]
+    low = np.where(seen, seq.positions, np.inf).min(axis=0)
+    high = np.where(seen, seq.positions, -np.inf).max(axis=0)
+    return low, high
+
+
+@pytest.mark.parametrize("method", ["adaptive", "kalman", "one-euro", "ema", "butterworth"])
+def test_bridged_keypoints_stay_within_their_detections(
+    openpose: KeypointSequence, method: str
+) -> None:
+    # The Kalman bridge extrapolated: cam01's LEar, never detected beyond x = 768 px, was
+    # placed at x = 866 px in its 50-frame gap (the 'kalman' method: LElbow, RKnee).
+    res = filter_keypoints(openpose, method)
+    out = res.sequence.positions
+    low, high = _detection_range(openpose)
+    inside = (out >= low - 1e-9) & (out <= high + 1e-9)
+    bridged = res.bridged & ~openpose.missing.all(axis=0)
+    assert bridged.sum() >= 90
+    outside = np.argwhere(bridged[..., None] & ~inside)
+    assert outside.size == 0, [(openpose.names[k], f, out[f, k]) for f, k, _ in outside[:5]]
+
+
+def test_a_gap_inside_the_take_is_interpolated_and_one_at_its_end_held(
+    openpose: KeypointSequence,
+) -> None:
+    ear = openpose.names.index("LEar")
+    missing = openpose.missing[:, ear]
+    # The README's cam01: LEar is missing on frames 38-87 (inside) and 91-99 (the end).
+    assert missing[38:88].all()
+    assert not missing[[37, 88, 90]].any()
+    assert missing[91:].all()
+    res = filter_keypoints(openpose, "adaptive")
+    out = res.sequence.positions[:, ear]
+    assert res.bridged[38:88, ear].all()
+    assert res.bridged[91:, ear].all()
+    ramp = np.linspace(0.0, 1.0, 52)[1:-1, None]
+    np.testing.assert_allclose(out[38:88], out[37] + ramp * (out[88] - out[37]), atol=1e-9)
+    np.testing.assert_array_equal(out[91:], np.repeat(out[90:91], 9, axis=0))
+    detected = openpose.positions[:, ear, 0]
+    assert np.nanmax(detected) == pytest.approx(768.0, abs=1.0)
+    assert np.nanmax(out[:, 0]) <= np.nanmax(detected)
+    # The first detection after the gap is not pulled toward an extrapolated position.
+    assert abs(out[88, 0] - detected[88]) < 10.0

@@ -36,3 +36,17 @@ def test_rmse_accel_and_jitter_on_simple_inputs() -> None:
     assert acceleration_error(b, a) == pytest.approx(0.0)
     assert jitter_score(np.array([0.0, 1.0, 0.0, 1.0, 0.0])) == 1.0
     assert jitter_score(np.arange(6.0)) == 0.0
+
+
+@pytest.mark.parametrize("n_frames", [0, 1, 2, 3])
+def test_lag_of_a_take_too_short_to_correlate_is_nan(n_frames: int) -> None:
+    # Fewer than 4 frames give fewer than 3 differences: no shift can be compared.
+    values = np.arange(n_frames * 6, dtype=np.float64).reshape(n_frames, 2, 3)
+    assert np.isnan(lag_frames(values, values + 1.0))
+
+
+def test_lag_of_still_signals_is_nan_not_the_largest_shift() -> None:
+    still = np.ones((40, 3))
+    assert np.isnan(lag_frames(still, still))
+    gap = np.full((40, 3), np.nan)
+    assert np.isnan(lag_frames(gap, gap))

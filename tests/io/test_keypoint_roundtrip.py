@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from mocapqa.cli.main import main
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import ParseError
 from mocapqa.io.formats import read_take, write_keypoints
@@ -146,3 +147,32 @@ def test_truncated_headers_say_what_is_missing() -> None:
     # It said "Expected a TRC file starting 'PathFileType', got 'PathFileType...'".
     with pytest.raises(ParseError, match="TRC header of 3 lines and a marker row, got 1 line"):
         parse_trc("PathFileType\t4\t(X/Y/Z)\tx.trc\n", "x.trc")
+
+
+def test_json_round_trip_keeps_the_start_time(corpus_dir: Path, tmp_path: Path) -> None:
+    # The Pose2Sim TRC starts at 1/60 s; its keypoint JSON read back started at 0.
+    source = read_trc(corpus_dir / TRC)
+    assert source.times is not None
+    assert source.times[0] == pytest.approx(0.016667, abs=1e-6)
+    path = tmp_path / "take.json"
+    assert main(["convert", str(corpus_dir / TRC), "-o", str(path)]) == 0
+    back = read_take(path)
+    assert isinstance(back, KeypointSequence)
+    assert back.times is not None
+    np.testing.assert_array_equal(back.times, source.times)
+    # On to TRC again: the time column is the source's.
+    assert main(["convert", str(path), "-o", str(tmp_path / "again.trc")]) == 0
+    again = read_trc(tmp_path / "again.trc")
+    assert again.times is not None
+    np.testing.assert_array_equal(again.times, source.times)
+
+
+def test_json_without_times_starts_at_0_and_bad_times_name_the_field() -> None:
+    head = '{"fps": 10, "keypoints": ["a"], "frames": [[[1, 2, 3]], [[1, 2, 4]]]'
+    assert parse_keypoint_json(head + "}").times is None
+    seq = parse_keypoint_json(head + ', "times": [0.5, 0.6]}')
+    assert seq.times is not None
+    assert seq.times.tolist() == [0.5, 0.6]
+    for times in ("[0.5]", '[0.5, "x"]', '"0.5"', "[0.5, true]", "[0.5, 1e999]"):
+        with pytest.raises(ParseError, match="field 'times"):
+            parse_keypoint_json(head + f', "times": {times}}}', "k.json")

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from mocapqa.cli.main import main
 from mocapqa.errors import ParseError
 from mocapqa.io.trc import format_trc, parse_trc, read_trc, write_trc
 
@@ -157,3 +159,46 @@ def test_infinity_is_rejected(corpus_dir: Path) -> None:
     lines[5] = "\t".join(cells)
     with pytest.raises(ParseError, match=r"line 6: Expected a finite number"):
         parse_trc("\n".join(lines), "x.trc")
+
+
+POSE2SIM = "keypoints/pose2sim/S00_P00_T01_BalancingTrial"
+TAKES = {
+    "openpose": f"{POSE2SIM}/pose/cam01_json",
+    "pose2sim trc": f"{POSE2SIM}/pose-3d/S00_P00_T01_BalancingTrial_0-100.trc",
+    "mediapipe csv": "keypoints/mediapipe/etfrobotics_full-body-kinematics/landmarks.csv",
+    "mediapipe pbtxt": "keypoints/mediapipe/google_mediapipe_testdata/pose_landmarks.pbtxt",
+}
+
+
+def _frame_column(path: Path) -> list[int]:
+    rows = path.read_text(encoding="utf-8").splitlines()[6:]
+    return [int(row.split("\t")[0]) for row in rows]
+
+
+@pytest.mark.parametrize("take", sorted(TAKES))
+def test_every_trc_mocapqa_writes_numbers_its_frames_from_1(
+    corpus_dir: Path, tmp_path: Path, take: str
+) -> None:
+    # OpenSim numbers TRC frames from 1; TRCs converted from OpenPose started at 0 (the
+    # OpenPose file numbers), the others at 1.
+    source = corpus_dir / TAKES[take]
+    converted, filtered = tmp_path / "converted.trc", tmp_path / "filtered.trc"
+    fps = [] if take != "mediapipe csv" else ["--fps", "90"]
+    assert main(["convert", str(source), "-o", str(converted), *fps]) == 0
+    assert main(["filter", str(source), "-o", str(filtered), *fps]) == 0
+    for path in (converted, filtered):
+        frames = _frame_column(path)
+        assert frames == list(range(1, len(frames) + 1)), (path.name, frames[:3])
+        assert read_trc(path).frame_numbers is not None
+
+
+def test_trc_frame_numbers_keep_their_spacing_from_1(corpus_dir: Path) -> None:
+    seq = read_trc(corpus_dir / TAKES["pose2sim trc"])
+    sparse = replace(seq, frame_numbers=np.arange(seq.n_frames) * 2 + 40)
+    frames = [int(r.split("\t")[0]) for r in format_trc(sparse).splitlines()[6:]]
+    assert frames[:3] == [1, 3, 5]
+    zero_based = replace(seq, frame_numbers=np.arange(seq.n_frames), start_frame=None)
+    text = format_trc(zero_based).splitlines()
+    assert [int(r.split("\t")[0]) for r in text[6:9]] == [1, 2, 3]
+    # OrigDataStartFrame keeps the source's first frame number (0 for OpenPose, as Pose2Sim).
+    assert text[2].split("\t")[6] == "0"

@@ -63,3 +63,18 @@ def test_still_options_bound_the_image_size() -> None:
     for size in ((MAX_SIDE_PX + 1, 480), (640, 100_000), (MIN_SIDE_PX - 1, 480)):
         with pytest.raises(ShapeError, match="16 to 8192 px"):
             StillOptions(width_px=size[0], height_px=size[1])
+
+
+def test_contact_sheet_of_a_run_says_which_intervals_were_not_applied(corpus_dir: Path) -> None:
+    from mocapqa.cli.report import analyze_take, sheet_tiles
+
+    # 005_05's real knee twists, none applied (a run with twist_apply "none").
+    run = analyze_take(corpus_dir / "bvh/cmu/iclone/005_05.bvh", {"twist_apply": "none"})
+    twists = [f for f in run.analysis["findings"] if f["kind"] == "twist"]
+    assert twists
+    assert not any(f["applied"] for f in twists)
+    tiles = sheet_tiles(run)
+    shown = [t for t in tiles if "offset" in t.label]
+    assert shown
+    for tile, finding in zip(shown, twists, strict=False):
+        assert tile.not_applied == f"not applied (confidence {finding['confidence']:.2f})"

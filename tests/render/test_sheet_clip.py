@@ -153,3 +153,47 @@ def test_missing_pyvista_raises_render_unavailable(monkeypatch: pytest.MonkeyPat
     monkeypatch.setitem(sys.modules, "pyvista", None)
     with pytest.raises(RenderUnavailableError, match="Expected pyvista with VTK to import"):
         load_pyvista()
+
+
+NOT_APPLIED = [
+    {"kind": "twist", "joint": BROKEN_JOINT, "start_frame": 40, "end_frame": 70,
+     "offset_deg": 40.0, "confidence": 0.93, "applied": True},
+    {"kind": "twist", "joint": BROKEN_JOINT, "start_frame": 100, "end_frame": 104,
+     "offset_deg": -17.6, "confidence": 0.14, "applied": False},
+    {"kind": "spin", "joint": "UpperLeg_L", "start_frame": 10, "end_frame": 12,
+     "offset_deg": 180.0},
+]  # fmt: skip
+
+
+def test_tiles_of_intervals_not_applied_say_so(kick: Motion, kick_broken: Motion) -> None:
+    # With apply=confident, a low-confidence interval is found but not applied: its tile
+    # showed a 'corrected' panel all the same.
+    raw, corrected = track_from_motion(kick_broken), track_from_motion(kick)
+    applied, skipped, spin = tiles_from_intervals(NOT_APPLIED, raw, corrected)
+    assert applied.not_applied is None
+    assert skipped.not_applied == "not applied (confidence 0.14)"
+    assert spin.not_applied == "not corrected (limb spin)"
+    # The frame of a tile not applied is not chosen by the corrected take's differences.
+    assert skipped.frame == 102
+
+
+@pytest.mark.render
+def test_contact_sheet_shows_no_corrected_pose_for_an_interval_not_applied(
+    kick: Motion, kick_broken: Motion, canvases: Any
+) -> None:
+    raw, corrected = track_from_motion(kick_broken), track_from_motion(kick)
+    tiles = tiles_from_intervals(NOT_APPLIED[:2], raw, corrected)
+    size, gap = 200, 8
+    sheet = render_contact_sheet(
+        raw, tiles, corrected, columns=1, tile_width_px=size, tile_height_px=size, canvases=canvases
+    )
+    first = sheet[gap : gap + size, gap : gap + 2 * size]
+    second = sheet[2 * gap + size : 2 * gap + 2 * size, gap : gap + 2 * size]
+    green = (first[..., 1].astype(int) - first[..., 0] > 60) & (first[..., 1] > 120)
+    assert green[45:, size:].any()
+    # The interval not applied: the raw pose only, its right panel holds no pose, only the
+    # caption at the top.
+    assert red_mask(second[:, :size]).any()
+    assert content_mask(second[45:, :size]).mean() > 0.002
+    assert content_mask(second[45:, size:]).sum() == 0
+    assert content_mask(second[:45, size:]).any()

@@ -109,3 +109,16 @@ def test_findings_are_normalised_by_kind() -> None:
     assert out[1]["violation_deg"] == 4.0
     twist = {"intervals": [{"joint": "A", "start_frame": 3, "end_frame": 9, "offset_deg": 12.5}]}
     assert twist_findings(twist)[0]["offset_deg"] == 12.5
+
+
+def test_twist_findings_keep_whether_the_interval_was_applied() -> None:
+    # The contact sheet draws a corrected pose only for applied intervals.
+    twist = {
+        "intervals": [
+            {"joint": "A", "start_frame": 3, "end_frame": 9, "confidence": 0.14, "applied": False},
+            {"joint": "A", "start_frame": 20, "end_frame": 22, "applied": True},
+            {"joint": "B", "start_frame": 1, "end_frame": 2},
+        ]
+    }
+    found = twist_findings(twist)
+    assert [f.get("applied") for f in found] == [False, True, None]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 from pathlib import Path
 from typing import Annotated, Any
@@ -61,7 +62,7 @@ def filter_command(
         require_frames,
         write_keypoints,
     )
-    from mocapqa.metrics.smoothness import lag_frames, mean_abs_jerk
+    from mocapqa.metrics.smoothness import MIN_FRAMES, lag_frames, mean_abs_jerk
 
     if fps is not None:
         check_fps(fps, "--fps")
@@ -93,7 +94,8 @@ def filter_command(
         if method not in FILTERS:
             raise InputError(f"Expected --method in {sorted(FILTERS)}, got {method!r}")
         result = filter_keypoints(take, method, preset, overrides)
-        write_keypoints(output, result.sequence)
+        # The report is made before anything is written: a metric that fails must not leave
+        # an output behind and then exit with an error.
         summary = result.to_json(max_points=2000)
         per_key = []
         for k, name in enumerate(take.names):
@@ -101,15 +103,36 @@ def filter_command(
             per_key.append(
                 {
                     "keypoint": name,
-                    "jerk_raw": mean_abs_jerk(raw, take.fps),
-                    "jerk_filtered": mean_abs_jerk(out, take.fps),
-                    "lag_frames_vs_input": lag_frames(raw, out),
+                    "jerk_raw": _available(mean_abs_jerk(raw, take.fps)),
+                    "jerk_filtered": _available(mean_abs_jerk(out, take.fps)),
+                    "lag_frames_vs_input": _available(lag_frames(raw, out)),
                 }
             )
         summary["per_keypoint"] = per_key
+        summary["notes"] = _metric_notes(take.n_frames, MIN_FRAMES, per_key)
+        write_keypoints(output, result.sequence)
     if report is not None:
         write_text(report, json.dumps(summary, indent=1, default=str, allow_nan=True))
     console.print(f"filtered {input_path} with {method} → {output}")
+    for note in summary.get("notes", []):
+        console.print(note)
+
+
+def _available(value: float) -> float | None:
+    """A metric for the report: None (JSON null, "not available") when it is not finite."""
+    return value if math.isfinite(value) else None
+
+
+def _metric_notes(n_frames: int, min_frames: int, rows: list[dict[str, Any]]) -> list[str]:
+    """What the report's per-keypoint metrics could not give, in words (empty: all given)."""
+    if n_frames < min_frames:
+        return [
+            f"jerk and lag not available (null): the take has {n_frames} frame(s), they need "
+            f"at least {min_frames}"
+        ]
+    if any(value is None for row in rows for value in row.values()):
+        return ["a null jerk or lag is not available: the keypoint has too few samples or is still"]
+    return []
 
 
 def _table(title: str, rows: list[dict[str, Any]]) -> Table:

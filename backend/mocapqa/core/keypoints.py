@@ -12,8 +12,9 @@ Conventions
   nothing is rescaled silently.
 * ``frame_numbers`` and ``times`` keep the source's own frame numbers and time column when it
   has them (a TRC's ``Frame#``/``Time``, an OpenPose folder's file numbers), so a writer can
-  write them back; None means frames ``0..F-1`` at ``frame / fps`` seconds. A copy whose frame
-  count differs (frames sliced off) drops them.
+  write them back (the TRC writer shifts the numbers to start at 1); None means frames
+  ``0..F-1`` at ``frame / fps`` seconds. A copy whose frame count differs (frames sliced off)
+  drops them.
 """
 
 from __future__ import annotations

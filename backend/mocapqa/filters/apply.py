@@ -5,10 +5,19 @@ Conventions
 The data's scale (:class:`~mocapqa.filters.registry.DataScale`) comes from the sequence's
 recorded ``length_unit``: metric units convert exactly; for ``normalized`` data one normalised
 unit is the unit itself; for ``px`` and ``unknown`` the scale is estimated from the body extent
-(median per-frame extent of the keypoints along their widest axis, read as 1.7 m). Causal
-filters cannot produce a value before a keypoint's first valid sample; those frames take the
-first output value and are marked bridged. A keypoint with no valid sample at all stays NaN and
-is marked bridged (a gap), rather than inventing values.
+(median per-frame extent of the keypoints along their widest axis, read as 1.7 m).
+
+Gaps are bridged offline and never extrapolated (:mod:`mocapqa.filters.gaps`): a keypoint's
+frames without a detection are filled before filtering (interpolated between the detections
+around them, held before the first and after the last), so a filter never coasts through a
+gap on its own prediction (a Kalman bridge placed cam01's OpenPose LEar 100 px beyond its
+detections); after filtering, those frames take the straight line between the filtered
+samples on either side of the gap, or hold the nearest one at the take's ends. Every bridged
+sample (also a filter's prediction over a low-confidence or rejected sample) is kept within
+the range of its keypoint's detections on each axis, so pixel data stay inside the image.
+Causal filters cannot produce a value before a keypoint's first valid sample; those frames
+take the first output value and are marked bridged. A keypoint with no valid sample at all
+stays NaN and is marked bridged (a gap), rather than inventing values.
 """
 
 from __future__ import annotations
@@ -27,6 +36,7 @@ from mocapqa.filters.adaptive import WEIGHT_NAMES, adaptive_filter
 from mocapqa.filters.butterworth import butterworth_filter, butterworth_quats
 from mocapqa.filters.ema import ema_filter
 from mocapqa.filters.euler_pd import euler_pd_filter, vector_pd_filter
+from mocapqa.filters.gaps import clamp_to_detections, fill_gaps
 from mocapqa.filters.kalman import kalman_filter
 from mocapqa.filters.one_euro import OneEuroParams, one_euro_filter
 from mocapqa.filters.quat_one_euro import quat_one_euro_filter
@@ -261,7 +271,11 @@ def filter_keypoints(
         raise InputError(f"Expected a keypoint filter method, got rotation method {method!r}")
     scale = data_scale(seq.length_unit, seq.fps, seq.positions)
     p = resolve_params(method, preset, scale, params)
-    pos, conf, fps = seq.positions, seq.confidence, seq.fps
+    missing, fps = seq.missing, seq.fps
+    # The filters run over the gaps filled from the detections on either side (weighed by
+    # their confidence), not over a coasting prediction.
+    pos = fill_gaps(seq.positions, missing)
+    conf = fill_gaps(seq.confidence, missing)
     conf3 = np.repeat(conf[:, :, None], 3, axis=2)
     weights: FloatArray | None = None
     names: tuple[str, ...] = ()
@@ -281,7 +295,10 @@ def filter_keypoints(
         values, b = butterworth_filter(pos, fps, p)
         bridged = _any3(b)
     values, b3 = _fill_leading(values, np.repeat(bridged[:, :, None], 3, axis=2))
-    bridged = _any3(b3)
+    detected = ~missing.all(axis=0)
+    bridged = _any3(b3) | (missing & detected)
+    values = fill_gaps(values, missing)
+    values = clamp_to_detections(values, seq.positions, bridged)
     out = dataclasses.replace(
         seq, positions=values, confidence=np.where(np.isnan(values).any(-1), 0.0, seq.confidence)
     )

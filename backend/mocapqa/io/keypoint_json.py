@@ -9,6 +9,10 @@ Conventions
 * ``n_dims`` is 2 when given so or when every entry has two coordinates; otherwise 3.
 * ``fps`` is the caller's, else the file's, else an error; ``unit`` is the caller's
   ``length_unit``, else the file's, else "unknown".
+* ``times`` (optional): the time of each frame, seconds, one number (or ``null``, unknown) per
+  frame. The writer writes it when the sequence has the source's times (a TRC's ``Time``
+  column, which starts at ``1 / DataRate`` in Pose2Sim files), so a take converted to JSON and
+  read back keeps its start time; without it frames are at ``frame / fps`` from 0.
 * The writer uses ``null`` for missing values and Python's shortest float repr, so a written
   file reads back exactly.
 """
@@ -22,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from mocapqa.core.arrays import FloatArray
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import ParseError
 from mocapqa.io.atomic import write_text
@@ -62,6 +67,18 @@ def _point(entry: Any, path: str, field: str) -> tuple[list[float], float, int]:
     if not (math.isnan(conf) or 0.0 <= conf <= 1.0):
         raise ParseError(f"Expected confidence in [0, 1], got {conf}", path, field=f"{field}[3]")
     return xyz, 0.0 if math.isnan(conf) else conf, len(values)
+
+
+def _times(value: Any, n_frames: int, path: str) -> FloatArray | None:
+    """The ``times`` member: None when absent, else one number (NaN for null) per frame."""
+    if value is None:
+        return None
+    if not isinstance(value, list) or len(value) != n_frames:
+        got = f"{len(value)} value(s)" if isinstance(value, list) else f"{str(value)[:20]!r}"
+        raise ParseError(
+            f"Expected a list of {n_frames} times (one per frame), got {got}", path, field="times"
+        )
+    return np.array([_number(v, path, f"times[{i}]") for i, v in enumerate(value)])
 
 
 def parse_keypoint_json(
@@ -121,12 +138,14 @@ def parse_keypoint_json(
     n_dims = document.get("n_dims", 2 if widths <= {0, 2} and 2 in widths else 3)
     if n_dims not in (2, 3) or isinstance(n_dims, bool):
         raise ParseError(f"Expected n_dims 2 or 3, got {str(n_dims)[:20]!r}", path, field="n_dims")
+    times = _times(document.get("times"), len(frames), path)
     notes: list[str] = []
     rate = resolve_fps(fps, file_fps, None, path, "JSON", notes)
     unit = resolve_length_unit(length_unit or unit, "unknown", path, notes)
     return build_keypoint_sequence(
         path, tuple(names), positions, confidence, rate,
         length_unit=unit, n_dims=int(n_dims), source_format="json", assumptions=notes,
+        times=times,
     )  # fmt: skip
 
 
@@ -148,7 +167,8 @@ def format_keypoint_json(seq: KeypointSequence) -> str:
     Returns
     -------
     str
-        Compact JSON with one frame per line; missing points are ``null``.
+        Compact JSON with one frame per line; missing points are ``null``. The sequence's
+        ``times``, when it has them, follow the frames (``null`` where unknown).
     """
     head = json.dumps(
         {
@@ -168,7 +188,11 @@ def format_keypoint_json(seq: KeypointSequence) -> str:
             else:
                 points.append([float(v) for v in xyz] + [float(seq.confidence[frame, k])])
         rows.append(json.dumps(points, allow_nan=False))
-    return head[:-1] + ', "frames": [\n' + ",\n".join(rows) + "\n]}\n"
+    tail = ""
+    if seq.times is not None:
+        times = [float(t) if math.isfinite(t) else None for t in seq.times.tolist()]
+        tail = ',\n"times": ' + json.dumps(times, allow_nan=False)
+    return head[:-1] + ', "frames": [\n' + ",\n".join(rows) + "\n]" + tail + "}\n"
 
 
 def write_keypoint_json(path: str | Path, seq: KeypointSequence) -> None:

@@ -14,8 +14,12 @@ Conventions
 * The frame rate is ``DataRate``; the unit is ``Units`` (``m``, ``mm``, ``cm``, ``in``, also
   spelled out), recorded as is and never rescaled. Confidence is 1.0 where a value exists.
 * The reader keeps the ``Frame#`` and ``Time`` columns (when frame numbers are whole and
-  increasing) and ``OrigDataStartFrame``, and the writer writes them back; a sequence without
-  them is written with frames from 1 at ``index / DataRate`` seconds.
+  increasing) and ``OrigDataStartFrame``. The writer numbers frames from 1, the OpenSim
+  convention, whatever the source's first number (an OpenPose folder's files count from 0):
+  the source's numbers are shifted so the first is 1, their gaps kept. It writes the source's
+  times as they were, and ``OrigDataStartFrame`` as the source's own field, else its first
+  frame number (0 for an OpenPose folder), else 1. A sequence without numbers or times is
+  written with frames from 1 at ``index / DataRate`` seconds.
 * The writer prints every number with Python's shortest round-trip repr, so a written file
   reads back exactly, and writes every cell of every row: a missing value is ``NaN`` (an
   empty trailing cell makes OpenSim refuse the file for a short row). Confidence is not
@@ -218,11 +222,13 @@ def format_trc(seq: KeypointSequence, file_name: str = "keypoints.trc") -> str:
     """
     n_frames, n_markers = seq.n_frames, seq.n_keypoints
     fps = repr(seq.fps)
-    numbers = (
-        seq.frame_numbers.tolist() if seq.frame_numbers is not None else range(1, n_frames + 1)
-    )
+    source = seq.frame_numbers if seq.frame_numbers is not None else np.arange(n_frames)
+    # OpenSim numbers frames from 1: the source's numbers are shifted there, gaps kept.
+    numbers = (source - (source[0] if n_frames else 0) + 1).tolist()
     times = seq.times if seq.times is not None else np.arange(n_frames) / seq.fps
-    first = seq.start_frame if seq.start_frame is not None else (numbers[0] if n_frames else 1)
+    first = seq.start_frame
+    if first is None:
+        first = int(seq.frame_numbers[0]) if seq.frame_numbers is not None and n_frames else 1
     out = [
         f"PathFileType\t4\t(X/Y/Z)\t{file_name}",
         "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\t"

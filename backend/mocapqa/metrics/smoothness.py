@@ -10,7 +10,8 @@ the first differences of the two signals summed over channels; positive means th
 signal trails the first. Differences are used instead of raw positions so that slow drifts do
 not dominate the correlation (the note correlates raw positions). A mean over no finite sample
 (a take of a few frames, a keypoint never seen) is NaN, without numpy's "Mean of empty slice"
-warning.
+warning. A metric that needs more frames than the take has (jerk: 4, lag: 4) is NaN, "not
+available", as is the lag of signals that do not move (no correlation peak to find).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import numpy as np
 from mocapqa.core.arrays import FloatArray
 
 __all__ = [
+    "MIN_FRAMES",
     "acceleration_error",
     "jitter_score",
     "lag_frames",
@@ -30,6 +32,9 @@ __all__ = [
     "mean_distance",
     "rmse",
 ]
+
+MIN_FRAMES = 4
+"""Frames the jerk and lag metrics need (three differences); shorter takes give NaN."""
 
 
 def _nanmean(values: Any, axis: int | None = None) -> Any:
@@ -55,7 +60,7 @@ def mean_distance(estimate: FloatArray, truth: FloatArray) -> float:
 def mean_abs_jerk(values: FloatArray, fps: float) -> float:
     """Mean absolute third difference × ``fps³`` over all channels of ``(F, ...)``, unit/s³."""
     values = np.asarray(values, dtype=np.float64)
-    if values.shape[0] < 4:
+    if values.shape[0] < MIN_FRAMES:
         return float("nan")
     return float(_nanmean(np.abs(np.diff(values, n=3, axis=0)))) * fps**3
 
@@ -85,11 +90,15 @@ def lag_frames(reference: FloatArray, signal: FloatArray, max_lag: int = 10) -> 
     Returns
     -------
     float
-        Sub-frame lag; positive when ``signal`` is late.
+        Sub-frame lag; positive when ``signal`` is late. NaN (not available) for fewer than
+        4 frames, where no shift leaves differences to compare, and when the correlation is
+        zero at every shift (signals that do not move, or have no finite sample).
     """
     a = np.diff(np.asarray(reference, dtype=np.float64), axis=0)
     b = np.diff(np.asarray(signal, dtype=np.float64), axis=0)
     n = a.shape[0]
+    if n < MIN_FRAMES - 1:
+        return float("nan")
     a = np.nan_to_num(a.reshape(n, -1) - _nanmean(a.reshape(n, -1), axis=0))
     b = np.nan_to_num(b.reshape(n, -1) - _nanmean(b.reshape(n, -1), axis=0))
     max_lag = max(1, min(max_lag, (n - 1) // 3))
@@ -98,6 +107,8 @@ def lag_frames(reference: FloatArray, signal: FloatArray, max_lag: int = 10) -> 
     # symmetric about the delay and the parabola's vertex is unbiased.
     ref = a[max_lag : n - max_lag]
     corr = np.array([np.sum(ref * b[max_lag + lag : n - max_lag + lag]) for lag in lags])
+    if not np.any(corr):
+        return float("nan")
     i = int(np.argmax(corr))
     if 0 < i < len(lags) - 1:
         y0, y1, y2 = corr[i - 1], corr[i], corr[i + 1]

@@ -4,8 +4,11 @@ Both wrap the filters package: :data:`mocapqa.filters.registry.FILTERS` and
 :class:`mocapqa.filters.adaptive.AdaptiveFilter`. The stream takes its parameters the way
 :func:`mocapqa.filters.apply.filter_keypoints` does: a registry preset (``default`` unless the
 client names another) converted to the stream's length unit and frame rate, so streaming a take
-gives the same output as filtering it in batch. For ``px``, ``normalized`` and ``unknown`` units
-the body size is estimated from the first frame (the batch filter uses the whole take).
+gives the same output as filtering it in batch, up to a keypoint's first gap: over a gap the
+batch filter, which sees the whole take, interpolates between the detections on either side
+(:mod:`mocapqa.filters.gaps`), while the stream can only carry the filter's prediction. For
+``px``, ``normalized`` and ``unknown`` units the body size is estimated from the first frame
+(the batch filter uses the whole take).
 """
 
 from __future__ import annotations

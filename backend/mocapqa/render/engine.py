@@ -258,15 +258,7 @@ class Canvas:
             )
             self._add_actor(glyphs, color)
         if title:
-            plotter.add_text(
-                title,
-                # A multi-line text actor grows upward from its anchor.
-                position=(0.02, 0.93 - 0.055 * title.count("\n")),
-                viewport=True,
-                font_size=9,
-                color="black",
-                render=False,
-            )
+            self._title(title)
         flagged_names = [track.names[j] for j in np.flatnonzero(marks)]
         if legend and flagged_names:
             shown = (
@@ -290,6 +282,31 @@ class Canvas:
         vtk_camera.SetViewAngle(30.0)
         plotter.renderer.camera_set = True
         plotter.renderer.reset_camera_clipping_range()
+
+    def _title(self, title: str) -> None:
+        """Text in the top-left corner of the current viewport."""
+        self.plotter.add_text(
+            title,
+            # A multi-line text actor grows upward from its anchor.
+            position=(0.02, 0.93 - 0.055 * title.count("\n")),
+            viewport=True,
+            font_size=9,
+            color="black",
+            render=False,
+        )
+
+    def caption(self, column: int, title: str) -> None:
+        """Write ``title`` in the top-left corner of viewport ``column`` and draw nothing else.
+
+        Parameters
+        ----------
+        column : int
+            Viewport index, 0-based from the left.
+        title : str
+            The text; lines split on ``\\n``.
+        """
+        self.plotter.subplot(0, column)
+        self._title(title)
 
     def image(self) -> ImageArray:
         """The rendered pixels, shape (H, W, 3) uint8."""

@@ -6,7 +6,11 @@ A tile shows the raw pose (flagged joints red) and, when a corrected take is giv
 corrected pose beside it (same joints green), with the camera framed on that pose so small
 twists stay visible. Tiles are laid out row by row on a white sheet with a gap between them.
 The frame of largest error is where raw and corrected positions differ most inside the
-interval; with no corrected take (or no difference) it is the interval's middle frame.
+interval; with no corrected take (or no difference) it is the interval's middle frame. An
+interval the corrected take does not fix shows no corrected pose: one found but not applied
+(``applied`` false in the run's findings, as a low-confidence interval under
+``apply=confident``) or never corrected (a limb spin) keeps the raw pose alone, its second view
+empty but for the caption ("not applied (confidence 0.14)"), at the interval's middle frame.
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ from mocapqa.render.scene import SkeletonTrack, check_same_shape, frame_camera
 __all__ = [
     "SheetTile",
     "frame_of_largest_difference",
+    "not_applied_reason",
     "render_contact_sheet",
     "tiles_from_intervals",
 ]
@@ -44,11 +49,15 @@ class SheetTile:
         Flagged joint indices.
     label : str
         Caption (joint, frames, offset or violation).
+    not_applied : str, optional
+        Why the corrected take does not fix this interval ("not applied (confidence 0.14)",
+        "not corrected (limb spin)"); the tile then shows no corrected pose. None when it does.
     """
 
     frame: int
     joints: tuple[int, ...]
     label: str
+    not_applied: str | None = None
 
 
 def frame_of_largest_difference(
@@ -100,6 +109,23 @@ def _joint_index(value: Any, names: Sequence[str]) -> int | None:
     return None
 
 
+def not_applied_reason(record: Mapping[str, Any]) -> str | None:
+    """Why the corrected take does not fix an interval record, or None when it does.
+
+    A limb spin (``kind`` "spin") is never corrected; a record with ``applied`` false was found
+    but not applied (its ``confidence`` is quoted when given). A record without ``applied``
+    (a limit violation, an interval list of other origin) counts as shown corrected.
+    """
+    if record.get("kind") == "spin":
+        return "not corrected (limb spin)"
+    if "applied" in record and not record["applied"]:
+        confidence = record.get("confidence")
+        if confidence is None:
+            return "not applied"
+        return f"not applied (confidence {float(confidence):.2f})"
+    return None
+
+
 def tiles_from_intervals(
     intervals: Sequence[Mapping[str, Any]],
     raw: SkeletonTrack,
@@ -112,9 +138,11 @@ def tiles_from_intervals(
     intervals : sequence of mapping
         Each with ``joint`` (name or index), ``start_frame`` and ``end_frame`` (inclusive), and
         optionally ``offset_deg`` or ``violation_deg`` for the caption (``kind`` "spin":
-        captioned as a limb spin, not corrected). Records naming an unknown joint are skipped.
+        captioned as a limb spin, not corrected), ``applied`` and ``confidence`` (an interval
+        not applied gets no corrected pose, see :func:`not_applied_reason`). Records naming an
+        unknown joint are skipped.
     raw, corrected : SkeletonTrack
-        The takes; ``corrected`` picks the frame of largest error.
+        The takes; ``corrected`` picks the frame of largest error of an applied interval.
     """
     tiles = []
     for record in intervals:
@@ -122,9 +150,11 @@ def tiles_from_intervals(
         if joint is None:
             continue
         start, end = int(record.get("start_frame", 0)), int(record.get("end_frame", 0))
-        frame = frame_of_largest_difference(
-            raw.positions, None if corrected is None else corrected.positions, start, end
-        )
+        reason = not_applied_reason(record)
+        # Where the corrected take differs inside an interval it does not fix says nothing
+        # about that interval (another fix or the filter moved the pose).
+        fixed = None if corrected is None or reason is not None else corrected.positions
+        frame = frame_of_largest_difference(raw.positions, fixed, start, end)
         frames = f"frame {start}" if start == end else f"frames {start}–{end}"
         label = f"{raw.names[joint]} · {frames}"
         if record.get("kind") == "spin" and record.get("offset_deg") is not None:
@@ -134,7 +164,7 @@ def tiles_from_intervals(
             label += f" · offset {float(record['offset_deg']):+.1f}°"
         if record.get("violation_deg") is not None:
             label += f" · violation {float(record['violation_deg']):.1f}°"
-        tiles.append(SheetTile(frame=frame, joints=(joint,), label=label))
+        tiles.append(SheetTile(frame=frame, joints=(joint,), label=label, not_applied=reason))
     return tiles
 
 
@@ -157,7 +187,8 @@ def render_contact_sheet(
     tiles : sequence of SheetTile
         At least one tile.
     corrected : SkeletonTrack, optional
-        The corrected take; each tile then shows raw | corrected.
+        The corrected take; each tile then shows raw | corrected, except a tile whose
+        ``not_applied`` is set: its second view holds that caption and no pose.
     columns : int
         Tiles per row.
     tile_width_px, tile_height_px : int
@@ -190,17 +221,16 @@ def render_contact_sheet(
                 raw, (tile.frame, tile.frame + 1), aspect=tile_width_px / tile_height_px
             )
             canvas = pool.get(views * tile_width_px, tile_height_px, views)
+            caption = f"raw · {tile.label}"
+            if corrected is None and tile.not_applied is not None:
+                caption += f" · {tile.not_applied}"
             canvas.draw(
-                0,
-                raw,
-                tile.frame,
-                camera,
-                flagged,
-                _two_lines(f"raw · {tile.label}"),
-                FLAG_COLOR,
-                legend=False,
+                0, raw, tile.frame, camera, flagged, _two_lines(caption), FLAG_COLOR, legend=False
             )
-            if corrected is not None:
+            if corrected is not None and tile.not_applied is not None:
+                # No corrected pose for an interval the corrected take does not fix.
+                canvas.caption(1, f"{tile.not_applied}:\nraw pose only, nothing corrected")
+            elif corrected is not None:
                 canvas.draw(
                     1,
                     corrected,

@@ -3,10 +3,11 @@
 Conventions
 -----------
 A finding is a dict ``{"kind", "joint", "start_frame", "end_frame", ...}`` with inclusive,
-0-based frames, plus ``offset_deg`` and ``confidence`` for twist intervals or
-``violation_deg`` (largest distance outside the limits) for limit runs. Limit runs are the
-maximal stretches of consecutive listed frames marked invalid; when the limits JSON was
-decimated (``max_points``) a run covers the listed frames it spans. Inputs are the
+0-based frames, plus ``offset_deg``, ``confidence`` and (when the input says) ``applied`` for
+twist intervals (whether the corrected take removes it; a contact sheet shows no corrected pose
+for one not applied) or ``violation_deg`` (largest distance outside the limits) for limit runs.
+Limit runs are the maximal stretches of consecutive listed frames marked invalid; when the
+limits JSON was decimated (``max_points``) a run covers the listed frames it spans. Inputs are the
 ``to_json()`` dicts of :class:`mocapqa.twist.analysis.TwistAnalysis` and
 :class:`mocapqa.limits.analysis.LimitsReport`, or the pipeline's sampled limits heat map
 (``joints``, ``frames``, ``score_deg`` as joints × frames); unknown keys are ignored. The
@@ -31,16 +32,17 @@ def twist_findings(twist: Mapping[str, Any] | None) -> list[dict[str, Any]]:
         return []
     found = []
     for record in twist.get("intervals", []):
-        found.append(
-            {
-                "kind": "twist",
-                "joint": str(record.get("joint")),
-                "start_frame": int(record.get("start_frame", 0)),
-                "end_frame": int(record.get("end_frame", 0)),
-                "offset_deg": float(record.get("offset_deg", 0.0)),
-                "confidence": float(record.get("confidence", 0.0)),
-            }
-        )
+        finding = {
+            "kind": "twist",
+            "joint": str(record.get("joint")),
+            "start_frame": int(record.get("start_frame", 0)),
+            "end_frame": int(record.get("end_frame", 0)),
+            "offset_deg": float(record.get("offset_deg", 0.0)),
+            "confidence": float(record.get("confidence", 0.0)),
+        }
+        if record.get("applied") is not None:
+            finding["applied"] = bool(record["applied"])
+        found.append(finding)
     return found
 
 
