@@ -16,7 +16,14 @@ from mocapqa.cli.app import bench_app
 if TYPE_CHECKING:
     from mocapqa.bench.api_load import Client, LoadResult, Seed, ServerProcess
 
-__all__ = ["LOAD_SETTINGS", "bench_api", "load_clients", "loaded_server", "seed_take"]
+__all__ = [
+    "LOAD_SETTINGS",
+    "bench_api",
+    "fresh_server",
+    "load_clients",
+    "loaded_server",
+    "seed_take",
+]
 
 LOAD_SETTINGS = {
     # Each simulated user uploads and runs a few takes in seconds: the per-user quotas, which
@@ -122,6 +129,29 @@ def loaded_server(data_dir: Path, database_url: str | None) -> Iterator[ServerPr
         server.stop()
 
 
+@contextmanager
+def fresh_server(database_url: str | None) -> Iterator[tuple[ServerProcess, str, str]]:
+    """A server on an empty store (a new SQLite in a scratch folder, or the PostgreSQL
+    database emptied), so that each measurement starts from the same state; yields the
+    server, its database URL and an admin's token."""
+    from mocapqa.store.upgrade import drop_database
+
+    with tempfile.TemporaryDirectory(prefix="mocapqa-bench-api-") as scratch:
+        data_dir = Path(scratch)
+        if database_url:
+            from sqlalchemy import create_engine
+
+            engine = create_engine(database_url)
+            try:
+                drop_database(engine)
+            finally:
+                engine.dispose()
+        url = database_url or f"sqlite:///{data_dir / 'mocapqa.sqlite3'}"
+        token = admin_token(url)
+        with loaded_server(data_dir, database_url) as server:
+            yield server, url, token
+
+
 def _table(result: LoadResult, what: str) -> object:
     from rich.table import Table
 
@@ -172,7 +202,10 @@ def bench_api(
     stream_frames: Annotated[int, typer.Option(min=1, max=10_000, help="Frames a stream.")] = 40,
     database_url: Annotated[
         str | None,
-        typer.Option(help="Database of the server (default: a new SQLite in a scratch folder)."),
+        typer.Option(
+            help="Database of the server (default: a new SQLite in a scratch folder); "
+            "a PostgreSQL database is emptied before each measurement."
+        ),
     ] = None,
 ) -> None:
     """Requests/s and p50/p95/p99 latency per route of a real server (a child process on
@@ -187,34 +220,31 @@ def bench_api(
     counts: Sequence[int] = clients or [1, 10, 50, 100]
     pauses: Sequence[float] = think if think is not None else [1.0, 0.0]
     console = Console()
-    with tempfile.TemporaryDirectory(prefix="mocapqa-bench-api-") as scratch:
-        data_dir = Path(scratch)
-        url = database_url or f"sqlite:///{data_dir / 'mocapqa.sqlite3'}"
-        token = admin_token(url)
-        with loaded_server(data_dir, database_url) as server:
-            with console.status("seeding: the demo take and its run"):
-                seed, take = seed_take(server.url, token)
-            for pause in pauses:
-                for count in counts:
-                    users = load_clients(url, count, writers, prefix=f"load{count}_{pause:g}")
-                    what = f"{count} client(s) × {rounds} round(s), pause {pause:g} s"
-                    with console.status(what):
-                        result = run_load(server.url, users, seed, take, rounds, pause)
-                    console.print(_table(result, f"{count} client(s), mean pause {pause:g} s"))
-                    health = [s.seconds for s in result.health]
-                    console.print(
-                        f"/health: {len(health)} checks, slowest {max(health) * 1000:.0f} ms; "
-                        f"5xx or no answer: {len(result.server_errors())}\n"
-                    )
-            if streams:
-                messages = frame_messages(stream_keypoints, stream_frames)
-                with console.status(f"{streams} live-filter streams × {stream_frames} frames"):
-                    result = run_streams(server.url, token, streams, messages, stream_keypoints)
-                console.print(_table(result, f"{streams} live-filter streams"))
-                health = [s.seconds for s in result.health]
-                console.print(
-                    f"{streams} streams of {stream_keypoints} keypoints: "
-                    f"{len(result.samples) / result.seconds:.0f} frames/s; /health median "
-                    f"{float(np.median(health)) * 1000:.0f} ms, slowest "
-                    f"{max(health) * 1000:.0f} ms"
-                )
+    for pause in pauses:
+        for count in counts:
+            with fresh_server(database_url) as (server, url, token):
+                with console.status(f"{count} client(s): seeding the demo take and its run"):
+                    seed, take = seed_take(server.url, token)
+                users = load_clients(url, count, writers)
+                with console.status(f"{count} client(s) × {rounds} round(s), pause {pause:g} s"):
+                    result = run_load(server.url, users, seed, take, rounds, pause)
+            console.print(_table(result, f"{count} client(s), mean pause {pause:g} s"))
+            health = [s.seconds for s in result.health]
+            console.print(
+                f"/health: {len(health)} checks, slowest {max(health) * 1000:.0f} ms; "
+                f"5xx or no answer: {len(result.server_errors())}\n"
+            )
+    if streams:
+        messages = frame_messages(stream_keypoints, stream_frames)
+        with (
+            fresh_server(database_url) as (server, _, token),
+            console.status(f"{streams} live-filter streams × {stream_frames} frames"),
+        ):
+            result = run_streams(server.url, token, streams, messages, stream_keypoints)
+        console.print(_table(result, f"{streams} live-filter streams"))
+        health = [s.seconds for s in result.health]
+        console.print(
+            f"{streams} streams of {stream_keypoints} keypoints: "
+            f"{len(result.samples) / result.seconds:.0f} frames/s; /health median "
+            f"{float(np.median(health)) * 1000:.0f} ms, slowest {max(health) * 1000:.0f} ms"
+        )
