@@ -393,6 +393,18 @@ def run_load(
         threading.Thread(target=work, args=(i, c), name=f"client-{i}", daemon=True)
         for i, c in enumerate(clients)
     ]
+    return _run_together(base, result, threads, gathered, health_every_s)
+
+
+def _run_together(
+    base: str,
+    result: LoadResult,
+    threads: Sequence[threading.Thread],
+    gathered: Sequence[Sequence[Sample]],
+    health_every_s: float,
+) -> LoadResult:
+    """Start every thread, wait for all with ``/health`` watched, and put the samples they
+    gathered and the wall-clock time into ``result``."""
     started = time.perf_counter()
     with _health_watch(base, result, health_every_s):
         for thread in threads:
@@ -440,15 +452,7 @@ def run_streams(
                 samples.append(Sample("WS frame", status, time.perf_counter() - begin))
 
     threads = [threading.Thread(target=work, args=(i,), daemon=True) for i in range(streams)]
-    started = time.perf_counter()
-    with _health_watch(base, result, 0.1):
-        for thread in threads:
-            thread.start()
-        for thread in threads:
-            thread.join()
-    result.seconds = time.perf_counter() - started
-    result.samples = [s for samples in gathered for s in samples]
-    return result
+    return _run_together(base, result, threads, gathered, 0.1)
 
 
 def route_figures(result: LoadResult) -> list[RouteFigures]:
