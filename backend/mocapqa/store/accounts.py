@@ -13,7 +13,7 @@ import hmac
 import re
 import secrets
 from dataclasses import dataclass
-from datetime import UTC, datetime, timedelta
+from datetime import datetime, timedelta
 from typing import Any
 
 from pwdlib import PasswordHash
@@ -24,6 +24,7 @@ from mocapqa.errors import AuthenticationError, ConflictError, InputError, NotFo
 from mocapqa.store.last_use import LastUse
 from mocapqa.store.repository import new_id, utc_now
 from mocapqa.store.roles import Role
+from mocapqa.store.rows import plain, utc
 from mocapqa.store.tables import audit, tokens, users
 
 __all__ = [
@@ -90,17 +91,9 @@ def _usable(row: Any, kind: str, secret: str, now: datetime | None = None) -> bo
         row.kind == kind
         and hmac.compare_digest(row.secret_sha256, _digest(secret))
         and row.revoked_at is None
-        and _aware(row.expires_at) > (now or utc_now())
+        and utc(row.expires_at) > (now or utc_now())
         and not row.disabled
     )
-
-
-def _aware(value: datetime) -> datetime:
-    return value if value.tzinfo else value.replace(tzinfo=UTC)
-
-
-def _plain(row: Any) -> dict[str, Any]:
-    return {k: _aware(v) if isinstance(v, datetime) else v for k, v in dict(row).items()}
 
 
 _USER_COLUMNS = (
@@ -121,7 +114,7 @@ def _joined_user(row: Any) -> User:
         role=Role(row.role),
         disabled=bool(row.disabled),
         has_password=row.password_hash is not None,
-        created_at=_aware(row.user_created_at),
+        created_at=utc(row.user_created_at),
     )
 
 
@@ -132,7 +125,7 @@ def _user(row: Any) -> User:
         role=Role(row.role),
         disabled=bool(row.disabled),
         has_password=row.password_hash is not None,
-        created_at=_aware(row.created_at),
+        created_at=utc(row.created_at),
     )
 
 
@@ -401,9 +394,7 @@ class Accounts:
             query = query.where(tokens.c.user_id == user_id)
         with self.engine.connect() as conn:
             rows = conn.execute(query).mappings()
-            return [
-                {k: _aware(v) if isinstance(v, datetime) else v for k, v in r.items()} for r in rows
-            ]
+            return [plain(r) for r in rows]
 
     def token_owner(self, token_id: str) -> int:
         """The user id of a personal token (:class:`NotFoundError` when missing)."""
@@ -462,7 +453,5 @@ class Accounts:
             rows = conn.execute(
                 select(audit).order_by(audit.c.id.desc()).limit(limit).offset(offset)
             ).mappings()
-            items = [
-                {k: _aware(v) if isinstance(v, datetime) else v for k, v in r.items()} for r in rows
-            ]
+            items = [plain(r) for r in rows]
         return items, total

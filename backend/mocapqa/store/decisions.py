@@ -6,27 +6,19 @@ interval is its decision. Rows go with their run (``ON DELETE CASCADE``).
 
 from __future__ import annotations
 
-from datetime import UTC
 from typing import Any
 
 from sqlalchemy import Engine, func, insert, select
 
 from mocapqa.errors import InputError
 from mocapqa.store.repository import utc_now
+from mocapqa.store.rows import plain
 from mocapqa.store.tables import interval_decisions
 
 __all__ = ["INTERVAL_DECISIONS", "IntervalDecisions"]
 
 INTERVAL_DECISIONS = ("accept", "reject")
 """What a reviewer can decide about one twist interval."""
-
-
-def _row(mapping: Any) -> dict[str, Any]:
-    row = dict(mapping)
-    created = row["created_at"]
-    if created.tzinfo is None:  # SQLite hands back naive datetimes; every stored time is UTC
-        row["created_at"] = created.replace(tzinfo=UTC)
-    return row
 
 
 class IntervalDecisions:
@@ -67,7 +59,7 @@ class IntervalDecisions:
                 )
                 .returning(interval_decisions)
             )
-            return _row(result.mappings().one())
+            return plain(result.mappings().one())
 
     def history(self, run_id: str) -> list[dict[str, Any]]:
         """Every decision on a run's intervals, newest first."""
@@ -76,7 +68,7 @@ class IntervalDecisions:
             rows = conn.execute(
                 select(table).where(table.c.run_id == run_id).order_by(table.c.id.desc())
             ).mappings()
-            return [_row(r) for r in rows]
+            return [plain(r) for r in rows]
 
     def latest(self, run_id: str) -> dict[int, str]:
         """Interval id → its newest decision, for the intervals that have one."""

@@ -31,6 +31,7 @@ from mocapqa import __version__
 from mocapqa.core.text import display_name
 from mocapqa.errors import ConflictError, InputError, NotFoundError
 from mocapqa.store.qa import lock_take, sync_take
+from mocapqa.store.rows import plain
 from mocapqa.store.tables import reviews, runs, shoots, take_qa, takes
 from mocapqa.store.upgrade import upgrade_database
 
@@ -93,17 +94,6 @@ def _sqlite_pragmas(dbapi_connection: Any, connection_record: Any) -> None:
     cursor.execute("PRAGMA journal_mode=WAL")
     cursor.execute("PRAGMA busy_timeout=10000")
     cursor.close()
-
-
-def _aware(value: Any) -> Any:
-    # SQLite hands back naive datetimes; every stored time is UTC.
-    if isinstance(value, datetime) and value.tzinfo is None:
-        return value.replace(tzinfo=UTC)
-    return value
-
-
-def _row(mapping: Any) -> dict[str, Any]:
-    return {key: _aware(value) for key, value in dict(mapping).items()}
 
 
 class Repository:
@@ -243,7 +233,7 @@ class Repository:
             .offset(offset)
         )
         with self.engine.connect() as conn:
-            rows = [_row(r) for r in conn.execute(page).mappings()]
+            rows = [plain(r) for r in conn.execute(page).mappings()]
             if take_id is not None:
                 return rows, len(rows)
             total = conn.execute(
@@ -328,7 +318,7 @@ class Repository:
             row = conn.execute(select(runs).where(runs.c.id == run_id)).mappings().first()
         if row is None:
             raise NotFoundError(f"Expected run {run_id!r} to exist, got none")
-        return _row(row)
+        return plain(row)
 
     def list_runs(self, take_id: str) -> list[dict[str, Any]]:
         """All runs of a take, oldest first."""
@@ -336,7 +326,7 @@ class Repository:
             rows = conn.execute(
                 select(runs).where(runs.c.take_id == take_id).order_by(runs.c.created_at)
             ).mappings()
-            return [_row(r) for r in rows]
+            return [plain(r) for r in rows]
 
     def require_done(self, run_id: str) -> dict[str, Any]:
         """The run, if it finished; :class:`ConflictError` otherwise."""
@@ -469,7 +459,7 @@ class Repository:
                 )
                 .returning(reviews)
             )
-            row = _row(result.mappings().one())
+            row = plain(result.mappings().one())
             sync_take(conn, take_id)
             return row
 
@@ -480,4 +470,4 @@ class Repository:
             rows = conn.execute(
                 select(reviews).where(reviews.c.take_id == take_id).order_by(reviews.c.id.desc())
             ).mappings()
-            return [_row(r) for r in rows]
+            return [plain(r) for r in rows]

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import unicodedata
 from collections.abc import Iterator
-from datetime import UTC, datetime
 from typing import Any
 
 from sqlalchemy import Connection, Engine, and_, delete, func, insert, or_, select, update
@@ -22,6 +21,7 @@ from mocapqa.pipeline.summary import SUMMARY_FIELDS
 from mocapqa.store.limits_runs import stale_limits_counts
 from mocapqa.store.qa import sync_take
 from mocapqa.store.repository import RUN_STATUSES, new_id, utc_now
+from mocapqa.store.rows import plain
 from mocapqa.store.tables import reviews, runs, shoots, source_hashes, take_qa, takes
 
 __all__ = ["SORT_COLUMNS", "ShootStore", "TakeFilter"]
@@ -102,15 +102,6 @@ class TakeFilter:
             pattern = "%" + self.search.lower().replace("%", r"\%").replace("_", r"\_") + "%"
             found.append(func.lower(take_qa.c.name).like(pattern, escape="\\"))
         return found
-
-
-def _plain(mapping: Any) -> dict[str, Any]:
-    # SQLite hands back naive datetimes; every stored time is UTC.
-    row = dict(mapping)
-    value = row.get("created_at")
-    if isinstance(value, datetime) and value.tzinfo is None:
-        row["created_at"] = value.replace(tzinfo=UTC)
-    return row
 
 
 def _after_in_order(row: Any) -> ColumnElement[bool]:
@@ -230,7 +221,7 @@ class ShootStore:
         else:
             counts = counts.where(take_qa.c.shoot_id.is_not(None))
         with self.engine.connect() as conn:
-            rows = [_plain(r) for r in conn.execute(query).mappings()]
+            rows = [plain(r) for r in conn.execute(query).mappings()]
             tallies = list(conn.execute(counts).mappings())
         by_id = {row["id"]: row for row in rows}
         stale = stale_limits_counts(self.engine, shoot_id)
@@ -334,7 +325,7 @@ class ShootStore:
                     .offset(max(0, offset - valued))
                 ).scalars()
             found = {
-                str(r["take_id"]): _plain(r)
+                str(r["take_id"]): plain(r)
                 for r in conn.execute(
                     select(take_qa, takes.c.format, takes.c.fps, takes.c.n_joints)
                     .join(takes, takes.c.id == take_qa.c.take_id)
@@ -450,7 +441,7 @@ class ShootStore:
                     found = conn.execute(first).mappings().first()
             else:
                 found = conn.execute(query.where(where)).mappings().first()
-        return (_plain(found) if found is not None else None), remaining
+        return (plain(found) if found is not None else None), remaining
 
     # batches ---------------------------------------------------------------------------
     def finished(self, sha256s: list[str], options: dict[str, Any]) -> dict[str, str]:
@@ -544,7 +535,7 @@ class ShootStore:
                 chunk = take_ids[start : start + 500]
                 query = select(take_qa).where(take_qa.c.take_id.in_(chunk))
                 for row in conn.execute(query).mappings():
-                    found[str(row["take_id"])] = _plain(row)
+                    found[str(row["take_id"])] = plain(row)
         return found
 
     def assign(self, take_id: str, shoot_id: str | None) -> None:
