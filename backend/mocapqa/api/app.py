@@ -14,8 +14,8 @@ import gzip
 import hashlib
 import logging
 import re
-from collections.abc import AsyncIterator, Sequence
-from contextlib import asynccontextmanager
+from collections.abc import AsyncIterator, Callable, Sequence
+from contextlib import AbstractAsyncContextManager, asynccontextmanager
 from pathlib import Path
 from typing import Any
 
@@ -124,30 +124,15 @@ def plotly_js_path() -> Path:
     return Path(plotly.__file__).resolve().parent / "package_data" / "plotly.min.js"
 
 
-def create_app(
-    settings: Settings, demo: bool = False, renderer: RenderService | None = None
-) -> FastAPI:
-    """Build the application.
-
-    Parameters
-    ----------
-    settings : Settings
-        Data folder, database URL, upload limit, worker count.
-    demo : bool
-        Load the bundled demo takes (analysed) when the database has no takes.
-    renderer : RenderService, optional
-        A render thread to share (the caller closes it). By default the app creates its own
-        (one per app: VTK renders on one thread) and closes it on shutdown. Rendering starts
-        lazily, so an app whose runs never draw pays nothing.
-    """
+def _services(settings: Settings, renderer: RenderService | None) -> Services:
+    """The store, files, render thread and job runner an app uses (a Dask engine when a
+    scheduler is named: one take is faster on a thread here otherwise)."""
     settings.data_dir.mkdir(parents=True, exist_ok=True)
     repository = Repository(
         settings.resolved_database_url, threads=settings.server_threads + settings.job_workers
     )
     files = FileStore(settings.data_dir)
-    owns_renderer = renderer is None
     render_service = RenderService() if renderer is None else renderer
-    # Runs go to a Dask cluster only when one is named; one take is faster on a thread here.
     engine = Engine(settings.dask_scheduler) if settings.dask_scheduler else None
     runner = JobRunner(
         repository,
@@ -159,8 +144,18 @@ def create_app(
         engine=engine,
         max_in_line=settings.max_queued_runs_per_user,
     )
-    services = Services(settings, repository, files, runner, render_service)
-    accounts = Accounts(repository.engine)
+    return Services(settings, repository, files, runner, render_service)
+
+
+def _lifespan(
+    services: Services, accounts: Accounts, demo: bool, owns_renderer: bool
+) -> Callable[[FastAPI], AbstractAsyncContextManager[None]]:
+    """Start: the thread limit, partial uploads swept, interrupted runs re-queued, the demo
+    loaded; stop: the runner, the Dask engine, the render thread (when the app made it), the
+    credentials' last uses written, the pool closed."""
+    settings, repository, files, runner = (
+        services.settings, services.repository, services.files, services.runner
+    )  # fmt: skip
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
@@ -177,18 +172,82 @@ def create_app(
             yield
         finally:
             runner.shutdown()
-            if engine is not None:
-                engine.close()
-            if owns_renderer:
-                render_service.close()
+            if runner.engine is not None:
+                runner.engine.close()
+            if owns_renderer and services.renderer is not None:
+                services.renderer.close()
             accounts.last_use.flush()
             repository.close()
 
+    return lifespan
+
+
+def _add_plotly_route(app: FastAPI) -> str:
+    """Serve the Plotly bundle under a name holding its digest (cached for a year, gzipped
+    once); returns that path."""
+    plotly_path = plotly_js_path()
+    digest = hashlib.sha256(plotly_path.read_bytes()).hexdigest()[:12]
+    path = f"/vendor/{plotly_path.stem.removesuffix('.min')}-{digest}.min.js"
+    compressed: list[bytes] = []
+
+    @app.get(path, include_in_schema=False)
+    def plotly_js(request: Request) -> Response:
+        headers = {
+            "Cache-Control": "public, max-age=31536000, immutable",
+            "Vary": "Accept-Encoding",
+        }
+        if "gzip" not in request.headers.get("accept-encoding", ""):
+            return FileResponse(plotly_path, media_type="text/javascript", headers=headers)
+        if not compressed:  # compressed once, not on every request
+            compressed.append(gzip.compress(plotly_path.read_bytes(), compresslevel=6))
+        headers["Content-Encoding"] = "gzip"
+        return Response(compressed[0], media_type="text/javascript", headers=headers)
+
+    return path
+
+
+def _add_pages(app: FastAPI, plotly_url: str) -> None:
+    """The dashboard's page, the take links it answers and its static files."""
+    static = frontend_dir()
+    page = index_page(static, plotly_url)
+    static_files = CompressedStaticFiles(directory=static)
+    page_files = [a.removeprefix(STATIC_URL) for a in page.modules]
+
+    @app.get("/", include_in_schema=False)
+    def index() -> HTMLResponse:
+        static_files.warm(page_files)  # the first page's modules gzipped before they are asked
+        return HTMLResponse(page.html, headers={"Cache-Control": "no-cache"})
+
+    @app.get("/take/{take_id}", include_in_schema=False)
+    def take_page(take_id: str) -> RedirectResponse:
+        return RedirectResponse(f"/#/take/{take_id}")
+
+    app.mount(STATIC_URL.rstrip("/"), static_files, name="static")
+
+
+def create_app(
+    settings: Settings, demo: bool = False, renderer: RenderService | None = None
+) -> FastAPI:
+    """Build the application.
+
+    Parameters
+    ----------
+    settings : Settings
+        Data folder, database URL, upload limit, worker count.
+    demo : bool
+        Load the bundled demo takes (analysed) when the database has no takes.
+    renderer : RenderService, optional
+        A render thread to share (the caller closes it). By default the app creates its own
+        (one per app: VTK renders on one thread) and closes it on shutdown. Rendering starts
+        lazily, so an app whose runs never draw pays nothing.
+    """
+    services = _services(settings, renderer)
+    accounts = Accounts(services.repository.engine)
     app = FastAPI(
         title="mocapqa",
         version=__version__,
         description="Motion-capture QA: twist errors, joint limits and keypoint filtering.",
-        lifespan=lifespan,
+        lifespan=_lifespan(services, accounts, demo, owns_renderer=renderer is None),
         # Every route: a form route refuses the parts it would not read (api/form_parts.py),
         # and a query parameter or JSON key read once may be sent once (api/query_repeats.py).
         dependencies=[
@@ -204,48 +263,13 @@ def create_app(
         app,
         settings,
         f"{API_PREFIX}/takes",
-        runner.pending,
+        services.runner.pending,
         lambda connection: quota_key_before_body(connection, accounts),
         re.compile(rf"{API_PREFIX}/shoots/([^/]+)/takes"),
-        ShootStore(repository.engine).require,
+        ShootStore(services.repository.engine).require,
     )
     install_error_handlers(app)
     for router, dependencies in ROUTERS:
         app.include_router(router, prefix=API_PREFIX, dependencies=list(dependencies))
-
-    plotly_path = plotly_js_path()
-    digest = hashlib.sha256(plotly_path.read_bytes()).hexdigest()[:12]
-    plotly_name = f"{plotly_path.stem.removesuffix('.min')}-{digest}.min.js"
-
-    compressed: list[bytes] = []
-
-    @app.get(f"/vendor/{plotly_name}", include_in_schema=False)
-    def plotly_js(request: Request) -> Response:
-        headers = {
-            "Cache-Control": "public, max-age=31536000, immutable",
-            "Vary": "Accept-Encoding",
-        }
-        if "gzip" not in request.headers.get("accept-encoding", ""):
-            return FileResponse(plotly_path, media_type="text/javascript", headers=headers)
-        if not compressed:  # compressed once, not on every request
-            compressed.append(gzip.compress(plotly_path.read_bytes(), compresslevel=6))
-        headers["Content-Encoding"] = "gzip"
-        return Response(compressed[0], media_type="text/javascript", headers=headers)
-
-    static = frontend_dir()
-
-    page = index_page(static, f"/vendor/{plotly_name}")
-    static_files = CompressedStaticFiles(directory=static)
-    page_files = [a.removeprefix(STATIC_URL) for a in page.modules]
-
-    @app.get("/", include_in_schema=False)
-    def index() -> HTMLResponse:
-        static_files.warm(page_files)  # the first page's modules gzipped before they are asked
-        return HTMLResponse(page.html, headers={"Cache-Control": "no-cache"})
-
-    @app.get("/take/{take_id}", include_in_schema=False)
-    def take_page(take_id: str) -> RedirectResponse:
-        return RedirectResponse(f"/#/take/{take_id}")
-
-    app.mount(STATIC_URL.rstrip("/"), static_files, name="static")
+    _add_pages(app, _add_plotly_route(app))
     return app
