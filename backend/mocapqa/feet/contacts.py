@@ -29,7 +29,14 @@ import numpy as np
 from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.feet.params import FeetParams
 from mocapqa.feet.points import SIDES, per_foot
-from mocapqa.feet.runs import close_short_gaps, column_runs, drop_short_runs, hysteresis, run_mean
+from mocapqa.feet.runs import (
+    close_short_gaps,
+    column_runs,
+    drop_short_runs,
+    frames_in,
+    hysteresis,
+    run_mean,
+)
 
 __all__ = [
     "Contact",
@@ -61,10 +68,6 @@ class Contact:
     end: int
     confidence: float
     part: str | None = None
-
-
-def _frames(seconds: float, fps: float) -> int:
-    return max(1, round(seconds * fps))
 
 
 def point_contact_mask(
@@ -100,8 +103,8 @@ def point_contact_mask(
             speeds < p.release_speed * leg_length
         )
     mask = hysteresis(enter, stay)
-    mask = close_short_gaps(mask, _frames(p.max_gap_s, fps))
-    return drop_short_runs(mask, _frames(p.min_contact_s, fps))
+    mask = close_short_gaps(mask, frames_in(p.max_gap_s, fps))
+    return drop_short_runs(mask, frames_in(p.min_contact_s, fps))
 
 
 def foot_contact_mask(
@@ -124,8 +127,8 @@ def foot_contact_mask(
     """
     p = params or FeetParams()
     mask = per_foot(point_mask, sides, np.logical_or)
-    mask = close_short_gaps(mask, _frames(p.max_gap_s, fps))
-    return drop_short_runs(mask, _frames(p.min_contact_s, fps))
+    mask = close_short_gaps(mask, frames_in(p.max_gap_s, fps))
+    return drop_short_runs(mask, frames_in(p.min_contact_s, fps))
 
 
 def contact_margins(

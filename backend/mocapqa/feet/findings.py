@@ -34,7 +34,14 @@ import numpy as np
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
 from mocapqa.feet.params import FeetParams
 from mocapqa.feet.points import SIDES, per_foot
-from mocapqa.feet.runs import Runs, close_short_gaps, column_runs, drop_short_runs, run_mean
+from mocapqa.feet.runs import (
+    Runs,
+    close_short_gaps,
+    column_runs,
+    drop_short_runs,
+    frames_in,
+    run_mean,
+)
 from mocapqa.feet.tracks import norms
 
 __all__ = [
@@ -284,17 +291,13 @@ def find_penetration(
     depth_points = np.where(np.isfinite(elevations), -elevations, -np.inf)
     excess = per_foot(depth_points - spreads, sides, np.maximum)
     depth = per_foot(depth_points, sides, np.maximum)
-    mask = close_short_gaps(excess > p.penetration_depth * leg_length, _frames(p.max_gap_s, fps))
+    mask = close_short_gaps(excess > p.penetration_depth * leg_length, frames_in(p.max_gap_s, fps))
     runs = column_runs(mask)
     if runs[0].size == 0:
         return []
     frame, column, run_index = _run_frames(runs)
     sizes, where = _run_argmax(depth[frame, column], run_index, runs[0].size)
     return _findings("penetration", runs, sizes, frame[where])
-
-
-def _frames(seconds: float, fps: float) -> int:
-    return max(1, round(seconds * fps))
 
 
 def find_floating(
@@ -337,7 +340,7 @@ def find_floating(
         & (lowest <= p.float_height * leg_length)
     )
     mask = drop_short_runs(
-        close_short_gaps(hovering, _frames(p.max_gap_s, fps)), _frames(p.min_float_s, fps)
+        close_short_gaps(hovering, frames_in(p.max_gap_s, fps)), frames_in(p.min_float_s, fps)
     )
     runs = column_runs(mask)
     if runs[0].size == 0:

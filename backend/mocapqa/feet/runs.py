@@ -22,6 +22,7 @@ __all__ = [
     "close_short_gaps",
     "column_runs",
     "drop_short_runs",
+    "frames_in",
     "hysteresis",
     "paint_runs",
     "run_maximum",
@@ -145,3 +146,8 @@ def run_mean(values: FloatArray, runs: Runs) -> FloatArray:
     with np.errstate(invalid="ignore", divide="ignore"):
         means: FloatArray = np.where(counts > 0, sums / np.maximum(counts, 1.0), np.nan)
     return means
+
+
+def frames_in(seconds: float, fps: float) -> int:
+    """Whole frames (at least one) in ``seconds`` at ``fps`` frames per second."""
+    return max(1, round(seconds * fps))
