@@ -9,6 +9,8 @@ after they are complete, so nothing half-written is ever marked done).
 from __future__ import annotations
 
 import logging
+import sqlite3
+import time
 import uuid
 from datetime import UTC, datetime
 from typing import Any, Literal, get_args
@@ -57,6 +59,8 @@ REVIEW_STATUSES: tuple[ReviewStatus, ...] = get_args(ReviewStatus)
 """The review decisions a take can have."""
 
 
+SQLITE_BUSY_MS = 10_000
+"""How long a SQLite connection waits for another's write lock before "database is locked"."""
 SPARE_CONNECTIONS = 5
 """Connections beyond one per thread: a thread may hold a second for a nested read."""
 
@@ -90,10 +94,28 @@ def utc_now() -> datetime:
 def _sqlite_pragmas(dbapi_connection: Any, connection_record: Any) -> None:
     del connection_record
     cursor = dbapi_connection.cursor()
+    cursor.execute(f"PRAGMA busy_timeout={SQLITE_BUSY_MS}")
     cursor.execute("PRAGMA foreign_keys=ON")
-    cursor.execute("PRAGMA journal_mode=WAL")
-    cursor.execute("PRAGMA busy_timeout=10000")
+    _switch_to_wal(cursor)
     cursor.close()
+
+
+def _switch_to_wal(cursor: Any) -> None:
+    """Put the database in WAL mode (kept in the file: once is enough). Switching needs the
+    file alone, and SQLite answers "database is locked" at once, without its busy wait, when
+    another connection opening the same new file is switching or migrating it: tried again
+    for up to :data:`SQLITE_BUSY_MS`."""
+    deadline = time.monotonic() + SQLITE_BUSY_MS / 1000
+    while True:
+        try:
+            mode = cursor.execute("PRAGMA journal_mode").fetchone()[0]
+            if str(mode).lower() != "wal":
+                cursor.execute("PRAGMA journal_mode=WAL")
+            return
+        except sqlite3.OperationalError as e:
+            if "locked" not in str(e) or time.monotonic() > deadline:
+                raise
+            time.sleep(0.01)
 
 
 class Repository:
