@@ -4,11 +4,13 @@ outside the process) and the crash test's free port."""
 
 from __future__ import annotations
 
+import json
 import socket
 import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import Any
 
 import uvicorn
 from fastapi import FastAPI
@@ -56,3 +58,18 @@ def live_server(settings: Settings, renderer: RenderService | None = None) -> It
     """Serve ``create_app(settings)`` (see :func:`serve`); yields the URL."""
     with serve(create_app(settings, renderer=renderer)) as url:
         yield url
+
+
+def read_answer(sock: socket.socket) -> tuple[int, dict[str, str], Any]:
+    """Read an HTTP answer with a JSON body from a socket a raw request was sent on: its
+    status, headers (lower-case names) and parsed body (the server closes or the JSON ends)."""
+    data = b""
+    while b"\r\n\r\n" not in data or not data.rstrip().endswith(b"}"):
+        chunk = sock.recv(65536)
+        if not chunk:
+            break
+        data += chunk
+    start, _, rest = data.partition(b"\r\n\r\n")
+    lines = start.decode("latin-1").split("\r\n")
+    headers = dict(line.lower().split(": ", 1) for line in lines[1:])
+    return int(lines[0].split(" ", 2)[1]), headers, json.loads(rest)

@@ -14,11 +14,10 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
 
-import httpx
 import pytest
 from fastapi.testclient import TestClient
 from tests.api.conftest import make_settings
-from tests.live_server import serve
+from tests.live_server import read_answer, serve
 
 from mocapqa.api.app import create_app
 from mocapqa.store.roles import Role
@@ -389,15 +388,8 @@ def raw_request(url: str, head: str, wait_s: float = 120.0) -> tuple[int, dict[s
     address = urlsplit(url)
     with socket.create_connection((address.hostname, address.port), timeout=wait_s) as sock:
         sock.sendall(head.encode())
-        data = b""
-        while b"\r\n\r\n" not in data or not data.rstrip().endswith(b"}"):
-            chunk = sock.recv(65536)
-            if not chunk:
-                break
-            data += chunk
-    start, _, rest = data.partition(b"\r\n\r\n")
-    status = int(start.split(b" ", 2)[1])
-    return status, httpx.Response(status, content=rest).json()
+        status, _, body = read_answer(sock)
+    return status, body
 
 
 def bodiless_upload_head(url: str, path: str, token: str | None) -> str:

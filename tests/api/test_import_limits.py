@@ -21,7 +21,7 @@ import pytest
 from fastapi.testclient import TestClient
 from tests.api.conftest import make_settings
 from tests.api.test_hostile_pass import SMALL_BVH, deflated_zip
-from tests.live_server import serve
+from tests.live_server import read_answer, serve
 
 import mocapqa.jobs.shoot_import as shoot_import
 from mocapqa.api.app import create_app
@@ -151,16 +151,7 @@ def answer(url: str, request: bytes) -> tuple[int, dict[str, str], dict[str, Any
     """Send a request's head only and read the answer (given before the body, or never)."""
     with connect(url) as sock:
         sock.sendall(request)
-        data = b""
-        while b"\r\n\r\n" not in data or not data.rstrip().endswith(b"}"):
-            chunk = sock.recv(65536)
-            if not chunk:
-                break
-            data += chunk
-    start, _, rest = data.partition(b"\r\n\r\n")
-    lines = start.decode("latin-1").split("\r\n")
-    headers = dict(line.lower().split(": ", 1) for line in lines[1:])
-    return int(lines[0].split(" ", 2)[1]), headers, httpx.Response(200, content=rest).json()
+        return read_answer(sock)
 
 
 def import_until_admitted(http: httpx.Client, shoot_id: str, files: BinaryIO | bytes) -> int:

@@ -16,7 +16,7 @@ import typer
 
 from mocapqa.cli.app import app
 from mocapqa.cli.reading import read_input
-from mocapqa.cli.roles import MappingOption, RootTranslationOption, load_mapping
+from mocapqa.cli.roles import FpsOption, MappingOption, RootTranslationOption, load_mapping
 from mocapqa.errors import InputError
 
 __all__ = ["feet_app", "feet_check"]
@@ -96,9 +96,7 @@ def _print_report(path: Path, report: dict[str, Any]) -> None:
 def feet_check(
     take: Annotated[Path, typer.Argument(help="A BVH or keypoint take (or OpenPose folder).")],
     json_output: Annotated[bool, typer.Option("--json", help="Print JSON instead.")] = False,
-    fps: Annotated[
-        float | None, typer.Option(help="Frames per second, for formats that do not store it.")
-    ] = None,
+    fps: FpsOption = None,
     length_unit: Annotated[
         str | None,
         typer.Option(

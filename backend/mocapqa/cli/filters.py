@@ -15,7 +15,7 @@ from rich.table import Table
 from mocapqa.cli.app import app, bench_app
 from mocapqa.cli.outputs import check_outputs, require_suffix, take_input
 from mocapqa.cli.reading import read_input
-from mocapqa.cli.roles import MappingOption, load_mapping, missing_roles
+from mocapqa.cli.roles import FpsOption, MappingOption, load_mapping, missing_roles
 from mocapqa.errors import InputError
 
 __all__ = ["bench_filters", "filter_command", "parse_overrides"]
@@ -44,10 +44,7 @@ def filter_command(
         list[str] | None, typer.Option(help="Override, NAME=VALUE (repeatable).")
     ] = None,
     report: Annotated[Path | None, typer.Option(help="Write a JSON report here.")] = None,
-    fps: Annotated[
-        float | None,
-        typer.Option(help="Frames per second, for formats that do not store it (NPY, CSV, ...)."),
-    ] = None,
+    fps: FpsOption = None,
     mapping: MappingOption = None,
 ) -> None:
     """Filter a keypoint file or the rotations of a BVH take."""

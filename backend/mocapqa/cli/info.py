@@ -16,6 +16,7 @@ import typer
 from mocapqa.cli.app import app
 from mocapqa.cli.reading import read_input
 from mocapqa.cli.roles import (
+    FpsOption,
     MappingOption,
     RootTranslationOption,
     load_mapping,
@@ -157,9 +158,7 @@ def _print_table(path: Path, summary: dict[str, Any]) -> None:
 def info_command(
     file: Annotated[Path, typer.Argument(help="A BVH or keypoint file (or OpenPose folder).")],
     json_output: Annotated[bool, typer.Option("--json", help="Print JSON instead.")] = False,
-    fps: Annotated[
-        float | None, typer.Option(help="Frames per second, for formats that do not store it.")
-    ] = None,
+    fps: FpsOption = None,
     mapping: MappingOption = None,
     root_translation: RootTranslationOption = "auto",
 ) -> None:

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     from mocapqa.core.motion import Skeleton
 
 __all__ = [
+    "FpsOption",
     "MappingOption",
     "RootTranslationOption",
     "load_mapping",
@@ -35,6 +36,14 @@ MappingOption = Annotated[
     ),
 ]
 """The ``--mapping FILE`` option."""
+
+FpsOption = Annotated[
+    float | None,
+    typer.Option(
+        help="Frames per second, for formats that do not store it (OpenPose, NPY, CSV, ...)."
+    ),
+]
+"""The ``--fps`` option of the commands that read a take."""
 
 RootTranslationOption = Annotated[
     Literal["auto", "add", "replace"],
