@@ -383,3 +383,85 @@ def test_batch_uses_the_shoot_limits_model(engine: Engine, cmu_walk: Path, tmp_p
     assert run["options"]["limits_model"] == "cmu"
     assert run["summary"]["steps"]["limits"] == "done"
     repository.close()
+
+
+def _blind_worker(address: str, hidden: Path, env: dict[str, str]) -> subprocess.Popen[bytes]:
+    """A ``dask worker`` in a mount namespace of its own, where ``hidden`` (the client's takes
+    and data folder) is an empty tmpfs: a worker on another machine, as far as files go."""
+    dask = str(Path(sys.executable).with_name("dask"))
+    script = (
+        'mount -t tmpfs none "$1" && exec "$2" worker "$3" --nworkers 1 --nthreads 1 --no-dashboard'
+    )
+    return subprocess.Popen(
+        ["unshare", "--mount", "--propagation", "private", "sh", "-c", script, "sh",
+         str(hidden), dask, address],
+        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+
+
+def test_batch_and_server_runs_on_a_worker_that_shares_no_disk(
+    corpus_copy: Path, tmp_path: Path
+) -> None:
+    """A worker that sees neither the takes nor the data folder is sent each take's bytes and
+    sends the run's files back: every take is done, with the same report as the single-take
+    analysis, and the server's runs on that cluster too."""
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    env = {
+        **_environment(tmp_path),
+        "DASK_CONFIG": str(ROOT / "backend" / "mocapqa" / WORKER_CONFIG),
+    }
+    dask = str(Path(sys.executable).with_name("dask"))
+    scheduler = subprocess.Popen(
+        [dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
+        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+    worker = _blind_worker(address, tmp_path, env)
+    try:
+        repository, shoots = _store(tmp_path)
+        data = tmp_path / "d"
+        rows: list[dict[str, Any]] = []
+        with Engine(scheduler=address) as remote:
+            remote.client().wait_for_workers(1, timeout=120)
+            # The worker is blind to the client's folder (what the test is about).
+            assert list(remote.client().run(os.path.exists, str(corpus_copy)).values()) == [False]
+            assert not remote.shares_disk(corpus_copy / "cmu_12_01_walk.bvh", data)
+            counts = run_batch([corpus_copy], shoots, AnalysisOptions(), rows.append, remote, data)
+        assert (counts.done, counts.failed) == (4, 1), rows
+        for row in (r for r in rows if r["status"] == "done"):
+            stored = repository.get_take(row["take_id"])
+            run_id = str(stored["latest_run_id"])
+            assert (data / "takes" / row["take_id"] / str(stored["file_name"])).is_file()
+            assert (data / "takes" / row["take_id"] / ".reading.json").is_file()
+            take = read_take_file(corpus_copy / Path(row["source"]).name, "")
+            alone = analyze(take, AnalysisOptions(limits_model=DEFAULT_MODEL))
+            alone_store = FileStore(tmp_path / "alone")
+            write_outputs(alone_store, run_id, alone)
+            assert _report_without_timings(
+                data / "runs" / run_id / "report.json"
+            ) == _report_without_timings(alone_store.run_dir(run_id) / "report.json")
+        repository.close()
+        settings = Settings(
+            allowed_hosts=["testserver"], data_dir=tmp_path / "server", dask_scheduler=address
+        )
+        with TestClient(create_app(settings)) as client:
+            with (corpus_copy / Path(TAKES[0]).name).open("rb") as handle:
+                created = client.post("/api/v1/takes", files={"file": ("bow.bvh", handle)})
+            assert created.status_code == 201, created.text
+            run_id = created.json()["run_id"]
+            deadline = time.monotonic() + 300
+            run: dict[str, Any] = {"status": "queued"}
+            while run["status"] not in ("done", "failed") and time.monotonic() < deadline:
+                time.sleep(0.2)
+                run = client.get(f"/api/v1/runs/{run_id}").json()
+            assert run["status"] == "done", run
+            assert client.get(f"/api/v1/runs/{run_id}/result").status_code == 200
+            assert (tmp_path / "server" / "runs" / run_id / "points.npz").is_file()
+    finally:
+        for process in (worker, scheduler):
+            process.terminate()
+        for process in (worker, scheduler):
+            try:
+                process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                process.kill()

@@ -5,6 +5,9 @@ taking the hash recorded for the same path, size and modification time), skips t
 content, options and mocapqa version already have a done run, sends the rest to the workers
 (:func:`mocapqa.jobs.take_task.analyse_path`, a bounded number in flight) and, as each
 finishes, stores its take and done run in one transaction and writes its result row.
+Workers that cannot read the client's files or the data folder (another machine) are sent
+each take's bytes and send the run's files back (:mod:`mocapqa.jobs.sent_files`), with at
+most :data:`SENT_BYTES_IN_FLIGHT` of takes on their way at once.
 Nothing is stored for a take until its run is complete, so an interrupted batch (Ctrl-C, a
 lost scheduler) leaves no half-made rows, and running it again finishes the rest without
 duplicates (an interrupted task may leave an orphan output folder behind, never a row).
@@ -18,12 +21,19 @@ import time
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path, PurePath
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 from mocapqa.errors import InputError, MocapQAError
 from mocapqa.io.keypoint_csv import is_csv_sidecar
 from mocapqa.jobs.engine import Engine
-from mocapqa.jobs.take_task import analyse_path, content_sha256
+from mocapqa.jobs.sent_files import SentFiles, pack
+from mocapqa.jobs.take_task import (
+    RETURNED_FILES,
+    analyse_path,
+    analyse_sent,
+    content_sha256,
+    sent_models,
+)
 from mocapqa.store.repository import new_id
 from mocapqa.store.shoots import ShootStore
 
@@ -33,6 +43,7 @@ if TYPE_CHECKING:
 __all__ = [
     "CHUNK_TAKES",
     "MOTION_SUFFIXES",
+    "SENT_BYTES_IN_FLIGHT",
     "SIDECAR_REASON",
     "BatchCounts",
     "chunk_size",
@@ -63,8 +74,13 @@ CHUNK_TAKES = 4
 9 ms of CPU beyond the take's own work (about 95 ms): one take per task made the Dask path
 about 10 % dearer than a loop, four per task make it about 2 % (docs/batch.md)."""
 
+SENT_BYTES_IN_FLIGHT = 256 * 1024 * 1024
+"""Most bytes of takes sent to workers and not yet answered, when the workers do not share
+the client's files (one take larger than this is still sent, alone)."""
+
 Row = dict[str, Any]
 Task = Callable[[str, dict[str, Any], str, str, str | None], dict[str, Any]]
+Send = Literal["auto", "paths", "bytes"]
 
 
 @dataclass
@@ -159,6 +175,7 @@ def run_batch(
     shoot_id: str | None = None,
     on_total: Callable[[int], None] | None = None,
     task: Task = analyse_path,
+    send: Send = "auto",
 ) -> BatchCounts:
     """Analyse every take under ``paths``; ``on_row`` receives one result row per take.
 
@@ -184,6 +201,11 @@ def run_batch(
         Called once with the number of rows to come.
     task : callable
         The per-take function (the default analyses and stores; tests pass wrappers).
+    send : {"auto", "paths", "bytes"}
+        What a Dask worker is sent: the take's path (it reads the client's files and writes
+        the data folder), its bytes (:func:`mocapqa.jobs.take_task.analyse_sent`; the run's
+        files come back), or "auto": paths when every worker shares the client's files
+        (:meth:`Engine.shares_disk`), else bytes.
 
     Returns
     -------
@@ -255,6 +277,8 @@ def run_batch(
             emit({"source": str(path), "status": "failed", "error": outcome["error"]})
             return
         values = {**outcome["take"], "sha256": sha, "shoot_id": shoot_id}
+        if RETURNED_FILES in outcome and data_dir is not None:
+            _store_returned(data_dir, outcome[RETURNED_FILES], path, take_id, values)
         summary = outcome["summary"]
         shoots.record_done(values, run_id, options_json, summary, float(outcome["time_s"]))
         emit(
@@ -276,8 +300,41 @@ def run_batch(
             )
         return counts
     if pending:  # a finished batch never starts (or connects to) a cluster
-        _run_on_dask(engine, pending, options_json, folder, task, finish, emit)
+        sent = None
+        sample = _sample_file(pending[0][0])
+        if send == "bytes" or (send == "auto" and not engine.shares_disk(sample, data_dir)):
+            sent = sent_models(data_dir, options.limits_model)
+        _run_on_dask(engine, pending, options_json, folder, task, sent, finish, emit)
     return counts
+
+
+def _sample_file(path: Path) -> Path:
+    """A file of a take (a frame folder's first file), for asking workers whether they see it."""
+    if path.is_dir():
+        return next(p for p in sorted(path.iterdir()) if p.is_file())
+    return path
+
+
+def _store_returned(
+    data_dir: Path, files: SentFiles, source: Path, take_id: str, values: dict[str, Any]
+) -> None:
+    """Write what a worker that shares nothing sent back (the run's files, the take's reading
+    facts) into the data folder, and copy the take there from the client's own disk."""
+    import shutil
+
+    from mocapqa.store.files import FileStore
+
+    store = FileStore(data_dir)
+    allowed = (store.root / "runs", store.take_dir(take_id))
+    for target, data in files.targets(store.root):
+        if not any(target.is_relative_to(folder) for folder in allowed):
+            raise InputError(f"Expected a worker to return its run's files only, got {target}")
+        store.write_bytes(target, data)
+    copy = store.take_dir(take_id) / str(values["file_name"])
+    if source.is_dir():
+        shutil.copytree(source, copy, dirs_exist_ok=True)
+    else:
+        shutil.copyfile(source, copy)
 
 
 def _run_on_dask(
@@ -286,13 +343,14 @@ def _run_on_dask(
     options_json: dict[str, Any],
     folder: str | None,
     task: Task,
+    sent: SentFiles | None,
     finish: Callable[[Path, str, str, str, dict[str, Any]], None],
     emit: Callable[[Row], None],
 ) -> None:
     from distributed.comm.core import CommClosedError
 
     try:
-        _submit_and_collect(engine, pending, options_json, folder, task, finish, emit)
+        _submit_and_collect(engine, pending, options_json, folder, task, sent, finish, emit)
     except CommClosedError as e:  # a call to the scheduler found it gone
         raise engine.lost_connection(e) from e
     except OSError as e:  # a timeout while the client reconnects; a full disk stays itself
@@ -302,7 +360,9 @@ def _run_on_dask(
         raise lost from e
 
 
-def _analyse_chunk(task: Task, items: list[tuple[Any, ...]]) -> list[tuple[bool, Any]]:
+def _analyse_chunk(
+    task: Callable[..., dict[str, Any]], items: list[tuple[Any, ...]]
+) -> list[tuple[bool, Any]]:
     """Run ``task`` on each argument tuple of ``items`` (one Dask task for several takes):
     ``(True, outcome)``, or ``(False, "Name: message")`` for a take whose task raised, so that
     one take's bug fails that take only."""
@@ -328,9 +388,12 @@ def _submit_and_collect(
     options_json: dict[str, Any],
     folder: str | None,
     task: Task,
+    sent: SentFiles | None,
     finish: Callable[[Path, str, str, str, dict[str, Any]], None],
     emit: Callable[[Row], None],
 ) -> None:
+    """Send the pending takes in chunks, a bounded number in flight; with ``sent`` (the data
+    folder's files the runs read) as bytes (:func:`analyse_sent`), else as paths (``task``)."""
     from collections import deque
 
     from distributed import as_completed
@@ -342,29 +405,47 @@ def _submit_and_collect(
         pending[start : start + size] for start in range(0, len(pending), size)
     )
     meta: dict[str, list[tuple[Path, str, str, str]]] = {}
+    sizes: dict[str, int] = {}
 
     def submit() -> Any:
         if not units:
             return None
         unit = [(path, sha, new_id(), new_id()) for path, sha in units.popleft()]
-        items = [
-            (str(path), options_json, take_id, run_id, folder) for path, _, take_id, run_id in unit
-        ]
+        size = 0
+        if sent is None:
+            items: list[tuple[Any, ...]] = [
+                (str(path), options_json, take_id, run_id, folder)
+                for path, _, take_id, run_id in unit
+            ]
+        else:
+            items = [
+                (pack(path.parent, [path]), options_json, take_id, run_id, sent)
+                for path, _, take_id, run_id in unit
+            ]
+            size = sum(item[0].size_bytes for item in items)
         _, sha, _, run_id = unit[0]
         future = client.submit(
             _analyse_chunk,
-            task,
+            task if sent is None else analyse_sent,
             items,
             key=f"analyse-{len(unit)}-{sha[:16]}-{run_id[:8]}",
             pure=False,
         )
         meta[future.key] = unit
+        sizes[future.key] = size
         return future
 
-    first = [f for f in (submit() for _ in range(in_flight)) if f is not None]
+    def room() -> bool:
+        """Whether another chunk may be sent: slots left, and bytes left when sending bytes."""
+        return len(meta) < in_flight and (not meta or sum(sizes.values()) < SENT_BYTES_IN_FLIGHT)
+
+    first: list[Any] = []
+    while room() and (following := submit()) is not None:
+        first.append(following)
     waiting = as_completed(first)  # type: ignore[no-untyped-call]
     for future in waiting:
         unit = meta.pop(future.key)
+        sizes.pop(future.key, None)
         try:
             results = future.result()
         except Exception as e:  # a crashed worker (KilledWorker) or a lost scheduler
@@ -392,7 +473,7 @@ def _submit_and_collect(
                     error = f"internal error: {outcome}"
                     emit({"source": str(path), "status": "failed", "error": error})
         future.release()
-        while len(meta) < in_flight:
+        while room():
             following = submit()
             if following is None:
                 break

@@ -3,8 +3,9 @@
 With no address, :class:`Engine` starts a ``distributed.LocalCluster`` of worker *processes*
 (one thread each, as many as the machine has cores unless told) the first time work is sent;
 with ``MOCAPQA_DASK_SCHEDULER`` / ``--scheduler`` (``tcp://host:8786``) it connects to an
-existing cluster instead. Work sent here runs in other processes, so it must read its inputs
-itself (paths on storage the workers share) and return small results.
+existing cluster instead. Work sent here runs in other processes: it reads its inputs itself
+when the workers share the client's storage, and is sent them as bytes otherwise
+(:meth:`Engine.shares_disk`, :mod:`mocapqa.jobs.sent_files`).
 
 A task whose worker dies is retried on another worker; on the local cluster the scheduler's
 ``allowed-failures`` is 1, so a take that kills two workers fails with ``KilledWorker`` and
@@ -26,6 +27,7 @@ import os
 import threading
 import time
 from concurrent.futures import CancelledError
+from pathlib import Path
 from typing import Any
 
 from mocapqa.errors import ClusterError
@@ -190,6 +192,33 @@ class Engine:
         if found is None and cancelled:
             return self.lost_connection(error)
         return found
+
+    def shares_disk(self, sample: Path, folder: Path | None) -> bool:
+        """Whether the workers read the client's files and write the data folder themselves.
+
+        The local cluster does, by construction; an existing cluster is asked (every connected
+        worker must read ``sample`` as the client does and, with a ``folder``, see and may
+        write in it: :func:`mocapqa.jobs.sent_files.workers_share`). When it does not, work is
+        sent as bytes and its files come back.
+
+        Parameters
+        ----------
+        sample : Path
+            One input file the client reads.
+        folder : Path, optional
+            The data folder the work writes to.
+        """
+        if not self.scheduler:
+            return True
+        from mocapqa.jobs.sent_files import workers_share
+
+        shared = workers_share(self.client(), sample, folder)
+        log.info(
+            "the workers of %s %s the client's files",
+            self.address,
+            "share" if shared else "do not share",
+        )
+        return shared
 
     def n_workers(self) -> int:
         """Workers connected now."""

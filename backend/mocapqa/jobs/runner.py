@@ -143,8 +143,9 @@ class JobRunner:
     read_limits : ReadLimits, optional
         Limits for re-reading a stored take (the upload was checked against the same).
     engine : Engine, optional
-        A Dask engine: the analysis then runs on the cluster (which must share the data
-        folder) while the thread here waits, records progress and renders the thumbnail.
+        A Dask engine: the analysis then runs on the cluster while the thread here waits,
+        records progress and renders the thumbnail (workers that cannot read the data folder
+        are sent the take's bytes and return the run's files: :mod:`mocapqa.jobs.sent_files`).
         Without one, the analysis runs on this thread (faster for one take, see
         ``docs/batch.md``).
     max_in_line : int, optional
@@ -179,6 +180,7 @@ class JobRunner:
         self._preloaded: dict[str, Take] = {}
         self._lock = threading.Lock()
         self._held: dict[str, int] = {}
+        self._shares_disk: bool | None = None
 
     def start(self) -> list[str]:
         """Start the workers; re-queue runs left by a stopped server (failing those already
@@ -346,27 +348,42 @@ class JobRunner:
         path: Any,
         started: float,
     ) -> None:
-        from mocapqa.jobs.take_task import analyse_stored
+        from mocapqa.jobs.sent_files import pack
+        from mocapqa.jobs.take_task import analyse_stored, analyse_stored_sent, sent_models
 
         self.repository.set_progress(run_id, 10, "analysing on the Dask cluster")
-        future = engine.client().submit(
-            analyse_stored,
-            str(path),
-            str(take["format"]),
-            str(take["name"]),
-            run["options"],
-            run_id,
-            str(self.files.root),
-            key=f"run-{run_id}",
-            pure=False,
-        )
+        if self._shares_disk is None:  # asked once: the cluster's workers keep their disks
+            self._shares_disk = engine.shares_disk(path, self.files.root)
+        format_name, name = str(take["format"]), str(take["name"])
+        if self._shares_disk:
+            future = engine.client().submit(
+                analyse_stored, str(path), format_name, name, run["options"], run_id,
+                str(self.files.root), key=f"run-{run_id}", pure=False,
+            )  # fmt: skip
+        else:
+            facts = [p for p in (path, path.parent / READING_FILE) if p.is_file()]
+            sent = pack(path.parent, facts)
+            models = sent_models(self.files.root, run["options"].get("limits_model"))
+            future = engine.client().submit(
+                analyse_stored_sent, sent, path.name, format_name, name, run["options"],
+                run_id, models, key=f"run-{run_id}", pure=False,
+            )  # fmt: skip
         try:
-            summary = future.result()
+            answer = future.result()
         except Exception as e:  # a lost scheduler fails the run with its address
             lost = engine.lost(e)
             if lost is not None:
                 raise lost from e
             raise
+        if self._shares_disk:
+            summary = answer
+        else:
+            summary, returned = answer
+            run_folder = self.files.run_dir(run_id)
+            for target, data in returned.targets(self.files.root):
+                if not target.is_relative_to(run_folder):
+                    raise InputError(f"Expected a worker to return its run's files, got {target}")
+                self.files.write_bytes(target, data)
         if self.renderer is not None:
             self.repository.set_progress(run_id, 97, "rendering the thumbnail")
             folder = self.files.run_dir(run_id)
