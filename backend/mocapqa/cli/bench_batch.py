@@ -227,6 +227,69 @@ def api_latency(
     return latency
 
 
+def _client_cost(folder: Path, summary: dict[str, Any], scratch: Path, engine: Any = None) -> Any:
+    """Run a batch of ``folder`` with :func:`empty_analysis` into a new SQLite store.
+
+    Parameters
+    ----------
+    folder : Path
+        The takes (hashed and stored as a real batch would).
+    summary : dict
+        The run summary every take gets.
+    scratch : Path
+        A new folder for the store.
+    engine : Engine, optional
+        A Dask engine (its local cluster's scheduler runs in this process, so its CPU is
+        counted); None runs the empty tasks in this process.
+    """
+    import functools
+
+    from mocapqa.bench.batch_client import ClientCost, empty_analysis
+    from mocapqa.jobs.batch import run_batch
+    from mocapqa.pipeline.options import AnalysisOptions
+    from mocapqa.store.repository import Repository
+    from mocapqa.store.shoots import ShootStore
+
+    scratch.mkdir(parents=True, exist_ok=True)
+    repository = Repository(f"sqlite:///{scratch / 'db.sqlite3'}")
+    task = functools.partial(empty_analysis, summary)
+    try:
+        clock, cpu = time.perf_counter(), time.process_time()
+        counts = run_batch(
+            [folder], ShootStore(repository.engine), AnalysisOptions(), lambda row: None,
+            engine, None, task=task,
+        )  # fmt: skip
+        return ClientCost(counts.done, time.process_time() - cpu, time.perf_counter() - clock)
+    finally:
+        repository.close()
+
+
+def _client_figures(console: Any, folder: Path, sample: str, root: Path) -> None:
+    """Print the client's CPU per take with an empty analysis, alone and on 2 Dask workers."""
+    from mocapqa.bench.batch_client import separate_cluster
+    from mocapqa.jobs.engine import Engine
+    from mocapqa.jobs.take_task import analyse_path, content_sha256
+    from mocapqa.pipeline.options import AnalysisOptions
+
+    summary = analyse_path(sample, AnalysisOptions().to_json(), "0" * 32, "1" * 32, None)
+    alone = _client_cost(folder, summary["summary"], root / "client-alone")
+    with separate_cluster(workers=2) as address, Engine(scheduler=address) as engine:
+        engine.client().wait_for_workers(2, timeout=120)
+        on_dask = _client_cost(folder, summary["summary"], root / "client-dask", engine)
+    cpu = time.process_time()
+    for path in sorted(folder.iterdir()):
+        content_sha256(path)
+    hashing_ms = 1000 * (time.process_time() - cpu) / max(1, alone.takes)
+    console.print(
+        f"client CPU per take, empty analysis ({alone.takes} takes; hash, store, row; of which "
+        f"hashing the take's bytes {hashing_ms:.2f} ms): "
+        f"tasks in the client's process {alone.cpu_ms_per_take:.2f} ms; sent to 2 Dask "
+        f"workers (scheduler and workers in processes of their own) "
+        f"{on_dask.cpu_ms_per_take:.2f} ms (target ≤ 1 ms)",
+        highlight=False,
+    )
+
+
 @bench_app.command("batch")
 def bench_batch(
     takes: Annotated[int, typer.Option(help="Tiled takes in the corpus.")] = 2000,
@@ -242,9 +305,13 @@ def bench_batch(
     scratch: Annotated[
         Path | None, typer.Option(help="Scratch folder (default: temporary).")
     ] = None,
+    client_only: Annotated[
+        bool, typer.Option(help="Measure only the client's CPU per take (empty analysis).")
+    ] = False,
 ) -> None:
     """Takes/s and frames/s on 1 and 2 Dask workers and in a plain loop; memory; resume time;
-    shoot-table API latency (list, sort by score, heat map) at ``--api-takes`` takes."""
+    the client's CPU per take with an empty analysis; shoot-table API latency (list, sort by
+    score, heat map) at ``--api-takes`` takes."""
     import os
 
     from rich.console import Console
@@ -280,6 +347,11 @@ def bench_batch(
     one = root / "one-take"
     one.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(warm[0], one / Path(warm[0]).name)
+    _client_figures(console, tiles.folder, warm[0], root)
+    if client_only:
+        if scratch is None:
+            shutil.rmtree(root, ignore_errors=True)
+        return
 
     def batch(name: str, folder: Path, workers: int, fresh: bool = True) -> Watched:
         """``mocapqa batch`` as its own process, into the database of ``name``."""

@@ -35,7 +35,7 @@ from mocapqa.jobs.take_task import (
     sent_models,
 )
 from mocapqa.store.repository import new_id
-from mocapqa.store.shoots import ShootStore
+from mocapqa.store.shoots import DoneTake, ShootStore
 
 if TYPE_CHECKING:
     from mocapqa.pipeline.options import AnalysisOptions
@@ -45,6 +45,8 @@ __all__ = [
     "MOTION_SUFFIXES",
     "SENT_BYTES_IN_FLIGHT",
     "SIDECAR_REASON",
+    "STORE_EVERY_S",
+    "STORE_EVERY_TAKES",
     "BatchCounts",
     "chunk_size",
     "discover",
@@ -74,6 +76,10 @@ CHUNK_TAKES = 4
 9 ms of CPU beyond the take's own work (about 95 ms): one take per task made the Dask path
 about 10 % dearer than a loop, four per task make it about 2 % (docs/batch.md)."""
 
+STORE_EVERY_TAKES = 64
+"""Done takes stored per transaction in a batch."""
+STORE_EVERY_S = 1.0
+"""Longest a done take waits to be stored, seconds (its row is emitted once it is)."""
 SENT_BYTES_IN_FLIGHT = 256 * 1024 * 1024
 """Most bytes of takes sent to workers and not yet answered, when the workers do not share
 the client's files (one take larger than this is still sent, alone)."""
@@ -280,32 +286,60 @@ def run_batch(
         if RETURNED_FILES in outcome and data_dir is not None:
             _store_returned(data_dir, outcome[RETURNED_FILES], path, take_id, values)
         summary = outcome["summary"]
-        shoots.record_done(values, run_id, options_json, summary, float(outcome["time_s"]))
-        emit(
-            {
-                **_summary_row(summary["qa"]),
-                "source": str(path),
-                "status": "done",
-                "error": None,
-                "take_id": take_id,
-                "review_status": "unreviewed",
-            }
-        )
+        done = DoneTake(values, run_id, options_json, summary, float(outcome["time_s"]))
+        row = {
+            **_summary_row(summary["qa"]),
+            "source": str(path),
+            "status": "done",
+            "error": None,
+            "take_id": take_id,
+            "review_status": "unreviewed",
+        }
+        stores.add(done, row)
 
-    if engine is None:
-        for path, sha in pending:
-            take_id, run_id = new_id(), new_id()
-            finish(
-                path, sha, take_id, run_id, task(str(path), options_json, take_id, run_id, folder)
-            )
-        return counts
-    if pending:  # a finished batch never starts (or connects to) a cluster
-        sent = None
-        sample = _sample_file(pending[0][0])
-        if send == "bytes" or (send == "auto" and not engine.shares_disk(sample, data_dir)):
-            sent = sent_models(data_dir, options.limits_model)
-        _run_on_dask(engine, pending, options_json, folder, task, sent, finish, emit)
+    stores = _StoreInBatches(shoots, emit)
+    try:
+        if engine is None:
+            for path, sha in pending:
+                take_id, run_id = new_id(), new_id()
+                outcome = task(str(path), options_json, take_id, run_id, folder)
+                finish(path, sha, take_id, run_id, outcome)
+        elif pending:  # a finished batch never starts (or connects to) a cluster
+            sent = None
+            sample = _sample_file(pending[0][0])
+            if send == "bytes" or (send == "auto" and not engine.shares_disk(sample, data_dir)):
+                sent = sent_models(data_dir, options.limits_model)
+            _run_on_dask(engine, pending, options_json, folder, task, sent, finish, emit)
+    finally:  # takes finished before an interruption are stored, with their rows
+        stores.flush()
     return counts
+
+
+class _StoreInBatches:
+    """Done takes held until :data:`STORE_EVERY_TAKES` of them (or :data:`STORE_EVERY_S`
+    seconds) are ready, then stored in one transaction and their rows emitted: one commit per
+    take cost the client more than the rest of its work (docs/batch.md)."""
+
+    def __init__(self, shoots: ShootStore, emit: Callable[[Row], None]) -> None:
+        self.shoots = shoots
+        self.emit = emit
+        self.held: list[tuple[DoneTake, Row]] = []
+        self.since = 0.0
+
+    def add(self, done: DoneTake, row: Row) -> None:
+        """Hold one done take; store the held ones when enough are held or waited long."""
+        if not self.held:
+            self.since = time.monotonic()
+        self.held.append((done, row))
+        if len(self.held) >= STORE_EVERY_TAKES or time.monotonic() - self.since >= STORE_EVERY_S:
+            self.flush()
+
+    def flush(self) -> None:
+        """Store every held take, then emit their rows (a row says "done" once stored)."""
+        held, self.held = self.held, []
+        self.shoots.record_done([done for done, _ in held])
+        for _, row in held:
+            self.emit(row)
 
 
 def _sample_file(path: Path) -> Path:

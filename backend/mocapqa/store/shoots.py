@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import unicodedata
 from collections.abc import Iterator
+from dataclasses import dataclass
 from typing import Any
 
 from sqlalchemy import Connection, Engine, and_, delete, func, insert, or_, select, update
@@ -19,12 +20,12 @@ from mocapqa.core.text import display_name
 from mocapqa.errors import ConflictError, InputError, NotFoundError
 from mocapqa.pipeline.summary import SUMMARY_FIELDS
 from mocapqa.store.limits_runs import stale_limits_counts
-from mocapqa.store.qa import sync_take
+from mocapqa.store.qa import qa_values, sync_take
 from mocapqa.store.repository import RUN_STATUSES, new_id, utc_now
 from mocapqa.store.rows import plain
 from mocapqa.store.tables import reviews, runs, shoots, source_hashes, take_qa, takes
 
-__all__ = ["SORT_COLUMNS", "ShootStore", "TakeFilter"]
+__all__ = ["SORT_COLUMNS", "DoneTake", "ShootStore", "TakeFilter"]
 
 SORT_COLUMNS = (
     "name",
@@ -36,6 +37,31 @@ SORT_COLUMNS = (
     "reviewer",
 )
 """Columns a shoot's take table can be sorted by."""
+
+
+@dataclass(frozen=True)
+class DoneTake:
+    """A take analysed elsewhere (a batch's worker), to be stored with its done run.
+
+    Parameters
+    ----------
+    take : dict
+        The ``takes`` row's values (``id``, ``name``, ``sha256``, ``shoot_id``, ...).
+    run_id : str
+        The run's id.
+    options : dict
+        The run's options as JSON.
+    summary : dict
+        The run summary (:func:`mocapqa.jobs.runner.run_summary`).
+    server_time_s : float
+        The analysis's own time, seconds.
+    """
+
+    take: dict[str, Any]
+    run_id: str
+    options: dict[str, Any]
+    summary: dict[str, Any]
+    server_time_s: float
 
 
 class TakeFilter:
@@ -466,36 +492,54 @@ class ShootStore:
                         found[str(row["input_sha256"])] = str(row["take_id"])
         return found
 
-    def record_done(
-        self,
-        take: dict[str, Any],
-        run_id: str,
-        options: dict[str, Any],
-        summary: dict[str, Any],
-        server_time_s: float,
-    ) -> None:
-        """Store a take analysed elsewhere and its done run, in one transaction."""
+    def record_done(self, done: list[DoneTake]) -> None:
+        """Store takes analysed elsewhere, each with its one done run, in one transaction.
+
+        Each take is new (a batch made its id), so its ``take_qa`` row is built from the
+        values at hand (its only run, no review) instead of read back per take; the three
+        tables get one multi-row insert each, a few statements for any number of takes.
+        """
+        if not done:
+            return
         now = utc_now()
-        with self.engine.begin() as conn:
-            conn.execute(insert(takes).values(**take, created_at=now))
-            conn.execute(
-                insert(runs).values(
-                    id=run_id,
-                    take_id=take["id"],
-                    status="done",
-                    progress=100,
-                    step="done",
-                    options=options,
-                    input_sha256=take["sha256"],
-                    version=__version__,
-                    summary=summary,
-                    server_time_s=server_time_s,
-                    created_at=now,
-                    started_at=now,
-                    finished_at=now,
-                )
+        take_rows, run_rows, qa_rows = [], [], []
+        for item in done:
+            take = {**item.take, "created_at": now}
+            run = {
+                "id": item.run_id,
+                "take_id": take["id"],
+                "status": "done",
+                "progress": 100,
+                "step": "done",
+                "options": item.options,
+                "input_sha256": take["sha256"],
+                "version": __version__,
+                "summary": item.summary,
+                "server_time_s": item.server_time_s,
+                "created_at": now,
+                "started_at": now,
+                "finished_at": now,
+            }
+            take_rows.append(take)
+            run_rows.append(run)
+            qa_rows.append(
+                {
+                    "take_id": take["id"],
+                    "shoot_id": take.get("shoot_id"),
+                    "name": take["name"],
+                    "kind": take["kind"],
+                    "created_at": now,
+                    "run_id": item.run_id,
+                    "status": "done",
+                    "review_status": "unreviewed",
+                    "reviewer": None,
+                    **qa_values(take, run),
+                }
             )
-            sync_take(conn, str(take["id"]))
+        with self.engine.begin() as conn:
+            conn.execute(insert(takes), take_rows)
+            conn.execute(insert(runs), run_rows)
+            conn.execute(insert(take_qa), qa_rows)
 
     def known_hashes(self, paths: list[str]) -> dict[str, tuple[int, int, str]]:
         """Cached ``(size, mtime_ns, sha256)`` of these source paths."""
