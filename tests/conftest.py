@@ -1,31 +1,20 @@
 """Shared fixtures. ``corpus_dir`` is the one way tests reach the real data in ``../shared/data``.
 
-It looks at ``MOCAPQA_CORPUS_DIR``, then ``MOCAPQA_DATA_DIR`` (when that folder holds the
-corpus' ``MANIFEST.tsv``), then ``shared/data`` beside the checkout. A missing corpus fails the
-test run loudly: real-data tests are never skipped.
+It finds the folder as the benchmarks and the demo shoot do (:func:`mocapqa.corpus.find_corpus`:
+``MOCAPQA_CORPUS_DIR``, then ``MOCAPQA_DATA_DIR`` when that folder holds the corpus'
+``MANIFEST.tsv``, then ``shared/data`` beside the checkout). A missing corpus fails the test run
+loudly: real-data tests are never skipped.
 """
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import pytest
 
+from mocapqa.corpus import find_corpus
+
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def find_corpus() -> Path | None:
-    """The real-data corpus folder, or None."""
-    candidates = []
-    for var in ("MOCAPQA_CORPUS_DIR", "MOCAPQA_DATA_DIR"):
-        if os.environ.get(var):
-            candidates.append(Path(os.environ[var]))
-    candidates += [ROOT.parent / "shared" / "data", ROOT / ".." / "shared" / "data"]
-    for path in candidates:
-        if (path / "MANIFEST.tsv").is_file():
-            return path.resolve()
-    return None
 
 
 @pytest.fixture(scope="session")

@@ -317,7 +317,7 @@ def bench_batch(
     from rich.console import Console
     from rich.table import Table
 
-    from mocapqa.bench.corpus import require_corpus
+    from mocapqa.corpus import require_corpus
     from mocapqa.bench.tiles import tile_corpus
     from mocapqa.bench.watch import Watched, run_watched
     from mocapqa.jobs.batch import run_batch

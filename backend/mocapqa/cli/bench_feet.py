@@ -39,7 +39,7 @@ def bench_feet(
     from rich.console import Console
     from rich.table import Table
 
-    from mocapqa.bench.corpus import require_corpus
+    from mocapqa.corpus import require_corpus
     from mocapqa.bench.feet import (
         CLEAN_FAMILIES,
         DEPTHS_CM,

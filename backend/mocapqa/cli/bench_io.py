@@ -38,7 +38,8 @@ def bench_io(
     from rich.progress import Progress
     from rich.table import Table
 
-    from mocapqa.bench.corpus import corpus_bvh_files, require_corpus
+    from mocapqa.bench.corpus import corpus_bvh_files
+    from mocapqa.corpus import require_corpus
     from mocapqa.bench.io import (
         IoBenchParams,
         Throughput,

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -152,16 +151,6 @@ def _fmt(value: Any) -> str:
     return str(value)
 
 
-def _default_corpus() -> Path:
-    env = os.environ.get("MOCAPQA_CORPUS_DIR")
-    if env:
-        return Path(env)
-    for base in (Path.cwd(), *Path.cwd().parents):
-        if (base / "shared" / "data" / "MANIFEST.tsv").is_file():
-            return base / "shared" / "data"
-    return Path.cwd() / "shared" / "data"
-
-
 @bench_app.command("filters")
 def bench_filters(
     data: Annotated[Path | None, typer.Option(help="Corpus folder (shared/data).")] = None,
@@ -185,8 +174,9 @@ def bench_filters(
         rotation_table,
         tune_quat_pd,
     )
+    from mocapqa.corpus import require_corpus
 
-    root = data or _default_corpus()
+    root = require_corpus(data)
     if not (root / "bvh" / "bandai").is_dir():
         raise InputError(f"Expected a corpus folder with bvh/bandai (--data), got {root}")
     train, test = split_takes(load_takes(root, limit))

@@ -13,7 +13,7 @@ import logging
 from importlib import resources
 from pathlib import Path
 
-from mocapqa.bench.corpus import find_corpus
+from mocapqa.corpus import find_corpus
 from mocapqa.jobs.intake import ingest_take
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.store.files import FileStore

@@ -37,13 +37,6 @@ from typing import Any
 
 import numpy as np
 
-from mocapqa.bench.limits import (
-    check_rig_family,
-    corpus_files,
-    held_back_names,
-    rig_positions,
-    split_group,
-)
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Skeleton
 from mocapqa.core.rig import SIDES, mapped_roles, require_mapped
@@ -69,6 +62,13 @@ from mocapqa.limits.canonical import (
 from mocapqa.limits.charting import canonical_rotations
 from mocapqa.limits.model import LimitsModel, StoredFrames
 from mocapqa.limits.rig import MODELLED_ROLES, rig_fingerprint
+from mocapqa.limits.split import (
+    check_rig_family,
+    corpus_files,
+    held_back_names,
+    rig_positions,
+    split_group,
+)
 
 __all__ = [
     "TakeSummary",
