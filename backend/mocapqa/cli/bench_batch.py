@@ -317,9 +317,9 @@ def bench_batch(
     from rich.console import Console
     from rich.table import Table
 
-    from mocapqa.corpus import require_corpus
     from mocapqa.bench.tiles import tile_corpus
     from mocapqa.bench.watch import Watched, run_watched
+    from mocapqa.corpus import require_corpus
     from mocapqa.jobs.batch import run_batch
     from mocapqa.jobs.engine import Engine
     from mocapqa.pipeline.options import AnalysisOptions

@@ -39,7 +39,6 @@ def bench_feet(
     from rich.console import Console
     from rich.table import Table
 
-    from mocapqa.corpus import require_corpus
     from mocapqa.bench.feet import (
         CLEAN_FAMILIES,
         DEPTHS_CM,
@@ -50,6 +49,7 @@ def bench_feet(
         family_figures,
         feet_speed,
     )
+    from mocapqa.corpus import require_corpus
     from mocapqa.feet.params import FeetParams
 
     console = Console()

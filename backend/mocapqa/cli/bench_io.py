@@ -39,7 +39,6 @@ def bench_io(
     from rich.table import Table
 
     from mocapqa.bench.corpus import corpus_bvh_files
-    from mocapqa.corpus import require_corpus
     from mocapqa.bench.io import (
         IoBenchParams,
         Throughput,
@@ -50,6 +49,7 @@ def bench_io(
         total_throughput,
         warm_up,
     )
+    from mocapqa.corpus import require_corpus
     from mocapqa.errors import NotFoundError
 
     params = IoBenchParams(
