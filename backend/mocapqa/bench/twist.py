@@ -46,7 +46,7 @@ from mocapqa.metrics.twist import (
 from mocapqa.twist.analysis import TwistAnalysis, analyze_twist, detect_chains
 from mocapqa.twist.angles import chain_geometry, wrap_angle
 from mocapqa.twist.detect import PaperParams, RobustParams
-from mocapqa.twist.inject import inject_twist_errors
+from mocapqa.twist.inject import InjectionTruth, inject_twist_errors
 from mocapqa.twist.refine import refine_quats
 
 __all__ = [
@@ -131,6 +131,9 @@ class MethodResult:
         ``(rig, held_out)`` → largest change of a target joint on its non-injected frames, °.
     records : list of IntervalRecord
         Every interval reported on the injected and the clean takes.
+    ends : dict
+        ``(rig, held_out)`` → [intervals injected at an end of the take, detected, corrected]
+        (with ``ends`` injections; see :func:`run_twist_bench`).
     """
 
     before: dict[tuple[str, bool, str, str], list[np.ndarray]] = field(default_factory=dict)
@@ -141,6 +144,13 @@ class MethodResult:
     per_take: dict[tuple[str, bool, str], list[int]] = field(default_factory=dict)
     spill: dict[tuple[str, bool], float] = field(default_factory=dict)
     records: list[IntervalRecord] = field(default_factory=list)
+    ends: dict[tuple[str, bool], list[int]] = field(default_factory=dict)
+
+    def end_counts(self, rigs: Sequence[str] = RIGS, held_out: bool | None = None) -> list[int]:
+        """[injected, detected, corrected] intervals at an end of the take over the selection."""
+        rows = [v for (rig, hold), v in self.ends.items()
+                if rig in rigs and (held_out is None or hold == held_out)]  # fmt: skip
+        return [sum(v[k] for v in rows) for k in range(3)]
 
     def bootstrap_fsr(
         self,
@@ -339,6 +349,38 @@ def interval_records(
     return out
 
 
+def _count_ends(
+    counts: list[int], analysis: TwistAnalysis, truth: InjectionTruth, corrected: Motion, ends: str
+) -> None:
+    """Add the injected intervals at an end of the take to ``counts`` ([injected, detected,
+    corrected]); ``corrected`` is the corrupted take (the refined one is in ``analysis``)."""
+    n_frames = truth.error_mask.shape[0]
+    for target in truth.targets:
+        joint = analysis.joint_names[target]
+        mine = [i for i in truth.intervals if i.joint == joint]
+        if not mine:
+            continue
+        end = (
+            max(mine, key=lambda i: i.end_frame)
+            if ends == "tail"
+            else min(mine, key=lambda i: i.start_frame)
+        )
+        if ends == "tail" and end.end_frame != n_frames - 1:
+            continue
+        rows = slice(end.start_frame, end.end_frame + 1)
+        covered = np.zeros(n_frames, dtype=bool)
+        for interval in analysis.intervals:
+            if interval.joint == joint:
+                covered[interval.start_frame : interval.end_frame + 1] = True
+        before = rotation_errors_deg(truth.clean_quats[rows, target], corrected.quats[rows, target])
+        after = rotation_errors_deg(
+            truth.clean_quats[rows, target], analysis.refined.quats[rows, target]
+        )
+        counts[0] += 1
+        counts[1] += int(2 * np.sum(covered[rows]) >= end.end_frame - end.start_frame + 1)
+        counts[2] += int(after.sum() <= 0.2 * before.sum())
+
+
 def run_twist_bench(
     files: Sequence[BenchFile],
     methods: dict[str, tuple[str, RobustParams | PaperParams | None]],
@@ -347,6 +389,7 @@ def run_twist_bench(
     on_file: Callable[[BenchFile], None] | None = None,
     apply: str = "confident",
     kind: str = "level",
+    ends: str = "",
 ) -> TwistBenchResult:
     """Inject, refine and score every take with every method.
 
@@ -365,6 +408,11 @@ def run_twist_bench(
         Which intervals the refinement applies (see :func:`mocapqa.twist.analysis.analyze_twist`).
     kind : {"level", "burst", "cluster"}
         The injected error shape (see :func:`mocapqa.twist.inject.inject_twist_errors`).
+    ends : {"", "head", "tail"}
+        Force one level shift per target to start on the first frame of motion or to end on
+        the last frame. Each such interval is *detected* when an interval reported on its
+        joint (applied or not) covers at least half of its frames, and *corrected* when the
+        refinement leaves at most 20 % of its summed rotation error.
 
     Returns
     -------
@@ -379,7 +427,7 @@ def run_twist_bench(
         for repeat in range(repeats):
             rng = np.random.default_rng((seed, name_key, repeat))
             try:
-                injected.append(inject_twist_errors(motion, rng, kind=kind))
+                injected.append(inject_twist_errors(motion, rng, kind=kind, ends=ends))
             except InputError:
                 continue
         n_injections += len(injected)
@@ -394,6 +442,9 @@ def run_twist_bench(
                 analysis = analyze_twist(corrupted, method, params=params, apply=apply)
                 refined = analysis.refined
                 result.records += interval_records(analysis, truth.offsets_rad, bench_file)
+                if ends:
+                    _count_ends(result.ends.setdefault(group, [0, 0, 0]), analysis, truth,
+                                corrected=corrupted, ends=ends)  # fmt: skip
                 for k, target in enumerate(truth.targets):
                     rows = truth.error_mask[:, target]
                     key = (bench_file.rig, bench_file.held_out, truth.sides[k], truth.segments[k])

@@ -264,6 +264,7 @@ def _run(
     console: Console,
     apply: str = "confident",
     kind: str = "level",
+    ends: str = "",
 ) -> Any:
     from mocapqa.bench.twist import run_twist_bench
 
@@ -277,6 +278,7 @@ def _run(
             on_file=lambda f: progress.update(task, advance=1, description=f.path.name),
             apply=apply,
             kind=kind,
+            ends=ends,
         )  # fmt: skip
 
 
@@ -397,6 +399,7 @@ def bench_twist(
     from mocapqa.cli.twist_tables import (
         calibration_table,
         disagreement_table,
+        ends_table,
         loro_table,
         loro_variants,
         rates_table,
@@ -450,6 +453,14 @@ def bench_twist(
                         kind="cluster").methods  # fmt: skip
         console.print("Clusters of separate flips and holds (injected, kind=cluster):")
         console.print(rates_table(clusters))
+        console.print(
+            ends_table([
+                (where, apply_choice,
+                 _run(bench_files, {"robust": ("robust", None)}, seed, repeats, console,
+                      apply_choice, ends=where).methods["robust"])
+                for where in ("tail", "head") for apply_choice in ("confident", "all")
+            ])
+        )  # fmt: skip
         for title, records in (
             ("level shifts", main_methods["robust"].records),
             ("bursts", bursts["robust"].records),

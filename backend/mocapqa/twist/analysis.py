@@ -19,8 +19,8 @@ from mocapqa.core.decimate import peak_frames
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.errors import InputError
-from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.kinematics.euler import euler_from_quats
+from mocapqa.twist.anatomy import anatomy_evidence
 from mocapqa.twist.angles import (
     ChainGeometry,
     chain_geometry,
@@ -39,6 +39,8 @@ from mocapqa.twist.detect import (
     RobustParams,
     detect_paper,
     detect_robust,
+    leading_pose_frames,
+    shift_detection,
 )
 from mocapqa.twist.refine import refine_quats
 
@@ -327,11 +329,13 @@ def detect_chains(
             dc = np.where(
                 good >= robust.min_conditioning, azimuth, child_increment_twists(child_quats, axes)
             )
-    # A bind-pose first frame is not motion: the step into frame 1 gets no increment.
-    skip = leading_bind_pose(quats)
-    dp[1 : skip + 1] = 0.0
-    dc[1 : skip + 1] = 0.0
-    return detect_robust(dp, dc, fps, robust)
+    # Bind-pose first frames are not motion and not a reference for the roll: the detector
+    # reads the take from its first frame of motion on (that frame has no increment).
+    skip = leading_pose_frames(quats)
+    if skip:
+        dp, dc = dp[skip:].copy(), dc[skip:].copy()
+        dp[0] = dc[0] = 0.0
+    return shift_detection(detect_robust(dp, dc, fps, robust), skip, n_frames)
 
 
 def refined_hint(
@@ -397,7 +401,8 @@ def analyze_twist(
         Detector parameters; the method's defaults when omitted.
     apply : str or frozenset of int
         ``"confident"`` (default: intervals whose calibrated probability is at least
-        :data:`mocapqa.twist.confidence.APPLY_THRESHOLD`), ``"all"``, ``"none"``, or interval
+        :data:`mocapqa.twist.confidence.APPLY_THRESHOLD` or that the anatomy evidence supports,
+        :func:`mocapqa.twist.confidence.decide`), ``"all"``, ``"none"``, or interval
         ids (a set, or text such as ``"0,3"``). The paper's method has no calibrated
         confidence: ``"confident"`` applies all its intervals.
 
@@ -421,8 +426,14 @@ def analyze_twist(
     n_frames = motion.n_frames
     detected = detection.offsets.reshape(n_frames, len(geometries))
     found = sorted(detection.intervals, key=lambda i: (i.chain, i.start_frame))
+    # Anatomy evidence (joint limits) of each interval, for the apply choice and its record.
+    anatomy = (
+        anatomy_evidence(motion, geometries, found, detected, mapping)
+        if method == "robust" and found
+        else None
+    )
     offsets, intervals = choose_intervals(
-        found, detected, geometries, skeleton.names, choice, method == "robust"
+        found, detected, geometries, skeleton.names, choice, method == "robust", anatomy
     )
     refined_quats = refine_quats(motion.quats, geometries, offsets)
     changed = np.any(refined_quats != motion.quats, axis=-1)

@@ -3,9 +3,11 @@
 ``apply`` is one of :data:`APPLY_CHOICES` or a set of interval ids. Ids number the intervals of
 a take in chain, then frame order. ``confident`` applies intervals whose calibrated probability
 is at least :data:`mocapqa.twist.confidence.APPLY_THRESHOLD` and that pass the minimum-evidence
-rule :func:`mocapqa.twist.confidence.has_evidence` (methods without a calibrated confidence apply
-all). Each :class:`TwistInterval` lists its ``levels``: the stretches of
-constant offset, so the refined take is exactly the raw one with the applied levels removed.
+rule :func:`mocapqa.twist.confidence.has_evidence`, or that the anatomy evidence supports, and
+never those it contradicts (:func:`mocapqa.twist.confidence.decide`; methods without a
+calibrated confidence apply all). Each interval's ``evidence`` records which evidence decided.
+Each :class:`TwistInterval` lists its ``levels``: the stretches of constant offset, so the
+refined take is exactly the raw one with the applied levels removed.
 """
 
 from __future__ import annotations
@@ -19,8 +21,9 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray
 from mocapqa.errors import InputError
+from mocapqa.twist.anatomy import AnatomyEvidence
 from mocapqa.twist.angles import ChainGeometry
-from mocapqa.twist.confidence import APPLY_THRESHOLD, has_evidence
+from mocapqa.twist.confidence import decide
 from mocapqa.twist.detect import DetectedInterval
 
 __all__ = ["APPLY_CHOICES", "MAX_APPLY_IDS", "TwistInterval", "choose_intervals", "parse_apply"]
@@ -96,6 +99,12 @@ class TwistInterval:
     levels : tuple of (int, int, float)
         ``(start_frame, end_frame, offset_deg)`` of each stretch of constant offset: the
         refined take is the raw one with exactly these removed, so they also undo it.
+    evidence : tuple of (str, float or str), optional
+        What ``apply="confident"`` decided on: ``calibrated`` (the probability), ``anatomy_deg``
+        (degrees the correction brings the parent's twist back inside its natural range:
+        raw minus corrected distance beyond it; absent when no limits model reads the joint),
+        ``child_anatomy_deg`` (the same for the child's rotation) and ``rule`` (one of
+        :data:`mocapqa.twist.confidence.RULES`). Empty for the paper's method.
     """
 
     joint: str
@@ -108,10 +117,11 @@ class TwistInterval:
     id: int = 0
     applied: bool = True
     levels: tuple[tuple[int, int, float], ...] = ()
+    evidence: tuple[tuple[str, float | str], ...] = ()
 
     def to_json(self) -> dict[str, Any]:
-        """The interval as a JSON-ready dict."""
-        return {
+        """The interval as a JSON-ready dict (``evidence`` only when recorded)."""
+        out = {
             "id": self.id,
             "joint": self.joint,
             "side": self.side,
@@ -123,6 +133,11 @@ class TwistInterval:
             "applied": self.applied,
             "levels": [[a, b, round(v, 6)] for a, b, v in self.levels],
         }
+        if self.evidence:
+            out["evidence"] = {
+                k: round(v, 4) if isinstance(v, float) else v for k, v in self.evidence
+            }
+        return out
 
 
 def choose_intervals(
@@ -132,6 +147,7 @@ def choose_intervals(
     names: Sequence[str],
     choice: str | frozenset[int],
     calibrated: bool,
+    anatomy: AnatomyEvidence | None = None,
 ) -> tuple[FloatArray, list[TwistInterval]]:
     """The offsets to remove and the report entry of every interval.
 
@@ -148,6 +164,8 @@ def choose_intervals(
         From :func:`parse_apply`.
     calibrated : bool
         Whether the confidences are calibrated probabilities (else ``confident`` applies all).
+    anatomy : AnatomyEvidence, optional
+        Anatomy evidence of each interval of ``found`` (:mod:`mocapqa.twist.anatomy`).
 
     Returns
     -------
@@ -171,13 +189,27 @@ def choose_intervals(
         )
     offsets = np.zeros_like(detected)
     intervals = []
+    probability = np.array([i.confidence for i in found], dtype=np.float64)
+    features = [i.features if calibrated else () for i in found]
+    chains = [i.chain for i in found]
+    confident, rules = decide(probability, features, anatomy, chains=chains)
     for k, i in enumerate(found):
         if isinstance(choice, frozenset):
             applied = k in choice
-        elif choice == "confident" and calibrated:
-            applied = i.confidence >= APPLY_THRESHOLD and has_evidence(i.features)
+        elif choice == "confident":
+            applied = bool(confident[k])
         else:
             applied = choice != "none"
+        evidence: tuple[tuple[str, float | str], ...] = ()
+        if features[k]:
+            evidence = (("calibrated", float(i.confidence)),)
+            if anatomy is not None and anatomy.checked[k]:
+                evidence += (
+                    ("anatomy_deg", float(anatomy.raw_deg[k] - anatomy.fixed_deg[k])),
+                    ("child_anatomy_deg",
+                     float(anatomy.child_raw_deg[k] - anatomy.child_fixed_deg[k])),
+                )  # fmt: skip
+            evidence += (("rule", rules[k]),)
         rows = slice(i.start_frame, i.end_frame + 1)
         if applied:
             offsets[rows, i.chain] = detected[rows, i.chain]
@@ -202,6 +234,7 @@ def choose_intervals(
                 id=k,
                 applied=applied,
                 levels=levels,
+                evidence=evidence,
             )
         )
     return offsets, intervals

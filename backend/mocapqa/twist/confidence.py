@@ -17,6 +17,19 @@ and raises no frame's error by more than 1°.
 must be at least ``MIN_LEVEL_DEG``, so a small interval inside the natural roll noise is reported
 but not applied, and the roll outside the interval must not contradict its jumps by more than
 ``MAX_DISAGREEMENT`` times the level (then nothing outside the events shows a level shift).
+
+:func:`decide` adds evidence whose meaning does not depend on the injected errors the
+calibration was fitted on (``docs/twist.md``, Confidence and applying): the joint-limits model
+(:mod:`mocapqa.twist.anatomy`). An interval whose raw twist lies at least ``ANATOMY_MIN_DEG``
+beyond the natural range while the correction brings it inside, whose child the correction does
+not push out of its range, and whose events counter-rotate within ``ANATOMY_MAX_MISMATCH``, is
+applied whatever its calibrated probability (rule ``"anatomy"``), unless the correction moves
+the twist of some frame ``ANATOMY_MIN_DEG`` or more toward the edge of the range (a level
+removed from natural frames) or the interval lasts longer than ``ANATOMY_MAX_S``; an interval
+whose correction moves a twist from inside the range to ``ANATOMY_MIN_DEG`` or more beyond it
+(on the parent or the child) is not (rule ``"anatomy_against"``). A repetition rule (the other
+strong intervals of the interval's chain, :mod:`mocapqa.twist.repetition`) can be asked for
+with ``min_family``; it is off by default (``REPETITION_MIN_FAMILY`` = 0, see the docs).
 """
 
 from __future__ import annotations
@@ -32,14 +45,23 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray
 from mocapqa.errors import InputError
+from mocapqa.twist.anatomy import AnatomyEvidence
 from mocapqa.twist.intervals import FEATURES
+from mocapqa.twist.repetition import family_counts
 
 __all__ = [
+    "ANATOMY_MAX_MISMATCH",
+    "ANATOMY_MAX_S",
+    "ANATOMY_MIN_DEG",
     "APPLY_THRESHOLD",
     "CALIBRATION_FILE",
     "MAX_DISAGREEMENT",
     "MIN_LEVEL_DEG",
+    "REPETITION_MIN_FAMILY",
+    "REPETITION_STRONG_P",
+    "RULES",
     "Calibration",
+    "decide",
     "default_calibration",
     "fit_calibration",
     "has_evidence",
@@ -55,6 +77,32 @@ MAX_DISAGREEMENT = 1.5
 level accumulated from its jumps, relative to the latter (the ``disagreement`` feature), of an
 interval that ``apply="confident"`` applies. Chosen on the injected takes as the smallest of
 1, 1.25, 1.5 and 1.75 that keeps every right interval: by each pair of rigs, 1.5 each time."""
+ANATOMY_MIN_DEG = 15.0
+"""Degrees beyond the natural twist range (joint-limits model) that count as anatomical evidence:
+a raw twist this far outside, brought inside by the correction, applies an interval; a twist
+inside pushed this far outside blocks it. Chosen on the fit takes' injected errors (docs)."""
+ANATOMY_MAX_MISMATCH = 0.5
+"""Largest counter-rotation mismatch ratio (the ``mismatch`` feature: how far the child's world
+orientation moves at the interval's events, relative to the jump) of an interval the anatomy
+rule applies: the events' own consistency rule, so the child keeps its world orientation."""
+ANATOMY_MAX_S = 0.25
+"""Longest interval, seconds, the anatomy rule applies: over a longer one most frames sit inside
+the range, so frames outside it say that an error is there, not that the whole interval's
+levels belong where they were put. Chosen on the fit takes' injected errors (docs)."""
+REPETITION_MIN_FAMILY = 0
+"""Other strong intervals on an interval's chain that apply it (``"repetition"``); 0: the
+repetition rule is off (measured on the fit takes, docs)."""
+REPETITION_STRONG_P = 0.9
+"""Calibrated probability from which an interval counts as strong for the repetition rule."""
+RULES = (
+    "calibrated",
+    "anatomy",
+    "anatomy_against",
+    "repetition",
+    "min_evidence",
+    "uncalibrated",
+)
+"""Which evidence decided an interval under ``apply="confident"`` (:func:`decide`)."""
 CALIBRATION_FILE = "calibration.json"
 """Name of the stored calibration in the package's ``data/twist`` folder."""
 
@@ -156,6 +204,101 @@ def has_evidence(features: Sequence[float]) -> bool:
         return True
     large = features[FEATURES.index("log_level_deg")] >= np.log(MIN_LEVEL_DEG)
     return bool(large and features[FEATURES.index("disagreement")] < MAX_DISAGREEMENT)
+
+
+def decide(
+    probability: FloatArray,
+    features: Sequence[Sequence[float]],
+    anatomy: AnatomyEvidence | None,
+    min_deg: float = ANATOMY_MIN_DEG,
+    max_mismatch: float = ANATOMY_MAX_MISMATCH,
+    max_s: float = ANATOMY_MAX_S,
+    chains: Sequence[int] | None = None,
+    min_family: int = REPETITION_MIN_FAMILY,
+    strong_p: float = REPETITION_STRONG_P,
+) -> tuple[np.ndarray, tuple[str, ...]]:
+    """Whether ``apply="confident"`` applies each interval, and which evidence decided.
+
+    In order: no calibrated features (the paper's method) applies (``"uncalibrated"``); failing
+    :func:`has_evidence` does not (``"min_evidence"``); a correction that moves the parent's
+    twist or the child's rotation from inside its range to ``min_deg`` or more beyond it does
+    not (``"anatomy_against"``); a raw twist ``min_deg`` or more beyond the range that the
+    correction brings inside, moving no frame's twist ``min_deg`` or more toward the range's
+    edge, with the child not pushed ``min_deg`` further out, a mismatch ratio of at most
+    ``max_mismatch`` and a duration of at most ``max_s``, applies (``"anatomy"``); with
+    ``min_family`` > 0, an interval as short and as well counter-rotated with at least
+    ``min_family`` other strong intervals on its chain (probability ≥ ``strong_p`` or the
+    anatomy rule, :func:`mocapqa.twist.repetition.family_counts`) applies (``"repetition"``);
+    otherwise the calibrated probability decides against :data:`APPLY_THRESHOLD`
+    (``"calibrated"``).
+
+    Parameters
+    ----------
+    probability : ndarray, shape (N,)
+        Calibrated probabilities.
+    features : sequence of sequence of float, length N
+        Each interval's :data:`FEATURES` (empty for the paper's method).
+    anatomy : AnatomyEvidence or None
+        From :func:`mocapqa.twist.anatomy.anatomy_evidence`; None: no anatomy evidence.
+    min_deg, max_mismatch, max_s : float
+        :data:`ANATOMY_MIN_DEG`, :data:`ANATOMY_MAX_MISMATCH` and :data:`ANATOMY_MAX_S` unless
+        measuring others.
+    chains : sequence of int, optional
+        Chain of each interval (for the repetition evidence; none without it).
+    min_family : int
+        Other strong intervals on the chain that support an interval; 0: no repetition rule.
+    strong_p : float
+        Calibrated probability from which an interval counts as strong.
+
+    Returns
+    -------
+    applied : ndarray of bool, shape (N,)
+    rules : tuple of str, length N
+        One of :data:`RULES` per interval.
+    """
+    n = len(features)
+    p = np.asarray(probability, dtype=np.float64).reshape(n)
+    if anatomy is None:
+        anatomy = AnatomyEvidence.empty(n)
+    calibrated = np.array([len(f) > 0 for f in features], dtype=bool)
+    evidence = np.array([has_evidence(f) for f in features], dtype=bool)
+    mismatch = np.array(
+        [f[FEATURES.index("mismatch")] if f else np.inf for f in features], dtype=np.float64
+    )
+    short = np.array(
+        [bool(f) and f[FEATURES.index("log_length_s")] <= np.log(max_s) for f in features],
+        dtype=bool,
+    )
+    raw, fixed = anatomy.raw_deg, anatomy.fixed_deg
+    child_raw, child_fixed = anatomy.child_raw_deg, anatomy.child_fixed_deg
+    pushed = ((raw <= 0.0) & (fixed >= min_deg)) | ((child_raw <= 0.0) & (child_fixed >= min_deg))
+    against = anatomy.checked & pushed
+    brought = (
+        (raw >= min_deg)
+        & (fixed <= 0.0)
+        & (anatomy.outward_deg < min_deg)
+        & (child_fixed - child_raw < min_deg)
+    )
+    support = anatomy.checked & brought & short & (mismatch <= max_mismatch) & ~against
+    family = np.zeros(n, dtype=bool)
+    if chains is not None and min_family > 0:
+        strong = calibrated & evidence & ~against & (support | (p >= strong_p))
+        others = family_counts(np.asarray(chains, dtype=np.intp), strong)
+        family = (
+            (others >= min_family) & calibrated & evidence & ~against & ~support
+            & short & (mismatch <= max_mismatch) & (p < APPLY_THRESHOLD)
+        )  # fmt: skip
+    applied = np.where(
+        ~calibrated,
+        True,
+        evidence & ~against & (support | family | (p >= APPLY_THRESHOLD)),
+    )
+    rules = np.select(
+        [~calibrated, ~evidence, against, support, family],
+        ["uncalibrated", "min_evidence", "anatomy_against", "anatomy", "repetition"],
+        "calibrated",
+    )
+    return applied.astype(bool), tuple(str(r) for r in rules)
 
 
 _LOADED: dict[str, Calibration] = {}

@@ -14,30 +14,39 @@ Conventions
   threshold scaled to the chain's own noise, and the child counter-rotates by the same amount
   modulo 2π (offsets near ±180° wrap). Each onset is paired with the release that brings the
   accumulated level back to zero within ``max_interval_s``; events left unpaired are ignored,
-  so a single spurious event cannot shift the rest of a take.
+  so a single spurious event cannot shift the rest of a take — except the first and last
+  events near the take's ends, which form an interval to that end when the level holds there
+  and the jump stands out (:func:`mocapqa.twist.intervals.one_sided`).
+* Bind-pose first frames (:func:`leading_pose_frames`) are left out of the detection.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
 from mocapqa.errors import InputError
+from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.twist.angles import wrap_angle
-from mocapqa.twist.confidence import default_calibration
 from mocapqa.twist.intervals import IntervalEstimate, chain_intervals
 
 __all__ = [
+    "MAX_HELD_POSE_FRAMES",
     "DetectedInterval",
     "Detection",
     "PaperParams",
     "RobustParams",
     "detect_paper",
     "detect_robust",
+    "leading_pose_frames",
     "runs",
+    "shift_detection",
 ]
+
+MAX_HELD_POSE_FRAMES = 240
+"""Most leading frames read as one held bind pose (a T-pose held longer is motion)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -133,6 +142,14 @@ class RobustParams:
         only if, between them, the child's level measured from outside mirrors the parent's
         (``|P + C| ≤ mirror × min(|P|, |C|)``); otherwise its bursts stand alone and its lone
         events are left unmatched (0: off).
+    ends : bool
+        Also report intervals that run to an end of the take: an unmatched onset within
+        ``max_interval_s`` of the last frame, or release within it of the first, whose level
+        holds to that end (:func:`mocapqa.twist.intervals.one_sided`).
+    end_contrast : float
+        Such an event's jump must be at least this many times every raw roll step of the
+        parent within ``burst_gap_s`` of it (one event is weaker evidence than an onset and a
+        release that cancel).
     """
 
     min_threshold_deg: float = 2.0
@@ -152,6 +169,8 @@ class RobustParams:
     closure_noise: float = 1.0
     precision: float = 2.0
     mirror: float = 0.5
+    ends: bool = True
+    end_contrast: float = 3.0
     parent_source: str = "increment"
     child_source: str = "increment"
     min_conditioning: float = 0.4
@@ -175,13 +194,13 @@ class RobustParams:
             )
         if (
             min(self.speed_factor, self.tail_s, self.tail_factor, self.mismatch_noise,
-                self.closure_noise, self.precision, self.mirror) < 0
+                self.closure_noise, self.precision, self.mirror, self.end_contrast) < 0
         ):  # fmt: skip
             raise InputError(
                 "Expected speed_factor, tail_s, tail_factor, mismatch_noise, closure_noise, "
-                f"precision and mirror ≥ 0, got {self.speed_factor}, {self.tail_s}, "
-                f"{self.tail_factor}, {self.mismatch_noise}, {self.closure_noise}, "
-                f"{self.precision}, {self.mirror}"
+                f"precision, mirror and end_contrast ≥ 0, got {self.speed_factor}, "
+                f"{self.tail_s}, {self.tail_factor}, {self.mismatch_noise}, "
+                f"{self.closure_noise}, {self.precision}, {self.mirror}, {self.end_contrast}"
             )
         if self.burst_gap_s <= 0 or self.agreement < 0 or self.min_fps < 0:
             raise InputError(
@@ -211,6 +230,9 @@ class DetectedInterval:
     features : tuple of float
         The confidence features (:data:`mocapqa.twist.intervals.FEATURES`; empty for the
         paper's method).
+    side : {"", "head", "tail"}
+        "head" for an interval from the take's first frame to a release with no onset,
+        "tail" for one from an onset with no release to its last frame, else "".
     """
 
     chain: int
@@ -219,6 +241,7 @@ class DetectedInterval:
     offset_rad: float
     confidence: float
     features: tuple[float, ...] = ()
+    side: str = ""
 
 
 @dataclass(frozen=True, slots=True)
@@ -252,6 +275,55 @@ def runs(mask: BoolArray) -> list[tuple[int, int]]:
     starts = np.flatnonzero(edges == 1)
     ends = np.flatnonzero(edges == -1) - 1
     return [(int(s), int(e)) for s, e in zip(starts, ends, strict=True)]
+
+
+def leading_pose_frames(quats: FloatArray) -> int:
+    """How many leading frames of a take are a bind pose rather than motion.
+
+    A bind pose is frame 0, or frame 0 held unchanged for up to :data:`MAX_HELD_POSE_FRAMES`
+    frames, followed by a step that :func:`mocapqa.kinematics.bindpose.leading_bind_pose`
+    recognises (far larger than any later step of the take).
+
+    Parameters
+    ----------
+    quats : ndarray, shape (F, J, 4)
+        Local rotations of the take.
+
+    Returns
+    -------
+    int
+        The number of bind-pose frames (0 when the take starts in motion).
+    """
+    n_frames = quats.shape[0]
+    if n_frames < 3 or quats.shape[1] == 0:
+        return 0
+    head = quats[: min(n_frames, MAX_HELD_POSE_FRAMES + 1)]
+    # Frames equal to frame 0 (to 1e-4° per joint): |q0 · qt| = cos(angle / 2).
+    closeness = np.abs(np.einsum("jc,fjc->fj", head[0], head[1:])).min(axis=1)
+    moved = np.flatnonzero(closeness < np.cos(np.deg2rad(1e-4) / 2.0))
+    if len(moved) == 0:
+        return 0
+    held = int(moved[0]) + 1
+    if held > MAX_HELD_POSE_FRAMES or n_frames - held < 3:
+        return 0
+    return held if leading_bind_pose(quats[held - 1 :]) else 0
+
+
+def shift_detection(detection: Detection, skip: int, n_frames: int) -> Detection:
+    """A detection made on frames ``skip`` … F − 1 of a take, as one of all ``n_frames`` frames:
+    the skipped frames have no increment, no event and no offset; intervals move by ``skip``."""
+    if skip == 0:
+        return detection
+
+    def pad(values: np.ndarray) -> np.ndarray:
+        return np.concatenate([np.zeros((skip, *values.shape[1:]), values.dtype), values])
+
+    return Detection(
+        pad(detection.parent_increments), pad(detection.child_increments),
+        pad(detection.candidates), pad(detection.offsets),
+        tuple(replace(i, start_frame=i.start_frame + skip, end_frame=i.end_frame + skip)
+              for i in detection.intervals),
+    )  # fmt: skip
 
 
 def _circular_mean(angles: FloatArray) -> float:
@@ -357,6 +429,9 @@ def detect_robust(
         ``offsets`` holds every interval found; their ``confidence`` is the calibrated
         probability of :func:`mocapqa.twist.confidence.default_calibration`.
     """
+    # Imported here: the calibration's evidence modules use this module's types.
+    from mocapqa.twist.confidence import default_calibration
+
     dp, dc = parent_increments, child_increments
     n_frames, n_chains = dp.shape
     stride = params.neighbour_stride(fps)
@@ -439,7 +514,7 @@ def detect_robust(
                 float(threshold[c]), float(roll_scale[c]), fps, params.closure_fraction,
                 params.agreement, params.burst_gap_s, params.max_interval_s, small[:, c],
                 params.tail_s, uncertainty[frames, c], params.precision,
-                (dc[:, c], natural_c[:, c]), params.mirror,
+                (dc[:, c], natural_c[:, c]), params.mirror, params.ends, params.end_contrast,
             )  # fmt: skip
         else:
             steps = np.zeros(n_frames)
@@ -460,7 +535,7 @@ def detect_robust(
     probabilities = iter(scores)
     intervals = tuple(
         DetectedInterval(c, e.start_frame, e.end_frame, e.offset_rad,
-                         float(next(probabilities)) if e.features else 0.5, e.features)
+                         float(next(probabilities)) if e.features else 0.5, e.features, e.side)
         for c, e in found
     )  # fmt: skip
     return Detection(dp, dc, events, offsets, intervals)

@@ -18,6 +18,11 @@ with its own offset of ±20–90° and alternating sign, then a tail of up to 0.
 linearly from 10–40 % of the last offset back to the natural level; the child counter-rotates
 by (1 + ε) δ with ε uniform in ±0.2 over the burst, since a real retarget rarely does it exactly.
 
+``ends="tail"`` makes each target's last interval end on the take's last frame (an onset with
+no release), ``ends="head"`` its first start on the take's first frame of motion (frame 0, or
+the first frame after a bind pose: a release with no onset); the other intervals stay between
+the two, as above.
+
 ``kind="cluster"`` injects *clusters of separate errors*: inside a window of up to 0.6 s, 2–4
 pieces, each a single-frame flip (half of them) or a hold of 2 frames up to 0.15 s, with its own
 offset of ±20–90° (independent signs) and its own child mismatch ε in ±0.2, separated by 1 frame
@@ -39,12 +44,23 @@ from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.errors import InputError
 from mocapqa.kinematics.quaternion import multiply, quats_from_axis_angle
 from mocapqa.twist.angles import ChainGeometry, chain_geometry
+from mocapqa.twist.detect import leading_pose_frames
 from mocapqa.twist.refine import refine_quats
 
-__all__ = ["KINDS", "InjectedInterval", "InjectionTruth", "choose_targets", "inject_twist_errors"]
+__all__ = [
+    "ENDS",
+    "KINDS",
+    "InjectedInterval",
+    "InjectionTruth",
+    "choose_targets",
+    "inject_twist_errors",
+]
 
 KINDS = ("level", "burst", "cluster")
 """The injected error shapes (``kind`` of :func:`inject_twist_errors`)."""
+ENDS = ("", "head", "tail")
+"""Where one interval per target is forced (``ends`` of :func:`inject_twist_errors`): nowhere,
+starting on the take's first frame of motion, or ending on its last frame."""
 
 TARGET_SEGMENTS = ("clavicle", "upper_arm", "forearm", "upper_leg", "lower_leg")
 _LIMB = {"clavicle": "arm", "upper_arm": "arm", "forearm": "arm", "upper_leg": "leg",
@@ -150,6 +166,23 @@ def _place_intervals(
     return out
 
 
+def _place_with_end(
+    rng: np.random.Generator, n_frames: int, count: int, max_length: int, ends: str, first: int
+) -> list[tuple[int, int]]:
+    """As :func:`_place_intervals`, with one interval ending on frame F − 1 (``ends="tail"``) or
+    starting on frame ``first`` (``"head"``) and the others inside, a clean frame apart."""
+    if not ends:
+        return _place_intervals(rng, n_frames, count, max_length)
+    span = n_frames - first
+    length = int(rng.integers(1, max_length + 1))
+    length = max(1, min(length, (span - 1) // 2))
+    inner = _place_intervals(rng, span - length, count - 1, max_length)
+    if ends == "tail":
+        return [(first + a, first + b) for a, b in inner] + [(n_frames - length, n_frames - 1)]
+    return [(first, first + length - 1)] + [(first + length + a, first + length + b)
+                                              for a, b in inner]  # fmt: skip
+
+
 def _burst_parts(
     rng: np.random.Generator, start: int, end: int, hold: int, tail_max: int
 ) -> list[tuple[int, int, float]]:
@@ -225,6 +258,7 @@ def inject_twist_errors(
     max_offset_deg: float = 180.0,
     mapping: dict[str, str] | None = None,
     kind: str = "level",
+    ends: str = "",
 ) -> tuple[Motion, InjectionTruth]:
     """Corrupt a take with level-shift twist errors.
 
@@ -248,6 +282,10 @@ def inject_twist_errors(
         The paper's level shifts, bursts of alternating flips, or clusters of separate flips
         and holds (see the module notes; for the last two the interval count is per burst or
         cluster and the offsets and lengths are their own).
+    ends : {"", "head", "tail"}
+        Force one interval per target to start on the first frame of motion (after a bind
+        pose, :func:`mocapqa.twist.detect.leading_pose_frames`) or to end on the last frame
+        (level shifts only).
 
     Returns
     -------
@@ -262,6 +300,8 @@ def inject_twist_errors(
     """
     if kind not in KINDS:
         raise InputError(f"Expected kind 'level', 'burst' or 'cluster', got {kind!r}")
+    if ends not in ENDS or (ends and kind != "level"):
+        raise InputError(f"Expected ends '', 'head' or 'tail' with kind 'level', got {ends!r}")
     if not (0 < min_offset_deg <= max_offset_deg <= 180.0):
         raise InputError(
             "Expected 0 < min_offset_deg ≤ max_offset_deg ≤ 180, got "
@@ -275,6 +315,7 @@ def inject_twist_errors(
     skeleton = motion.skeleton
     geometries = choose_targets(motion, rng, n_targets, mapping)
     n_frames, n_joints = motion.quats.shape[:2]
+    first = leading_pose_frames(motion.quats) if ends == "head" else 0
     chain_offsets = np.zeros((n_frames, len(geometries)))
     error_mask = np.zeros((n_frames, n_joints), dtype=bool)
     offsets_rad = np.zeros((n_frames, n_joints))
@@ -287,7 +328,7 @@ def inject_twist_errors(
         longest = {"level": max_interval_frames, "burst": 4 * hold + tail_max,
                    "cluster": max(3, round(0.6 * motion.fps))}[kind]  # fmt: skip
         parent = geometry.chain.parent
-        for start, end in _place_intervals(rng, n_frames, count, longest):
+        for start, end in _place_with_end(rng, n_frames, count, longest, ends, first):
             parts = [(start, end, 0.0)]
             if kind == "burst":
                 parts = _burst_parts(rng, start, end, hold, tail_max)

@@ -30,6 +30,17 @@ Conventions
   mirrors the parent's between them (:func:`mocapqa.twist.outside.split_unmirrored`); the
   bursts of a group split there are marked (feature ``split``), and every interval's
   ``unreturned`` feature reads, from the rolls outside it, how much twist offset its end leaves.
+* *One-sided intervals* (:func:`one_sided`): an error that runs to the take's last frame has an
+  onset and no release; one that starts before the take's first frame has a release and no
+  onset. The counter-rotation at that one event is the same evidence as at an interior onset,
+  so the first or last event of a chain, when it belongs to no group, lies within
+  ``max_interval_s`` of the take's end and no other event lies within ``burst_gap_s`` of it,
+  forms the interval ``[onset, last frame]`` or ``[first frame, release − 1]`` with the event's
+  jump as its level — when the level holds: next to the event, the parent's and the child's
+  rolls (taken off their natural travel) step by the jump and its mirror against the natural
+  side (within ``agreement`` of the jump, and ``|wrap(P + C)| ≤`` :data:`_END_MIRROR` ``×
+  min(|P|, |C|)``), and the jump stands out against the parent's steps beside it. A natural
+  step that is not held, or that the child does not keep counter-rotating, fails that test.
 """
 
 from __future__ import annotations
@@ -42,7 +53,7 @@ from mocapqa.core.arrays import FloatArray, IntArray
 from mocapqa.twist.angles import wrap_angle
 from mocapqa.twist.outside import anchors, forbidden_frames, hermite_deviation, split_unmirrored
 
-__all__ = ["FEATURES", "IntervalEstimate", "chain_intervals"]
+__all__ = ["FEATURES", "IntervalEstimate", "chain_intervals", "one_sided"]
 
 FEATURES = (
     "log_jump_ratio",
@@ -76,12 +87,17 @@ class IntervalEstimate:
         Circular mean of the level over the interval, radians.
     features : tuple of float
         The values named by :data:`FEATURES`.
+    side : {"", "head", "tail"}
+        "" for an interval between two events; "head" for one from the take's first frame
+        to a release with no onset, "tail" for one from an onset with no release to the
+        take's last frame.
     """
 
     start_frame: int
     end_frame: int
     offset_rad: float
     features: tuple[float, ...]
+    side: str = ""
 
 
 def _closes(
@@ -187,6 +203,42 @@ def _groups(
     return merged
 
 
+def _free_first_release(
+    frames: IntArray,
+    jumps: FloatArray,
+    groups: list[list[int]],
+    threshold: float,
+    closure_fraction: float,
+    max_frames: int,
+) -> list[list[int]]:
+    """Groups with the take's first event freed when it reads better as a release with no
+    onset.
+
+    Bracket matching pairs the chain's first event A with the next one B whenever their jumps
+    cancel, but near the start A may be the release of an error the take began with and B the
+    onset of another interval. When the first group is exactly A and B, A lies within
+    ``max_frames`` of frame 0, and a later event C that no group holds, before any other group,
+    cancels B (within the closure tolerance) and lies within ``max_frames`` of it, both readings
+    fit the jumps: A–B an interval (and C an unmatched event), or A the release of a head and
+    B–C an interval. An onset and the release of one error read the same jump twice, so the
+    pair that cancels better is taken: B is paired with C, and A left for :func:`one_sided`,
+    only when ``|wrap(B + C)| < |wrap(A + B)|``.
+    """
+    if not groups or groups[0] != [0, 1] or frames[0] > max_frames:
+        return groups
+    held = {k for g in groups for k in g}
+    stop = frames[min(groups[1])] if len(groups) > 1 else np.inf
+    for k in range(2, len(frames)):
+        if frames[k] > stop or frames[k] - frames[1] > max_frames:
+            break
+        net = float(wrap_angle(np.array(jumps[1] + jumps[k])))
+        largest = max(abs(float(jumps[1])), abs(float(jumps[k])))
+        if k not in held and _closes(net, largest, threshold, closure_fraction):
+            first = abs(float(wrap_angle(np.array(jumps[0] + jumps[1]))))
+            return [[1, k], *groups[1:]] if abs(net) < first else groups
+    return groups
+
+
 def _spread(values: FloatArray) -> float:
     """Robust scale (1.4826 × median absolute deviation from the circular mean) of angles."""
     centre = np.angle(np.mean(np.exp(1j * values)))
@@ -217,6 +269,174 @@ def _unreturned(
     return min(abs(p_net), abs(c_net)) if p_net * c_net < 0 else 0.0
 
 
+_END_MIRROR = 0.25
+"""Tolerance of the child's mirror at a one-sided interval's event, as a fraction of the
+smaller level (half the events' own ``consistency``: one event carries no closure)."""
+
+
+def _held_level(roll: FloatArray, natural: FloatArray, stretch: slice, reference: slice) -> float:
+    """The roll's level over ``stretch`` against its level over ``reference``, each taken off
+    its natural travel (the natural increments summed), radians: circular means, wrapped."""
+    off = roll - np.cumsum(natural)
+    levels = [np.angle(np.mean(np.exp(1j * off[s]))) for s in (stretch, reference)]
+    return float(wrap_angle(np.array(levels[0] - levels[1])))
+
+
+def one_sided(
+    frames: IntArray,
+    jumps: FloatArray,
+    mismatch: FloatArray,
+    groups: list[list[int]],
+    parent: tuple[FloatArray, FloatArray],
+    child: tuple[FloatArray, FloatArray],
+    threshold: float,
+    scale: float,
+    fps: float,
+    burst_gap: int,
+    max_frames: int,
+    agreement: float,
+    mirror: float,
+    contrast: float,
+    closure_fraction: float = 0.2,
+) -> list[IntervalEstimate]:
+    """Intervals that run to an end of the take: an onset with no release, a release with no
+    onset.
+
+    The chain's last event (for a *tail*) or first event (for a *head*) qualifies when it
+    belongs to no group, no other event lies within ``burst_gap`` frames of it, and it lies
+    within ``max_frames`` of the take's end on its side. Its level is held when the parent's
+    level over up to ``burst_gap`` frames on the event's error side, against its level over up
+    to ``burst_gap`` frames from the anchor on the natural side outwards (the frame before an
+    onset, the frame of a release; moved past other intervals and events), each roll taken off
+    its natural travel, is within ``agreement`` × |jump| of the level the jump implies, and
+    the child's mirrors it (``|wrap(P + C)| ≤ mirror × min(|P|, |C|)``). A held event gives
+    the interval ``[onset, F − 1]`` at level ``jump`` or ``[0, release − 1]`` at level
+    ``−jump``.
+
+    One event is weaker evidence than an onset and a release that cancel, so the jump must
+    also be at least ``contrast`` times every raw roll step of the parent within ``burst_gap``
+    frames of it: the peak of a fast natural roll that the child partly counter-rotates (an
+    arm rolling 2–9° per frame, its forearm rolling back) is not an onset. The child's own
+    roll beside it is not compared: a foot or hand turning under a still calf or forearm does
+    not make the parent's step any less of a step.
+
+    Parameters
+    ----------
+    frames : ndarray of int, shape (E,)
+        Event frames, increasing, all ≥ 1.
+    jumps, mismatch : ndarray, shape (E,)
+        Jump of each event (radians) and its counter-rotation mismatch ratio.
+    groups : list of list of int
+        Event indices of each interval between events.
+    parent, child : tuple of ndarray, each shape (F,)
+        Integrated roll and natural roll increments of the parent and of the child, radians.
+    threshold, scale : float
+        Jump threshold and natural roll scale per frame of the chain, radians.
+    fps : float
+        Frames per second.
+    burst_gap, max_frames : int
+        Largest gap inside a cluster and longest level shift, frames.
+    agreement, mirror : float
+        Tolerances of the held level (fraction of the jump) and of the child's mirror
+        (fraction of the smaller level). An unmatched event on the side away from the end,
+        within ``max_frames``, whose jump cancels this one's within ``agreement`` of the
+        larger also rules it out (the two ends of one interval that read differently).
+    contrast : float
+        Smallest ratio of the jump to the largest raw roll step of the parent beside it.
+    closure_fraction : float
+        An event whose jump cancels, to this fraction of its own jump, the net jump of the
+        burst next to it on the side away from the take's end (events each within
+        ``burst_gap`` of the next, the nearest within ``max_frames``), a burst whose own jumps
+        do not cancel, is that burst's release (onset) and forms no one-sided interval.
+
+    Returns
+    -------
+    list of IntervalEstimate
+        At most one head and one tail; their ``features`` are those of an interior level shift
+        whose other end the take cut off: the one end jump, its mismatch, closure 0, the
+        disagreement of the held level with the jump, the duration, the level, split 0 and
+        unreturned 0.
+    """
+    n_frames = len(parent[0])
+    found: list[IntervalEstimate] = []
+    if len(frames) == 0:
+        return found
+    grouped = np.zeros(len(frames), dtype=bool)
+    grouped[[k for g in groups for k in g]] = True
+    taken = -1
+    for side, k in (("tail", len(frames) - 1), ("head", 0)):
+        frame = int(frames[k])
+        reach = n_frames - frame if side == "tail" else frame
+        near = frames[np.abs(frames - frame) <= burst_gap]
+        if k == taken or grouped[k] or len(near) > 1 or reach > max_frames:
+            continue
+        # The anchor on the event's natural side, moved past the other intervals and events.
+        forbidden = forbidden_frames(frames, [*groups, [k]], n_frames, burst_gap)
+        before, after = anchors(forbidden, frame, frame)
+        jump = float(jumps[k])
+        beside = np.r_[max(frame - burst_gap, 1) : frame, frame + 1 : min(frame + burst_gap + 1,
+                                                                            n_frames)]  # fmt: skip
+        steps = np.abs(wrap_angle(parent[0][beside] - parent[0][beside - 1]))
+        if abs(jump) < contrast * float(np.max(steps, initial=0.0)):
+            continue
+        # An event that cancels the net jump of the burst next to it (the events before a
+        # tail's onset, or after a head's release, each within burst_gap of the next; the
+        # nearest within max_frames), a burst whose own jumps do not cancel, is that burst's
+        # release (onset): a burst whose last holds made no event.
+        order = np.arange(k - 1, -1, -1) if side == "tail" else np.arange(k + 1, len(frames))
+        if len(order) and abs(int(frames[order[0]]) - frame) <= max_frames:
+            burst = order[: 1 + int(np.argmax(np.append(np.abs(np.diff(frames[order])) > burst_gap,
+                                                           True)))]  # fmt: skip
+            net = float(wrap_angle(np.array(np.sum(jumps[burst]))))
+            together = abs(float(wrap_angle(np.array(net + jump))))
+            if len(burst) >= 2 and together <= closure_fraction * abs(jump) < abs(net):
+                continue
+        # An unmatched event on that side whose jump nearly cancels this one (within
+        # ``agreement`` of the larger): more likely the two ends of one interval that read
+        # differently than an error running to the take's end.
+        loose = np.flatnonzero(
+            ~grouped
+            & (np.abs(frames - frame) <= max_frames)
+            & ((frames < frame) == (side == "tail"))
+            & (frames != frame)
+        )
+        sizes = np.maximum(np.abs(jumps[loose]), abs(jump))
+        if np.any(np.abs(wrap_angle(jumps[loose] + jump)) <= agreement * sizes):
+            continue
+        # The level is read next to the event, up to burst_gap frames on each side: on the
+        # error side from the event on, on the natural side from the anchor outwards (a
+        # single frame may hold a one-frame natural counter-rotation of the child, and far
+        # from the event the natural travel near the take's end is read less well).
+        if side == "tail":
+            stretch, level = slice(frame, n_frames), jump
+            held = slice(frame, min(frame + burst_gap, n_frames))
+            reference = slice(max(before - burst_gap + 1, 0), before + 1)
+        else:
+            stretch, level = slice(0, frame), -jump
+            held = slice(max(frame - burst_gap, 0), frame)
+            reference = slice(after, min(after + burst_gap, n_frames))
+        p_level, c_level = (_held_level(r, n, held, reference) for r, n in (parent, child))
+        gap = abs(float(wrap_angle(np.array(p_level - level))))
+        mirrored = abs(float(wrap_angle(np.array(p_level + c_level)))) <= mirror * min(
+            abs(p_level), abs(c_level)
+        )
+        if gap > agreement * abs(level) or not mirrored:
+            continue
+        taken = k
+        features = (
+            float(np.log(abs(jump) / scale)),
+            float(mismatch[k]),
+            0.0,
+            float(min(gap / max(abs(level), threshold), 2.0)),
+            float(np.log((stretch.stop - stretch.start) / fps)),
+            float(np.log(np.rad2deg(abs(level)))),
+            0.0,
+            0.0,
+        )
+        found.append(IntervalEstimate(stretch.start, stretch.stop - 1, level, features, side))
+    return found
+
+
 def chain_intervals(
     frames: IntArray,
     jumps: FloatArray,
@@ -236,6 +456,8 @@ def chain_intervals(
     precision: float = 0.0,
     child: tuple[FloatArray, FloatArray] | None = None,
     mirror: float = 0.0,
+    ends: bool = False,
+    end_contrast: float = 3.0,
 ) -> tuple[FloatArray, list[IntervalEstimate]]:
     """Offsets and intervals of one chain.
 
@@ -288,6 +510,11 @@ def chain_intervals(
         every stretch between them, the child's level measured from outside mirrors the
         parent's within this fraction of the smaller; otherwise its bursts stand alone and its
         lone events are left unmatched. 0: off.
+    ends : bool
+        With ``child``: also the intervals that run to an end of the take
+        (:func:`one_sided`; their tolerances are ``agreement`` and :data:`_END_MIRROR`).
+    end_contrast : float
+        With ``ends``: smallest ratio of the one event's jump to every raw roll step beside it.
 
     Returns
     -------
@@ -303,15 +530,40 @@ def chain_intervals(
     keep = frames >= 1
     frames, jumps, mismatch = frames[keep], jumps[keep], mismatch[keep]
     sigma = np.zeros(len(frames)) if uncertainty is None else np.asarray(uncertainty)[keep]
-    if len(frames) < 2:
+    if len(frames) < (1 if ends and child is not None else 2):
         return offsets, found
     burst_gap = max(1, round(burst_gap_s * fps))
     max_frames = max(2, round(max_interval_s * fps))
     tail_frames = max(0, round(tail_s * fps)) if small_steps is not None else 0
     roll = np.cumsum(increments)
     groups = _groups(frames, jumps, threshold, closure_fraction, burst_gap, max_frames, sigma)
-    split = [False] * len(groups)
     child_roll = None if child is None else (np.cumsum(child[0]), child[1])
+    if ends and child_roll is not None:
+        # A first (last) event paired with the next (previous) one may be a head's release
+        # (a tail's onset): re-paired only when it then forms that one-sided interval.
+        last = len(frames) - 1
+        for side in ("head", "tail"):
+            if side == "head":
+                freed = _free_first_release(
+                    frames, jumps, groups, threshold, closure_fraction, max_frames
+                )
+            else:
+                backwards = _free_first_release(
+                    n_frames - 1 - frames[::-1], -jumps[::-1],
+                    [[last - k for k in g[::-1]] for g in groups[::-1]],
+                    threshold, closure_fraction, max_frames,
+                )  # fmt: skip
+                freed = [[last - k for k in g[::-1]] for g in backwards[::-1]]
+            if freed != groups and any(
+                e.side == side
+                for e in one_sided(
+                    frames, jumps, mismatch, freed, (roll, natural), child_roll, threshold,
+                    scale, fps, burst_gap, max_frames, agreement, _END_MIRROR,
+                    end_contrast, closure_fraction,
+                )
+            ):  # fmt: skip
+                groups = freed
+    split = [False] * len(groups)
     if mirror > 0 and child_roll is not None:
         groups, split = split_unmirrored(
             frames, groups, (roll, child_roll[0]), (natural, child_roll[1]), burst_gap, mirror
@@ -368,10 +620,10 @@ def chain_intervals(
         if len(nonzero) == 0:
             continue
         applied = applied[nonzero[0] : nonzero[-1] + 1]
-        ends = min(abs(float(steps[0])), abs(float(steps[-1])))
+        end_jump = min(abs(float(steps[0])), abs(float(steps[-1])))
         unreturned = _unreturned((roll, natural), child_roll, before, after)
         features = (
-            float(np.log(ends / scale)),
+            float(np.log(end_jump / scale)),
             float(np.max(mismatch[group])),
             abs(net) / float(np.max(np.abs(steps))),
             float(min(disagreement, 2.0)),
@@ -383,4 +635,12 @@ def chain_intervals(
         level_mean = float(np.angle(np.mean(np.exp(1j * applied))))
         start, end = first + int(nonzero[0]), first + int(nonzero[-1])
         found.append(IntervalEstimate(start, end, level_mean, features))
+    if ends and child_roll is not None:
+        for estimate in one_sided(
+            frames, jumps, mismatch, groups, (roll, natural), child_roll, threshold, scale, fps,
+            burst_gap, max_frames, agreement, _END_MIRROR, end_contrast,
+            closure_fraction,
+        ):  # fmt: skip
+            offsets[estimate.start_frame : estimate.end_frame + 1] = estimate.offset_rad
+            found.append(estimate)
     return offsets, found
