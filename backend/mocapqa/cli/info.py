@@ -3,6 +3,9 @@
 Reading goes through :mod:`mocapqa.io.formats` (imported inside the commands, so that the CLI
 starts fast); ``info`` prints a Rich table, or JSON with ``--json``. For BVH it lists the rig
 roles found by :func:`mocapqa.core.rig.find_roles` and, as plainly, the roles it could not map.
+A C3D is read with :func:`mocapqa.io.c3d.read_c3d` (its analogs, events and first frame are
+listed too), and ``convert`` of a C3D to ``.c3d`` writes through the source, keeping its analogs,
+force plates and other parameters.
 """
 
 from __future__ import annotations
@@ -27,8 +30,15 @@ from mocapqa.errors import InputError, UnsupportedFormatError
 if TYPE_CHECKING:
     from mocapqa.core.keypoints import KeypointSequence
     from mocapqa.core.motion import Motion
+    from mocapqa.io.c3d import MarkerTake
 
-__all__ = ["convert_command", "info_command", "keypoints_summary", "motion_summary"]
+__all__ = [
+    "convert_command",
+    "info_command",
+    "keypoints_summary",
+    "marker_take_summary",
+    "motion_summary",
+]
 
 
 def motion_summary(
@@ -116,6 +126,46 @@ def keypoints_summary(seq: KeypointSequence, format_name: str) -> dict[str, Any]
     }
 
 
+def marker_take_summary(take: MarkerTake) -> dict[str, Any]:
+    """What a C3D take holds, as a JSON-ready dict.
+
+    Returns
+    -------
+    dict
+        Format, reader ("ezc3d" or "py-c3d"), frames, fps, duration (s), markers, length
+        unit, first frame (1-based, as stored), the share of missing frame × marker samples
+        (0–1), analog channels and their rate (None without channels), events (label, context,
+        time in s, 0-based frame), what the reader assumed, and the marker names.
+    """
+    seq = take.points
+    return {
+        "format": "c3d",
+        "reader": take.reader,
+        "frames": seq.n_frames,
+        "fps": seq.fps,
+        "duration_s": seq.duration_s,
+        "markers": seq.n_keypoints,
+        "length_unit": seq.length_unit,
+        "first_frame": take.first_frame,
+        "missing_fraction": seq.missing_fraction if seq.n_keypoints else 0.0,
+        "analog_channels": len(take.analog_labels),
+        "analog_rate": take.analog_rate,
+        "events": [
+            {"label": e.label, "context": e.context, "time_s": e.time_s, "frame": e.frame}
+            for e in take.events
+        ],
+        "assumptions": list(seq.assumptions),
+        "marker_names": list(seq.names),
+    }
+
+
+def _read_marker_take(path: Path) -> MarkerTake:
+    from mocapqa.config import get_settings
+    from mocapqa.io.c3d import read_c3d
+
+    return read_c3d(path, get_settings().read_limits)
+
+
 def _print_table(path: Path, summary: dict[str, Any]) -> None:
     from rich.console import Console
     from rich.table import Table
@@ -125,7 +175,7 @@ def _print_table(path: Path, summary: dict[str, Any]) -> None:
     table.add_column("value", overflow="fold")
     table.add_row("file", str(path))
     for key, value in summary.items():
-        if key in ("joint_names", "keypoint_names"):
+        if key in ("joint_names", "keypoint_names", "marker_names"):
             continue
         if key == "fps" or key == "duration_s":
             text = f"{value:.6g}"
@@ -144,6 +194,16 @@ def _print_table(path: Path, summary: dict[str, Any]) -> None:
                 if value
                 else "none"
             )
+        elif key == "events":
+            text = (
+                "\n".join(
+                    f"{e['label']} {e['context']} {e['time_s']:.3f} s (frame {e['frame']})"
+                    for e in value
+                )
+                or "none"
+            )
+        elif key == "analog_rate":
+            text = "none" if value is None else f"{value:.6g}"
         elif key == "limb_chains":
             text = "\n".join(value) or "none"
         elif key == "assumptions":
@@ -156,7 +216,7 @@ def _print_table(path: Path, summary: dict[str, Any]) -> None:
 
 @app.command("info")
 def info_command(
-    file: Annotated[Path, typer.Argument(help="A BVH or keypoint file (or OpenPose folder).")],
+    file: Annotated[Path, typer.Argument(help="A BVH, C3D or keypoint file (or OpenPose folder).")],
     json_output: Annotated[bool, typer.Option("--json", help="Print JSON instead.")] = False,
     fps: FpsOption = None,
     mapping: MappingOption = None,
@@ -170,6 +230,15 @@ def info_command(
         check_fps(fps, "--fps")
     roles = load_mapping(mapping)
     format_name = detect_format(file)
+    if format_name == "c3d":
+        if roles is not None:
+            raise InputError("Expected --mapping only for BVH input, got a c3d file")
+        summary = marker_take_summary(_read_marker_take(file))
+        if json_output:
+            typer.echo(json.dumps({"path": str(file), **summary}, indent=2))
+        else:
+            _print_table(file, summary)
+        return
     take = read_input(file, fps=fps, number_reader="auto", root_translation=root_translation)
     if isinstance(take, Motion):
         summary = motion_summary(take, roles, root_translation)
@@ -194,11 +263,18 @@ def convert_command(
     precision: Annotated[int, typer.Option(help="Decimal places of BVH channel values.")] = 6,
     mapping: MappingOption = None,
 ) -> None:
-    """Convert a take: BVH to BVH, keypoints between TRC, CSV, NPY, NPZ and JSON."""
+    """Convert a take: BVH to BVH, keypoints and C3D between TRC, CSV, NPY, NPZ, JSON and C3D."""
     from mocapqa.cli.outputs import check_outputs, take_input
     from mocapqa.core.motion import Motion
     from mocapqa.io.bvh_write import write_bvh
-    from mocapqa.io.formats import KEYPOINT_WRITE_FORMATS, check_fps, write_keypoints
+    from mocapqa.io.c3d import write_c3d
+    from mocapqa.io.formats import (
+        KEYPOINT_WRITE_FORMATS,
+        check_fps,
+        detect_format,
+        require_frames,
+        write_keypoints,
+    )
 
     if fps is not None:
         check_fps(fps, "--fps")
@@ -207,6 +283,23 @@ def convert_command(
     suffix = output.suffix.lower().lstrip(".")
     check_outputs({"-o": output}, [take_input(source), mapping], sidecars=True)
     roles = load_mapping(mapping)
+    if detect_format(source) == "c3d":
+        if roles is not None:
+            raise InputError("Expected --mapping only for BVH input, got a c3d file")
+        if suffix not in KEYPOINT_WRITE_FORMATS:
+            raise UnsupportedFormatError(
+                f"Expected a keypoint output among {', '.join(KEYPOINT_WRITE_FORMATS)}, "
+                f"got {output.name!r}"
+            )
+        markers = _read_marker_take(source)
+        if suffix == "c3d":
+            # Through the source (analogs, force plates, events kept) when ezc3d reads it.
+            write_c3d(output, markers, source if markers.reader == "ezc3d" else None)
+        else:
+            require_frames(markers.points, source)
+            write_keypoints(output, markers.points)
+        typer.echo(f"wrote {output} ({suffix}, {markers.points.n_frames} frames)")
+        return
     take = read_input(source, fps=fps, number_reader="auto")
     if isinstance(take, Motion):
         missing_roles(take.skeleton, roles)

@@ -2,13 +2,19 @@
 
 Conventions
 -----------
-* :func:`detect_format` looks at the extension first and sniffs the content to tell the
-  variants apart (OpenPose, MediaPipe or generic JSON; MediaPipe or generic CSV); a file with an
-  unknown extension is sniffed by its first bytes. A folder of OpenPose JSON is "openpose".
+* :func:`detect_format` looks at the extension first (``.c3d`` in any case; a C3D without it is
+  known by its second byte, 0x50, after a parameter block number of 2 or more) and sniffs the
+  content to tell the variants apart (OpenPose, MediaPipe or generic JSON; MediaPipe or
+  generic CSV); a file with an unknown extension is sniffed by its first bytes. A folder of
+  OpenPose JSON is "openpose".
 * :func:`read_take` returns a :class:`~mocapqa.core.motion.Motion` for BVH and a
-  :class:`~mocapqa.core.keypoints.KeypointSequence` for every keypoint format. ``fps`` and
+  :class:`~mocapqa.core.keypoints.KeypointSequence` for every keypoint format (a C3D's points:
+  :func:`mocapqa.io.c3d.read_c3d` gives the residuals, events and analogs too). ``fps`` and
   ``length_unit`` are used only where a format does not store them (see each reader).
-* :func:`write_keypoints` picks the writer from the extension (or ``format``).
+* :func:`write_keypoints` picks the writer from the extension (or ``format``); a ``.c3d``
+  written from a keypoint sequence has its points only (residual 0 where present, −1 where
+  missing): ``mocapqa convert`` of a C3D writes with :func:`mocapqa.io.c3d.write_c3d` and the
+  source instead, keeping analogs and parameters.
 * Unknown formats raise :class:`~mocapqa.errors.UnsupportedFormatError`.
 """
 
@@ -21,11 +27,14 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Literal
 
+import numpy as np
+
 from mocapqa.core.bounds import MAX_FPS, MIN_FPS
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError, ParseError, UnsupportedFormatError
 from mocapqa.io.bvh import NumberReader, read_bvh
+from mocapqa.io.c3d import MarkerTake, read_c3d, write_c3d
 from mocapqa.io.guards import ReadLimits, check_take_input, check_take_size
 from mocapqa.io.keypoint_arrays import (
     read_keypoint_npy,
@@ -63,10 +72,10 @@ KEYPOINT_FORMATS: tuple[str, ...] = (
     "npz",
     "json",
 )
-# Every format read_take accepts.
-TAKE_FORMATS: tuple[str, ...] = ("bvh", *KEYPOINT_FORMATS)
+# Every format read_take accepts: a C3D's markers are read as keypoints.
+TAKE_FORMATS: tuple[str, ...] = ("bvh", *KEYPOINT_FORMATS, "c3d")
 # Formats write_keypoints can write, by file extension.
-KEYPOINT_WRITE_FORMATS: tuple[str, ...] = ("trc", "csv", "npy", "npz", "json")
+KEYPOINT_WRITE_FORMATS: tuple[str, ...] = ("trc", "csv", "npy", "npz", "json", "c3d")
 
 _SNIFF_BYTES = 4096
 _PARSE_TO_DETECT_BYTES = 1_000_000
@@ -76,6 +85,7 @@ _BY_EXTENSION = {
     ".npy": "npy",
     ".npz": "npz",
     ".pbtxt": "mediapipe-pbtxt",
+    ".c3d": "c3d",
 }
 
 
@@ -137,6 +147,8 @@ def _sniff(path: Path) -> str | None:
         return "npy"
     if head.startswith(b"PK\x03\x04"):
         return "npz"
+    if len(head) >= 512 and head[1] == 0x50 and head[0] >= 2:
+        return "c3d"
     if stripped[:1] in (b"{", b"["):
         return _json_kind(path)
     if stripped.startswith(b"# proto-") or stripped.startswith(b"landmarks {"):
@@ -162,7 +174,7 @@ def detect_format(path: str | Path, display_name: str | None = None) -> str:
     -------
     str
         One of :data:`TAKE_FORMATS`: "bvh", "trc", "openpose", "mediapipe-csv",
-        "mediapipe-json", "mediapipe-pbtxt", "csv", "npy", "npz" or "json".
+        "mediapipe-json", "mediapipe-pbtxt", "csv", "npy", "npz", "json" or "c3d".
 
     Raises
     ------
@@ -337,6 +349,8 @@ def _read(
         )
     if kind == "trc":
         return read_trc(path)
+    if kind == "c3d":
+        return read_c3d(path, limits).points
     if kind == "openpose":
         return read_openpose(path, fps=fps, person_index=person_index)
     if kind == "mediapipe-pbtxt":
@@ -379,6 +393,7 @@ def write_keypoints(path: str | Path, seq: KeypointSequence, format: str | None 
         "npy": write_keypoint_npy,
         "npz": write_keypoint_npz,
         "json": write_keypoint_json,
+        "c3d": _write_keypoints_c3d,
     }
     if kind not in writers:
         raise UnsupportedFormatError(
@@ -386,3 +401,24 @@ def write_keypoints(path: str | Path, seq: KeypointSequence, format: str | None 
             f"got {kind or 'no extension'!r} for {path.name!r}"
         )
     writers[kind](path, seq)
+
+
+def _write_keypoints_c3d(path: Path, seq: KeypointSequence) -> None:
+    """A keypoint sequence as a new C3D: residual 0 where present, −1 where missing."""
+    if seq.n_dims != 3:
+        raise UnsupportedFormatError(
+            f"Expected 3D keypoints for a C3D output, got {seq.n_dims}D for {path.name!r}"
+        )
+    missing = seq.confidence <= 0
+    take = MarkerTake(
+        points=seq,
+        residuals=np.where(missing, -1.0, 0.0),
+        camera_masks=np.zeros(missing.shape, dtype=np.intp),
+        descriptions=(),
+        first_frame=seq.start_frame if seq.start_frame is not None and seq.start_frame > 0 else 1,
+        events=(),
+        analog_rate=None,
+        analog_labels=(),
+        reader="",
+    )
+    write_c3d(path, take)

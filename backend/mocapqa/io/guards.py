@@ -23,6 +23,7 @@ from __future__ import annotations
 import codecs
 import math
 import re
+import struct
 import tokenize
 import zipfile
 from dataclasses import dataclass
@@ -36,14 +37,17 @@ from mocapqa.errors import ParseError, TooLargeError
 __all__ = [
     "JSON_FORMATS",
     "TEXT_FORMATS",
+    "C3DHeader",
     "NpyHeader",
     "ReadLimits",
+    "check_c3d_header",
     "check_frame_points",
     "check_json_depth",
     "check_line_length",
     "check_take_input",
     "check_take_size",
     "json_nesting",
+    "read_c3d_header",
     "read_npy_header",
 ]
 
@@ -404,6 +408,177 @@ def check_frame_points(path: str | Path, kind: str, limits: ReadLimits) -> None:
             )
 
 
+@dataclass(frozen=True, slots=True)
+class C3DHeader:
+    """What a C3D file's 512-byte header declares.
+
+    Parameters
+    ----------
+    parameter_block : int
+        1-based 512-byte block where the parameter section starts.
+    parameter_blocks : int
+        Blocks in the parameter section, as the section's first bytes say (some writers
+        write too few: readers walk the records instead).
+    processor : int
+        84 Intel, 85 DEC, 86 MIPS (big-endian).
+    n_points : int
+        Points per frame.
+    analog_per_frame : int
+        Analog samples (all channels) per point frame.
+    first_frame, last_frame : int
+        1-based frame numbers, as stored.
+    scale : float
+        ``POINT:SCALE`` as the header holds it: negative for float storage.
+    data_block : int
+        1-based block where the data start.
+    frame_rate : float
+        Point frames per second.
+    file_size : int
+        Bytes in the file.
+    """
+
+    parameter_block: int
+    parameter_blocks: int
+    processor: int
+    n_points: int
+    analog_per_frame: int
+    first_frame: int
+    last_frame: int
+    scale: float
+    data_block: int
+    frame_rate: float
+    file_size: int
+
+    @property
+    def byte_order(self) -> str:
+        """``struct`` byte order of the file's integers."""
+        return ">" if self.processor == 86 else "<"
+
+    @property
+    def n_frames(self) -> int:
+        """Frames the header declares (``last − first + 1``)."""
+        return self.last_frame - self.first_frame + 1
+
+    @property
+    def data_bytes(self) -> int:
+        """Bytes of point and analog data the header declares."""
+        word = 4 if self.scale < 0 else 2
+        return self.n_frames * (4 * self.n_points + self.analog_per_frame) * word
+
+
+_C3D_PROCESSORS = {84: "Intel", 85: "DEC", 86: "MIPS"}
+
+
+def _c3d_float(raw: bytes, processor: int) -> float:
+    if processor == 86:
+        return float(struct.unpack(">f", raw)[0])
+    if processor == 85:  # DEC F-float: 16-bit halves swapped, exponent bias 2 higher
+        return float(struct.unpack("<f", raw[2:4] + raw[0:2])[0]) / 4.0
+    return float(struct.unpack("<f", raw)[0])
+
+
+def read_c3d_header(path: str | Path) -> C3DHeader:
+    """Read and check a C3D file's 512-byte header (and the processor byte after it).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+
+    Returns
+    -------
+    C3DHeader
+
+    Raises
+    ------
+    ParseError
+        On an empty or short file, a second byte other than 0x50, an unknown processor type,
+        a frame range or data start that cannot be, or data declared beyond the end of the
+        file.
+    """
+    path = Path(path)
+    try:
+        size = path.stat().st_size
+        with path.open("rb") as handle:
+            head = handle.read(512)
+            parameter_block = head[0] if head else 0
+            handle.seek(max(parameter_block - 1, 0) * 512)
+            section_head = handle.read(4)
+    except OSError as e:
+        raise ParseError(f"Expected a readable file, got {e.strerror or e}", path) from e
+    if size == 0:
+        raise ParseError("Expected a C3D file, got an empty file", path)
+    if len(head) < 512:
+        raise ParseError(f"Expected a 512-byte C3D header, got {len(head)} bytes", path)
+    if head[1] != 0x50:
+        raise ParseError(f"Expected a C3D file (second byte 0x50), got 0x{head[1]:02x}", path)
+    if parameter_block < 2 or len(section_head) < 4:
+        raise ParseError(
+            f"Expected a parameter section after the header, got block {parameter_block} of a "
+            f"{size}-byte file (truncated file?)",
+            path,
+        )
+    processor = section_head[3]
+    if processor not in _C3D_PROCESSORS:
+        raise ParseError(
+            f"Expected processor type 84 (Intel), 85 (DEC) or 86 (MIPS), got {processor}", path
+        )
+    order = ">" if processor == 86 else "<"
+    words = struct.unpack(f"{order}9H", head[2:20])
+    n_points, analog, first, last = words[0], words[1], words[2], words[3]
+    header = C3DHeader(
+        parameter_block=parameter_block,
+        parameter_blocks=section_head[2],
+        processor=processor,
+        n_points=n_points,
+        analog_per_frame=analog,
+        first_frame=first,
+        last_frame=last,
+        scale=_c3d_float(head[12:16], processor),
+        data_block=words[7],
+        frame_rate=_c3d_float(head[20:24], processor),
+        file_size=size,
+    )
+    if header.n_frames < 0:
+        raise ParseError(f"Expected a last frame from the first on, got {first} to {last}", path)
+    if not math.isfinite(header.scale) or (header.scale == 0 and n_points):
+        raise ParseError(f"Expected a non-zero POINT:SCALE, got {header.scale:g}", path)
+    data_start = (header.data_block - 1) * 512
+    if header.data_bytes and header.data_block <= parameter_block:
+        raise ParseError(
+            f"Expected the data to start after the parameters (block {parameter_block + 1} or "
+            f"later), got block {header.data_block}",
+            path,
+        )
+    if header.data_bytes and data_start + header.data_bytes > size:
+        raise ParseError(
+            f"Expected the {header.data_bytes} bytes of data the header declares "
+            f"({header.n_frames} frames), got {max(size - data_start, 0)} (truncated file?)",
+            path,
+        )
+    return header
+
+
+def check_c3d_header(header: C3DHeader, name: str, limits: ReadLimits) -> None:
+    """Refuse a C3D whose header declares more than ``limits``, before it is parsed.
+
+    Raises
+    ------
+    TooLargeError
+        Frames × points over ``max_frame_points``, or data bytes over ``max_unpacked_bytes``.
+    """
+    if header.n_frames * header.n_points > limits.max_frame_points:
+        raise TooLargeError(
+            f"{name}: Expected at most {limits.max_frame_points} frames × points (setting "
+            f"max_frame_points), got {header.n_frames} × {header.n_points}"
+        )
+    if header.data_bytes > limits.max_unpacked_bytes:
+        raise TooLargeError(
+            f"{name}: Expected at most {limits.max_unpacked_bytes} bytes of data (setting "
+            f"max_unpacked_bytes), got {header.data_bytes}"
+        )
+
+
 def check_take_input(path: str | Path, kind: str, limits: ReadLimits) -> None:
     """Refuse a take file (or OpenPose folder) that exceeds ``limits``, before reading it.
 
@@ -424,6 +599,9 @@ def check_take_input(path: str | Path, kind: str, limits: ReadLimits) -> None:
     path = Path(path)
     if kind in ("npy", "npz"):
         _check_arrays(path, kind, limits)
+        return
+    if kind == "c3d":
+        check_c3d_header(read_c3d_header(path), path.name, limits)
         return
     for file in _files(path):
         if kind in TEXT_FORMATS:

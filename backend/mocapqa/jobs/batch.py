@@ -54,7 +54,7 @@ __all__ = [
     "skip_reason",
 ]
 
-MOTION_SUFFIXES = (".bvh", ".trc", ".csv", ".json", ".npy", ".npz", ".pbtxt")
+MOTION_SUFFIXES = (".bvh", ".trc", ".c3d", ".csv", ".json", ".npy", ".npz", ".pbtxt")
 """File suffixes a batch analyses; other files under a folder are ignored."""
 SIDECAR_REASON = "a keypoint CSV's .meta.json sidecar (read with its CSV), not a take"
 """Why a batch skips a CSV's sidecar (a shoot import gives its own reason: it does not read it)."""
