@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -297,29 +298,69 @@ def _free_port() -> int:
         return int(sock.getsockname()[1])
 
 
-def test_batch_on_separate_scheduler_and_worker(corpus_copy: Path, tmp_path: Path) -> None:
+@contextlib.contextmanager
+def _cluster(tmp_path: Path, blind: bool = False) -> Iterator[str]:
+    """A ``dask scheduler`` and a one-process ``dask worker`` with the settings file as the
+    image installs it for the compose file's workers (/etc/dask); with ``blind``, the worker
+    runs in a mount namespace of its own where ``tmp_path`` (the client's takes and data
+    folders) is an empty tmpfs: a worker on another machine, as far as files go. Yields the
+    scheduler's address."""
     port = _free_port()
     address = f"tcp://127.0.0.1:{port}"
-    # The settings file as the image installs it for the compose file's workers (/etc/dask).
     env = {
         **_environment(tmp_path),
         "DASK_CONFIG": str(ROOT / "backend" / "mocapqa" / WORKER_CONFIG),
     }
     dask = str(Path(sys.executable).with_name("dask"))
-    scheduler = subprocess.Popen(
-        [dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
-        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-    )  # fmt: skip
-    worker = subprocess.Popen(
-        [dask, "worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard"],
-        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-    )  # fmt: skip
+    worker = [dask, "worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard"]
+    if blind:
+        script = 'mount -t tmpfs none "$1" && shift && exec "$@"'
+        worker = ["unshare", "--mount", "--propagation", "private", "sh", "-c", script, "sh",
+                  str(tmp_path), *worker]  # fmt: skip
+    processes = [
+        subprocess.Popen(
+            [dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
+            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        ),
+        subprocess.Popen(worker, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL),
+    ]  # fmt: skip
     try:
+        yield address
+    finally:
+        for process in reversed(processes):
+            process.terminate()
+        for process in reversed(processes):
+            try:
+                process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                process.kill()
+
+
+def _server_run(address: str, data_dir: Path, take: Path) -> tuple[dict[str, Any], int]:
+    """Upload ``take`` to a server whose runs go to the scheduler at ``address``; the finished
+    run and the status code of its result."""
+    settings = Settings(allowed_hosts=["testserver"], data_dir=data_dir, dask_scheduler=address)
+    with TestClient(create_app(settings)) as client:
+        with take.open("rb") as handle:
+            created = client.post("/api/v1/takes", files={"file": ("bow.bvh", handle)})
+        assert created.status_code == 201, created.text
+        run_id = created.json()["run_id"]
+        deadline = time.monotonic() + 300
+        run: dict[str, Any] = {"status": "queued"}
+        while run["status"] not in ("done", "failed") and time.monotonic() < deadline:
+            time.sleep(0.2)
+            run = client.get(f"/api/v1/runs/{run_id}").json()
+        return run, client.get(f"/api/v1/runs/{run_id}/result").status_code
+
+
+def test_batch_on_separate_scheduler_and_worker(corpus_copy: Path, tmp_path: Path) -> None:
+    with _cluster(tmp_path) as address:
         repository, shoots = _store(tmp_path)
         rows: list[dict[str, Any]] = []
         with Engine(scheduler=address) as remote:
             remote.client().wait_for_workers(1, timeout=120)
             assert set(remote.client().run(_worker_settings).values()) == {(None, False)}
+            assert remote.shares_disk(corpus_copy / "cmu_12_01_walk.bvh", tmp_path / "d")
             counts = run_batch(
                 [corpus_copy], shoots, AnalysisOptions(), rows.append, remote, tmp_path / "d"
             )
@@ -327,30 +368,10 @@ def test_batch_on_separate_scheduler_and_worker(corpus_copy: Path, tmp_path: Pat
         assert repository.list_takes()[1] == 4
         repository.close()
         # The server sends its runs to the same cluster when MOCAPQA_DASK_SCHEDULER is set.
-        settings = Settings(
-            allowed_hosts=["testserver"], data_dir=tmp_path / "server", dask_scheduler=address
-        )
-        with TestClient(create_app(settings)) as client:
-            with (corpus_copy / Path(TAKES[0]).name).open("rb") as handle:
-                created = client.post("/api/v1/takes", files={"file": ("bow.bvh", handle)})
-            assert created.status_code == 201, created.text
-            run_id = created.json()["run_id"]
-            deadline = time.monotonic() + 300
-            run: dict[str, Any] = {"status": "queued"}
-            while run["status"] not in ("done", "failed") and time.monotonic() < deadline:
-                time.sleep(0.2)
-                run = client.get(f"/api/v1/runs/{run_id}").json()
-            assert run["status"] == "done", run
-            assert run["summary"]["qa"]["score"] is not None
-            assert client.get(f"/api/v1/runs/{run_id}/result").status_code == 200
-    finally:
-        for process in (worker, scheduler):
-            process.terminate()
-        for process in (worker, scheduler):
-            try:
-                process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                process.kill()
+        run, result = _server_run(address, tmp_path / "server", corpus_copy / Path(TAKES[0]).name)
+        assert run["status"] == "done", run
+        assert run["summary"]["qa"]["score"] is not None
+        assert result == 200
 
 
 def test_batch_uses_the_shoot_limits_model(engine: Engine, cmu_walk: Path, tmp_path: Path) -> None:
@@ -385,39 +406,13 @@ def test_batch_uses_the_shoot_limits_model(engine: Engine, cmu_walk: Path, tmp_p
     repository.close()
 
 
-def _blind_worker(address: str, hidden: Path, env: dict[str, str]) -> subprocess.Popen[bytes]:
-    """A ``dask worker`` in a mount namespace of its own, where ``hidden`` (the client's takes
-    and data folder) is an empty tmpfs: a worker on another machine, as far as files go."""
-    dask = str(Path(sys.executable).with_name("dask"))
-    script = (
-        'mount -t tmpfs none "$1" && exec "$2" worker "$3" --nworkers 1 --nthreads 1 --no-dashboard'
-    )
-    return subprocess.Popen(
-        ["unshare", "--mount", "--propagation", "private", "sh", "-c", script, "sh",
-         str(hidden), dask, address],
-        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-    )  # fmt: skip
-
-
 def test_batch_and_server_runs_on_a_worker_that_shares_no_disk(
     corpus_copy: Path, tmp_path: Path
 ) -> None:
     """A worker that sees neither the takes nor the data folder is sent each take's bytes and
     sends the run's files back: every take is done, with the same report as the single-take
     analysis, and the server's runs on that cluster too."""
-    port = _free_port()
-    address = f"tcp://127.0.0.1:{port}"
-    env = {
-        **_environment(tmp_path),
-        "DASK_CONFIG": str(ROOT / "backend" / "mocapqa" / WORKER_CONFIG),
-    }
-    dask = str(Path(sys.executable).with_name("dask"))
-    scheduler = subprocess.Popen(
-        [dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
-        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-    )  # fmt: skip
-    worker = _blind_worker(address, tmp_path, env)
-    try:
+    with _cluster(tmp_path, blind=True) as address:
         repository, shoots = _store(tmp_path)
         data = tmp_path / "d"
         rows: list[dict[str, Any]] = []
@@ -441,27 +436,7 @@ def test_batch_and_server_runs_on_a_worker_that_shares_no_disk(
                 data / "runs" / run_id / "report.json"
             ) == _report_without_timings(alone_store.run_dir(run_id) / "report.json")
         repository.close()
-        settings = Settings(
-            allowed_hosts=["testserver"], data_dir=tmp_path / "server", dask_scheduler=address
-        )
-        with TestClient(create_app(settings)) as client:
-            with (corpus_copy / Path(TAKES[0]).name).open("rb") as handle:
-                created = client.post("/api/v1/takes", files={"file": ("bow.bvh", handle)})
-            assert created.status_code == 201, created.text
-            run_id = created.json()["run_id"]
-            deadline = time.monotonic() + 300
-            run: dict[str, Any] = {"status": "queued"}
-            while run["status"] not in ("done", "failed") and time.monotonic() < deadline:
-                time.sleep(0.2)
-                run = client.get(f"/api/v1/runs/{run_id}").json()
-            assert run["status"] == "done", run
-            assert client.get(f"/api/v1/runs/{run_id}/result").status_code == 200
-            assert (tmp_path / "server" / "runs" / run_id / "points.npz").is_file()
-    finally:
-        for process in (worker, scheduler):
-            process.terminate()
-        for process in (worker, scheduler):
-            try:
-                process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                process.kill()
+        run, result = _server_run(address, tmp_path / "server", corpus_copy / Path(TAKES[0]).name)
+        assert run["status"] == "done", run
+        assert result == 200
+        assert (tmp_path / "server" / "runs" / run["id"] / "points.npz").is_file()
