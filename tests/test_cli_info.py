@@ -235,7 +235,7 @@ def test_the_command_table_names_every_command_s_module() -> None:
     for path, module in commands.items():
         assert module in modules_for(path.split()), path
     # Groups load their module for their own help; every other key is a command.
-    groups_keys = {"limits", "users", "tokens", "db", "feet"}
+    groups_keys = {"limits", "users", "tokens", "db", "feet", "markers"}
     assert set(COMMAND_MODULES) - set(commands) == groups_keys
     assert all(path.split()[0] in groups_keys for path in set(commands) - set(COMMAND_MODULES))
 

@@ -1,0 +1,209 @@
+"""PCA-intercorrelation fill of one marker gap (Gløersen & Federolf 2016).
+
+Gløersen Ø, Federolf P (2016), "Predicting missing marker trajectories in human motion data using
+marker intercorrelations", PLoS One 11(3): e0152616. Conventions as in
+:mod:`mocapqa.markers.fill_methods`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.markers.fill_methods import anchor, frames_around, recorded_around
+
+__all__ = ["PcaModel", "pca_fill", "pca_model"]
+
+
+@dataclass(frozen=True, slots=True)
+class PcaModel:
+    """The normalised, weighted training matrix of a PCA fill (see :func:`pca_model`).
+
+    Parameters
+    ----------
+    cols : ndarray of int, shape (K + 1,)
+        The target marker followed by the model markers.
+    train : ndarray of int, shape (N,)
+        Training frames, increasing.
+    z : ndarray, shape (N, 3 (K + 1))
+        Normalised, weighted coordinates of the training frames.
+    gram : ndarray, shape (3 (K + 1), 3 (K + 1))
+        ``z.T @ z``.
+    mean, sd, weight : ndarray, shape (3 (K + 1),)
+        Per-coordinate mean and standard deviation (file units) and marker weight.
+    """
+
+    cols: IntArray
+    train: IntArray
+    z: FloatArray
+    gram: FloatArray
+    mean: FloatArray
+    sd: FloatArray
+    weight: FloatArray
+
+
+def pca_model(
+    positions: FloatArray,
+    visible: BoolArray,
+    m: int,
+    model: IntArray,
+    *,
+    exclude: tuple[int, int],
+    weight_scale: float,
+    max_train: int,
+) -> PcaModel | None:
+    """Training matrix of the PCA fill of marker ``m`` from the ``model`` markers.
+
+    Parameters
+    ----------
+    positions : ndarray, shape (F, M, 3)
+        Marker positions in file units, NaN where missing.
+    visible : ndarray of bool, shape (F, M)
+        Where ``positions`` holds a sample.
+    m : int
+        Target marker.
+    model : ndarray of int, shape (K,)
+        The other markers of the model.
+    exclude : tuple of int
+        First and last frame left out of training (the gap).
+    weight_scale : float
+        Distance (file units) of the marker weights' fall-off.
+    max_train : int
+        Most training frames used (evenly spaced).
+
+    Returns
+    -------
+    PcaModel or None
+        None without model markers or with fewer training frames than coordinates.
+    """
+    if model.size == 0:
+        return None
+    cols = np.concatenate(([m], model)).astype(np.intp)
+    train_ok: BoolArray = np.asarray(visible[:, cols].all(axis=1))
+    train_ok[exclude[0] : exclude[1] + 1] = False
+    train = np.flatnonzero(train_ok)
+    p = 3 * cols.size
+    if train.size < max(p, 10):
+        return None
+    if train.size > max_train:
+        train = train[np.linspace(0, train.size - 1, max_train).round().astype(np.intp)]
+    xyz = positions[train[:, None], cols]
+    x = xyz.reshape(train.size, p)
+    mean = x.mean(axis=0)
+    sd = x.std(axis=0)
+    sd[sd == 0] = 1.0
+    dist = np.linalg.norm(xyz - xyz[:, :1], axis=2).mean(axis=0)
+    weight = np.repeat(np.exp(-((dist / weight_scale) ** 2)), 3)
+    z = (x - mean) / sd * weight
+    return PcaModel(cols, train, z, z.T @ z, mean, sd, weight)
+
+
+def pca_fill(
+    positions: FloatArray,
+    visible: BoolArray,
+    m: int,
+    a: int,
+    b: int,
+    model: IntArray,
+    *,
+    weight_scale: float,
+    variance: float,
+    max_train: int,
+    window: int,
+    smooth: bool = False,
+    hidden: tuple[int, int] | None = None,
+    fitted: PcaModel | None = None,
+    before: bool = True,
+    after: bool = True,
+) -> FloatArray | None:
+    """Fill a gap from the take's marker intercorrelations (Gløersen & Federolf 2016).
+
+    The frames where the target and every model marker are visible (outside ``a..b`` and
+    ``hidden``, at most ``max_train`` evenly spaced) are normalised per coordinate (mean and
+    standard deviation) and weighted per marker by ``exp(-(d / weight_scale)²)``, ``d`` the
+    marker's mean distance to the target, so that nearby markers dominate. A PCA of that matrix
+    keeps the components that explain ``variance`` of it. In the gap, the target's coordinates
+    are reconstructed from the visible model markers' weighted coordinates as their conditional
+    mean under the probabilistic PCA model (the kept components plus isotropic noise at the
+    discarded ones' mean variance): the paper's least-squares fit of the component scores,
+    with weak components shrunk rather than trusted fully. Frames where other markers are
+    missing too are handled by the choice of ``model`` (markers visible over the gap) and of the
+    training frames (where all of them are visible). The result is corrected by its errors
+    either side of the gap (:func:`~mocapqa.markers.fill_methods.anchor`).
+
+    Parameters
+    ----------
+    positions : ndarray, shape (F, M, 3)
+        Marker positions in file units, NaN where missing.
+    visible : ndarray of bool, shape (F, M)
+        Where ``positions`` holds a sample.
+    m, a, b : int
+        Marker index and first and last missing frame (inclusive).
+    model : ndarray of int, shape (K,)
+        The other markers of the model, visible over ``a..b``.
+    weight_scale : float
+        Distance (file units) of the marker weights' fall-off.
+    variance : float
+        Share of the weighted, normalised variance the kept components explain, in (0, 1].
+    max_train : int
+        Most training frames used.
+    window : int
+        Frames either side of the gap whose errors correct the prediction.
+    smooth : bool
+        Correct by a cubic spline of the errors rather than the boundary errors' linear blend.
+    hidden : tuple of int, optional
+        Another stretch of the target (first, last frame) to leave out of training.
+    fitted : PcaModel, optional
+        A training matrix of the same target and model built by :func:`pca_model` (its
+        training frames inside ``a..b`` and ``hidden`` are taken out); built here when omitted.
+    before, after : bool
+        Whether samples before ``a`` / after ``b`` may be used.
+
+    Returns
+    -------
+    ndarray, shape (b - a + 1, 3), or None
+        None without model markers, with fewer training frames than coordinates, or when a
+        model marker is missing in the gap.
+    """
+    n = positions.shape[0]
+    times, _, _ = frames_around(n, a, b, window, before, after)
+    if model.size == 0:
+        return None
+    times = times[visible[times[:, None], model].all(axis=1)]
+    if np.count_nonzero((times >= a) & (times <= b)) < b - a + 1:
+        return None
+    if fitted is None:
+        fitted = pca_model(
+            positions, visible, m, model,
+            exclude=hidden or (a, b), weight_scale=weight_scale, max_train=max_train,
+        )  # fmt: skip
+        if fitted is None:
+            return None
+    gram = fitted.gram
+    for lo, hi in {(a, b), hidden or (a, b)}:
+        rows = fitted.z[
+            np.searchsorted(fitted.train, lo) : np.searchsorted(fitted.train, hi, "right")
+        ]
+        if rows.size:
+            gram = gram - rows.T @ rows
+    p = fitted.cols.size * 3
+    eigval, eigvec = np.linalg.eigh(gram)
+    eigval, eigvec = np.maximum(eigval[::-1], 0.0), eigvec[:, ::-1]
+    share = np.cumsum(eigval) / max(float(np.sum(eigval)), np.finfo(np.float64).tiny)
+    k = min(int(np.searchsorted(share, variance)) + 1, p - 3)
+    v = eigvec[:, :k]
+    mean, sd, weight = fitted.mean, fitted.sd, fitted.weight
+    y = positions[times[:, None], fitted.cols[1:]].reshape(times.size, p - 3)
+    zo = (y - mean[3:]) / sd[3:] * weight[3:]
+    # Conditional mean of the target given the visible coordinates under the probabilistic PCA
+    # model (kept components plus isotropic noise at the discarded components' mean variance):
+    # a least-squares fit of the scores that shrinks the weak components instead of trusting
+    # them fully.
+    noise = max(float(eigval[k:].mean()) if k < p else 0.0, 1e-9 * float(eigval[0]))
+    cov = (v * eigval[:k]) @ v.T + noise * np.eye(p)
+    zt = cov[:3, 3:] @ np.linalg.solve(cov[3:, 3:], zo.T)
+    predicted = zt.T / weight[:3] * sd[:3] + mean[:3]
+    recorded = recorded_around(positions, visible, m, times, a, b)
+    return anchor(predicted, times, recorded, a, b, smooth=smooth)
