@@ -1,15 +1,21 @@
-"""``mocapqa bench feet``: threshold choice on the fit takes, then recall of injected slides
-and penetrations and false skate flags on the held-back takes, and speed
-(:mod:`mocapqa.bench.feet`)."""
+"""``mocapqa bench feet``: contacts against the force plates of the C3D gait trials (contact
+speeds chosen leaving each trial out), threshold choice on the fit takes, then recall of
+injected slides and penetrations and false skate flags on the held-back takes, and speed
+(:mod:`mocapqa.bench.feet`). ``--plates-only`` stops after the force plates."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from mocapqa.cli.app import bench_app
+
+if TYPE_CHECKING:
+    from rich.console import Console
+
+    from mocapqa.core.arrays import FloatArray
 
 __all__ = ["bench_feet"]
 
@@ -17,6 +23,83 @@ __all__ = ["bench_feet"]
 def _share(pair: tuple[int, int]) -> str:
     found, tried = pair
     return f"{found}/{tried}" if tried else "–"
+
+
+def _ms(errors: object, q: float) -> str:
+    import numpy as np
+
+    values = np.abs(np.asarray(errors, dtype=np.float64))
+    return f"{np.percentile(values, q):.0f}" if values.size else "–"
+
+
+def _plates_table(console: Console, root: Path) -> None:
+    """The contact detector against the force plates, one row per C3D trial with plates."""
+    import numpy as np
+    from rich.table import Table
+
+    from mocapqa.bench.feet import marker_params_by_leave_one_out, plate_trials
+    from mocapqa.feet.plates import PLATE_THRESHOLD_N
+
+    with console.status("reading the force-plate trials"):
+        trials = plate_trials(root)
+        rows, chosen = marker_params_by_leave_one_out(trials)
+    table = Table(
+        title=f"Contacts against force plates (> {PLATE_THRESHOLD_N:g} N), each trial scored "
+        "with the contact speeds chosen on the others",
+        title_justify="left",
+    )
+    for column in (
+        "trial",
+        "fps",
+        "strikes",
+        "found",
+        "right/judged",
+        "P",
+        "R",
+        "onset ms",
+        "offset ms",
+        "speeds",
+        "window s",
+    ):
+        table.add_column(column, justify="left" if column == "trial" else "right")  # fmt: skip
+    pooled_on: list[FloatArray] = []
+    pooled_off: list[FloatArray] = []
+    skipped = []
+    for row in rows:
+        score, trial = row.score, row.trial
+        if score is None or trial.points is None:
+            plural = "s" if trial.plates != 1 else ""
+            skipped.append(f"{trial.name} ({trial.plates} plate{plural}): {trial.note}")
+            continue
+        pooled_on.append(score.onset_ms)
+        pooled_off.append(score.offset_ms)
+        table.add_row(
+            Path(trial.name).name, f"{trial.points.fps:g}",
+            f"{score.plate_contacts}" + (f"+{score.unassigned}" if score.unassigned else ""),
+            str(score.found), f"{score.right}/{score.judged}",
+            f"{score.precision:.2f}", f"{score.recall:.2f}",
+            f"{_ms(score.onset_ms, 50)} / {_ms(score.onset_ms, 90)}",
+            f"{_ms(score.offset_ms, 50)} / {_ms(score.offset_ms, 90)}",
+            f"{row.params.contact_speed:g} / {row.params.release_speed:g}",
+            f"{row.params.speed_window_s:g}",
+        )  # fmt: skip
+    onsets = np.concatenate(pooled_on) if pooled_on else np.zeros(0)
+    offsets = np.concatenate(pooled_off) if pooled_off else np.zeros(0)
+    table.caption = (
+        "strikes: plate contacts of one foot (+ those with no foot, not counted); right/judged: "
+        "detected contacts standing on a plate that overlap a strike of their foot; onset and "
+        "offset: |detected − plate| median / 90th percentile; speeds (leg/s) and smoothing "
+        "window: contact / release speed and speed_window_s chosen on the other trials"
+    )
+    console.print(table)
+    console.print(
+        f"all trials: onset {_ms(onsets, 50)} / {_ms(onsets, 90)} ms, offset "
+        f"{_ms(offsets, 50)} / {_ms(offsets, 90)} ms (median / 90th percentile); chosen on all "
+        f"trials: contact_speed {chosen.contact_speed:g}, release_speed "
+        f"{chosen.release_speed:g} leg/s, speed_window_s {chosen.speed_window_s:g}"
+    )
+    for line in skipped:
+        console.print(f"not scored: {line}")
 
 
 @bench_app.command("feet")
@@ -34,8 +117,12 @@ def bench_feet(
             "defaults as they are.",
         ),
     ] = True,
+    plates_only: Annotated[
+        bool, typer.Option("--plates-only", help="Only the force-plate contacts (C3D trials).")
+    ] = False,
 ) -> None:
-    """Injected slide and penetration recall, false skate flags per minute, foot-frames/s."""
+    """Contacts against force plates; injected slide and penetration recall, false skate flags
+    per minute, foot-frames/s."""
     from rich.console import Console
     from rich.table import Table
 
@@ -54,6 +141,9 @@ def bench_feet(
 
     console = Console()
     root = require_corpus(data)
+    _plates_table(console, root)
+    if plates_only:
+        return
     with console.status("reading the corpus"):
         takes = bench_takes(root)
     params = FeetParams()

@@ -1,7 +1,8 @@
 """``mocapqa feet check``: up axis, floor, foot contacts and foot findings of a take.
 
 The take is read through :func:`mocapqa.cli.reading.read_input` (the reading limits apply);
-BVH and keypoint takes both work (:mod:`mocapqa.pipeline.feet`). ``--json`` prints the report
+BVH, keypoint and C3D marker takes work (:mod:`mocapqa.pipeline.feet`; a C3D take's heel and
+toe markers are found by name, :mod:`mocapqa.feet.markers`). ``--json`` prints the report
 object of :func:`mocapqa.pipeline.feet.feet_report_json`; without it, Rich tables. The exit
 code is 0 whatever the take holds; errors exit as in every command (3 for input errors).
 """
@@ -94,7 +95,7 @@ def _print_report(path: Path, report: dict[str, Any]) -> None:
 
 @feet_app.command("check")
 def feet_check(
-    take: Annotated[Path, typer.Argument(help="A BVH or keypoint take (or OpenPose folder).")],
+    take: Annotated[Path, typer.Argument(help="A BVH, keypoint or C3D take (or OpenPose folder).")],
     json_output: Annotated[bool, typer.Option("--json", help="Print JSON instead.")] = False,
     fps: FpsOption = None,
     length_unit: Annotated[

@@ -14,6 +14,8 @@ Foot points
   ``LEFT_FOOT_INDEX``, ...); the heel stands for the rear of the foot where there is one, the
   ankle otherwise. Hips and knees give the pelvis and the leg length. 2D keypoints (OpenPose,
   pixels) are checked in the image plane.
+* **Markers** (C3D): per side the heel (or ankle) and toe markers by name, subject prefixes
+  left out (:func:`mocapqa.feet.markers.marker_foot_points`).
 
 Units
 -----
@@ -39,6 +41,7 @@ from mocapqa.core.rig import find_roles
 from mocapqa.core.rig_names import split_side, token_of
 from mocapqa.errors import InputError
 from mocapqa.feet.check import FeetReport, check_feet
+from mocapqa.feet.markers import MARKER_PARAMS, marker_foot_points
 from mocapqa.feet.params import FeetParams
 from mocapqa.feet.points import LEG_HEIGHT_RATIO, SIDES, FootPoints, cm_per_unit
 from mocapqa.kinematics.bindpose import leading_bind_pose
@@ -221,6 +224,16 @@ def check_take_feet(
 ) -> tuple[FootPoints, FeetReport, int]:
     """Foot points and the feet check of a take.
 
+    Parameters
+    ----------
+    take : Motion or KeypointSequence
+        A BVH motion, or keypoints (a C3D take's markers when ``source_format`` is "c3d").
+    mapping : mapping, optional
+        Role key → joint name (BVH only).
+    params : FeetParams, optional
+        Thresholds; None gives the defaults, or
+        :data:`mocapqa.feet.markers.MARKER_PARAMS` for a C3D take.
+
     Returns
     -------
     points : FootPoints
@@ -241,7 +254,11 @@ def check_take_feet(
     else:
         if mapping:
             raise InputError("Expected --mapping only for a BVH take, got a keypoint take")
-        points, skipped = keypoint_foot_points(take), 0
+        markers = take.source_format == "c3d"
+        points = marker_foot_points(take) if markers else keypoint_foot_points(take)
+        skipped = 0
+        if params is None and markers:
+            params = MARKER_PARAMS
     return points, check_feet(points, params), skipped
 
 
