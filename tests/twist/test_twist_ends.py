@@ -15,8 +15,10 @@ from mocapqa.io.bvh import read_bvh
 from mocapqa.metrics.twist import rotation_errors_deg
 from mocapqa.twist.analysis import analyze_twist
 from mocapqa.twist.angles import ChainGeometry, chain_geometry
-from mocapqa.twist.detect import leading_pose_frames
+from mocapqa.twist.confidence import END_MAX_MISMATCH, END_MIN_LEVEL_DEG, decide
+from mocapqa.twist.detect import RobustParams, leading_pose_frames
 from mocapqa.twist.inject import inject_twist_errors
+from mocapqa.twist.intervals import FEATURES
 from mocapqa.twist.refine import refine_quats
 
 OFFSET_DEG = 40.0
@@ -145,3 +147,44 @@ def test_the_cmu_walks_bind_pose_frame_is_not_the_reference(takes: dict[str, Mot
         (i.start_frame, i.end_frame, i.offset_deg) for i in without.intervals
     ]
     assert np.array_equal(with_pose.refined.quats[1:], without.refined.quats)
+
+
+def test_an_interior_shift_whose_release_made_no_event_is_not_corrected_to_an_end(
+    corpus_dir: Path,
+) -> None:
+    # A 7° shift of a Bandai knee over frames 16–34: its onset is an event, its release at 35
+    # is not (the fit-take injection that read the onset as a head's release and moved the
+    # clean frames 0–15 by 7°). The roll steps back over the stretch a head would leave
+    # natural, so no one-sided interval forms and no clean frame moves.
+    motion = read_bvh(corpus_dir / "bvh/bandai/dataset-1_run_giant_001.bvh")
+    geometry = _chain(motion, "lower_leg", "right")
+    offsets = np.zeros((motion.n_frames, 1))
+    offsets[16:35] = np.deg2rad(7.0)
+    shifted = replace(motion, quats=refine_quats(motion.quats, (geometry,), -offsets))
+    clean = np.ones(motion.n_frames, dtype=bool)
+    clean[16:35] = False
+    parent = geometry.chain.parent
+    without = analyze_twist(shifted, params=RobustParams(end_return=0.0))
+    assert [(f.side, f.start_frame, f.end_frame) for f in without.found] == [("head", 0, 15)]
+    moved = rotation_errors_deg(motion.quats[clean, parent], without.refined.quats[clean, parent])
+    assert moved.max() > 5.0
+    analysis = analyze_twist(shifted)
+    assert not [f for f in analysis.found if f.side]
+    assert np.array_equal(analysis.refined.quats[clean], motion.quats[clean])
+
+
+def test_a_small_one_sided_interval_with_an_inexact_counter_rotation_is_reported_not_applied() -> (
+    None
+):
+    level = FEATURES.index("log_level_deg")
+    mismatch = FEATURES.index("mismatch")
+    base = [5.0, 0.0, 0.0, 0.0, -1.0, float(np.log(14.0)), 0.0, 0.0]
+    inexact = list(base)
+    inexact[mismatch] = 0.1
+    large = list(inexact)
+    large[level] = float(np.log(END_MIN_LEVEL_DEG))
+    features = [inexact, inexact, base, large]
+    applied, rules = decide(np.ones(4), features, None, sides=["head", "", "tail", "tail"])
+    assert applied.tolist() == [False, True, True, True]
+    assert rules[0] == "end_evidence"
+    assert END_MAX_MISMATCH < 0.1

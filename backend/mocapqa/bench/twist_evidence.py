@@ -131,7 +131,15 @@ def take_decisions(
     anatomy = anatomy_evidence(motion, analysis.chains, found, analysis.detected_offsets_rad)
     chains = [i.chain for i in found]
     after, rules = decide(
-        probability, features, anatomy, min_deg, max_mismatch, max_s, chains, min_family
+        probability,
+        features,
+        anatomy,
+        min_deg,
+        max_mismatch,
+        max_s,
+        chains,
+        min_family,
+        sides=[i.side for i in found],
     )
     return TakeDecisions(analysis, before, after, rules)
 

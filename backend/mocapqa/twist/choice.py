@@ -192,7 +192,9 @@ def choose_intervals(
     probability = np.array([i.confidence for i in found], dtype=np.float64)
     features = [i.features if calibrated else () for i in found]
     chains = [i.chain for i in found]
-    confident, rules = decide(probability, features, anatomy, chains=chains)
+    confident, rules = decide(
+        probability, features, anatomy, chains=chains, sides=[i.side for i in found]
+    )
     for k, i in enumerate(found):
         if isinstance(choice, frozenset):
             applied = k in choice

@@ -55,6 +55,8 @@ __all__ = [
     "ANATOMY_MIN_DEG",
     "APPLY_THRESHOLD",
     "CALIBRATION_FILE",
+    "END_MAX_MISMATCH",
+    "END_MIN_LEVEL_DEG",
     "MAX_DISAGREEMENT",
     "MIN_LEVEL_DEG",
     "REPETITION_MIN_FAMILY",
@@ -89,6 +91,16 @@ ANATOMY_MAX_S = 0.25
 """Longest interval, seconds, the anatomy rule applies: over a longer one most frames sit inside
 the range, so frames outside it say that an error is there, not that the whole interval's
 levels belong where they were put. Chosen on the fit takes' injected errors (docs)."""
+END_MIN_LEVEL_DEG = 20.0
+"""Smallest level, degrees, at which ``apply="confident"`` applies a one-sided interval (one that
+runs to an end of the take) whose event's counter-rotation is not exact (mismatch above
+:data:`END_MAX_MISMATCH`): the top of the small-offset range (5–20°), which natural roll steps
+reach. One event carries no closure check, so such an interval is reported, not applied.
+Chosen on the fit takes' injections (docs)."""
+END_MAX_MISMATCH = 0.05
+"""Largest counter-rotation mismatch ratio of the one event at which a one-sided interval under
+:data:`END_MIN_LEVEL_DEG` is applied by ``apply="confident"`` (a tenth of the events'
+``consistency``). Chosen on the fit takes' injections (docs)."""
 REPETITION_MIN_FAMILY = 0
 """Other strong intervals on an interval's chain that apply it (``"repetition"``); 0: the
 repetition rule is off (measured on the fit takes, docs)."""
@@ -100,6 +112,7 @@ RULES = (
     "anatomy_against",
     "repetition",
     "min_evidence",
+    "end_evidence",
     "uncalibrated",
 )
 """Which evidence decided an interval under ``apply="confident"`` (:func:`decide`)."""
@@ -216,21 +229,23 @@ def decide(
     chains: Sequence[int] | None = None,
     min_family: int = REPETITION_MIN_FAMILY,
     strong_p: float = REPETITION_STRONG_P,
+    sides: Sequence[str] | None = None,
 ) -> tuple[np.ndarray, tuple[str, ...]]:
     """Whether ``apply="confident"`` applies each interval, and which evidence decided.
 
     In order: no calibrated features (the paper's method) applies (``"uncalibrated"``); failing
-    :func:`has_evidence` does not (``"min_evidence"``); a correction that moves the parent's
-    twist or the child's rotation from inside its range to ``min_deg`` or more beyond it does
-    not (``"anatomy_against"``); a raw twist ``min_deg`` or more beyond the range that the
-    correction brings inside, moving no frame's twist ``min_deg`` or more toward the range's
-    edge, with the child not pushed ``min_deg`` further out, a mismatch ratio of at most
-    ``max_mismatch`` and a duration of at most ``max_s``, applies (``"anatomy"``); with
-    ``min_family`` > 0, an interval as short and as well counter-rotated with at least
-    ``min_family`` other strong intervals on its chain (probability ≥ ``strong_p`` or the
-    anatomy rule, :func:`mocapqa.twist.repetition.family_counts`) applies (``"repetition"``);
-    otherwise the calibrated probability decides against :data:`APPLY_THRESHOLD`
-    (``"calibrated"``).
+    :func:`has_evidence` does not (``"min_evidence"``); a one-sided interval (``sides``: "head" or
+    "tail") whose level is under :data:`END_MIN_LEVEL_DEG` and whose event's mismatch ratio is over
+    :data:`END_MAX_MISMATCH` does not (``"end_evidence"``); a correction that moves the parent's
+    twist or the child's rotation from inside its range to ``min_deg`` or more beyond it does not
+    (``"anatomy_against"``); a raw twist ``min_deg`` or more beyond the range that the correction
+    brings inside, moving no frame's twist ``min_deg`` or more toward the range's edge, with the
+    child not pushed ``min_deg`` further out, a mismatch ratio of at most ``max_mismatch`` and a
+    duration of at most ``max_s``, applies (``"anatomy"``); with ``min_family`` > 0, an interval as
+    short and as well counter-rotated with at least ``min_family`` other strong intervals on its
+    chain (probability ≥ ``strong_p`` or the anatomy rule,
+    :func:`mocapqa.twist.repetition.family_counts`) applies (``"repetition"``); otherwise the
+    calibrated probability decides against :data:`APPLY_THRESHOLD` (``"calibrated"``).
 
     Parameters
     ----------
@@ -249,6 +264,8 @@ def decide(
         Other strong intervals on the chain that support an interval; 0: no repetition rule.
     strong_p : float
         Calibrated probability from which an interval counts as strong.
+    sides : sequence of str, optional
+        Each interval's side ("", "head" or "tail"); None: no one-sided interval.
 
     Returns
     -------
@@ -262,6 +279,18 @@ def decide(
         anatomy = AnatomyEvidence.empty(n)
     calibrated = np.array([len(f) > 0 for f in features], dtype=bool)
     evidence = np.array([has_evidence(f) for f in features], dtype=bool)
+    one_sided = np.array(
+        [False] * n if sides is None else [bool(side) for side in sides], dtype=bool
+    )
+    weak_end = one_sided & np.array(
+        [
+            bool(f)
+            and f[FEATURES.index("log_level_deg")] < np.log(END_MIN_LEVEL_DEG)
+            and f[FEATURES.index("mismatch")] > END_MAX_MISMATCH
+            for f in features
+        ],
+        dtype=bool,
+    )
     mismatch = np.array(
         [f[FEATURES.index("mismatch")] if f else np.inf for f in features], dtype=np.float64
     )
@@ -291,11 +320,18 @@ def decide(
     applied = np.where(
         ~calibrated,
         True,
-        evidence & ~against & (support | family | (p >= APPLY_THRESHOLD)),
+        evidence & ~weak_end & ~against & (support | family | (p >= APPLY_THRESHOLD)),
     )
     rules = np.select(
-        [~calibrated, ~evidence, against, support, family],
-        ["uncalibrated", "min_evidence", "anatomy_against", "anatomy", "repetition"],
+        [~calibrated, ~evidence, weak_end, against, support, family],
+        [
+            "uncalibrated",
+            "min_evidence",
+            "end_evidence",
+            "anatomy_against",
+            "anatomy",
+            "repetition",
+        ],
         "calibrated",
     )
     return applied.astype(bool), tuple(str(r) for r in rules)

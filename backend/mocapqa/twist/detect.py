@@ -150,6 +150,12 @@ class RobustParams:
         Such an event's jump must be at least this many times every raw roll step of the
         parent within ``burst_gap_s`` of it (one event is weaker evidence than an onset and a
         release that cancel).
+    end_return : float
+        Such an event forms no one-sided interval when, between it and its neighbouring events
+        (within ``max_interval_s``) on either side, the parent's roll steps back by its jump
+        and the child's by the mirror, each within this fraction of the jump, over windows of
+        up to ``burst_gap_s`` (the other end of an interior interval that made no event;
+        :func:`mocapqa.twist.intervals.one_sided`). 0: off.
     """
 
     min_threshold_deg: float = 2.0
@@ -171,6 +177,7 @@ class RobustParams:
     mirror: float = 0.5
     ends: bool = True
     end_contrast: float = 3.0
+    end_return: float = 0.5
     parent_source: str = "increment"
     child_source: str = "increment"
     min_conditioning: float = 0.4
@@ -194,13 +201,15 @@ class RobustParams:
             )
         if (
             min(self.speed_factor, self.tail_s, self.tail_factor, self.mismatch_noise,
-                self.closure_noise, self.precision, self.mirror, self.end_contrast) < 0
+                self.closure_noise, self.precision, self.mirror, self.end_contrast,
+                self.end_return) < 0
         ):  # fmt: skip
             raise InputError(
                 "Expected speed_factor, tail_s, tail_factor, mismatch_noise, closure_noise, "
-                f"precision, mirror and end_contrast ≥ 0, got {self.speed_factor}, "
+                f"precision, mirror, end_contrast and end_return ≥ 0, got {self.speed_factor}, "
                 f"{self.tail_s}, {self.tail_factor}, {self.mismatch_noise}, "
-                f"{self.closure_noise}, {self.precision}, {self.mirror}, {self.end_contrast}"
+                f"{self.closure_noise}, {self.precision}, {self.mirror}, {self.end_contrast}, "
+                f"{self.end_return}"
             )
         if self.burst_gap_s <= 0 or self.agreement < 0 or self.min_fps < 0:
             raise InputError(
@@ -515,6 +524,7 @@ def detect_robust(
                 params.agreement, params.burst_gap_s, params.max_interval_s, small[:, c],
                 params.tail_s, uncertainty[frames, c], params.precision,
                 (dc[:, c], natural_c[:, c]), params.mirror, params.ends, params.end_contrast,
+                params.end_return,
             )  # fmt: skip
         else:
             steps = np.zeros(n_frames)

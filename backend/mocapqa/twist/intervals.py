@@ -41,6 +41,8 @@ Conventions
   side (within ``agreement`` of the jump, and ``|wrap(P + C)| ≤`` :data:`_END_MIRROR` ``×
   min(|P|, |C|)``), and the jump stands out against the parent's steps beside it. A natural
   step that is not held, or that the child does not keep counter-rotating, fails that test.
+  Nor does an event whose roll steps back by its jump (the child mirroring it) between it and
+  the next event on either side: the other end of an interior interval that made no event.
 """
 
 from __future__ import annotations
@@ -282,6 +284,70 @@ def _held_level(roll: FloatArray, natural: FloatArray, stretch: slice, reference
     return float(wrap_angle(np.array(levels[0] - levels[1])))
 
 
+def _returned(
+    parent: tuple[FloatArray, FloatArray],
+    child: tuple[FloatArray, FloatArray],
+    frame: int,
+    jump: float,
+    bounds: tuple[int, int],
+    window: int,
+    tolerance: float,
+) -> bool:
+    """Whether the roll near a lone event steps back by its jump where no event was found: the
+    other end of an interior interval, whose counter-rotation was too spread or too jittery to
+    make an event.
+
+    An interval's onset and release step by opposite amounts, whichever comes first, so the missed
+    end of the event's interval is a step of ``−jump`` on either side of it: inside the stretch a
+    one-sided interval would cover (a release after a tail's onset, an onset before a head's
+    release, which would move the clean frames beyond it) or on the natural side (the event then
+    ends an interior interval; a one-sided interval would move the clean frames before the take's
+    end). At every frame ``t`` between ``bounds`` and the event, on either side, the parent's and
+    the child's levels over up to ``window`` frames after ``t`` are compared with those over up to
+    ``window`` frames before it (never across the event), each roll taken off its natural travel; a
+    parent step within ``tolerance`` × |jump| of ``−jump``, with the child's step within the same
+    tolerance of ``+jump``, is such an end.
+
+    Parameters
+    ----------
+    parent, child : tuple of ndarray, each shape (F,)
+        Integrated roll and natural roll increments, radians.
+    frame : int
+        The event's frame (its step is the increment into it).
+    jump : float
+        The event's jump, radians.
+    bounds : tuple of int
+        First and last frame (exclusive) searched: the other events next to this one, or the
+        farthest frames an interval through it may reach.
+    window : int
+        Frames averaged on each side of a step.
+    tolerance : float
+        Largest gap of either step from its target, as a fraction of |jump|; 0: no check.
+
+    Returns
+    -------
+    bool
+    """
+    if tolerance <= 0:
+        return False
+    n_frames = len(parent[0])
+    levels = [roll - np.cumsum(natural) for roll, natural in (parent, child)]
+    for lo, hi in ((max(bounds[0], 0), frame), (frame, min(bounds[1], n_frames))):
+        if hi - lo < 2:
+            continue
+        t = np.arange(lo + 1, hi)
+        start, stop = np.maximum(t - window, lo), np.minimum(t + window, hi)
+        ok = np.ones(len(t), dtype=bool)
+        for level, target in zip(levels, (-jump, jump), strict=True):
+            sums = np.r_[0.0, np.cumsum(level[lo:hi])]
+            after = (sums[stop - lo] - sums[t - lo]) / (stop - t)
+            before = (sums[t - lo] - sums[start - lo]) / (t - start)
+            ok &= np.abs(wrap_angle(after - before - target)) <= tolerance * abs(jump)
+        if np.any(ok):
+            return True
+    return False
+
+
 def one_sided(
     frames: IntArray,
     jumps: FloatArray,
@@ -298,6 +364,7 @@ def one_sided(
     mirror: float,
     contrast: float,
     closure_fraction: float = 0.2,
+    returns: float = 0.0,
 ) -> list[IntervalEstimate]:
     """Intervals that run to an end of the take: an onset with no release, a release with no
     onset.
@@ -348,6 +415,12 @@ def one_sided(
         burst next to it on the side away from the take's end (events each within
         ``burst_gap`` of the next, the nearest within ``max_frames``), a burst whose own jumps
         do not cancel, is that burst's release (onset) and forms no one-sided interval.
+    returns : float
+        An event whose roll steps back by its jump between it and the next other event on
+        either side (within ``max_frames``), the parent within this fraction of the jump and
+        the child mirroring it, over windows of up to ``burst_gap`` frames, is one end of an
+        interior interval whose other end made no event and forms no one-sided interval
+        (:func:`_returned`); 0: no such check.
 
     Returns
     -------
@@ -422,6 +495,13 @@ def one_sided(
         )
         if gap > agreement * abs(level) or not mirrored:
             continue
+        bounds = (
+            int(np.max(frames[frames < frame], initial=frame - max_frames)),
+            int(np.min(frames[frames > frame], initial=frame + max_frames)),
+        )
+        bounds = (max(bounds[0], frame - max_frames), min(bounds[1], frame + max_frames))
+        if _returned(parent, child, frame, jump, bounds, burst_gap, returns):
+            continue
         taken = k
         features = (
             float(np.log(abs(jump) / scale)),
@@ -458,6 +538,7 @@ def chain_intervals(
     mirror: float = 0.0,
     ends: bool = False,
     end_contrast: float = 3.0,
+    end_return: float = 0.0,
 ) -> tuple[FloatArray, list[IntervalEstimate]]:
     """Offsets and intervals of one chain.
 
@@ -559,7 +640,7 @@ def chain_intervals(
                 for e in one_sided(
                     frames, jumps, mismatch, freed, (roll, natural), child_roll, threshold,
                     scale, fps, burst_gap, max_frames, agreement, _END_MIRROR,
-                    end_contrast, closure_fraction,
+                    end_contrast, closure_fraction, end_return,
                 )
             ):  # fmt: skip
                 groups = freed
@@ -639,7 +720,7 @@ def chain_intervals(
         for estimate in one_sided(
             frames, jumps, mismatch, groups, (roll, natural), child_roll, threshold, scale, fps,
             burst_gap, max_frames, agreement, _END_MIRROR, end_contrast,
-            closure_fraction,
+            closure_fraction, end_return,
         ):  # fmt: skip
             offsets[estimate.start_frame : estimate.end_frame + 1] = estimate.offset_rad
             found.append(estimate)
