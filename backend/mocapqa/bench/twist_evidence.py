@@ -41,6 +41,7 @@ from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
+from mocapqa.limits.rig import rig_family
 from mocapqa.metrics.twist import rotation_errors_deg
 from mocapqa.twist.analysis import TwistAnalysis, analyze_twist
 from mocapqa.twist.anatomy import anatomy_evidence
@@ -55,6 +56,7 @@ from mocapqa.twist.confidence import (
 )
 from mocapqa.twist.inject import InjectionTruth, inject_twist_errors
 from mocapqa.twist.inject_unpaired import inject_unpaired_bursts
+from mocapqa.twist.natural_roll import default_natural_roll
 from mocapqa.twist.refine import refine_quats
 
 __all__ = [
@@ -120,7 +122,8 @@ def take_decisions(
     min_family: int = REPETITION_MIN_FAMILY,
 ) -> TakeDecisions:
     """Every interval of the robust method on ``motion`` and its default choice before and after
-    the anatomy evidence (with these parameters)."""
+    the anatomy evidence (with these parameters; "after" also with the shipped natural roll
+    levels, :mod:`mocapqa.twist.natural_roll`)."""
     analysis = analyze_twist(motion, "robust", apply="none")
     found = analysis.found
     probability = np.array([i.confidence for i in found], dtype=np.float64)
@@ -130,6 +133,9 @@ def take_decisions(
     )
     anatomy = anatomy_evidence(motion, analysis.chains, found, analysis.detected_offsets_rad)
     chains = [i.chain for i in found]
+    family = rig_family(motion.skeleton)
+    natural = default_natural_roll()
+    natural_deg = [natural.level_deg(family, analysis.chains[i.chain].chain.segment) for i in found]
     after, rules = decide(
         probability,
         features,
@@ -140,6 +146,7 @@ def take_decisions(
         chains,
         min_family,
         sides=[i.side for i in found],
+        natural_deg=natural_deg,
     )
     return TakeDecisions(analysis, before, after, rules)
 

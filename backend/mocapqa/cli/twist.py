@@ -383,6 +383,12 @@ def bench_twist(
         Path | None,
         typer.Option(help="Fit the confidence calibration on the fit takes, write it here, stop."),
     ] = None,
+    fit_natural_roll: Annotated[
+        Path | None,
+        typer.Option(
+            help="Read each rig's natural roll level from its clean fit takes, write it here, stop."
+        ),
+    ] = None,
 ) -> None:
     """The paper's Tables 1 and 2 with bootstrap intervals, real-error, clean-take,
     calibration and (optionally) leave-one-rig-out figures, and the speed."""
@@ -394,7 +400,12 @@ def bench_twist(
         fit_on_fit_takes,
         reliability,
     )
-    from mocapqa.bench.twist import find_bench_files, speed_frames_per_s
+    from mocapqa.bench.twist import (
+        clean_event_jumps,
+        find_bench_files,
+        small_offset_rows,
+        speed_frames_per_s,
+    )
     from mocapqa.bench.unpaired import run_unpaired_bench
     from mocapqa.cli.twist_tables import (
         calibration_table,
@@ -402,11 +413,15 @@ def bench_twist(
         ends_table,
         loro_table,
         loro_variants,
+        natural_levels_table,
         rates_table,
+        small_offsets_table,
         unpaired_table,
     )
     from mocapqa.io.bvh import read_bvh
     from mocapqa.twist.intervals import FEATURES
+    from mocapqa.twist.natural_roll import default_natural_roll
+    from mocapqa.twist.natural_roll import fit_natural_roll as fit_levels
 
     split = FEATURES.index("split")
     methods_chosen = method or ["robust", "paper"]
@@ -415,6 +430,16 @@ def bench_twist(
     data_dir = data if data is not None else _default_corpus()
     bench_files = find_bench_files(data_dir, files)
     console = Console(highlight=False, width=max(Console().width, 170))
+    if fit_natural_roll is not None:
+        fit_files = [f for f in bench_files if not f.held_out]
+        natural = fit_levels(
+            clean_event_jumps(fit_files),
+            f"robust detector's event jumps (defaults) on {len(fit_files)} clean fit takes",
+            fit_natural_roll,
+        )
+        console.print(f"natural roll levels written to {fit_natural_roll}: {natural.fitted_on}")
+        console.print(natural_levels_table(clean_event_jumps(bench_files), natural))
+        return
     if fit_calibration is not None:
         fit_files = [f for f in bench_files if not f.held_out]
         records = [
@@ -445,6 +470,10 @@ def bench_twist(
     for label, res in main_methods.items():
         console.print(_table2(label, res))
     if "robust" in main_methods:
+        natural = default_natural_roll()
+        console.print(natural_levels_table(clean_event_jumps(bench_files), natural))
+        held_out = [f for f in bench_files if f.held_out]
+        console.print(small_offsets_table(small_offset_rows(held_out, natural, seed, repeats)))
         bursts = _run(bench_files, {"robust": ("robust", None)}, seed, repeats, console,
                       kind="burst").methods  # fmt: skip
         console.print("Bursts of alternating flips (injected, kind=burst):")

@@ -17,8 +17,10 @@ __all__ = [
     "ends_table",
     "loro_table",
     "loro_variants",
+    "natural_levels_table",
     "natural_table",
     "rates_table",
+    "small_offsets_table",
     "unpaired_table",
 ]
 
@@ -222,5 +224,61 @@ def unpaired_table(figures: dict[Any, Any]) -> Table:
             name, str(t.n_injected), str(t.n_jumps), f"{t.n_removed} ({100 * share:.1f} %)",
             _pct(*wilson_interval(t.n_removed, t.n_jumps)), str(t.n_far_cells),
             str(t.n_far_moved), str(t.n_takes_moved), f"{t.max_far_move_deg:.1f}",
+        )  # fmt: skip
+    return table
+
+
+def natural_levels_table(clean: dict[str, Any], fitted: Any) -> Table:
+    """The detector's event jumps on clean takes per rig family (and segment): how many, their
+    95th and 99th percentiles over every clean take, and the level the rule uses (fit takes)."""
+    import numpy as np
+
+    table = Table(
+        title="Natural roll on clean takes: the robust detector's event jumps (defaults), by rig; "
+        "the rule's level is the p99 on the clean fit takes"
+    )
+    for column in ("rig / segment", "events", "p95 °", "p99 °", "largest °", "rule level (fit) °"):
+        table.add_column(column, justify="left" if column == "rig / segment" else "right")
+    known = ("cmu", "character_creator", "bandai")
+    others = sorted({k.split("/")[0] for k in clean} - set(known))
+    for family in (*known, *others):
+        keys = sorted(k for k in clean if k.startswith(family + "/"))
+        jumps = np.concatenate([clean[k] for k in keys]) if keys else np.zeros(0)
+        stored = any(k in fitted.levels_deg for k in keys)
+        rows = [(family, jumps, "per segment:" if stored else "")]
+        rows += [(f"  {k.split('/')[1]}", clean[k],
+                  f"{fitted.levels_deg[k]:.1f}" if k in fitted.levels_deg else "")
+                 for k in keys]  # fmt: skip
+        for label, values, level in rows:
+            cells = (
+                [f"{v:.1f}" for v in (*np.percentile(values, [95.0, 99.0]), values.max())]
+                if len(values)
+                else ["—", "—", "—"]
+            )
+            table.add_row(label, str(len(values)), *cells, level or "— (5.0 minimum)")
+    return table
+
+
+def small_offsets_table(rows: Sequence[Any]) -> Table:
+    """Injected level shifts by rig and offset band: distinguishable from natural roll, found,
+    applied by default and corrected, without → with the natural roll rule."""
+    table = Table(
+        title="Small offsets, held-out takes, default settings: injected level shifts by offset "
+        "band (before → after the natural roll rule)"
+    )
+    for column in ("rig", "offset band", "injected", "distinguishable", "found",
+                   "applied (default)", "not distinguishable, applied", "FSR %"):  # fmt: skip
+        table.add_column(column, justify="left" if column in ("rig", "offset band") else "right")
+    for r in rows:
+        low, high = r.band
+        band = f"> {low:g}°" if high >= 180.0 else f"{low:g}–{high:g}°"
+
+        def pct(n: int, total: int = r.frames) -> str:
+            return f"{100 * n / total:.1f}" if total else "—"
+
+        table.add_row(
+            r.rig, band, str(r.injected), str(r.distinguishable), str(r.found),
+            f"{r.applied_before} → {r.applied}", f"{r.hidden_applied_before} → {r.hidden_applied}",
+            f"{pct(r.corrected_before)} → {pct(r.corrected)}",
         )  # fmt: skip
     return table

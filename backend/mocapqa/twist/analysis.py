@@ -20,6 +20,7 @@ from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.errors import InputError
 from mocapqa.kinematics.euler import euler_from_quats
+from mocapqa.limits.rig import rig_family
 from mocapqa.twist.anatomy import anatomy_evidence
 from mocapqa.twist.angles import (
     ChainGeometry,
@@ -42,6 +43,7 @@ from mocapqa.twist.detect import (
     leading_pose_frames,
     shift_detection,
 )
+from mocapqa.twist.natural_roll import NaturalRoll, default_natural_roll
 from mocapqa.twist.refine import refine_quats
 
 __all__ = [
@@ -386,6 +388,7 @@ def analyze_twist(
     mapping: dict[str, str] | None = None,
     params: RobustParams | PaperParams | None = None,
     apply: str | frozenset[int] = "confident",
+    natural_roll: NaturalRoll | None = None,
 ) -> TwistAnalysis:
     """Detect axial twist errors in a take and remove those chosen by ``apply``.
 
@@ -405,6 +408,10 @@ def analyze_twist(
         :func:`mocapqa.twist.confidence.decide`), ``"all"``, ``"none"``, or interval
         ids (a set, or text such as ``"0,3"``). The paper's method has no calibrated
         confidence: ``"confident"`` applies all its intervals.
+    natural_roll : NaturalRoll, optional
+        Natural roll levels per rig family and segment (:mod:`mocapqa.twist.natural_roll`);
+        ``confident`` applies no interval smaller than its rig segment's level. Default: the
+        shipped levels; ``NaturalRoll()`` for none.
 
     Returns
     -------
@@ -432,9 +439,13 @@ def analyze_twist(
         if method == "robust" and found
         else None
     )
+    natural = default_natural_roll() if natural_roll is None else natural_roll
+    family = rig_family(skeleton)
+    natural_deg = [natural.level_deg(family, geometries[i.chain].chain.segment) for i in found]
     offsets, intervals = choose_intervals(
-        found, detected, geometries, skeleton.names, choice, method == "robust", anatomy
-    )
+        found, detected, geometries, skeleton.names, choice, method == "robust", anatomy,
+        natural_deg,
+    )  # fmt: skip
     refined_quats = refine_quats(motion.quats, geometries, offsets)
     changed = np.any(refined_quats != motion.quats, axis=-1)
     if changed.any():

@@ -5,7 +5,9 @@ a take in chain, then frame order. ``confident`` applies intervals whose calibra
 is at least :data:`mocapqa.twist.confidence.APPLY_THRESHOLD` and that pass the minimum-evidence
 rule :func:`mocapqa.twist.confidence.has_evidence`, or that the anatomy evidence supports, and
 never those it contradicts (:func:`mocapqa.twist.confidence.decide`; methods without a
-calibrated confidence apply all). Each interval's ``evidence`` records which evidence decided.
+calibrated confidence apply all); an interval smaller than its rig segment's natural roll
+(:mod:`mocapqa.twist.natural_roll`) is never applied by ``confident``. Each interval's
+``evidence`` records which evidence decided, and why when it is the natural roll.
 Each :class:`TwistInterval` lists its ``levels``: the stretches of constant offset, so the
 refined take is exactly the raw one with the applied levels removed.
 """
@@ -103,8 +105,10 @@ class TwistInterval:
         What ``apply="confident"`` decided on: ``calibrated`` (the probability), ``anatomy_deg``
         (degrees the correction brings the parent's twist back inside its natural range:
         raw minus corrected distance beyond it; absent when no limits model reads the joint),
-        ``child_anatomy_deg`` (the same for the child's rotation) and ``rule`` (one of
-        :data:`mocapqa.twist.confidence.RULES`). Empty for the paper's method.
+        ``child_anatomy_deg`` (the same for the child's rotation), ``natural_roll_deg`` (the
+        natural roll level of the rig's segment, when one is stored), ``rule`` (one of
+        :data:`mocapqa.twist.confidence.RULES`) and, for the rule ``natural_roll``, ``reason``
+        (readable). Empty for the paper's method.
     """
 
     joint: str
@@ -148,6 +152,7 @@ def choose_intervals(
     choice: str | frozenset[int],
     calibrated: bool,
     anatomy: AnatomyEvidence | None = None,
+    natural_deg: Sequence[float] | None = None,
 ) -> tuple[FloatArray, list[TwistInterval]]:
     """The offsets to remove and the report entry of every interval.
 
@@ -166,6 +171,9 @@ def choose_intervals(
         Whether the confidences are calibrated probabilities (else ``confident`` applies all).
     anatomy : AnatomyEvidence, optional
         Anatomy evidence of each interval of ``found`` (:mod:`mocapqa.twist.anatomy`).
+    natural_deg : sequence of float, optional
+        Natural roll level of each interval's rig segment, degrees (0: none stored;
+        :mod:`mocapqa.twist.natural_roll`); None: no natural roll rule.
 
     Returns
     -------
@@ -193,8 +201,9 @@ def choose_intervals(
     features = [i.features if calibrated else () for i in found]
     chains = [i.chain for i in found]
     confident, rules = decide(
-        probability, features, anatomy, chains=chains, sides=[i.side for i in found]
-    )
+        probability, features, anatomy, chains=chains, sides=[i.side for i in found],
+        natural_deg=natural_deg,
+    )  # fmt: skip
     for k, i in enumerate(found):
         if isinstance(choice, frozenset):
             applied = k in choice
@@ -211,7 +220,16 @@ def choose_intervals(
                     ("child_anatomy_deg",
                      float(anatomy.child_raw_deg[k] - anatomy.child_fixed_deg[k])),
                 )  # fmt: skip
+            natural = 0.0 if natural_deg is None else float(natural_deg[k])
+            if natural > 0.0:
+                evidence += (("natural_roll_deg", natural),)
             evidence += (("rule", rules[k]),)
+            if rules[k] == "natural_roll":
+                segment = geometries[i.chain].chain.segment.replace("_", " ")
+                evidence += (
+                    ("reason",
+                     f"smaller than this rig's natural {segment} roll (p99 {natural:.1f}°)"),
+                )  # fmt: skip
         rows = slice(i.start_frame, i.end_frame + 1)
         if applied:
             offsets[rows, i.chain] = detected[rows, i.chain]

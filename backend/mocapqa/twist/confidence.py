@@ -112,6 +112,7 @@ RULES = (
     "anatomy_against",
     "repetition",
     "min_evidence",
+    "natural_roll",
     "end_evidence",
     "uncalibrated",
 )
@@ -230,11 +231,15 @@ def decide(
     min_family: int = REPETITION_MIN_FAMILY,
     strong_p: float = REPETITION_STRONG_P,
     sides: Sequence[str] | None = None,
+    natural_deg: Sequence[float] | None = None,
 ) -> tuple[np.ndarray, tuple[str, ...]]:
     """Whether ``apply="confident"`` applies each interval, and which evidence decided.
 
     In order: no calibrated features (the paper's method) applies (``"uncalibrated"``); failing
-    :func:`has_evidence` does not (``"min_evidence"``); a one-sided interval (``sides``: "head" or
+    :func:`has_evidence` does not (``"min_evidence"``); an interval whose largest level is under
+    the natural roll level of its rig's segment (``natural_deg``,
+    :mod:`mocapqa.twist.natural_roll`) does not, whatever else speaks for it (``"natural_roll"``):
+    it cannot be told from natural roll by its size; a one-sided interval (``sides``: "head" or
     "tail") whose level is under :data:`END_MIN_LEVEL_DEG` and whose event's mismatch ratio is over
     :data:`END_MAX_MISMATCH` does not (``"end_evidence"``); a correction that moves the parent's
     twist or the child's rotation from inside its range to ``min_deg`` or more beyond it does not
@@ -266,6 +271,9 @@ def decide(
         Calibrated probability from which an interval counts as strong.
     sides : sequence of str, optional
         Each interval's side ("", "head" or "tail"); None: no one-sided interval.
+    natural_deg : sequence of float, optional
+        Natural roll level of each interval's rig segment, degrees (0: none stored, the
+        :data:`MIN_LEVEL_DEG` of :func:`has_evidence` holds); None: no natural roll rule.
 
     Returns
     -------
@@ -291,6 +299,12 @@ def decide(
         ],
         dtype=bool,
     )
+    natural = np.zeros(n) if natural_deg is None else np.asarray(natural_deg, dtype=np.float64)
+    level = np.array(
+        [np.exp(f[FEATURES.index("log_level_deg")]) if f else np.inf for f in features],
+        dtype=np.float64,
+    )
+    rolled = calibrated & evidence & (level < natural.reshape(n))
     mismatch = np.array(
         [f[FEATURES.index("mismatch")] if f else np.inf for f in features], dtype=np.float64
     )
@@ -320,13 +334,14 @@ def decide(
     applied = np.where(
         ~calibrated,
         True,
-        evidence & ~weak_end & ~against & (support | family | (p >= APPLY_THRESHOLD)),
+        evidence & ~rolled & ~weak_end & ~against & (support | family | (p >= APPLY_THRESHOLD)),
     )
     rules = np.select(
-        [~calibrated, ~evidence, weak_end, against, support, family],
+        [~calibrated, ~evidence, rolled, weak_end, against, support, family],
         [
             "uncalibrated",
             "min_evidence",
+            "natural_roll",
             "end_evidence",
             "anatomy_against",
             "anatomy",

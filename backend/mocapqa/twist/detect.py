@@ -268,6 +268,9 @@ class Detection:
     offsets : ndarray, shape (F, C)
         offset(t), radians; exactly 0 outside intervals for the robust method.
     intervals : tuple of DetectedInterval
+    jumps : ndarray, shape (F, C), optional
+        The jump read at each event (robust method), radians, 0 elsewhere; None for the
+        paper's method.
     """
 
     parent_increments: FloatArray
@@ -275,6 +278,7 @@ class Detection:
     candidates: BoolArray
     offsets: FloatArray
     intervals: tuple[DetectedInterval, ...]
+    jumps: FloatArray | None = None
 
 
 def runs(mask: BoolArray) -> list[tuple[int, int]]:
@@ -332,6 +336,7 @@ def shift_detection(detection: Detection, skip: int, n_frames: int) -> Detection
         pad(detection.candidates), pad(detection.offsets),
         tuple(replace(i, start_frame=i.start_frame + skip, end_frame=i.end_frame + skip)
               for i in detection.intervals),
+        None if detection.jumps is None else pad(detection.jumps),
     )  # fmt: skip
 
 
@@ -447,7 +452,7 @@ def detect_robust(
     reach = 3 * stride
     if n_frames <= 2 * reach + 1 or fps < params.min_fps:
         zeros = np.zeros_like(dp)
-        return Detection(dp, dc, zeros.astype(bool), zeros, ())
+        return Detection(dp, dc, zeros.astype(bool), zeros, (), zeros)
     floor = np.deg2rad(params.min_threshold_deg)
     natural_p = _neighbour_median(dp, stride)
     natural_c = _neighbour_median(dc, stride)
@@ -548,4 +553,4 @@ def detect_robust(
                          float(next(probabilities)) if e.features else 0.5, e.features, e.side)
         for c, e in found
     )  # fmt: skip
-    return Detection(dp, dc, events, offsets, intervals)
+    return Detection(dp, dc, events, offsets, intervals, jumps)
