@@ -36,10 +36,15 @@ import numpy as np
 
 from mocapqa.bench.limits import corpus_files, held_back_names, split_group
 from mocapqa.core.arrays import BoolArray
+from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
 from mocapqa.feet.check import check_feet
 from mocapqa.feet.findings import Finding
-from mocapqa.feet.inject import inject_penetration, inject_slide
+from mocapqa.feet.fix import foot_rig, lock_feet, shift_ankles
+from mocapqa.feet.ground import UpAxis
+from mocapqa.feet.ik import leg_subtree
+from mocapqa.feet.inject import inject_penetration, inject_slide, leg_slide_offsets
+from mocapqa.feet.lock import BLEND_S, Lock
 from mocapqa.feet.markers import marker_foot_points
 from mocapqa.feet.params import FeetParams
 from mocapqa.feet.plates import (
@@ -49,15 +54,19 @@ from mocapqa.feet.plates import (
     plate_contacts,
     score_contacts,
 )
-from mocapqa.feet.points import FootPoints, per_foot
+from mocapqa.feet.points import SIDES, FootPoints, per_foot
+from mocapqa.feet.tracks import horizontal_axes
 from mocapqa.io.bvh import read_bvh
 from mocapqa.io.c3d import read_c3d
 from mocapqa.io.c3d_plates import read_force_plates
+from mocapqa.kinematics.forward import forward_kinematics
+from mocapqa.kinematics.quaternion import geodesic_angle
 from mocapqa.limits.rig import rig_family
 from mocapqa.pipeline.feet import motion_foot_points
 
 __all__ = [
     "ASSUMED_HEIGHT_CM",
+    "CLEANUP_SLIDES_CM",
     "CLEAN_FAMILIES",
     "DEPTHS_CM",
     "MARKER_GRID",
@@ -67,6 +76,7 @@ __all__ = [
     "SLIDES_CM",
     "BenchTake",
     "Choice",
+    "CleanupTrial",
     "FamilyFigures",
     "PlateRow",
     "PlateTrial",
@@ -74,8 +84,10 @@ __all__ = [
     "bench_takes",
     "choose_params",
     "clean_flags",
+    "cleanup_trials",
     "family_figures",
     "feet_speed",
+    "held_back_cleanup",
     "marker_params_by_leave_one_out",
     "plate_trial",
     "plate_trials",
@@ -630,3 +642,166 @@ def marker_params_by_leave_one_out(
         else:
             rows.append(PlateRow(trial, FeetParams(), None))
     return rows, candidates[choose(list(range(len(scorable))))]
+
+
+# Foot cleanup ---------------------------------------------------------------------------------
+
+CLEANUP_SLIDES_CM = (2.0, 5.0, 8.0)
+"""Slides injected into the legs of the held-back takes before the foot lock, centimetres."""
+
+
+@dataclass(frozen=True, slots=True)
+class CleanupTrial:
+    """One slide injected through a leg, then ``feet fix --apply all``.
+
+    Parameters
+    ----------
+    take, family, foot : str
+    size_cm : float
+        Injected slide.
+    clean_cm, injected_cm, fixed_cm : float
+        The check's travel of the contact (skate measure with no threshold) on the clean
+        take, the injected one and the fixed one, centimetres.
+    hip_knee_deg_blends : float
+        Largest change of a hip or knee local rotation in the blend frames (outside the
+        locked contacts), degrees.
+    hip_knee_deg_outside : float
+        The same outside the locked contacts and their blends (0 by construction).
+    upper_body_changed : int
+        Joints outside the legs whose world position changed in any frame.
+    pop_cm_s : dict of str to float
+        Per anchor ("middle", "start"), the largest speed the lock adds to an ankle in a
+        blend frame, cm/s.
+    clamped_frames, locked_frames : int
+        Solved foot-frames out of the leg's reach, and all solved foot-frames.
+    cpu_s : float
+        CPU seconds of the lock (forward kinematics, IK, the travel after).
+    """
+
+    take: str
+    family: str
+    foot: str
+    size_cm: float
+    clean_cm: float
+    injected_cm: float
+    fixed_cm: float
+    hip_knee_deg_blends: float
+    hip_knee_deg_outside: float
+    upper_body_changed: int
+    pop_cm_s: dict[str, float]
+    clamped_frames: int
+    locked_frames: int
+    cpu_s: float
+
+
+def _travel_cm(
+    motion: Motion, up: UpAxis, params: FeetParams, foot: str, start: int, end: int, scale: float
+) -> float:
+    """The check's travel (skate with no threshold) of ``foot`` over motion frames
+    ``start..end``, centimetres."""
+    points, skipped = motion_foot_points(motion)
+    report = check_feet(points, dataclasses.replace(params, skate_travel=0.0), up)
+    return _overlapping(report.findings, "skate", foot, start - skipped, end - skipped) * scale
+
+
+def cleanup_trials(
+    path: Path,
+    family: str,
+    params: FeetParams,
+    seed: int,
+    slides_cm: Sequence[float] = CLEANUP_SLIDES_CM,
+) -> list[CleanupTrial]:
+    """Inject each slide into each contact (longer than 0.15 s) of a clean take through the
+    leg (:func:`mocapqa.feet.inject.leg_slide_offsets`, over the contact's middle as
+    :func:`run_trials` does, held to the contact's end and eased out after it), run the check
+    on the result and lock every contact it finds (``--apply all``); measure what is left
+    of the slide and what else changed (:class:`CleanupTrial`)."""
+    known = family in _CM_FAMILIES or path.name in _CM_TAKES
+    motion = read_bvh(path, length_unit="cm") if known else read_bvh(path)
+    points, skipped = motion_foot_points(motion)
+    scale = 1.0 if known else ASSUMED_HEIGHT_CM / points.body_height
+    clean = check_feet(points, params)
+    rig = foot_rig(motion)
+    legs = leg_subtree(motion.skeleton, rig.legs[0].hip) | leg_subtree(
+        motion.skeleton, rig.legs[1].hip
+    )
+    hip_knee = [j for leg in rig.legs for j in (leg.hip, leg.knee)]
+    blend = max(1, round(BLEND_S * motion.fps))
+    flat_axes = list(horizontal_axes(clean.up.axis))
+    plant = params.plant_speed * points.leg_length
+    rng = np.random.default_rng([seed, sum(path.name.encode())])
+    trials = []
+    for contact in clean.contacts:
+        if (contact.end - contact.start + 1) / points.fps < _MIN_CONTACT_S:
+            continue
+        start, end = contact.start + skipped, contact.end + skipped
+        foot = SIDES.index(contact.foot)
+        middle = (start + end) // 2
+        reach = min((end - start) // 2, int(params.skate_window_s * points.fps / 2))
+        clean_cm = _travel_cm(motion, clean.up, params, contact.foot, start, end, scale)
+        for size in slides_cm:
+            angle = rng.uniform(0.0, 2.0 * np.pi)
+            displacement = np.zeros(3)
+            displacement[flat_axes] = (size / scale) * np.array([np.cos(angle), np.sin(angle)])
+            offsets, changed = leg_slide_offsets(
+                motion.n_frames, foot, middle - reach, middle + reach, end, displacement, blend
+            )
+            injected, _ = shift_ankles(motion, rig, offsets, changed)
+            in_points, _ = motion_foot_points(injected)
+            report = check_feet(in_points, params, clean.up)
+            locks = [Lock(c.foot, c.start + skipped, c.end + skipped) for c in report.contacts]
+            pops = {}
+            for anchor in ("start", "middle"):
+                began = time.process_time()
+                result = lock_feet(
+                    injected,
+                    rig,
+                    clean.up,
+                    locks,
+                    plant,
+                    points.leg_length,
+                    anchor,
+                    first=skipped,
+                )
+                cpu = time.process_time() - began
+                before = forward_kinematics(injected)[1]
+                after = forward_kinematics(result.motion)[1]
+                moved = (
+                    after[:, [leg.ankle for leg in rig.legs]]
+                    - before[:, [leg.ankle for leg in rig.legs]]
+                )
+                added = np.linalg.norm(np.diff(moved, axis=0), axis=-1) * motion.fps * scale
+                pops[anchor] = float(added.max()) if added.size else 0.0
+            inside = np.zeros((motion.n_frames, 2), dtype=bool)
+            for lock in locks:
+                inside[lock.start : lock.end + 1, SIDES.index(lock.foot)] = True
+            angles = np.rad2deg(
+                geodesic_angle(injected.quats[:, hip_knee], result.motion.quats[:, hip_knee])
+            ).reshape(motion.n_frames, 2, 2)  # (F, leg, hip/knee)
+            per_leg = angles.max(axis=-1)
+            blends = result.changed & ~inside
+            untouched = ~result.changed & ~inside
+            trials.append(
+                CleanupTrial(
+                    path.name, family, contact.foot, size, clean_cm,
+                    _travel_cm(injected, clean.up, params, contact.foot, start, end, scale),
+                    _travel_cm(result.motion, clean.up, params, contact.foot, start, end, scale),
+                    float(per_leg[blends].max(initial=0.0)),
+                    float(per_leg[untouched].max(initial=0.0)),
+                    int(np.sum(np.any(after[:, ~legs] != before[:, ~legs], axis=(0, 2)))),
+                    pops, int(result.clamped.sum()), int(result.changed.sum()), cpu,
+                )
+            )  # fmt: skip
+    return trials
+
+
+def held_back_cleanup(
+    corpus_dir: Path, takes: Sequence[BenchTake], params: FeetParams, seed: int
+) -> list[CleanupTrial]:
+    """:func:`cleanup_trials` on every held-back take of ``takes`` (the bench's split)."""
+    held = {t.name: t.family for t in takes if t.held_back}
+    trials: list[CleanupTrial] = []
+    for path in corpus_files(corpus_dir):
+        if path.name in held:
+            trials += cleanup_trials(path, held[path.name], params, seed)
+    return trials

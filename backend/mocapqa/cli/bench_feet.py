@@ -1,12 +1,14 @@
 """``mocapqa bench feet``: contacts against the force plates of the C3D gait trials (contact
 speeds chosen leaving each trial out), threshold choice on the fit takes, then recall of
 injected slides and penetrations and false skate flags on the held-back takes, and speed
-(:mod:`mocapqa.bench.feet`). ``--plates-only`` stops after the force plates."""
+and the foot lock on held-back takes with slides injected through the leg
+(:mod:`mocapqa.bench.feet`). ``--plates-only`` stops after the force plates, ``--cleanup-only``
+runs only the foot lock's table (with the default parameters)."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -102,6 +104,67 @@ def _plates_table(console: Console, root: Path) -> None:
         console.print(f"not scored: {line}")
 
 
+def _cleanup_table(console: Console, root: Path, takes: list[Any], params: Any, seed: int) -> None:
+    """The foot lock after ``feet fix --apply all`` on slides injected into held-back takes."""
+    import numpy as np
+    from rich.table import Table
+
+    from mocapqa.bench.feet import CLEANUP_SLIDES_CM, held_back_cleanup
+
+    with console.status("locking feet on the held-back takes"):
+        trials = held_back_cleanup(root, takes, params, seed)
+    table = Table(
+        title=f"Foot lock (feet fix --apply all) after slides of "
+        f"{', '.join(f'{s:g}' for s in CLEANUP_SLIDES_CM)} cm injected through the leg, "
+        f"held-back takes, seed {seed}",
+        title_justify="left",
+    )
+    columns = (
+        "family", "takes", "trials", "injected cm", "residual cm", "≤ 0.5 cm",
+        "clean cm", "hip/knee ° blends", "° elsewhere", "upper body", "clamped",
+        "pop cm/s", "foot-frames/s",
+    )  # fmt: skip
+    for column in columns:
+        table.add_column(column, justify="left" if column == "family" else "right")
+    groups = sorted({t.family for t in trials})
+    for family in [*groups, "all"]:
+        rows = [t for t in trials if family in ("all", t.family)]
+        if not rows:
+            continue
+
+        def values(name: str, group: list[Any] = rows) -> Any:
+            return np.array([getattr(t, name) for t in group], dtype=np.float64)
+
+        residual = values("fixed_cm")
+        pop = {a: np.array([t.pop_cm_s[a] for t in rows]) for a in ("middle", "start")}
+        locked = values("locked_frames").sum()
+        table.add_row(
+            family, str(len({t.take for t in rows})), str(len(rows)),
+            f"{np.median(values('injected_cm')):.2f}",
+            f"{np.median(residual):.2f} / {residual.max():.2f}",
+            f"{np.mean(residual <= 0.5):.1%}",
+            f"{np.median(values('clean_cm')):.2f}",
+            f"{values('hip_knee_deg_blends').max():.1f}",
+            f"{values('hip_knee_deg_outside').max():.1f}",
+            f"{int(values('upper_body_changed').max())}",
+            f"{values('clamped_frames').sum() / locked:.1%}",
+            f"{np.median(pop['middle']):.0f} ({np.median(pop['start']):.0f})",
+            f"{locked / values('cpu_s').sum():,.0f}",
+        )  # fmt: skip
+    table.caption = (
+        "injected / residual / clean: the check's travel of the contact (skate measure, no "
+        "threshold), median (residual: median / max) on the injected take, after the lock, and "
+        "on the clean take; hip/knee °: largest change of a hip or knee rotation in the blend "
+        "frames around locked contacts, and anywhere else outside them; upper body: joints "
+        "outside the legs whose world position changed; clamped: solved foot-frames whose "
+        "ankle missed its target by more than 0.001 leg; pop: median over trials of the "
+        "largest speed the lock adds to an ankle, anchor at the contact's middle (at its "
+        "start); foot-frames/s: solved foot-frames per CPU second of the lock (forward "
+        "kinematics, IK and the slide after, each take locked twice)"
+    )
+    console.print(table)
+
+
 @bench_app.command("feet")
 def bench_feet(
     data: Annotated[
@@ -119,6 +182,10 @@ def bench_feet(
     ] = True,
     plates_only: Annotated[
         bool, typer.Option("--plates-only", help="Only the force-plate contacts (C3D trials).")
+    ] = False,
+    cleanup_only: Annotated[
+        bool,
+        typer.Option("--cleanup-only", help="Only the foot lock's table (default parameters)."),
     ] = False,
 ) -> None:
     """Contacts against force plates; injected slide and penetration recall, false skate flags
@@ -141,12 +208,16 @@ def bench_feet(
 
     console = Console()
     root = require_corpus(data)
-    _plates_table(console, root)
+    if not cleanup_only:
+        _plates_table(console, root)
     if plates_only:
         return
     with console.status("reading the corpus"):
         takes = bench_takes(root)
     params = FeetParams()
+    if cleanup_only:
+        _cleanup_table(console, root, takes, params, seed)
+        return
     if choose:
         with console.status("choosing the skate parameters on the fit takes"):
             choice = choose_params(takes, seed)
@@ -200,6 +271,7 @@ def bench_feet(
         "|measured − injected| of the slides found"
     )
     console.print(recall_table)
+    _cleanup_table(console, root, takes, params, seed)
     with console.status("timing"):
         rate = feet_speed(takes, params)
         long_rate = feet_speed(takes, params, concatenate=True)

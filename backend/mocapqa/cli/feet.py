@@ -1,14 +1,23 @@
-"""``mocapqa feet check``: up axis, floor, foot contacts and foot findings of a take.
+"""``mocapqa feet check``: up axis, floor, foot contacts and foot findings of a take;
+``mocapqa feet fix``: the same take with chosen contacts locked (BVH and keypoint takes).
 
 The take is read through :func:`mocapqa.cli.reading.read_input` (the reading limits apply);
 BVH, keypoint and C3D marker takes work (:mod:`mocapqa.pipeline.feet`; a C3D take's heel and
 toe markers are found by name, :mod:`mocapqa.feet.markers`). ``--json`` prints the report
 object of :func:`mocapqa.pipeline.feet.feet_report_json`; without it, Rich tables. The exit
 code is 0 whatever the take holds; errors exit as in every command (3 for input errors).
+
+``feet fix`` checks the take, locks the contacts ``--apply`` names
+(:func:`mocapqa.feet.fix_choice.choose_locks`; BVH: :func:`mocapqa.feet.fix.lock_feet`,
+keypoints: :func:`mocapqa.feet.pin.pin_feet`), writes the take and
+reports every finding and contact with applied or not and its slide before and after
+(:func:`mocapqa.feet.fix_report.fix_report_json`), printed with ``--json`` and written with
+``--report``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 from typing import Annotated, Any
@@ -20,7 +29,7 @@ from mocapqa.cli.reading import read_input
 from mocapqa.cli.roles import FpsOption, MappingOption, RootTranslationOption, load_mapping
 from mocapqa.errors import InputError
 
-__all__ = ["feet_app", "feet_check"]
+__all__ = ["feet_app", "feet_check", "feet_fix"]
 
 feet_app = typer.Typer(
     help="Feet and ground: up axis, floor, contacts, skate and penetration.",
@@ -127,7 +136,170 @@ def feet_check(
     )  # fmt: skip
     points, report, skipped = check_take_feet(read, roles)
     result = {"path": str(take), **feet_report_json(points, report, skipped)}
+    _add_ids(result, report, skipped)
     if json_output:
         typer.echo(json.dumps(result, indent=2))
     else:
         _print_report(take, result)
+
+
+def _add_ids(result: dict[str, Any], report: Any, skipped: int) -> None:
+    """Give each contact and finding of the check's JSON its id (``feet fix --apply IDS``),
+    and each skate finding the confidence of its contact (``--apply confident``)."""
+    from mocapqa.feet.fix_choice import contact_id, finding_confidence, finding_id
+
+    for item, contact in zip(result["contacts"], report.contacts, strict=True):
+        item["id"] = contact_id(contact, skipped)
+    for item, finding in zip(result["findings"], report.findings, strict=True):
+        item["id"] = finding_id(finding, skipped)
+        if finding.kind == "skate":
+            item["confidence"] = finding_confidence(finding, report.contacts)
+
+
+def _print_fix(path: Path, out: Path, result: dict[str, Any]) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    def slide(item: dict[str, Any], key: str) -> str:
+        if item.get(key) is None:
+            return ""
+        cm = item[f"{key}_cm"]
+        return f"{cm:.2f} cm" if cm is not None else f"{100 * item[f'{key}_rel_height']:.2f} %"
+
+    table = Table(title=f"Feet fix: {path} → {out}", title_justify="left")
+    for column in ("id", "frames", "confidence", "applied", "slide before", "after", "clamped"):
+        table.add_column(
+            column, justify="left" if column == "id" else "right", no_wrap=column == "id"
+        )
+    for item in result["findings"]:
+        confidence = item["confidence"]
+        table.add_row(
+            item["id"], f"{item['start']}–{item['end']}",
+            "" if confidence is None else f"{confidence:.2f}",
+            "yes" if item["applied"] else "no", slide(item, "slide_before"),
+            slide(item, "slide_after"), "",
+        )  # fmt: skip
+    for item in result["contacts"]:
+        if item["applied"]:
+            table.add_row(
+                item["id"], f"{item['start']}–{item['end']}", f"{item['confidence']:.2f}", "yes",
+                slide(item, "slide_before"), slide(item, "slide_after"),
+                str(item["clamped_frames"]),
+            )  # fmt: skip
+    summary = result["summary"]
+    table.caption = (
+        f"--apply {result['apply']}: {summary['contacts_locked']} contacts locked, "
+        f"{summary['clamped_frames']} frames out of reach; skate findings "
+        f"{summary['skate_findings_before']} → {summary['skate_findings_after']}; slides in % "
+        "are of the estimated body height"
+    )
+    Console().print(table)
+
+
+@feet_app.command("fix")
+def feet_fix(
+    take: Annotated[Path, typer.Argument(help="A BVH or keypoint take.")],
+    output: Annotated[
+        Path,
+        typer.Option(
+            "--output", "-o", help="The file to write (BVH; keypoints: trc, csv, json, npy, npz)."
+        ),
+    ],
+    apply: Annotated[
+        str,
+        typer.Option(
+            "--apply",
+            help="Which contacts to lock: confident (skate findings whose contact confidence is "
+            "at least 0.5), all (every contact), none, or comma-separated ids from "
+            "`mocapqa feet check --json` (skate findings, contacts).",
+        ),
+    ] = "confident",
+    report_path: Annotated[
+        Path | None, typer.Option("--report", help="Write the report JSON to this file.")
+    ] = None,
+    json_output: Annotated[bool, typer.Option("--json", help="Print the report JSON.")] = False,
+    fps: FpsOption = None,
+    length_unit: Annotated[
+        str | None,
+        typer.Option("--length-unit", help="The take's length unit (m, cm, mm, in)."),
+    ] = None,
+    mapping: MappingOption = None,
+    root_translation: RootTranslationOption = "auto",
+) -> None:
+    """Lock planted feet (BVH: two-bone leg IK; keypoints: pinned), blended, and write the take."""
+    from mocapqa.core.keypoints import LENGTH_UNITS
+    from mocapqa.core.motion import Motion
+    from mocapqa.feet.fix import foot_rig, lock_feet
+    from mocapqa.feet.fix_choice import choose_locks
+    from mocapqa.feet.fix_report import fix_report_json
+    from mocapqa.feet.lock import Lock
+    from mocapqa.feet.params import FeetParams
+    from mocapqa.feet.pin import foot_keypoints, pin_feet
+    from mocapqa.io.atomic import write_text
+    from mocapqa.io.bvh_write import write_bvh
+    from mocapqa.io.formats import check_fps, write_keypoints
+    from mocapqa.pipeline.feet import check_take_feet
+
+    if fps is not None:
+        check_fps(fps, "--fps")
+    if length_unit is not None and length_unit not in LENGTH_UNITS:
+        raise InputError(
+            f"Expected --length-unit among {', '.join(LENGTH_UNITS)}, got {length_unit!r}"
+        )
+    if not apply.strip() or (apply.strip().startswith(",") or apply.strip().endswith(",")):
+        raise InputError(f"Expected --apply confident, all, none or ids, got {apply!r}")
+    roles = load_mapping(mapping)
+    read = read_input(
+        take, fps=fps, length_unit=length_unit, number_reader="auto",
+        root_translation=root_translation,
+    )  # fmt: skip
+    if not isinstance(read, Motion) and read.source_format == "c3d":
+        raise InputError(
+            "Expected a BVH or keypoint take: foot cleanup is for BVH and keypoint takes for "
+            f"now, got a C3D marker take: {take}"
+        )
+    params = FeetParams()
+    points, report, skipped = check_take_feet(read, roles, params)
+    chosen = choose_locks(apply.strip(), report.contacts, report.findings, skipped)
+
+    def shifted(contacts: Any) -> list[Lock]:
+        return [Lock(c.foot, c.start + skipped, c.end + skipped) for c in contacts]
+
+    plant = params.plant_speed * points.leg_length
+    n_contacts = len(report.contacts)
+    if isinstance(read, Motion):
+        locked = lock_feet(
+            read, foot_rig(read, roles), report.up, shifted(chosen), plant, points.leg_length,
+            first=skipped, measure=shifted(report.contacts),
+        )  # fmt: skip
+        _, after, _ = check_take_feet(locked.motion, roles, params)
+        write_bvh(output, locked.motion)
+        before, after_slide = locked.before, locked.after
+        clamped, miss = locked.clamped.tolist(), locked.miss.tolist()
+    else:
+        feet, members = foot_keypoints(read.names, points.names, points.sides)
+        pinned = pin_feet(
+            read.positions, feet, members, report.up, shifted(chosen), read.fps, plant,
+            measure=shifted(report.contacts),
+        )  # fmt: skip
+        moved = dataclasses.replace(read, positions=pinned.positions)
+        _, after, _ = check_take_feet(moved, None, params)
+        write_keypoints(output, moved)
+        before, after_slide = pinned.before, pinned.after
+        clamped, miss = [0] * n_contacts, [0.0] * n_contacts
+    fixed = {
+        "path": str(take),
+        "output": str(output),
+        "apply": apply.strip(),
+        **fix_report_json(
+            points, report.contacts, report.findings, chosen, before.tolist(),
+            after_slide.tolist(), clamped, miss, after.findings, skipped,
+        ),
+    }  # fmt: skip
+    text = json.dumps(fixed, indent=2)
+    if report_path is not None:
+        write_text(report_path, text + "\n")
+    if json_output:
+        typer.echo(text)
+    else:
+        _print_fix(take, output, fixed)

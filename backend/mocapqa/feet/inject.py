@@ -16,12 +16,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from mocapqa.core.arrays import FloatArray
+from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.errors import InputError
 from mocapqa.feet.ground import UpAxis
 from mocapqa.feet.tracks import horizontal_axes
 
-__all__ = ["inject_penetration", "inject_slide"]
+__all__ = ["inject_penetration", "inject_slide", "leg_slide_offsets"]
 
 
 def _check_frames(n_frames: int, start: int, end: int) -> None:
@@ -72,3 +72,48 @@ def inject_penetration(
     out = np.array(positions, dtype=np.float64, copy=True)
     out[start : end + 1, points, up.axis] -= up.sign * depth
     return out
+
+
+def leg_slide_offsets(
+    n_frames: int,
+    foot: int,
+    start: int,
+    end: int,
+    release: int,
+    displacement: FloatArray,
+    blend: int,
+) -> tuple[FloatArray, BoolArray]:
+    """Ankle offsets of a slide injected into a motion through its leg (for the foot lock's
+    bench and tests): ramping linearly from zero at ``start`` to ``displacement`` at ``end``,
+    held until ``release`` (the contact's last frame), then eased back to zero over ``blend``
+    frames with a smoothstep, so the take is as it was outside ``start..release + blend``.
+
+    Parameters
+    ----------
+    n_frames : int
+    foot : int
+        0 for the left foot, 1 for the right.
+    start, end, release : int
+        Frames, ``start ≤ end ≤ release``.
+    displacement : ndarray, shape (3,)
+        Take units.
+    blend : int
+        Frames (≥ 1).
+
+    Returns
+    -------
+    offsets : ndarray, shape (F, 2, 3)
+    changed : ndarray of bool, shape (F, 2)
+        The frames to solve.
+    """
+    _check_frames(n_frames, start, end)
+    frames = np.arange(n_frames)
+    ramp = np.clip((frames - start) / max(end - start, 1), 0.0, 1.0)
+    x = np.clip(1.0 - (frames - release) / (blend + 1.0), 0.0, 1.0)
+    ease = np.where(frames <= release, 1.0, x * x * (3.0 - 2.0 * x))
+    weight = ramp * ease
+    offsets = np.zeros((n_frames, 2, 3))
+    offsets[:, foot] = weight[:, None] * np.asarray(displacement, dtype=np.float64)
+    changed = np.zeros((n_frames, 2), dtype=bool)
+    changed[:, foot] = weight > 0
+    return offsets, changed

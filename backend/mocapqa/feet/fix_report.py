@@ -1,0 +1,147 @@
+"""The report of ``mocapqa feet fix``: each finding and contact, locked or not, with its slide
+before and after.
+
+Slides are the pivot's planted travel over a contact (:func:`mocapqa.feet.lock.planted_travel`),
+in take units, in centimetres when the unit converts (``*_cm``, else null) and over the body
+height estimated from the leg length (``*_rel_height``), as in ``mocapqa feet check``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from mocapqa.feet.contacts import Contact
+from mocapqa.feet.findings import Finding
+from mocapqa.feet.fix_choice import contact_id, finding_confidence, finding_id
+from mocapqa.feet.points import FootPoints, cm_per_unit
+
+__all__ = ["fix_report_json"]
+
+
+def _round(value: float | None, digits: int = 5) -> float | None:
+    return None if value is None else round(float(value), digits)
+
+
+def fix_report_json(
+    points: FootPoints,
+    contacts: Sequence[Contact],
+    findings: Sequence[Finding],
+    locked: Sequence[Contact],
+    before: Sequence[float],
+    after: Sequence[float],
+    clamped: Sequence[int],
+    miss: Sequence[float],
+    findings_after: Sequence[Finding],
+    skipped: int = 0,
+) -> dict[str, Any]:
+    """The ``feet fix`` report as a JSON-ready dict.
+
+    Parameters
+    ----------
+    points : FootPoints
+        Of the input take (units and leg length).
+    contacts, findings : sequence
+        The feet check of the input, frames of the check.
+    locked : sequence of Contact
+        The contacts locked.
+    before, after : sequence of float
+        Per contact of ``contacts``, the slide in the input and in the output, take units.
+    clamped : sequence of int
+        Per contact of ``contacts``, frames (with its blends) whose target was out of reach.
+    miss : sequence of float
+        Per contact of ``contacts``, the largest distance the ankle fell short, take units.
+    findings_after : sequence of Finding
+        The feet check of the output.
+    skipped : int
+        Leading bind-pose frames, added to every frame.
+
+    Returns
+    -------
+    dict
+        ``contacts`` and ``findings`` with ``id``, frames, ``applied``, ``slide_before`` and
+        ``slide_after`` (skate findings: of their contact) and ``skate_after`` (the skate the
+        check still finds on the output overlapping it, or null); a ``summary``.
+    """
+    to_cm = cm_per_unit(points.length_unit)
+    height = points.body_height
+    locked_keys = {(c.foot, c.start) for c in locked}
+
+    def sizes(prefix: str, value: float | None) -> dict[str, float | None]:
+        return {
+            prefix: _round(value),
+            f"{prefix}_cm": None if value is None or to_cm is None else _round(value * to_cm, 3),
+            f"{prefix}_rel_height": None if value is None else _round(value / height),
+        }
+
+    def contact_index(foot: str, start: int, end: int) -> int | None:
+        best, overlap = None, 0
+        for i, c in enumerate(contacts):
+            shared = min(c.end, end) - max(c.start, start) + 1
+            if c.foot == foot and shared > overlap:
+                best, overlap = i, shared
+        return best
+
+    def skate_after(foot: str, start: int, end: int) -> dict[str, Any] | None:
+        hits = [f for f in findings_after if f.kind == "skate" and f.foot == foot
+                and f.start <= end and f.end >= start]  # fmt: skip
+        if not hits:
+            return None
+        worst = max(hits, key=lambda f: f.size)
+        return {"start": worst.start + skipped, "end": worst.end + skipped,
+                **sizes("size", worst.size)}  # fmt: skip
+
+    contact_items = []
+    for i, c in enumerate(contacts):
+        contact_items.append(
+            {
+                "id": contact_id(c, skipped),
+                "foot": c.foot,
+                "start": c.start + skipped,
+                "end": c.end + skipped,
+                "confidence": c.confidence,
+                "applied": (c.foot, c.start) in locked_keys,
+                "clamped_frames": int(clamped[i]),
+                **sizes("reach_miss", miss[i]),
+                **sizes("slide_before", before[i]),
+                **sizes("slide_after", after[i]),
+            }
+        )
+    finding_items = []
+    for f in findings:
+        item: dict[str, Any] = {
+            "id": finding_id(f, skipped),
+            "kind": f.kind,
+            "foot": f.foot,
+            "start": f.start + skipped,
+            "end": f.end + skipped,
+            "confidence": finding_confidence(f, contacts),
+            **sizes("size", f.size),
+        }
+        index = contact_index(f.foot, f.start, f.end) if f.kind == "skate" else None
+        if index is None:
+            item.update(applied=False, contact=None, slide_before=None, slide_after=None)
+        else:
+            c = contacts[index]
+            item.update(
+                applied=(c.foot, c.start) in locked_keys,
+                contact=contact_id(c, skipped),
+                **sizes("slide_before", before[index]),
+                **sizes("slide_after", after[index]),
+                skate_after=skate_after(f.foot, f.start, f.end),
+            )
+        finding_items.append(item)
+    return {
+        "length_unit": points.length_unit,
+        "cm_per_unit": to_cm,
+        "body_height_estimate": _round(height),
+        "bind_pose_frames": skipped,
+        "contacts": contact_items,
+        "findings": finding_items,
+        "summary": {
+            "contacts_locked": len(locked_keys),
+            "clamped_frames": int(sum(clamped)),
+            "skate_findings_before": sum(f.kind == "skate" for f in findings),
+            "skate_findings_after": sum(f.kind == "skate" for f in findings_after),
+        },
+    }
