@@ -162,7 +162,7 @@ def test_convert_refuses_to_overwrite_an_input_csv_sidecar_or_an_openpose_frame(
     check()
 
 
-KEYPOINT_EXTENSIONS = ".trc or .csv or .npy or .npz or .json"
+KEYPOINT_EXTENSIONS = ".trc or .csv or .npy or .npz or .json or .c3d"
 WRONG_EXTENSION: dict[str, tuple[str, str]] = {
     "render still": ("render {in} --frame 0 -o {dir}/r.txt", ".png"),
     "render clip": ("render {in} --interval LeftArm:0-3 -o {dir}/r.png", ".gif or .mp4"),

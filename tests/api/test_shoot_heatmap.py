@@ -15,7 +15,7 @@ from mocapqa.jobs.demo import demo_paths
 from mocapqa.jobs.take_task import analyse_path
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.repository import Repository, new_id
-from mocapqa.store.shoots import ShootStore
+from mocapqa.store.shoots import DoneTake, ShootStore
 
 API = "/api/v1"
 SOURCES = (
@@ -42,7 +42,7 @@ def _fill(settings: Settings, shoot_id: str, corpus_dir: Path) -> None:
             "sha256": f"{index:064x}",
             "shoot_id": shoot_id,
         }
-        store.record_done(take, new_id(), options, outcome["summary"], 0.1)
+        store.record_done([DoneTake(take, new_id(), options, outcome["summary"], 0.1)])
     repository.close()
 
 

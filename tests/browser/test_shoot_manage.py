@@ -25,7 +25,7 @@ from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.accounts import Accounts
 from mocapqa.store.repository import Repository, new_id
 from mocapqa.store.roles import Role
-from mocapqa.store.shoots import ShootStore
+from mocapqa.store.shoots import DoneTake, ShootStore
 
 pytestmark = pytest.mark.browser
 
@@ -233,7 +233,7 @@ def test_heatmap_pages_beyond_200_takes(
             "sha256": f"{index + 1:064x}",
             "shoot_id": shoot_id,
         }
-        store.record_done(take, new_id(), options, outcome["summary"], 0.1)
+        store.record_done([DoneTake(take, new_id(), options, outcome["summary"], 0.1)])
     repository.close()
 
     context = chromium.new_context(viewport={"width": 1300, "height": 900})

@@ -13,7 +13,7 @@ import pytest
 from mocapqa.jobs.take_task import analyse_path
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.repository import Repository, new_id
-from mocapqa.store.shoots import ShootStore, TakeFilter
+from mocapqa.store.shoots import DoneTake, ShootStore, TakeFilter
 
 WALK = "bvh/cmu/cmu_12_01_walk.bvh"
 N_TAKES = 41
@@ -53,7 +53,7 @@ def test_pages_are_slices_of_one_order(repository: Repository, analysed: dict[st
             "sha256": f"{index + 1:064x}",
             "shoot_id": shoot,
         }
-        store.record_done(take, new_id(), options, summary, 0.1)
+        store.record_done([DoneTake(take, new_id(), options, summary, 0.1)])
     everything, total = store.page(shoot, 500, 0, "name")
     assert total == N_TAKES
     assert sum(r["score"] is None for r in everything) == 9

@@ -79,7 +79,7 @@ about 10 % dearer than a loop, four per task make it about 2 % (docs/batch.md)."
 STORE_EVERY_TAKES = 64
 """Done takes stored per transaction in a batch."""
 STORE_EVERY_S = 1.0
-"""Longest a done take waits to be stored, seconds (its row is emitted once it is)."""
+"""Seconds after a store from which the next done take is stored at once (with any held)."""
 SENT_BYTES_IN_FLIGHT = 256 * 1024 * 1024
 """Most bytes of takes sent to workers and not yet answered, when the workers do not share
 the client's files (one take larger than this is still sent, alone)."""
@@ -316,27 +316,31 @@ def run_batch(
 
 
 class _StoreInBatches:
-    """Done takes held until :data:`STORE_EVERY_TAKES` of them (or :data:`STORE_EVERY_S`
-    seconds) are ready, then stored in one transaction and their rows emitted: one commit per
-    take cost the client more than the rest of its work (docs/batch.md)."""
+    """Done takes stored in one transaction when :data:`STORE_EVERY_TAKES` of them are held or
+    :data:`STORE_EVERY_S` seconds have passed since the last store (so a batch's first take is
+    stored as soon as it is done, and a slow batch stores each take as it comes), then their
+    rows emitted: one commit per take cost the client more than the rest of its work
+    (docs/batch.md)."""
 
     def __init__(self, shoots: ShootStore, emit: Callable[[Row], None]) -> None:
         self.shoots = shoots
         self.emit = emit
         self.held: list[tuple[DoneTake, Row]] = []
-        self.since = 0.0
+        self.stored_at = time.monotonic() - STORE_EVERY_S
 
     def add(self, done: DoneTake, row: Row) -> None:
-        """Hold one done take; store the held ones when enough are held or waited long."""
-        if not self.held:
-            self.since = time.monotonic()
+        """Hold one done take; store the held ones when enough are held or time has passed."""
         self.held.append((done, row))
-        if len(self.held) >= STORE_EVERY_TAKES or time.monotonic() - self.since >= STORE_EVERY_S:
+        if (
+            len(self.held) >= STORE_EVERY_TAKES
+            or time.monotonic() - self.stored_at >= STORE_EVERY_S
+        ):
             self.flush()
 
     def flush(self) -> None:
         """Store every held take, then emit their rows (a row says "done" once stored)."""
         held, self.held = self.held, []
+        self.stored_at = time.monotonic()
         self.shoots.record_done([done for done, _ in held])
         for _, row in held:
             self.emit(row)
