@@ -50,8 +50,14 @@ export function runOptionsLabel(run) {
   return parts.filter(Boolean).join(" · ");
 }
 
-/** Run checks a take of this kind can run (twist and limits need joint rotations). */
-export const checksFor = (kind) => (kind === "motion" ? ["twist", "limits", "filter"] : ["filter"]);
+/** Which of GET /run-options' `take_checks` a take reads from: "motion", "markers" (a keypoint
+ * take of one of its `marker_formats`: C3D, TRC) or "keypoints". */
+export const takeChecksKind = (take, described) =>
+  (take.kind === "motion" ? "motion" : (described.marker_formats || []).includes(take.format) ? "markers" : "keypoints");
+
+/** Run checks a take can run, as the server says (`take_checks` of GET /run-options, from
+ * pipeline/options.py): twist and limits need joint rotations, the marker checks markers. */
+export const checksFor = (take, described) => described.take_checks[takeChecksKind(take, described)] || [];
 
 /**
  * The finding N (dir 1) or P (dir −1) opens, or null at either end. The findings kept are walked

@@ -41,7 +41,7 @@ function rolesGroup(roleKeys, joints, summary, mapping, onJoint) {
 export function rerunPanel(take, run, filters, described, context = {}) {
   const target = take.kind === "motion" ? "rotations" : "keypoints";
   const usable = filters.filter((f) => f.applies_to.includes(target));
-  const available = checksFor(take.kind).filter((c) => described.checks.includes(c));
+  const available = checksFor(take, described).filter((c) => described.checks.includes(c));
   const fields = Object.fromEntries(described.groups.flatMap((g) => g.fields).map((f) => [f.name, f]));
   const inputs = {}; // option name -> its control
   const checks = {}; // check name -> its box
@@ -93,7 +93,8 @@ export function rerunPanel(take, run, filters, described, context = {}) {
       : g.fields.length ? h("div", { class: "option-fields" }, g.fields.map((f) => {
         inputs[f.name] = f.type === "choice" ? choiceControl(f) : numberControl(f);
         return h("label", { class: "option-field" }, h("span", { class: "option-name" }, f.label), inputs[f.name], unitText(f.unit));
-      })) : h("p", { class: "muted" }, g.name === "limits" ? "the rig's joint-limit model; no settings" : "");
+      })) : h("p", { class: "muted" }, g.name === "limits" ? "the rig's joint-limit model; no settings"
+        : g.name === "markers" ? "swaps repaired, then confident gap fills applied; no settings" : "");
     const legend = h("legend", {}, check ? h("label", {}, check, ` ${g.label}`) : g.label);
     const set = h("fieldset", { class: "option-group", "data-group": g.name }, g.advanced ? null : legend, body);
     return g.advanced ? h("details", { class: "option-advanced", id: `options-${g.name}` }, h("summary", {}, g.label), set) : set;

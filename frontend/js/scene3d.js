@@ -13,6 +13,7 @@ const MARKED = new THREE.Color("#f39c12");
 const JOINT = new THREE.Color("#1f4e79");
 const SELECTED = new THREE.Color("#f1c40f");
 const BRIDGED = new THREE.Color("#8e44ad"); // a keypoint the filter bridged (no valid input)
+const FILLED = new THREE.Color("#16a085"); // a marker sample written by a gap fill
 const AXES = ["#d62728", "#2ca02c", "#1f77b4"].map((c) => new THREE.Color(c));
 
 const LIGHT_AMBIENT = 1.6, LIGHT_DIRECT = 1.6; // intensities of a white ambient and directional light
@@ -36,8 +37,27 @@ function viewScene(bonesCount, nPoints, nJoints, oriented) {
   axes.visible = false;
   const ghost = new THREE.LineSegments(lineGeometry(bonesCount * 2), new THREE.LineBasicMaterial({ color: 0x7f8c8d, transparent: true, opacity: 0.45 }));
   ghost.visible = false;
-  for (const o of [bones, joints, axes, ghost]) { o.frustumCulled = false; scene.add(o); }
-  return { scene, bones, joints, axes, ghost };
+  // Filled samples (marker takes): a hollow ring drawn around the point.
+  const rings = new THREE.Points(lineGeometry(nPoints), new THREE.PointsMaterial({ size: 15, sizeAttenuation: false, map: ringTexture(), transparent: true, alphaTest: 0.5, color: FILLED }));
+  rings.visible = false;
+  for (const o of [bones, joints, axes, ghost, rings]) { o.frustumCulled = false; scene.add(o); }
+  return { scene, bones, joints, axes, ghost, rings };
+}
+
+let ring = null;
+/** A ring on a transparent square: the point sprite of a filled sample. */
+function ringTexture() {
+  if (ring) return ring;
+  const canvas = document.createElement("canvas");
+  canvas.width = canvas.height = 32;
+  const g = canvas.getContext("2d");
+  g.strokeStyle = "#ffffff";
+  g.lineWidth = 6;
+  g.beginPath();
+  g.arc(16, 16, 12, 0, 2 * Math.PI);
+  g.stroke();
+  ring = new THREE.CanvasTexture(canvas);
+  return ring;
 }
 
 function lineGeometry(vertices, colored = false) {
@@ -123,7 +143,7 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
 
   const root = oriented ? drawnRoot : -1;
   let focus = "body";
-  let frame = null, triadsOn = false, overlayOn = false, renders = 0, drawn = 0, scheduled = 0, marked = false;
+  let frame = null, triadsOn = false, overlayOn = false, renders = 0, drawn = 0, scheduled = 0, marked = false, filledShown = 0;
   const sizeOf = (view) => [view.div.clientWidth, view.div.clientHeight];
   // The shown views' rectangles (inside their borders, from the row's padding edge, where the
   // absolutely placed canvas is measured from) → the canvas box and the viewports.
@@ -178,7 +198,7 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   const colorFrom = (css) => { let c = colorCache.get(css); if (!c) { c = new THREE.Color(css); colorCache.set(css, c); } return c; };
   const rgb = (c) => [c.r, c.g, c.b];
   const [markedRgb, bodyRgb, selectedRgb] = [MARKED, BODY, SELECTED].map(rgb);
-  const write = (view, points, rotations, flagged, selected, confidence = null, bridged = null) => {
+  const write = (view, points, rotations, flagged, selected, confidence = null, bridged = null, filled = null) => {
     const colorOf = (j) => (j === selected ? SELECTED : flagged.has(j) ? colorFrom(flagged.get(j)) : null);
     if (oriented) {
       const position = view.bones.geometry.attributes.position;
@@ -197,11 +217,24 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
       jp.array[3 * j] = ok ? p[0] : NaN; jp.array[3 * j + 1] = ok ? p[1] : NaN; jp.array[3 * j + 2] = ok ? p[2] : NaN;
       // A bridged keypoint is drawn purple at full strength (the filter's value, not a detection).
       const isBridged = bridged && bridged[j];
-      let c = colorOf(j) || (isBridged ? BRIDGED : JOINT);
-      if (confidence && !colorOf(j) && !isBridged) c = new THREE.Color(...geo.fade([c.r, c.g, c.b], confidence[j]));
+      const isFilled = filled && filled[j] > 0;
+      let c = colorOf(j) || (isFilled ? FILLED : isBridged ? BRIDGED : JOINT);
+      if (confidence && !colorOf(j) && !isBridged && !isFilled) c = new THREE.Color(...geo.fade([c.r, c.g, c.b], confidence[j]));
       jc.array[3 * j] = c.r; jc.array[3 * j + 1] = c.g; jc.array[3 * j + 2] = c.b;
     });
     jp.needsUpdate = true; jc.needsUpdate = true;
+    view.rings.visible = Boolean(filled);
+    if (filled) {
+      const rp = view.rings.geometry.attributes.position;
+      let shown = 0;
+      points.forEach((p, j) => {
+        const on = filled[j] > 0 && geo.present(p);
+        shown += on;
+        rp.array[3 * j] = on ? p[0] : NaN; rp.array[3 * j + 1] = on ? p[1] : NaN; rp.array[3 * j + 2] = on ? p[2] : NaN;
+      });
+      rp.needsUpdate = true;
+      filledShown = shown;
+    }
     if (triadsOn && oriented) {
       const t = geo.triads(points, rotations, nJoints, 0.05 * size, geo.identity);
       const ap = view.axes.geometry.attributes.position, ac = view.axes.geometry.attributes.color;
@@ -218,7 +251,7 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
   const show = (next) => {
     frame = next;
     write(views.raw, next.raw, next.rawRotations, next.rawFlagged || next.flagged, next.selected, next.confidence);
-    write(views.corrected, next.corrected, next.correctedRotations, next.flagged, next.selected, next.confidence, next.bridged);
+    write(views.corrected, next.corrected, next.correctedRotations, next.flagged, next.selected, next.confidence, next.bridged, next.filled);
     if (overlayOn) writeLines(views.corrected.ghost.geometry.attributes.position, next.raw, bones);
     // Auto-framing: the orbit's target follows the body over the floor, the root (follow) or
     // the selected joint (close-in).
@@ -280,7 +313,8 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
     const best = nearest(view, e);
     tooltip.hidden = best == null;
     if (best != null) {
-      const marks = frame.confidence ? ` · confidence ${frame.confidence[best].toFixed(2)}${frame.bridged && frame.bridged[best] && view === views.corrected ? " · bridged" : ""}` : "";
+      const corrected = view === views.corrected;
+      const marks = frame.confidence ? ` · confidence ${frame.confidence[best].toFixed(2)}${frame.bridged && frame.bridged[best] && corrected ? " · bridged" : ""}${frame.filled && frame.filled[best] > 0 && corrected ? " · filled" : ""}` : "";
       tooltip.textContent = names[best] + marks;
       tooltip.style.left = `${e.pageX + 12}px`;
       tooltip.style.top = `${e.pageY + 12}px`;
@@ -300,6 +334,8 @@ export function createViews(divs, skeleton, overview, onSelect = () => {}) {
     get bones() { return oriented ? bones.length : 0; },
     get points() { return names.length; },
     get lines() { return bones.length; },
+    /** Filled samples (marker takes) drawn in the corrected view of the shown frame. */
+    get filledShown() { return filledShown; },
     /** Screen position of a point of the shown frame in one view (for tests and focus). */
     screenOf(viewName, index) {
       const view = views[viewName];

@@ -13,6 +13,7 @@ import { createTimeline } from "./timeline.js";
 import { reviewPanel } from "./review.js";
 import { rerunPanel } from "./rerun.js";
 import { intervalDecisions } from "./decisions.js";
+import { MARKER_COLORS, createGapTimeline, gapRows } from "./gaptimeline.js";
 
 const OVERVIEW_FRAMES = 800; // frames of a take drawn before any window is loaded
 const LIMITS_COLOR = "#e67e22";
@@ -57,7 +58,10 @@ export async function takeView(main, takeId, params, onTeardown) {
   // run (on the time bar and on a joint flagged by several).
   const KIND_ORDER = { limits: 0, spin: 1, twist: 2 };
   const byKind = (a, b) => (KIND_ORDER[a.kind] ?? 0) - (KIND_ORDER[b.kind] ?? 0);
-  const findingColor = (f) => (f.kind === "twist" ? chainColor.get(f.joint) || "#c0392b" : f.kind === "spin" ? charts.SPIN_COLOR : LIMITS_COLOR);
+  const findingColor = (f) => (f.kind === "twist" ? chainColor.get(f.joint) || "#c0392b" : f.kind === "spin" ? charts.SPIN_COLOR : MARKER_COLORS[f.kind] || LIMITS_COLOR);
+  // A marker take the markers step checked: its corrected view has the swaps repaired and the
+  // confident gaps filled (then filtered), filled samples marked.
+  const markersRan = Boolean(result.steps.markers && result.steps.markers.state === "done");
   let detail = null;
 
   // Layout
@@ -70,7 +74,7 @@ export async function takeView(main, takeId, params, onTeardown) {
   const corrDiv = h("div", { id: "view-corrected", class: "view3d" });
   const rawTitle = h("h3", { class: "view-title" }, "raw");
   // Keypoints are filtered, not corrected: the right-hand view says which it shows.
-  const outcome = result.kind === "keypoints" ? "filtered" : "corrected";
+  const outcome = result.kind === "keypoints" && !markersRan ? "filtered" : "corrected";
   const corrTitle = h("h3", { class: "view-title" }, outcome);
   const rawPanel = h("div", { class: "col panel", id: "panel-raw" }, rawTitle, rawDiv);
   const presets = ["front", "side", "top"].map((name) => h("button", { id: `camera-${name}`, class: "small" }, name));
@@ -88,7 +92,8 @@ export async function takeView(main, takeId, params, onTeardown) {
     h("div", { class: "controls view-options" }, "camera ", presets, closeButton, followButton,
       h("label", {}, triadsBox, " joint axes"), h("label", {}, overlayBox, " overlay (raw as ghost)"),
       h("span", { class: "muted", id: "view-legend" }, oriented ? "bones are drawn in their parent joint's frame; the orange side marks the roll"
-        : "keypoints fade with their detection confidence; purple: bridged by the filter (hatched on the time bar)")),
+        : markersRan ? "markers; sticks join the segments inferred from the take; hollow green: filled by a gap fill (outlined on the gap timeline); purple: bridged by the filter"
+          : "keypoints fade with their detection confidence; purple: bridged by the filter (hatched on the time bar)")),
     viewsRow,
     h("div", { class: "panel player", id: "player" },
       h("div", { class: "controls" }, playButton, "speed ", speed, frameLabel, jointLabel, scrubber),
@@ -113,6 +118,9 @@ export async function takeView(main, takeId, params, onTeardown) {
   document.getElementById("player").append(timebar.el);
   const bridgedRuns = result.series.filter && result.series.filter.bridged_runs;
   if (bridgedRuns) timebar.setGaps(bridgedRuns);
+  const gapRowsShown = markersRan ? gapRows(result.findings, nFrames, names) : [];
+  const gapTimeline = gapRowsShown.length ? createGapTimeline(gapRowsShown, nFrames, (f) => { if (player.playing) togglePlay(); jump(f); }) : null;
+  if (gapTimeline) document.getElementById("player").append(gapTimeline.el);
   const rerunSlot = h("div", {});
   // A take no check could read is said above its (empty) findings, not only under Steps.
   const unchecked = Object.entries(result.steps).filter(([, st]) => st.state === "no_roles" || st.state === "no_model");
@@ -145,6 +153,7 @@ export async function takeView(main, takeId, params, onTeardown) {
       rawRotations: oriented ? source.raw_rotations[k] : null, correctedRotations: oriented ? source.corrected_rotations[k] : null,
       flagged: flaggedAt(f), selected: jointIndex.get(store.state.joint),
       confidence: source.confidence ? source.confidence[k] : null, bridged: source.bridged ? source.bridged[k] : null,
+      filled: source.filled ? source.filled[k] : null,
     };
   };
 
@@ -173,6 +182,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     corrTitle.textContent = store.state.overlay ? `${outcome} (solid) and raw (ghost) — frame ${frame.shown}` : `${outcome} — frame ${frame.shown}`;
     scrubber.value = f;
     timebar.setFrame(f);
+    if (gapTimeline) gapTimeline.setFrame(f);
     if (timeline) timeline.setFrame(f);
   };
   const remember = () => {
@@ -370,7 +380,10 @@ function runPicker(take, run, frameNow) {
 }
 
 function downloadsPanel(run, result) {
-  const labels = { bvh: "corrected BVH (the run's choice, before review)", csv: "filtered keypoints (CSV)", trc: "filtered keypoints (TRC)", report: "JSON report", "report.html": "HTML report" };
+  const labels = {
+    bvh: "corrected BVH (the run's choice, before review)", csv: "filtered keypoints (CSV)", trc: "filtered keypoints (TRC)",
+    c3d: "corrected C3D (swaps repaired, gaps filled; residual 0 on filled samples)", report: "JSON report", "report.html": "HTML report",
+  };
   const kinds = [...(result.downloads || ["report"]), "report.html"];
   return h("div", { class: "panel" }, h("h2", {}, "Downloads"),
     kinds.map((k) => h("a", { href: api.downloadUrl(run.id, k), download: "", id: `download-${k.replace(".", "-")}`, class: "download" }, labels[k] || k)));

@@ -30,12 +30,13 @@ FIELDS: dict[str, dict[str, Any]] = {
 GROUPS = [
     ("twist", "twist", ["twist_method", "twist_apply"]),
     ("limits", "limits", []),
+    ("markers", "markers", []),
     ("filter", "filter", ["filter_method", "filter_preset"]),
     ("advanced", None, ["max_points"]),
 ]
 """(name, check, field names) of each group, in the form's order."""
 DEFAULT_REQUEST: dict[str, Any] = {
-    "checks": ["twist", "limits", "filter"],
+    "checks": ["twist", "limits", "filter", "markers"],
     "twist_method": "robust",
     "twist_apply": "confident",
     "filter_method": None,
@@ -52,6 +53,7 @@ PRESETS: dict[str, dict[str, Any]] = {
     "full check, every twist interval applied": {"twist_apply": "all"},
     "limits only": {"checks": ["limits"]},
     "filter only": {"checks": ["filter"]},
+    "markers only": {"checks": ["markers"]},
 }
 """Each preset's difference from :data:`DEFAULT_REQUEST`."""
 SIDES = ("left", "right")
@@ -62,10 +64,16 @@ def test_the_api_serves_the_form(client: TestClient) -> None:
     served = client.get("/api/v1/run-options")
     assert served.status_code == 200
     body = served.json()
-    assert body["checks"] == ["twist", "limits", "filter"]
+    assert body["checks"] == ["twist", "limits", "filter", "markers"]
     groups = body["groups"]
     assert [(g["name"], g["check"], [f["name"] for f in g["fields"]]) for g in groups] == GROUPS
-    assert [g.get("advanced", False) for g in groups] == [False, False, False, True]
+    assert [g.get("advanced", False) for g in groups] == [False] * 4 + [True]
+    assert body["take_checks"] == {
+        "motion": ["twist", "limits", "filter"],
+        "markers": ["markers", "filter"],
+        "keypoints": ["filter"],
+    }
+    assert body["marker_formats"] == ["c3d", "trc"]
     for group in groups:
         assert group["label"], group["name"]
         for field in group["fields"]:

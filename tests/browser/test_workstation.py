@@ -427,12 +427,13 @@ def test_narrow_window_and_a_keypoint_take(
     middles = [b["y"] + b["height"] / 2 for b in read_outs]
     assert max(middles) - min(middles) < 2  # on one line
     p.screenshot(path=str(ARTIFACTS / "workstation-take-900px.png"))
-    # A TRC take: the re-run form offers only the filter; the run picker names what ran.
+    # A TRC take (marker data): the re-run form offers the marker checks and the filter; the
+    # run picker names what ran.
     narrow.open_take(live_server, takes["trc"])
     offered = p.evaluate(
         "() => [...document.querySelectorAll('#rerun-panel input[name=check]')].map((c) => c.value)"
     )
-    assert offered == ["filter"]
+    assert offered == ["markers", "filter"]
     # Pose2Sim's markers are joined by the bones of their layout, not drawn as loose dots.
     assert p.evaluate("() => window.mocapqaViews.lines") >= 20
     # Every keypoint (the head's too) is drawn inside both views, clear of their edges.

@@ -23,9 +23,15 @@ test("the run label names the steps that ran, not the ones requested", () => {
   assert.equal(format.stepsRan({ ...run, summary: { steps: { twist: "skipped" } } }), "no step ran");
 });
 
-test("keypoint takes are offered the filter only", () => {
-  assert.deepEqual(format.checksFor("keypoints"), ["filter"]);
-  assert.deepEqual(format.checksFor("motion"), ["twist", "limits", "filter"]);
+test("each kind of take is offered the checks the server says it can run", () => {
+  const described = {
+    take_checks: { motion: ["twist", "limits", "filter"], markers: ["markers", "filter"], keypoints: ["filter"] },
+    marker_formats: ["c3d", "trc"],
+  };
+  assert.deepEqual(format.checksFor({ kind: "keypoints", format: "openpose" }, described), ["filter"]);
+  assert.deepEqual(format.checksFor({ kind: "keypoints", format: "c3d" }, described), ["markers", "filter"]);
+  assert.deepEqual(format.checksFor({ kind: "keypoints", format: "trc" }, described), ["markers", "filter"]);
+  assert.deepEqual(format.checksFor({ kind: "motion", format: "bvh" }, described), ["twist", "limits", "filter"]);
 });
 
 test("N/P walk the findings one at a time in time order, two on one frame included", () => {

@@ -21,7 +21,15 @@ __all__ = ["MAX_WINDOW_VALUES", "Window", "read_window", "window_json", "window_
 MAX_WINDOW_VALUES = 3_000_000
 """Most values (frames × points × components, over every array) one window may hold."""
 
-ARRAYS = ("raw", "corrected", "raw_rotations", "corrected_rotations", "confidence", "bridged")
+ARRAYS = (
+    "raw",
+    "corrected",
+    "raw_rotations",
+    "corrected_rotations",
+    "confidence",
+    "bridged",
+    "filled",
+)
 """The stored arrays a window carries, in this order (those a run has)."""
 
 
@@ -41,7 +49,8 @@ class Window:
         ``raw`` and ``corrected`` (F, P, 3) positions in file units (NaN where missing); motion
         takes ``raw_rotations`` and ``corrected_rotations`` (F, P, 4) world unit quaternions,
         scalar-last; keypoint takes ``confidence`` (F, P) in 0–1 and, when filtered,
-        ``bridged`` (F, P), 1 where the filter had no valid input.
+        ``bridged`` (F, P), 1 where the filter had no valid input; marker takes checked by the
+        markers step ``filled`` (F, P), 1 on samples a gap fill wrote.
     """
 
     frames: np.ndarray
@@ -78,7 +87,8 @@ def read_window(path: Path, start: int, stop: int | None, step: int, max_frames:
 def window_json(window: Window) -> bytes:
     """The window as JSON: ``frames``, ``n_frames``, ``step`` and the arrays as nested lists.
 
-    Positions and rotations are rounded to 3 decimals, confidence to 2; ``bridged`` is 0/1.
+    Positions and rotations are rounded to 3 decimals, confidence to 2; ``bridged`` and
+    ``filled`` are 0/1.
     A missing point is ``[null, null, null]``.
     """
     payload: dict[str, object] = {
@@ -87,7 +97,7 @@ def window_json(window: Window) -> bytes:
         "step": window.step,
     }
     for name, values in window.arrays.items():
-        if name == "bridged":
+        if name in ("bridged", "filled"):
             payload[name] = values.astype(np.int8).tolist()
         else:
             digits = 2 if name == "confidence" else 3

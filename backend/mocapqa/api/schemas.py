@@ -217,10 +217,13 @@ class FilterInfo(BaseModel):
 
 
 class RunOptionsInfo(BaseModel):
-    """The run options for the UI form: fields grouped by check, named presets, and the rig
-    role keys a ``mapping`` may name."""
+    """The run options for the UI form: fields grouped by check, the checks each kind of take
+    can run (``motion``, ``markers``: a take of one of ``marker_formats``, ``keypoints``),
+    named presets, and the rig role keys a ``mapping`` may name."""
 
     checks: list[str]
+    take_checks: dict[str, list[str]]
+    marker_formats: list[str]
     groups: list[dict[str, Any]]
     presets: dict[str, dict[str, Any]]
     role_keys: list[str]

@@ -47,18 +47,60 @@ from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
 
-__all__ = ["JobRunner", "read_options", "run_summary", "write_outputs"]
+__all__ = ["JobRunner", "read_options", "run_summary", "write_corrected_c3d", "write_outputs"]
 
 log = logging.getLogger(__name__)
 
 
-def write_outputs(files: FileStore, run_id: str, result: AnalysisResult) -> list[str]:
-    """Write a run's files (report, points, corrected BVH or filtered keypoints).
+def write_corrected_c3d(path: Path, source: Path, result: AnalysisResult) -> None:
+    """Write a marker run's corrected take as C3D: the source's points with the repaired swaps
+    and the applied fills (no filter), residuals and camera masks exchanged with the swaps,
+    residual 0 and no cameras on every filled sample (C3D's mark of an interpolated sample);
+    the source's analogs, force plates, events and other groups unchanged, or (a source ezc3d
+    cannot open) the markers alone.
+
+    Raises
+    ------
+    MocapQAError
+        When the source cannot be read or the take written.
+    """
+    from dataclasses import replace
+
+    from mocapqa.errors import UnsupportedFormatError
+    from mocapqa.io.c3d import read_c3d, write_c3d
+
+    repair = result.markers
+    if repair is None:
+        raise InputError("Expected a run of the markers step to write a corrected C3D, got none")
+    take = read_c3d(source)
+    residuals = repair.carry(take.residuals, 0.0)
+    masks = repair.carry(take.camera_masks, 0)
+    points = replace(take.points, positions=repair.positions)
+    corrected = replace(take, points=points, residuals=residuals, camera_masks=masks)
+    try:
+        write_c3d(path, corrected, source=source)
+    except UnsupportedFormatError:
+        write_c3d(path, corrected)
+
+
+def write_outputs(
+    files: FileStore, run_id: str, result: AnalysisResult, source: Path | None = None
+) -> list[str]:
+    """Write a run's files (report, points, corrected BVH or filtered keypoints; for a C3D
+    marker take, ``corrected.c3d``: :func:`write_corrected_c3d`).
+
+    Parameters
+    ----------
+    files : FileStore
+    run_id : str
+    result : AnalysisResult
+    source : Path, optional
+        The take's stored file (a C3D's is opened again for its residuals and other groups).
 
     Returns
     -------
     list of str
-        The download kinds written (``"report"``, ``"bvh"``, ``"csv"``, ``"trc"``).
+        The download kinds written (``"report"``, ``"bvh"``, ``"csv"``, ``"trc"``, ``"c3d"``).
     """
     folder = files.run_dir(run_id)
     kinds = ["report"]
@@ -75,6 +117,8 @@ def write_outputs(files: FileStore, run_id: str, result: AnalysisResult) -> list
         arrays["confidence"] = result.confidence.astype(np.float16)
     if result.bridged is not None:
         arrays["bridged"] = result.bridged
+    if result.markers is not None:
+        arrays["filled"] = result.markers.filled
     np.savez(buffer, **arrays)
     files.write_bytes(folder / "points.npz", buffer.getvalue())
     if result.corrected_motion is not None:
@@ -93,10 +137,19 @@ def write_outputs(files: FileStore, run_id: str, result: AnalysisResult) -> list
                 kinds.append(suffix)
             except MocapQAError as e:
                 log.info("no %s output for run %s: %s", suffix, run_id, e)
+    if result.markers is not None and source is not None and source.suffix.lower() == ".c3d":
+        try:
+            write_corrected_c3d(folder / "corrected.c3d", source, result)
+            kinds.append("c3d")
+        except MocapQAError as e:
+            log.info("no c3d output for run %s: %s", run_id, e)
     points = result.report["points"]
     if result.report["kind"] == "keypoints":
-        # The 3D views join the keypoints of a known layout (BODY_25B, MediaPipe 33, Pose2Sim).
-        points = {**points, "bones": bones_for_keypoints(tuple(points["names"])).tolist()}
+        # The 3D views join the keypoints of a known layout (BODY_25B, MediaPipe 33, Pose2Sim);
+        # markers of no known layout by the sticks of their inferred segments, when checked.
+        layout = bones_for_keypoints(tuple(points["names"])).tolist()
+        if layout or "bones" not in points:
+            points = {**points, "bones": layout}
     report = {**result.report, "points": points, "downloads": kinds}
     files.write_bytes(folder / "report.json", json.dumps(report, allow_nan=False).encode())
     return kinds
@@ -323,7 +376,7 @@ class JobRunner:
             catalog = ModelCatalog.of_data_folder(self.files.root)
             result = analyze(motion_or_keypoints, options, progress, catalog)
             progress(96, "writing the outputs")
-            write_outputs(self.files, run_id, result)
+            write_outputs(self.files, run_id, result, path)
             if self.renderer is not None:
                 progress(97, "rendering the thumbnail")
                 render_thumbnail(

@@ -140,7 +140,7 @@ def analyse_path(
             shutil.copyfile(source, folder / name)
         facts = reading_facts(take, ReadOptions())
         files.write_bytes(folder / READING_FILE, json.dumps(facts).encode())
-        write_outputs(files, run_id, result)
+        write_outputs(files, run_id, result, source if source.is_file() else None)
     size = (
         sum(p.stat().st_size for p in source.iterdir() if p.is_file())
         if source.is_dir()
@@ -186,7 +186,7 @@ def analyse_stored(
     take = read_take_file(stored, format_name, name, read_options(stored.parent))
     catalog = ModelCatalog.of_data_folder(data_dir)
     result = analyze(take, AnalysisOptions.from_json(options), catalog=catalog)
-    write_outputs(FileStore(Path(data_dir)), run_id, result)
+    write_outputs(FileStore(Path(data_dir)), run_id, result, stored)
     return run_summary(result)
 
 

@@ -12,7 +12,7 @@ neither touches are bit-identical to the input.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -54,6 +54,13 @@ class MarkerRepair:
     def filled(self) -> BoolArray:
         """``(F, M)``: the samples a fill wrote."""
         return self.fills.filled
+
+    def carry(self, samples: np.ndarray, on_filled: float) -> np.ndarray:
+        """Another per-sample array of the take (residuals, camera masks), ``(F, M)``, as the
+        repair leaves it: exchanged with the repaired swaps, ``on_filled`` on filled samples;
+        its dtype kept."""
+        exchanged = repair_swaps(np.asarray(samples), self.repaired)
+        return np.where(self.filled, on_filled, exchanged).astype(exchanged.dtype)
 
     def to_json(self, names: Sequence[str], length_unit: str) -> dict[str, Any]:
         """A JSON-ready account: ``swaps`` (each with ``applied``), ``gaps`` (marker name,
@@ -121,11 +128,7 @@ def repair_markers(
     chosen = tuple(select_swaps(report.swaps, apply, params))
     swapped = repair_swaps(positions, chosen)
     fills = fill_gaps(swapped, fps, fill_params, apply, units_per_mm=unit_scale(length_unit))
-    exchanged = repair_swaps(np.asarray(residuals, dtype=np.float64), chosen)
-    return MarkerRepair(
-        positions=fills.positions,
-        residuals=np.where(fills.filled, 0.0, exchanged),
-        swaps=tuple(report.swaps),
-        repaired=chosen,
-        fills=fills,
+    repair = MarkerRepair(
+        fills.positions, np.asarray(residuals), tuple(report.swaps), chosen, fills
     )
+    return replace(repair, residuals=repair.carry(np.asarray(residuals, dtype=np.float64), 0.0))

@@ -1,4 +1,5 @@
-"""One analysis of a take: twist refinement, joint limits and filtering, with progress.
+"""One analysis of a take: twist refinement, joint limits, marker checks and filtering, with
+progress.
 
 ``analyze(take, options, progress)`` calls the algorithm entry points and gathers what the UI
 and the downloads need into an :class:`AnalysisResult`:
@@ -6,7 +7,8 @@ and the downloads need into an :class:`AnalysisResult`:
 * ``report`` — JSON-ready: summary, per-step state, findings, and the plotted time series
   on one frame axis of at most ``options.max_points`` frames that keeps every series' peaks
   and every finding's first and last frame (:func:`series_json`);
-* the corrected motion (twist-refined, optionally filtered) or the filtered keypoints;
+* the corrected motion (twist-refined, optionally filtered) or the filtered keypoints (of a
+  marker take: swaps repaired and gaps filled first, the filled samples marked);
 * raw and corrected point positions ``(F, P, 3)`` for the 3D view (served in windows).
 
 Each algorithm step lives in :mod:`mocapqa.pipeline.steps`; a step that does not apply (a rig
@@ -31,9 +33,11 @@ from mocapqa.core.rig import find_roles
 from mocapqa.errors import InputError
 from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
+from mocapqa.markers.repair import MarkerRepair
 from mocapqa.pipeline.frames import motion_pose, rigid_bones
 from mocapqa.pipeline.loading import Take
-from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.pipeline.marker_step import run_markers
+from mocapqa.pipeline.options import AnalysisOptions, take_checks
 from mocapqa.pipeline.steps import (
     StepOutcome,
     run_filter_keypoints,
@@ -71,6 +75,9 @@ class AnalysisResult:
         Detection confidence in [0, 1] of each point, for keypoint takes (0 where missing).
     bridged : ndarray of bool, shape (F, P), optional
         Samples the keypoint filter bridged (no valid input), for filtered keypoint takes.
+    markers : MarkerRepair, optional
+        The marker step's repaired and filled take, for marker takes it checked; its
+        ``filled`` mask marks the filled samples.
     """
 
     report: dict[str, Any]
@@ -82,6 +89,7 @@ class AnalysisResult:
     corrected_rotations: FloatArray | None = None
     confidence: FloatArray | None = None
     bridged: BoolArray | None = None
+    markers: MarkerRepair | None = None
 
 
 def _no_progress(percent: int, step: str) -> None:
@@ -181,6 +189,7 @@ def _analyze_motion(
             corrected = outcome.motion
     else:
         outcomes["filter"] = StepOutcome("skipped", "no filter chosen for motion takes")
+    outcomes["markers"] = StepOutcome("skipped", "BVH takes have joints, not markers")
 
     progress(85, "forward kinematics (corrected)")
     clock = time.perf_counter()
@@ -239,12 +248,27 @@ def _analyze_keypoints(
         "limits": StepOutcome("skipped", "keypoint takes have no joint rotations"),
     }
     plotted: dict[str, StepOutcome] = {}
-    filtered = sequence
     findings: list[dict[str, Any]] = []
+    correction: MarkerRepair | None = None
+    corrected = sequence
+    if "markers" not in take_checks("keypoints", sequence.source_format):
+        reason = "video keypoints are detections, not markers (C3D and TRC takes only)"
+        outcomes["markers"] = StepOutcome("skipped", reason)
+    elif "markers" in options.checks:
+        progress(15, "checking markers, repairing swaps, filling gaps")
+        outcome = run_markers(sequence)
+        outcomes["markers"] = plotted["markers"] = outcome
+        correction = outcome.markers
+        if outcome.keypoints is not None:
+            corrected = outcome.keypoints
+        findings += outcome.findings
+    else:
+        outcomes["markers"] = StepOutcome("skipped", "not requested")
+    filtered = corrected
     if "filter" in options.checks:
         progress(30, "filtering keypoints")
         outcome = run_filter_keypoints(
-            sequence,
+            corrected,
             options.filter_method or "adaptive",
             options.filter_preset,
             options.filter_params,
@@ -259,6 +283,14 @@ def _analyze_keypoints(
     # Missing keypoints stay NaN: drawing them at the origin would show points never seen.
     raw_points = sequence.positions
     corrected_points = filtered.positions
+    points: dict[str, Any] = {
+        "names": list(sequence.names),
+        "parents": [-1] * sequence.n_keypoints,
+        "n_joints": sequence.n_keypoints,
+    }
+    series = series_json(plotted, sequence.n_frames, sequence.fps, options.max_points)
+    if series.get("markers"):  # the inferred segments, drawn as sticks
+        points["bones"] = series["markers"]["sticks"]
     report = {
         "kind": "keypoints",
         "version": __version__,
@@ -276,12 +308,8 @@ def _analyze_keypoints(
         "options": options.to_json(),
         "steps": _steps_json(outcomes),
         "findings": findings,
-        "points": {
-            "names": list(sequence.names),
-            "parents": [-1] * sequence.n_keypoints,
-            "n_joints": sequence.n_keypoints,
-        },
-        "series": series_json(plotted, sequence.n_frames, sequence.fps, options.max_points),
+        "points": points,
+        "series": series,
     }
     bridged = outcomes["filter"].bridged
     return AnalysisResult(
@@ -292,6 +320,7 @@ def _analyze_keypoints(
         corrected_points,
         confidence=sequence.confidence,
         bridged=bridged,
+        markers=correction,
     )
 
 

@@ -23,6 +23,7 @@ from mocapqa.twist.choice import APPLY_CHOICES, parse_apply
 
 __all__ = [
     "CHECKS",
+    "MARKER_FORMATS",
     "MAX_POINTS_RANGE",
     "RUN_PRESETS",
     "TWIST_APPLY_CHOICES",
@@ -34,15 +35,32 @@ __all__ = [
     "check_checks",
     "check_mapping",
     "describe_options",
+    "take_checks",
 ]
 
 ParamValue = float | int | bool | str
 """Value of one filter parameter override."""
 
-Check = Literal["twist", "limits", "filter"]
+Check = Literal["twist", "limits", "filter", "markers"]
 """A check a run can do."""
 CHECKS: tuple[Check, ...] = get_args(Check)
 """The checks a run can do."""
+MARKER_FORMATS = ("c3d", "trc")
+"""Formats whose points are optical markers (the ``markers`` check runs on them); the points of
+every other keypoint format are detections from video."""
+
+
+def take_checks(kind: str, source_format: str | None = None) -> tuple[Check, ...]:
+    """The checks a take can run: joint rotations (``twist``, ``limits``) for a ``"motion"``
+    take, ``markers`` for points read from one of :data:`MARKER_FORMATS`, ``filter`` for all.
+    A run asked for another check reports it as skipped, with the reason."""
+    if kind == "motion":
+        return ("twist", "limits", "filter")
+    if source_format in MARKER_FORMATS:
+        return ("markers", "filter")
+    return ("filter",)
+
+
 TwistMethod = Method
 """A twist detection method."""
 TWIST_METHODS = METHODS
@@ -363,6 +381,7 @@ RUN_PRESETS: dict[str, AnalysisOptions] = {
     "full check, every twist interval applied": AnalysisOptions(twist_apply="all"),
     "limits only": AnalysisOptions(checks=("limits",)),
     "filter only": AnalysisOptions(checks=("filter",)),
+    "markers only": AnalysisOptions(checks=("markers",)),
 }
 """Named option sets offered by the re-run form (a preset fills the form; every field stays
 editable). The filter's own presets are the filter registry's."""
@@ -370,8 +389,9 @@ editable). The filter's own presets are the filter registry's."""
 
 def describe_options() -> dict[str, Any]:
     """The run options for a form: fields grouped by check, with types, units, choices, bounds,
-    defaults and the check each field belongs to, :data:`RUN_PRESETS` as JSON options, and the
-    role keys a ``mapping`` may name (:data:`mocapqa.core.rig.ROLE_KEYS`).
+    defaults and the check each field belongs to, :data:`RUN_PRESETS` as JSON options, the
+    checks each kind of take can run (:func:`take_checks`) and the role keys a ``mapping`` may
+    name (:data:`mocapqa.core.rig.ROLE_KEYS`).
 
     Derived from :class:`AnalysisOptions` and the constants above, so a form offers exactly
     what ``from_json`` accepts. Filter parameters come from the filter registry
@@ -408,6 +428,7 @@ def describe_options() -> dict[str, Any]:
             ],
         },
         {"name": "limits", "label": "Joint limits", "check": "limits", "fields": []},
+        {"name": "markers", "label": "Markers", "check": "markers", "fields": []},
         {
             "name": "filter",
             "label": "Filter",
@@ -452,6 +473,14 @@ def describe_options() -> dict[str, Any]:
     ]
     return {
         "checks": list(CHECKS),
+        # Which checks a take can run, by the take's kind ("markers": a keypoint take read from
+        # one of ``marker_formats``): the form offers those only.
+        "take_checks": {
+            "motion": list(take_checks("motion")),
+            "markers": list(take_checks("keypoints", MARKER_FORMATS[0])),
+            "keypoints": list(take_checks("keypoints")),
+        },
+        "marker_formats": list(MARKER_FORMATS),
         "groups": groups,
         "presets": {name: options.request_json() for name, options in RUN_PRESETS.items()},
         # The rig roles a ``mapping`` may name (BVH takes), in the rig module's order.

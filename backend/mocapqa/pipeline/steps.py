@@ -8,6 +8,8 @@
   ``"no_model"`` ("no model for this rig") instead of failing the run
 * filters — :func:`mocapqa.filters.apply.filter_keypoints` and
   :func:`~mocapqa.filters.apply.filter_motion`
+* markers — :func:`mocapqa.pipeline.marker_step.run_markers` (checks, swap repair, gap fill of
+  a marker take)
 
 Every step returns a :class:`StepOutcome` whose ``findings`` share one shape
 (``kind, joint, start_frame, end_frame, value, unit, confidence``; frames inclusive) and whose
@@ -21,7 +23,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -37,6 +39,9 @@ from mocapqa.limits.model import LimitsModel
 from mocapqa.pipeline.options import ParamValue
 from mocapqa.twist.analysis import analyze_twist, interval_frames
 from mocapqa.twist.spin import LimbSpin, find_limb_spins
+
+if TYPE_CHECKING:
+    from mocapqa.markers.repair import MarkerRepair
 
 __all__ = [
     "STEP_STATES",
@@ -95,6 +100,8 @@ class StepOutcome:
         Filtered keypoints, when the step makes them.
     bridged : ndarray of bool, shape (F, K), optional
         Samples the keypoint filter bridged (no valid input), when the step filters keypoints.
+    markers : MarkerRepair, optional
+        The swaps repaired and the gaps filled, when the step checks markers.
     """
 
     state: str
@@ -104,6 +111,7 @@ class StepOutcome:
     motion: Motion | None = None
     keypoints: KeypointSequence | None = None
     bridged: BoolArray | None = None
+    markers: MarkerRepair | None = None
 
 
 def _finding_edges(findings: list[dict[str, Any]]) -> IntArray:

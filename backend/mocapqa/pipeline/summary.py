@@ -9,7 +9,13 @@ One flat, JSON-ready dict per take, the same for the batch table, the API and th
 * ``joint_violations`` — per joint, share of frames outside the limits (joints with any)
 * ``filter_residual_mm`` — RMS distance between raw and filtered keypoints, mm (keypoint takes
   in a metric unit; None otherwise)
-* ``missing_share`` — share of missing keypoint samples (0 for BVH takes)
+* ``missing_share`` — share of missing keypoint samples (0 for BVH takes); of a marker take
+  the markers step checked, the share still missing after its fills
+* ``marker_gaps``, ``gaps_filled``, ``filled_share`` (filled samples over frames × markers),
+  ``marker_swaps``, ``swaps_repaired``, ``marker_spikes`` and ``marker_label_problems``
+  (static, absent, unlabelled and duplicate-labelled markers) — marker takes the markers step
+  checked (None otherwise); in the run's summary and the report, not columns of the shoot
+  table (its score counts them)
 * ``score`` — 0–100, see :func:`qa_score`; None for a motion take on which neither the twist
   nor the limits check ran (nothing was checked, so nothing can be called clean)
 
@@ -28,7 +34,14 @@ from mocapqa.limits.rig import rig_family
 if TYPE_CHECKING:  # the store reads SUMMARY_FIELDS without loading the analysis stack
     from mocapqa.pipeline.analyze import AnalysisResult
 
-__all__ = ["MM_PER_UNIT", "SCORE_TERMS", "SUMMARY_FIELDS", "qa_score", "qa_summary"]
+__all__ = [
+    "MARKER_FIELDS",
+    "MM_PER_UNIT",
+    "SCORE_TERMS",
+    "SUMMARY_FIELDS",
+    "qa_score",
+    "qa_summary",
+]
 
 MM_PER_UNIT = {"m": 1000.0, "cm": 10.0, "mm": 1.0}
 """Millimetres per length unit, for the units a residual can be given in mm."""
@@ -39,6 +52,10 @@ SCORE_TERMS: dict[str, tuple[float, float]] = {
     "violation_share": (0.40, 0.05),
     "missing_share": (0.40, 0.05),
     "filter_residual_mm": (0.20, 20.0),
+    "filled_share": (0.10, 0.05),
+    "marker_swaps": (0.30, 1.0),
+    "marker_spikes": (0.20, 5.0),
+    "marker_label_problems": (0.20, 1.0),
 }
 """Per defect ``x``: weight ``w`` and half-effect value ``s`` of the factor ``1 − w·x/(x+s)``."""
 
@@ -56,6 +73,17 @@ SUMMARY_FIELDS = (
     "score",
 )
 """The summary's scalar columns, in table order (``joint_violations`` is the per-joint map)."""
+MARKER_FIELDS = (
+    "marker_gaps",
+    "gaps_filled",
+    "filled_share",
+    "marker_swaps",
+    "swaps_repaired",
+    "marker_spikes",
+    "marker_label_problems",
+)
+"""The summary's marker counts (marker takes; None for others)."""
+_LABEL_KINDS = ("static marker", "absent marker", "unlabelled marker", "duplicate label")
 
 
 def qa_score(defects: dict[str, float | None]) -> float:
@@ -90,6 +118,29 @@ def _union_frames(findings: list[dict[str, Any]], n_frames: int) -> int:
             flagged[start] += 1
             flagged[stop] -= 1
     return int(np.count_nonzero(np.cumsum(flagged)[:n_frames]))
+
+
+def _marker_counts(findings: list[dict[str, Any]], samples: int) -> dict[str, Any]:
+    """The marker fields of the summary from the markers step's findings."""
+    count = {kind: 0 for kind in ("gap", "gap not filled", "swap", "spike")}
+    filled = repaired = labels = 0
+    for finding in findings:
+        kind = finding["kind"]
+        if kind in count:
+            count[kind] += 1
+        if kind == "gap":
+            filled += int(finding["end_frame"]) - int(finding["start_frame"]) + 1
+        repaired += kind == "swap" and bool(finding.get("applied"))
+        labels += kind in _LABEL_KINDS
+    return {
+        "marker_gaps": count["gap"] + count["gap not filled"],
+        "gaps_filled": count["gap"],
+        "filled_share": round(filled / max(samples, 1), 6),
+        "marker_swaps": count["swap"],
+        "swaps_repaired": repaired,
+        "marker_spikes": count["spike"],
+        "marker_label_problems": labels,
+    }
 
 
 def _residual_mm(result: AnalysisResult, unit: str) -> float | None:
@@ -127,6 +178,7 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
     twist_ran = motion and steps["twist"]["state"] == "done"
     limits_ran = motion and steps["limits"]["state"] == "done"
     filter_ran = not motion and steps["filter"]["state"] == "done"
+    markers_ran = steps.get("markers", {}).get("state") == "done"
 
     twist = [f for f in findings if f["kind"] == "twist"]
     spins = [f for f in findings if f["kind"] == "spin"]
@@ -152,6 +204,9 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
 
     residual = _residual_mm(result, str(info.get("length_unit"))) if filter_ran else None
     missing = 0.0 if motion else round(float(info.get("missing_fraction") or 0.0), 6)
+    markers = _marker_counts(findings, n_frames * n_joints) if markers_ran else None
+    if markers is not None:  # the fills' samples are no longer missing
+        missing = round(max(0.0, missing - float(markers["filled_share"])), 6)
     summary: dict[str, Any] = {
         "n_frames": n_frames,
         "duration_s": round(float(info["duration_s"]), 4),
@@ -164,6 +219,7 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
         "filter_residual_mm": residual,
         "missing_share": missing,
         "joint_violations": joint_violations,
+        **(markers or dict.fromkeys(MARKER_FIELDS)),
     }
     # A motion take on which neither check ran (a rig whose roles were not found, a run of
     # the filter only) has no score: 100 would read as "checked and clean".
@@ -176,6 +232,7 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
                 "violation_share": violation_share,
                 "missing_share": missing,
                 "filter_residual_mm": residual,
+                **{k: float(markers[k]) for k in MARKER_FIELDS if k in SCORE_TERMS and markers},
             }
         )
         if checked

@@ -30,6 +30,7 @@ DOWNLOADS = {
     "bvh": ("corrected.bvh", "text/plain", "corrected.bvh"),
     "csv": ("filtered.csv", "text/csv", "filtered.csv"),
     "trc": ("filtered.trc", "text/plain", "filtered.trc"),
+    "c3d": ("corrected.c3d", "application/octet-stream", "corrected.c3d"),
     "report": ("report.json", "application/json", "report.json"),
 }
 MAX_FRAME = 2**31 - 1
@@ -105,7 +106,9 @@ def get_frames(
 
     A missing point (a keypoint not detected in that frame) is ``[null, null, null]``.
     Keypoint takes also carry ``confidence`` (per point, 0–1, two decimals) and, when they were
-    filtered, ``bridged`` (per point, 1 where the filter had no valid input and bridged it).
+    filtered, ``bridged`` (per point, 1 where the filter had no valid input and bridged it);
+    marker takes the markers step checked, ``filled`` (per point, 1 on samples a gap fill
+    wrote into the corrected take).
 
     The step grows so that at most ``max_frames`` frames come back; the answer states the
     frame indices it holds.
@@ -130,7 +133,8 @@ def get_frames_packed(
 
     A uint32 ``n``, an ``n``-byte JSON header (``start``, ``step``, ``count``, ``n_frames``,
     ``points``, ``arrays`` as ``[name, components]``), then each array, shape
-    (count, points, components), in that order; missing points are NaN, ``bridged`` 0 or 1.
+    (count, points, components), in that order; missing points are NaN, ``bridged`` and
+    ``filled`` 0 or 1.
     A quarter of the bytes of the JSON and no parsing in the browser.
     """
     window = read_window(points_path(services, run_id), start, stop, step, max_frames)
@@ -162,14 +166,23 @@ def download_html_report(run_id: str, services: ServicesDep) -> Response:
     "/runs/{run_id}/download/{kind}",
     response_class=FileResponse,
     responses={
-        200: {"content": {"text/plain": {}, "text/csv": {}, "application/json": {}}},
+        200: {
+            "content": {
+                "text/plain": {},
+                "text/csv": {},
+                "application/json": {},
+                "application/octet-stream": {},
+            }
+        },
         **responses(401, 404, 409),
     },
 )
 def download(
-    run_id: str, kind: Literal["bvh", "csv", "trc", "report"], services: ServicesDep
+    run_id: str, kind: Literal["bvh", "csv", "trc", "c3d", "report"], services: ServicesDep
 ) -> FileResponse:
-    """A run's output: ``bvh`` (corrected), ``csv``/``trc`` (filtered keypoints), ``report``."""
+    """A run's output: ``bvh`` (corrected), ``csv``/``trc`` (filtered keypoints), ``c3d`` (a
+    marker take's swaps repaired and gaps filled, filled samples with residual 0),
+    ``report``."""
     run = services.repository.require_done(run_id)
     file_name, media_type, suffix = DOWNLOADS[kind]
     path = services.files.run_dir(run_id) / file_name
