@@ -5,10 +5,19 @@
 
 # three.js (the dashboard's 3D views) and Plotly's cartesian bundle (its charts) come from the npm
 # registry, pinned by package-lock.json.
+#
+# A network that inspects TLS needs its CA bundle for the two registries (npm's, PyPI's): pass
+# the machine's as a build secret, mounted for the downloading steps and never copied into the
+# image; without it the images' own CAs are used and nothing changes:
+#   docker build --secret id=ca-certificates,src=/etc/ssl/certs/ca-certificates.crt .
 FROM node:20.18.0-bookworm-slim AS three
 WORKDIR /js
 COPY package.json package-lock.json ./
-RUN npm ci --omit=dev --no-audit --no-fund && mkdir -p vendor/three \
+RUN --mount=type=secret,id=ca-certificates,target=/run/secrets/ca-certificates.crt \
+    if [ -s /run/secrets/ca-certificates.crt ]; then \
+      export NODE_EXTRA_CA_CERTS=/run/secrets/ca-certificates.crt; \
+    fi \
+ && npm ci --omit=dev --no-audit --no-fund && mkdir -p vendor/three \
  && cp node_modules/three/build/three.module.min.js node_modules/three/build/three.core.min.js \
        node_modules/three/LICENSE vendor/three/ \
  && mkdir -p vendor/plotly && cp node_modules/plotly.js-cartesian-dist-min/plotly-cartesian.min.js \
@@ -36,20 +45,37 @@ RUN groupadd --system --gid 10001 mocapqa \
     && useradd --system --uid 10001 --gid mocapqa --home-dir /app --shell /usr/sbin/nologin mocapqa
 
 WORKDIR /app
+# The package's dependencies first, read from pyproject.toml alone, with its PostgreSQL driver;
+# dask[distributed] is one of them. Their versions are bounded in pyproject.toml; the ones the
+# image serves with are pinned here so that app, scheduler and workers match. A change to the
+# code then rebuilds only the layers below (the package itself, seconds), not this one (minutes).
+# Wheels only: nothing is compiled (the image has no compiler).
 COPY pyproject.toml README.md ./
+RUN --mount=type=secret,id=ca-certificates,target=/run/secrets/ca-certificates.crt \
+    if [ -s /run/secrets/ca-certificates.crt ]; then \
+      export PIP_CERT=/run/secrets/ca-certificates.crt; \
+    fi \
+    && pip install "pip==24.2" \
+    && python -c "import tomllib; p = tomllib.load(open('pyproject.toml', 'rb'))['project']; \
+print('\n'.join(p['dependencies'] + p['optional-dependencies']['postgres']))" \
+       > /tmp/requirements.txt \
+    && pip install --only-binary=:all: -r /tmp/requirements.txt "dask[distributed]==2026.8.0" \
+    && rm /tmp/requirements.txt
 COPY backend ./backend
 COPY frontend ./frontend
 COPY --from=three /js/vendor/three ./frontend/vendor/three
 COPY --from=three /js/vendor/plotly ./frontend/vendor/plotly
 # Dask settings of the workers (and the scheduler): read from /etc/dask by every dask process.
 COPY backend/mocapqa/data/dask/mocapqa.yaml /etc/dask/mocapqa.yaml
-# The package with its PostgreSQL driver; dask[distributed] is a dependency of the package.
-# Versions of the package's own dependencies are bounded in pyproject.toml; the ones the image
-# serves with are pinned here so that app, scheduler and workers match.
-# "." is this project's own package (DL3013 asks for a version it cannot have).
+# The package itself ("." is this project's own package: DL3013 asks for a version it cannot
+# have), built by setuptools; `pip check` fails the build if a dependency went missing.
 # hadolint ignore=DL3013
-RUN pip install "pip==24.2" \
-    && pip install ".[postgres]" "dask[distributed]==2026.8.0" \
+RUN --mount=type=secret,id=ca-certificates,target=/run/secrets/ca-certificates.crt \
+    if [ -s /run/secrets/ca-certificates.crt ]; then \
+      export PIP_CERT=/run/secrets/ca-certificates.crt; \
+    fi \
+    && pip install --no-deps . \
+    && pip check \
     && mkdir -p /data \
     && chown 10001:10001 /data
 
