@@ -415,6 +415,7 @@ def bench_twist(
         loro_variants,
         natural_levels_table,
         rates_table,
+        rows_table,
         small_offsets_table,
         unpaired_table,
     )
@@ -543,6 +544,13 @@ def bench_twist(
         console.print(loro_table(grid))
     if real:
         _print_real(data_dir, console, methods_chosen)
+    if real and "robust" in methods_chosen:
+        # What decided each interval (calibrated probability, anatomy, ends, natural roll) on
+        # the real errors, the clean takes and the held-out injected takes, with reliability.
+        from mocapqa.bench.twist_evidence import evidence_tables
+
+        for title, rows in evidence_tables(data_dir, seed, repeats).items():
+            console.print(rows_table(f"Evidence: {title}", rows))
     cmu = [f for f in bench_files if f.rig == "cmu"]
     if cmu:
         motion = read_bvh(cmu[0].path)

@@ -282,3 +282,17 @@ def small_offsets_table(rows: Sequence[Any]) -> Table:
             f"{pct(r.corrected_before)} → {pct(r.corrected)}",
         )  # fmt: skip
     return table
+
+
+def rows_table(title: str, rows: Sequence[dict[str, Any]]) -> Table:
+    """A table of plain rows (one column per key of the first row; floats to 4 figures)."""
+    table = Table(title=title, title_justify="left")
+    columns = list(rows[0]) if rows else ["(none)"]
+    for column in columns:
+        table.add_column(str(column), justify="left" if column == columns[0] else "right")
+    for row in rows:
+        table.add_row(
+            *(f"{row[c]:.4g}" if isinstance(row.get(c), float) else str(row.get(c, "–"))
+              for c in columns)
+        )  # fmt: skip
+    return table
