@@ -38,6 +38,7 @@ from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
 from mocapqa.limits.model import LimitsModel
 from mocapqa.pipeline.options import ParamValue
 from mocapqa.twist.analysis import analyze_twist, interval_frames
+from mocapqa.twist.choice import decision_readout
 from mocapqa.twist.spin import LimbSpin, find_limb_spins
 
 if TYPE_CHECKING:
@@ -156,6 +157,7 @@ def run_twist(
             "confidence": round(float(interval.confidence), 3),
             "id": interval.id,
             "applied": interval.applied,
+            "readout": decision_readout(dict(interval.evidence)),
         }
         for interval in analysis.intervals
     ] + [spin_finding(spin) for spin in spins]

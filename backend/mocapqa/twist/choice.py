@@ -28,7 +28,14 @@ from mocapqa.twist.angles import ChainGeometry
 from mocapqa.twist.confidence import decide
 from mocapqa.twist.detect import DetectedInterval
 
-__all__ = ["APPLY_CHOICES", "MAX_APPLY_IDS", "TwistInterval", "choose_intervals", "parse_apply"]
+__all__ = [
+    "APPLY_CHOICES",
+    "MAX_APPLY_IDS",
+    "TwistInterval",
+    "choose_intervals",
+    "decision_readout",
+    "parse_apply",
+]
 
 APPLY_CHOICES = ("confident", "all", "none")
 """Which intervals a refinement applies, besides an explicit list of interval ids:
@@ -223,7 +230,7 @@ def choose_intervals(
             natural = 0.0 if natural_deg is None else float(natural_deg[k])
             if natural > 0.0:
                 evidence += (("natural_roll_deg", natural),)
-            evidence += (("rule", rules[k]),)
+            evidence += (("rule", rules[k]), ("default", "applied" if confident[k] else "listed"))
             if rules[k] == "natural_roll":
                 segment = geometries[i.chain].chain.segment.replace("_", " ")
                 evidence += (
@@ -258,3 +265,46 @@ def choose_intervals(
             )
         )
     return offsets, intervals
+
+
+_READOUTS = {
+    "calibrated": "{verdict}: calibrated probability {calibrated:.2f} (applied from 0.50)",
+    "anatomy": (
+        "{verdict}: the raw roll is {anatomy_deg:.0f}° further outside the natural range than "
+        "the corrected one (calibrated {calibrated:.2f})"
+    ),
+    "anatomy_against": (
+        "{verdict}: the correction would take a natural roll outside the range "
+        "(calibrated {calibrated:.2f})"
+    ),
+    "repetition": "{verdict}: other strong intervals on this joint (calibrated {calibrated:.2f})",
+    "min_evidence": (
+        "{verdict}: too small, or the roll outside contradicts its jumps "
+        "(calibrated {calibrated:.2f})"
+    ),
+    "end_evidence": (
+        "{verdict}: runs to the take's end with a small level and a poor counter-rotation "
+        "(calibrated {calibrated:.2f})"
+    ),
+    "uncalibrated": "{verdict}: no calibrated probability",
+}
+
+
+def decision_readout(evidence: dict[str, float | str]) -> str:
+    """One line saying what the default (``apply="confident"``) does with an interval and which
+    evidence decided (its ``evidence`` as :meth:`TwistInterval.to_json` writes it): for the
+    findings list and the report, whatever the run applied.
+
+    Examples: ``"default applied: the raw roll is 31° further outside the natural range than
+    the corrected one (calibrated 0.14)"``; ``"default listed: smaller than this rig's natural
+    upper arm roll (p99 16.5°)"``. Empty when nothing was recorded (the paper's method).
+    """
+    rule = str(evidence.get("rule", ""))
+    if not rule:
+        return ""
+    verdict = f"default {evidence.get('default', 'listed')}"
+    if "reason" in evidence:
+        return f"{verdict}: {evidence['reason']}"
+    values = {"calibrated": 0.0, "anatomy_deg": 0.0, **evidence, "verdict": verdict}
+    template = _READOUTS.get(rule, "{verdict}: " + rule.replace("_", " "))
+    return template.format(**values)
