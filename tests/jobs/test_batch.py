@@ -7,7 +7,6 @@ import contextlib
 import json
 import os
 import signal
-import socket
 import sqlite3
 import subprocess
 import sys
@@ -23,6 +22,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from mocapqa.api.app import create_app
+from mocapqa.bench.batch_client import separate_cluster
 from mocapqa.config import Settings
 from mocapqa.jobs.batch import CHUNK_TAKES, chunk_size, run_batch
 from mocapqa.jobs.engine import WORKER_CONFIG, Engine
@@ -292,12 +292,6 @@ def test_resume_after_the_client_is_killed(corpus_copy: Path, tmp_path: Path) ->
     assert runs == total - 1
 
 
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
 @contextlib.contextmanager
 def _cluster(tmp_path: Path, blind: bool = False) -> Iterator[str]:
     """A ``dask scheduler`` and a one-process ``dask worker`` with the settings file as the
@@ -305,35 +299,15 @@ def _cluster(tmp_path: Path, blind: bool = False) -> Iterator[str]:
     runs in a mount namespace of its own where ``tmp_path`` (the client's takes and data
     folders) is an empty tmpfs: a worker on another machine, as far as files go. Yields the
     scheduler's address."""
-    port = _free_port()
-    address = f"tcp://127.0.0.1:{port}"
     env = {
         **_environment(tmp_path),
         "DASK_CONFIG": str(ROOT / "backend" / "mocapqa" / WORKER_CONFIG),
     }
-    dask = str(Path(sys.executable).with_name("dask"))
-    worker = [dask, "worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard"]
-    if blind:
-        script = 'mount -t tmpfs none "$1" && shift && exec "$@"'
-        worker = ["unshare", "--mount", "--propagation", "private", "sh", "-c", script, "sh",
-                  str(tmp_path), *worker]  # fmt: skip
-    processes = [
-        subprocess.Popen(
-            [dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
-            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-        ),
-        subprocess.Popen(worker, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL),
-    ]  # fmt: skip
-    try:
+    script = 'mount -t tmpfs none "$1" && shift && exec "$@"'
+    prefix = ["unshare", "--mount", "--propagation", "private", "sh", "-c", script, "sh",
+              str(tmp_path)] if blind else []  # fmt: skip
+    with separate_cluster(workers=1, env=env, worker_prefix=prefix) as address:
         yield address
-    finally:
-        for process in reversed(processes):
-            process.terminate()
-        for process in reversed(processes):
-            try:
-                process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                process.kill()
 
 
 def _server_run(address: str, data_dir: Path, take: Path) -> tuple[dict[str, Any], int]:

@@ -12,7 +12,7 @@ import contextlib
 import socket
 import subprocess
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -80,27 +80,39 @@ class ClientCost:
 
 
 @contextlib.contextmanager
-def separate_cluster(workers: int = 2) -> Iterator[str]:
+def separate_cluster(
+    workers: int = 2,
+    env: Mapping[str, str] | None = None,
+    worker_prefix: Sequence[str] = (),
+) -> Iterator[str]:
     """A ``dask scheduler`` and a ``dask worker`` of ``workers`` processes, each a process of
     its own (as on a real cluster, so the client's process CPU is the client's alone); yields
-    the scheduler's address and stops both after."""
+    the scheduler's address and stops both after.
+
+    Parameters
+    ----------
+    workers : int
+        Worker processes.
+    env : mapping, optional
+        Their environment (this process's when None).
+    worker_prefix : sequence of str
+        A command the worker is started under (``unshare …``, to hide the client's disk).
+    """
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         port = int(sock.getsockname()[1])
     address = f"tcp://127.0.0.1:{port}"
     dask = str(Path(sys.executable).with_name("dask"))
-    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    worker = [dask, "worker", address, "--nworkers", str(workers), "--nthreads", "1",
+              "--no-dashboard"]  # fmt: skip
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "env": env}
     processes = [
         subprocess.Popen(
             [dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
             **quiet,  # type: ignore[call-overload]
         ),
-        subprocess.Popen(
-            [dask, "worker", address, "--nworkers", str(workers), "--nthreads", "1",
-             "--no-dashboard"],
-            **quiet,  # type: ignore[call-overload]
-        ),
-    ]  # fmt: skip
+        subprocess.Popen([*worker_prefix, *worker], **quiet),  # type: ignore[call-overload]
+    ]
     try:
         yield address
     finally:

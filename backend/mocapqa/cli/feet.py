@@ -20,7 +20,7 @@ from __future__ import annotations
 import dataclasses
 import json
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 import typer
 
@@ -102,26 +102,28 @@ def _print_report(path: Path, report: dict[str, Any]) -> None:
     console.print(findings)
 
 
-@feet_app.command("check")
-def feet_check(
-    take: Annotated[Path, typer.Argument(help="A BVH, keypoint or C3D take (or OpenPose folder).")],
-    json_output: Annotated[bool, typer.Option("--json", help="Print JSON instead.")] = False,
-    fps: FpsOption = None,
-    length_unit: Annotated[
-        str | None,
-        typer.Option(
-            "--length-unit",
-            help="The take's length unit (m, cm, mm, in), for files that do not store it "
-            "(BVH): sizes are then given in cm.",
-        ),
-    ] = None,
-    mapping: MappingOption = None,
-    root_translation: RootTranslationOption = "auto",
-) -> None:
-    """Find the up axis, the floor, foot contacts, skate, penetration, floating and jitter."""
+LengthUnitOption = Annotated[
+    str | None,
+    typer.Option(
+        "--length-unit",
+        help="The take's length unit (m, cm, mm, in), for files that do not store it "
+        "(BVH): sizes are then given in cm.",
+    ),
+]
+"""The ``--length-unit`` option of the feet commands."""
+
+
+def _read_take(
+    take: Path,
+    fps: float | None,
+    length_unit: str | None,
+    mapping: Path | None,
+    root_translation: Literal["auto", "add", "replace"],
+) -> tuple[Any, Any]:
+    """The take and its hand-named roles, the options checked first (``--fps``,
+    ``--length-unit``, ``--mapping``)."""
     from mocapqa.core.keypoints import LENGTH_UNITS
     from mocapqa.io.formats import check_fps
-    from mocapqa.pipeline.feet import check_take_feet, feet_report_json
 
     if fps is not None:
         check_fps(fps, "--fps")
@@ -134,6 +136,22 @@ def feet_check(
         take, fps=fps, length_unit=length_unit, number_reader="auto",
         root_translation=root_translation,
     )  # fmt: skip
+    return read, roles
+
+
+@feet_app.command("check")
+def feet_check(
+    take: Annotated[Path, typer.Argument(help="A BVH, keypoint or C3D take (or OpenPose folder).")],
+    json_output: Annotated[bool, typer.Option("--json", help="Print JSON instead.")] = False,
+    fps: FpsOption = None,
+    length_unit: LengthUnitOption = None,
+    mapping: MappingOption = None,
+    root_translation: RootTranslationOption = "auto",
+) -> None:
+    """Find the up axis, the floor, foot contacts, skate, penetration, floating and jitter."""
+    from mocapqa.pipeline.feet import check_take_feet, feet_report_json
+
+    read, roles = _read_take(take, fps, length_unit, mapping, root_translation)
     points, report, skipped = check_take_feet(read, roles)
     result = {"path": str(take), **feet_report_json(points, report, skipped)}
     _add_ids(result, report, skipped)
@@ -219,15 +237,11 @@ def feet_fix(
     ] = None,
     json_output: Annotated[bool, typer.Option("--json", help="Print the report JSON.")] = False,
     fps: FpsOption = None,
-    length_unit: Annotated[
-        str | None,
-        typer.Option("--length-unit", help="The take's length unit (m, cm, mm, in)."),
-    ] = None,
+    length_unit: LengthUnitOption = None,
     mapping: MappingOption = None,
     root_translation: RootTranslationOption = "auto",
 ) -> None:
     """Lock planted feet (BVH: two-bone leg IK; keypoints: pinned), blended, and write the take."""
-    from mocapqa.core.keypoints import LENGTH_UNITS
     from mocapqa.core.motion import Motion
     from mocapqa.feet.fix import foot_rig, lock_feet
     from mocapqa.feet.fix_choice import choose_locks
@@ -237,22 +251,12 @@ def feet_fix(
     from mocapqa.feet.pin import foot_keypoints, pin_feet
     from mocapqa.io.atomic import write_text
     from mocapqa.io.bvh_write import write_bvh
-    from mocapqa.io.formats import check_fps, write_keypoints
+    from mocapqa.io.formats import write_keypoints
     from mocapqa.pipeline.feet import check_take_feet
 
-    if fps is not None:
-        check_fps(fps, "--fps")
-    if length_unit is not None and length_unit not in LENGTH_UNITS:
-        raise InputError(
-            f"Expected --length-unit among {', '.join(LENGTH_UNITS)}, got {length_unit!r}"
-        )
     if not apply.strip() or (apply.strip().startswith(",") or apply.strip().endswith(",")):
         raise InputError(f"Expected --apply confident, all, none or ids, got {apply!r}")
-    roles = load_mapping(mapping)
-    read = read_input(
-        take, fps=fps, length_unit=length_unit, number_reader="auto",
-        root_translation=root_translation,
-    )  # fmt: skip
+    read, roles = _read_take(take, fps, length_unit, mapping, root_translation)
     if not isinstance(read, Motion) and read.source_format == "c3d":
         raise InputError(
             "Expected a BVH or keypoint take: foot cleanup is for BVH and keypoint takes for "
