@@ -14,6 +14,7 @@ import { reviewPanel } from "./review.js";
 import { rerunPanel } from "./rerun.js";
 import { intervalDecisions } from "./decisions.js";
 import { MARKER_COLORS, createGapTimeline, gapRows } from "./gaptimeline.js";
+import { contactRows, createContactTimeline } from "./contacttimeline.js";
 
 const OVERVIEW_FRAMES = 800; // frames of a take drawn before any window is loaded
 const LIMITS_COLOR = "#e67e22";
@@ -100,7 +101,7 @@ export async function takeView(main, takeId, params, onTeardown) {
       h("div", { class: "controls" }, loopButton, loopFindingButton, clearLoopButton, loopLabel)),
   );
   const help = h("p", { class: "muted", id: "keys-help" },
-    "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · I/O in/out point · L loop in/out · shift+L loop the finding · C close-in · A/F/R approve, needs fix, reject the take (saves) · Y/X accept, reject the focused or last opened twist interval (saves) · Enter on a row opens it · ? shows or hides this line");
+    "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · I/O in/out point · L loop in/out · shift+L loop the finding · C close-in · A/F/R approve, needs fix, reject the take (saves) · Y/X accept, reject the focused or last opened twist interval or swap (saves) · Enter on a row opens it · ? shows or hides this line");
   const timelines = h("div", {});
   const review = reviewPanel(take);
   const decided = intervalDecisions(run, result, take);
@@ -121,6 +122,10 @@ export async function takeView(main, takeId, params, onTeardown) {
   const gapRowsShown = markersRan ? gapRows(result.findings, nFrames, names) : [];
   const gapTimeline = gapRowsShown.length ? createGapTimeline(gapRowsShown, nFrames, (f) => { if (player.playing) togglePlay(); jump(f); }) : null;
   if (gapTimeline) document.getElementById("player").append(gapTimeline.el);
+  // The feet step's contacts (two rows: left and right foot), its findings marked on them.
+  const feetSeries = result.series.feet;
+  const contactTimeline = feetSeries ? createContactTimeline(contactRows(feetSeries.contacts, result.findings, nFrames), nFrames, (f) => { if (player.playing) togglePlay(); jump(f); }) : null;
+  if (contactTimeline) document.getElementById("player").append(contactTimeline.el);
   const rerunSlot = h("div", {});
   // A take no check could read is said above its (empty) findings, not only under Steps.
   const unchecked = Object.entries(result.steps).filter(([, st]) => st.state === "no_roles" || st.state === "no_model");
@@ -183,6 +188,7 @@ export async function takeView(main, takeId, params, onTeardown) {
     scrubber.value = f;
     timebar.setFrame(f);
     if (gapTimeline) gapTimeline.setFrame(f);
+    if (contactTimeline) contactTimeline.setFrame(f);
     if (timeline) timeline.setFrame(f);
   };
   const remember = () => {

@@ -104,7 +104,7 @@ def take_id(client: TestClient) -> str:
 @pytest.mark.parametrize(
     ("checks", "words"),
     [
-        (["twist"] * 100_000, "at most 4"),
+        (["twist"] * 100_000, "at most 5"),
         (["twist", "limits", "twist"], "at most once"),
         (["limits", "limits"], "at most once"),
     ],

@@ -31,12 +31,13 @@ GROUPS = [
     ("twist", "twist", ["twist_method", "twist_apply"]),
     ("limits", "limits", []),
     ("markers", "markers", []),
+    ("feet", "feet", []),
     ("filter", "filter", ["filter_method", "filter_preset"]),
     ("advanced", None, ["max_points"]),
 ]
 """(name, check, field names) of each group, in the form's order."""
 DEFAULT_REQUEST: dict[str, Any] = {
-    "checks": ["twist", "limits", "filter", "markers"],
+    "checks": ["twist", "limits", "filter", "markers", "feet"],
     "twist_method": "robust",
     "twist_apply": "confident",
     "filter_method": None,
@@ -54,6 +55,7 @@ PRESETS: dict[str, dict[str, Any]] = {
     "limits only": {"checks": ["limits"]},
     "filter only": {"checks": ["filter"]},
     "markers only": {"checks": ["markers"]},
+    "feet only": {"checks": ["feet"]},
 }
 """Each preset's difference from :data:`DEFAULT_REQUEST`."""
 SIDES = ("left", "right")
@@ -64,14 +66,14 @@ def test_the_api_serves_the_form(client: TestClient) -> None:
     served = client.get("/api/v1/run-options")
     assert served.status_code == 200
     body = served.json()
-    assert body["checks"] == ["twist", "limits", "filter", "markers"]
+    assert body["checks"] == ["twist", "limits", "filter", "markers", "feet"]
     groups = body["groups"]
     assert [(g["name"], g["check"], [f["name"] for f in g["fields"]]) for g in groups] == GROUPS
-    assert [g.get("advanced", False) for g in groups] == [False] * 4 + [True]
+    assert [g.get("advanced", False) for g in groups] == [False] * 5 + [True]
     assert body["take_checks"] == {
-        "motion": ["twist", "limits", "filter"],
-        "markers": ["markers", "filter"],
-        "keypoints": ["filter"],
+        "motion": ["twist", "limits", "feet", "filter"],
+        "markers": ["markers", "feet", "filter"],
+        "keypoints": ["feet", "filter"],
     }
     assert body["marker_formats"] == ["c3d", "trc"]
     for group in groups:

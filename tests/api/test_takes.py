@@ -43,7 +43,7 @@ def test_upload_runs_and_the_corrected_bvh_reads_back(
     run = wait_for_run(client, created["run_id"])
     assert run["status"] == "done", run["error"]
     assert run["progress"] == 100
-    assert run["options"]["checks"] == ["twist", "limits", "filter", "markers"]
+    assert run["options"]["checks"] == ["twist", "limits", "filter", "markers", "feet"]
     download = client.get(f"/api/v1/runs/{created['run_id']}/download/bvh")
     assert download.status_code == 200
     corrected = parse_bvh(download.content, "corrected.bvh")

@@ -70,11 +70,11 @@ def test_findings_grouped_by_joint_filtered_and_walked(
             assert f"worst {worst:.1f}" in heads.nth(k).inner_text()
     assert len(rows(page)) == len(findings)
     # Each limits finding shows its anatomical read-out under the joint ("… over-inverted 136°"),
-    # each limb spin its sentence ("right arm spun 24° about its axis …").
-    readouts = [
-        f["readout"] for f in findings if f["kind"] in ("limits", "spin") and f.get("readout")
-    ]
-    assert readouts
+    # each limb spin its sentence ("right arm spun 24° about its axis …"), each twist interval
+    # what the default does with it and why ("default applied: calibrated probability 0.82 …").
+    readouts = [f["readout"] for f in findings if f.get("readout")]
+    assert {f["kind"] for f in findings if f.get("readout")} >= {"limits", "twist"}
+    assert any(r.startswith("default ") for r in readouts)
     shown = p.locator("#findings tr.finding .readout").all_inner_texts()
     assert sorted(shown) == sorted(readouts)
     p.locator("#findings-panel").scroll_into_view_if_needed()
@@ -93,13 +93,15 @@ def test_findings_grouped_by_joint_filtered_and_walked(
     )
 
     # Filters: kind, joint, smallest magnitude, words.
+    kinds = {f["kind"] for f in findings}
     p.uncheck("#filter-kind-limits")
-    assert {r["kind"] for r in rows(page)} == {"twist", "spin"}
-    p.uncheck("#filter-kind-spin")
+    assert {r["kind"] for r in rows(page)} == kinds - {"limits"}
+    for kind in kinds - {"limits", "twist"}:
+        p.uncheck(f"#filter-kind-{kind}")
     assert {r["kind"] for r in rows(page)} == {"twist"}
     assert "shown" in p.inner_text("#findings-panel h2")
-    p.check("#filter-kind-limits")
-    p.check("#filter-kind-spin")
+    for kind in kinds - {"twist"}:
+        p.check(f"#filter-kind-{kind}")
     p.select_option("#filter-joint", busiest)
     assert {r["joint"] for r in rows(page)} == {busiest}
     p.select_option("#filter-joint", "")
@@ -144,8 +146,8 @@ def test_findings_grouped_by_joint_filtered_and_walked(
     # marks only those.
     marks = "() => document.querySelectorAll('#timebar .tb-mark').length"
     assert p.evaluate(marks) == len(findings)
-    p.uncheck("#filter-kind-limits")
-    p.uncheck("#filter-kind-spin")
+    for kind in kinds - {"twist"}:
+        p.uncheck(f"#filter-kind-{kind}")
     assert p.evaluate(marks) == sum(f["kind"] == "twist" for f in findings)
     p.evaluate("() => document.activeElement.blur()")
     scrub(page, 0)
@@ -364,7 +366,7 @@ def test_options_form_grouped_with_units_presets_and_checks(
         "fs => fs.map(f => f.dataset.group)"
     )
     # A BVH take also has its rig roles (the mapping), folded when every role was found.
-    assert groups == ["twist", "limits", "filter", "advanced", "roles"]
+    assert groups == ["twist", "limits", "feet", "filter", "advanced", "roles"]
     assert p.locator("#options-roles").get_attribute("open") is None
     # Every numeric field carries its unit: the advanced one, and the filter's parameters.
     p.click("#options-advanced summary")

@@ -340,7 +340,7 @@ def test_keyboard_only_review_from_the_take_list(
     page.settle()
     # A twist finding focuses its joint: the twist chart shows that chain only.
     twist_row = p.locator("#findings tr.finding", has_text="twist").first
-    chain = twist_row.locator("td").nth(1).inner_text()
+    chain = twist_row.get_attribute("data-joint")
     twist_row.focus()
     p.keyboard.press("Enter")
     shown = p.evaluate(
@@ -433,7 +433,7 @@ def test_narrow_window_and_a_keypoint_take(
     offered = p.evaluate(
         "() => [...document.querySelectorAll('#rerun-panel input[name=check]')].map((c) => c.value)"
     )
-    assert offered == ["markers", "filter"]
+    assert offered == ["markers", "feet", "filter"]
     # Pose2Sim's markers are joined by the bones of their layout, not drawn as loose dots.
     assert p.evaluate("() => window.mocapqaViews.lines") >= 20
     # Every keypoint (the head's too) is drawn inside both views, clear of their edges.

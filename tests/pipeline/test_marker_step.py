@@ -34,12 +34,12 @@ def clean(corpus_dir: Path) -> KeypointSequence:
 
 
 def test_marker_formats_run_the_markers_check_and_the_form_says_so() -> None:
-    assert take_checks("keypoints", "c3d") == ("markers", "filter")
-    assert take_checks("keypoints", "trc") == ("markers", "filter")
-    assert take_checks("keypoints", "openpose") == ("filter",)
+    assert take_checks("keypoints", "c3d") == ("markers", "feet", "filter")
+    assert take_checks("keypoints", "trc") == ("markers", "feet", "filter")
+    assert take_checks("keypoints", "openpose") == ("feet", "filter")
     assert "markers" not in take_checks("motion")
     described = describe_options()
-    assert described["take_checks"]["markers"] == ["markers", "filter"]
+    assert described["take_checks"]["markers"] == ["markers", "feet", "filter"]
     assert "c3d" in described["marker_formats"]
     assert "markers" in AnalysisOptions().checks
 

@@ -1,5 +1,5 @@
-"""One analysis of a take: twist refinement, joint limits, marker checks and filtering, with
-progress.
+"""One analysis of a take: twist refinement, joint limits, marker checks, the feet check and
+filtering, with progress.
 
 ``analyze(take, options, progress)`` calls the algorithm entry points and gathers what the UI
 and the downloads need into an :class:`AnalysisResult`:
@@ -34,6 +34,7 @@ from mocapqa.errors import InputError
 from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
 from mocapqa.markers.repair import MarkerRepair
+from mocapqa.pipeline.feet_step import run_feet
 from mocapqa.pipeline.frames import motion_pose, rigid_bones
 from mocapqa.pipeline.loading import Take
 from mocapqa.pipeline.marker_step import run_markers
@@ -179,6 +180,18 @@ def _analyze_motion(
     else:
         outcomes["limits"] = StepOutcome("skipped", "not requested")
 
+    if "feet" in options.checks:
+        progress(65, "feet and floor check")
+        clock = time.perf_counter()
+        outcome = run_feet(motion, options.mapping)
+        timings["feet_s"] = time.perf_counter() - clock
+        outcomes["feet"] = outcome
+        if outcome.state == "done":
+            plotted["feet"] = outcome
+        findings += outcome.findings
+    else:
+        outcomes["feet"] = StepOutcome("skipped", "not requested")
+
     if "filter" in options.checks and options.filter_method:
         progress(75, "filtering the corrected motion")
         clock = time.perf_counter()
@@ -264,6 +277,15 @@ def _analyze_keypoints(
         findings += outcome.findings
     else:
         outcomes["markers"] = StepOutcome("skipped", "not requested")
+    if "feet" in options.checks:  # the feet of the take as read
+        progress(25, "feet and floor check")
+        outcome = run_feet(sequence)
+        outcomes["feet"] = outcome
+        if outcome.state == "done":
+            plotted["feet"] = outcome
+        findings += outcome.findings
+    else:
+        outcomes["feet"] = StepOutcome("skipped", "not requested")
     filtered = corrected
     if "filter" in options.checks:
         progress(30, "filtering keypoints")

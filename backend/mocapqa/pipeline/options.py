@@ -41,7 +41,7 @@ __all__ = [
 ParamValue = float | int | bool | str
 """Value of one filter parameter override."""
 
-Check = Literal["twist", "limits", "filter", "markers"]
+Check = Literal["twist", "limits", "filter", "markers", "feet"]
 """A check a run can do."""
 CHECKS: tuple[Check, ...] = get_args(Check)
 """The checks a run can do."""
@@ -52,13 +52,15 @@ every other keypoint format are detections from video."""
 
 def take_checks(kind: str, source_format: str | None = None) -> tuple[Check, ...]:
     """The checks a take can run: joint rotations (``twist``, ``limits``) for a ``"motion"``
-    take, ``markers`` for points read from one of :data:`MARKER_FORMATS`, ``filter`` for all.
-    A run asked for another check reports it as skipped, with the reason."""
+    take, ``markers`` for points read from one of :data:`MARKER_FORMATS`, ``feet`` and
+    ``filter`` for all. A run asked for another check reports it as skipped, with the reason;
+    so does the feet check on a take without usable feet (a rig without legs, keypoints without
+    hips, knees and ankles, markers without foot markers)."""
     if kind == "motion":
-        return ("twist", "limits", "filter")
+        return ("twist", "limits", "feet", "filter")
     if source_format in MARKER_FORMATS:
-        return ("markers", "filter")
-    return ("filter",)
+        return ("markers", "feet", "filter")
+    return ("feet", "filter")
 
 
 TwistMethod = Method
@@ -382,6 +384,7 @@ RUN_PRESETS: dict[str, AnalysisOptions] = {
     "limits only": AnalysisOptions(checks=("limits",)),
     "filter only": AnalysisOptions(checks=("filter",)),
     "markers only": AnalysisOptions(checks=("markers",)),
+    "feet only": AnalysisOptions(checks=("feet",)),
 }
 """Named option sets offered by the re-run form (a preset fills the form; every field stays
 editable). The filter's own presets are the filter registry's."""
@@ -429,6 +432,7 @@ def describe_options() -> dict[str, Any]:
         },
         {"name": "limits", "label": "Joint limits", "check": "limits", "fields": []},
         {"name": "markers", "label": "Markers", "check": "markers", "fields": []},
+        {"name": "feet", "label": "Feet and floor", "check": "feet", "fields": []},
         {
             "name": "filter",
             "label": "Filter",

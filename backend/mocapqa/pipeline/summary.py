@@ -16,8 +16,12 @@ One flat, JSON-ready dict per take, the same for the batch table, the API and th
   (static, absent, unlabelled and duplicate-labelled markers) — marker takes the markers step
   checked (None otherwise); in the run's summary and the report, not columns of the shoot
   table (its score counts them)
-* ``score`` — 0–100, see :func:`qa_score`; None for a motion take on which neither the twist
-  nor the limits check ran (nothing was checked, so nothing can be called clean)
+* ``foot_contacts``, ``foot_skates``, ``foot_penetrations``, ``foot_floating`` and
+  ``foot_jitter`` — the feet step's contacts and findings by kind, for takes it checked (None
+  otherwise); in the run's summary and the report, not columns of the shoot table (its score
+  counts the findings)
+* ``score`` — 0–100, see :func:`qa_score`; None for a motion take on which none of the twist,
+  limits and feet checks ran (nothing was checked, so nothing can be called clean)
 
 Checks that did not run leave their fields None; they then cost the score nothing.
 """
@@ -35,6 +39,7 @@ if TYPE_CHECKING:  # the store reads SUMMARY_FIELDS without loading the analysis
     from mocapqa.pipeline.analyze import AnalysisResult
 
 __all__ = [
+    "FEET_FIELDS",
     "MARKER_FIELDS",
     "MM_PER_UNIT",
     "SCORE_TERMS",
@@ -56,6 +61,10 @@ SCORE_TERMS: dict[str, tuple[float, float]] = {
     "marker_swaps": (0.30, 1.0),
     "marker_spikes": (0.20, 5.0),
     "marker_label_problems": (0.20, 1.0),
+    "foot_skates": (0.25, 2.0),
+    "foot_penetrations": (0.15, 2.0),
+    "foot_floating": (0.10, 2.0),
+    "foot_jitter": (0.10, 3.0),
 }
 """Per defect ``x``: weight ``w`` and half-effect value ``s`` of the factor ``1 − w·x/(x+s)``."""
 
@@ -83,6 +92,14 @@ MARKER_FIELDS = (
     "marker_label_problems",
 )
 """The summary's marker counts (marker takes; None for others)."""
+FEET_FIELDS = ("foot_contacts", "foot_skates", "foot_penetrations", "foot_floating", "foot_jitter")
+"""The summary's feet counts (takes the feet step checked; None for others)."""
+_FEET_KINDS = {
+    "skate": "foot_skates",
+    "penetration": "foot_penetrations",
+    "floating": "foot_floating",
+    "jitter": "foot_jitter",
+}
 _LABEL_KINDS = ("static marker", "absent marker", "unlabelled marker", "duplicate label")
 
 
@@ -143,6 +160,17 @@ def _marker_counts(findings: list[dict[str, Any]], samples: int) -> dict[str, An
     }
 
 
+def _feet_counts(findings: list[dict[str, Any]], contacts: int) -> dict[str, int]:
+    """The feet fields of the summary from the feet step's findings and its contacts."""
+    counts = dict.fromkeys(FEET_FIELDS, 0)
+    counts["foot_contacts"] = contacts
+    for finding in findings:
+        field = _FEET_KINDS.get(finding["kind"])
+        if field is not None and "foot" in finding:
+            counts[field] += 1
+    return counts
+
+
 def _residual_mm(result: AnalysisResult, unit: str) -> float | None:
     scale = MM_PER_UNIT.get(unit)
     if scale is None:
@@ -179,6 +207,7 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
     limits_ran = motion and steps["limits"]["state"] == "done"
     filter_ran = not motion and steps["filter"]["state"] == "done"
     markers_ran = steps.get("markers", {}).get("state") == "done"
+    feet_ran = steps.get("feet", {}).get("state") == "done"
 
     twist = [f for f in findings if f["kind"] == "twist"]
     spins = [f for f in findings if f["kind"] == "spin"]
@@ -207,6 +236,10 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
     markers = _marker_counts(findings, n_frames * n_joints) if markers_ran else None
     if markers is not None:  # the fills' samples are no longer missing
         missing = round(max(0.0, missing - float(markers["filled_share"])), 6)
+    feet = None
+    if feet_ran:
+        feet_series = (report.get("series") or {}).get("feet") or {}
+        feet = _feet_counts(findings, len(feet_series.get("contacts") or ()))
     summary: dict[str, Any] = {
         "n_frames": n_frames,
         "duration_s": round(float(info["duration_s"]), 4),
@@ -220,10 +253,12 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
         "missing_share": missing,
         "joint_violations": joint_violations,
         **(markers or dict.fromkeys(MARKER_FIELDS)),
+        **(feet or dict.fromkeys(FEET_FIELDS)),
     }
-    # A motion take on which neither check ran (a rig whose roles were not found, a run of
-    # the filter only) has no score: 100 would read as "checked and clean".
-    checked = twist_ran or limits_ran or not motion
+    # A motion take on which none of the twist, limits and feet checks ran (a rig whose roles
+    # were not found, a run of the filter only) has no score: 100 would read as "checked and
+    # clean".
+    checked = twist_ran or limits_ran or feet_ran or not motion
     summary["score"] = (
         qa_score(
             {
@@ -233,6 +268,7 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
                 "missing_share": missing,
                 "filter_residual_mm": residual,
                 **{k: float(markers[k]) for k in MARKER_FIELDS if k in SCORE_TERMS and markers},
+                **{k: float(feet[k]) for k in FEET_FIELDS if k in SCORE_TERMS and feet},
             }
         )
         if checked

@@ -1,0 +1,153 @@
+"""The run's feet step: contacts, foot skate, floor penetration, floating and jitter of a take.
+
+:func:`run_feet` calls :func:`mocapqa.pipeline.feet.check_take_feet` (the check of
+``mocapqa feet check``, docs/feet.md) on a BVH take, a keypoint take or a C3D/TRC marker take,
+and turns its findings into the run's shape (``kind, joint, start_frame, end_frame, value,
+unit, confidence``; frames 0-based and inclusive, counted in the take as read):
+
+* ``kind`` — ``skate``, ``penetration``, ``floating`` or ``jitter``
+  (:data:`FEET_FINDING_KINDS`);
+* ``joint`` — the foot's rear point (a BVH's ankle joint, a heel or ankle keypoint or marker),
+  ``foot`` — ``"left"`` or ``"right"``;
+* ``value`` — the finding's size in cm (``unit`` ``"cm"``) when the take's length unit converts
+  to cm; else (a BVH, which stores no unit; pixels) the size over the body height estimated
+  from the leg length, in % (``unit`` ``"% height"``);
+* ``confidence`` — that of the contact a skate lies in (None for the other kinds);
+* ``id`` (``skate-left-120``, as ``mocapqa feet fix --apply`` takes), ``peak`` and, for a
+  skate, ``speed_cm_s``; a one-line ``readout`` for the findings list.
+
+The step's plotted series (``series.feet`` of the report) hold the contacts
+(``{"id", "foot", "start", "end", "confidence"}``), the up axis, the floor and its check, and
+the counts of the check's summary: what the take view's contact timeline draws.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from mocapqa.core.arrays import IntArray
+from mocapqa.core.keypoints import KeypointSequence
+from mocapqa.core.motion import Motion
+from mocapqa.errors import InputError
+from mocapqa.feet.fix_choice import contact_id, finding_confidence, finding_id
+from mocapqa.feet.points import SIDES
+from mocapqa.pipeline.feet import check_take_feet, feet_report_json
+from mocapqa.pipeline.steps import Plot, StepOutcome
+
+__all__ = ["FEET_FINDING_KINDS", "feet_findings", "run_feet"]
+
+FEET_FINDING_KINDS = ("skate", "penetration", "floating", "jitter")
+"""The kinds of finding the feet step reports."""
+
+_WHAT = {
+    "skate": "planted foot sliding",
+    "penetration": "foot below the floor",
+    "floating": "still foot above the floor",
+    "jitter": "noise on a planted foot",
+}
+
+
+def feet_findings(check: Mapping[str, Any], joints: Mapping[str, str]) -> list[dict[str, Any]]:
+    """The feet step's findings (fields in the module docstring) from the feet check's JSON.
+
+    Parameters
+    ----------
+    check : mapping
+        :func:`mocapqa.pipeline.feet.feet_report_json` of the take, its findings with ``id``
+        (and a skate's ``confidence``).
+    joints : mapping of str to str
+        Foot (``"left"``, ``"right"``) → the name of that foot's rear point.
+    """
+    findings: list[dict[str, Any]] = []
+    for item in check["findings"]:
+        if item["size_cm"] is not None:
+            value, unit = item["size_cm"], "cm"
+        else:
+            rel = item["size_rel_height"]
+            value, unit = (None if rel is None else round(100.0 * rel, 3)), "% height"
+        speed = item.get("speed_cm_s")
+        size = "" if value is None else f"{value:g} {unit}"
+        readout = f"{item['foot']} foot, {_WHAT[item['kind']]}" + (f" {size}" if size else "")
+        if speed is not None:
+            readout += f" at {speed:g} cm/s"
+        findings.append({
+            "kind": item["kind"],
+            "joint": joints[item["foot"]],
+            "start_frame": item["start"],
+            "end_frame": item["end"],
+            "value": value,
+            "unit": unit,
+            "confidence": item.get("confidence"),
+            "foot": item["foot"],
+            "id": item["id"],
+            "peak": item["peak"],
+            "speed_cm_s": speed,
+            "readout": readout,
+        })  # fmt: skip
+    return findings
+
+
+def run_feet(
+    take: Motion | KeypointSequence, mapping: Mapping[str, str] | None = None
+) -> StepOutcome:
+    """Check the feet of a take.
+
+    Parameters
+    ----------
+    take : Motion or KeypointSequence
+        A BVH motion, or keypoints (a C3D take's markers when ``source_format`` is "c3d").
+    mapping : mapping, optional
+        Role key → joint name (BVH only).
+
+    Returns
+    -------
+    StepOutcome
+        ``"done"`` with the findings of the module docstring and the contacts in the plot's
+        series; ``"skipped"`` with the reason when the take has no feet the check can use (a
+        rig without legs, keypoints without hips, knees and ankles, markers without foot
+        markers).
+    """
+    try:
+        points, report, skipped = check_take_feet(
+            take, mapping if isinstance(take, Motion) else None
+        )
+    except InputError as e:
+        return StepOutcome("skipped", f"no feet to check: {e}")
+    check = feet_report_json(points, report, skipped)
+    for item, contact in zip(check["contacts"], report.contacts, strict=True):
+        item["id"] = contact_id(contact, skipped)
+    for item, finding in zip(check["findings"], report.findings, strict=True):
+        item["id"] = finding_id(finding, skipped)
+        if finding.kind == "skate":
+            item["confidence"] = finding_confidence(finding, report.contacts)
+    rear: dict[str, str] = {}
+    for name, side in zip(points.names, points.sides, strict=True):
+        rear.setdefault(side, name)  # each side's rear point (ankle or heel) comes first
+    findings = feet_findings(check, rear)
+    series = {
+        "contacts": check["contacts"],
+        "up_axis": check["up_axis"],
+        "floor": check["floor"],
+        "floor_check": {k: check["floor_check"][k] for k in ("tilted", "moving", "tilt_deg")},
+        "length_unit": check["length_unit"],
+        "sizes": check["sizes"],
+        "checked_frames": check["checked_frames"],
+        "feet": {side: rear.get(side) for side in SIDES},
+        "summary": check["summary"],
+    }
+    edges: IntArray = np.asarray(
+        [f["start_frame"] for f in findings] + [f["end_frame"] for f in findings], dtype=np.intp
+    )
+    counts = check["summary"]["findings"]
+    contacts = check["summary"]["contacts"]
+    return StepOutcome(
+        "done",
+        f"{contacts['left']} left and {contacts['right']} right contact(s), up {check['up_axis']}"
+        f"{', floor tilted' if check['floor_check']['tilted'] else ''}; "
+        + ", ".join(f"{counts[k]} {k}" for k in FEET_FINDING_KINDS),
+        findings,
+        Plot(np.empty((take.n_frames, 0)), edges, lambda frames: series),
+    )
