@@ -99,8 +99,9 @@ export function prefetchTake(takeId, runId) {
 export const startRun = (takeId, options) => request("POST", `/takes/${takeId}/runs`, options);
 export const addReview = (takeId, review) => request("POST", `/takes/${takeId}/reviews`, review);
 export const getDecisions = (runId) => request("GET", `/runs/${runId}/decisions`);
-export const addDecision = (runId, intervalId, body) => request("POST", `/runs/${runId}/intervals/${intervalId}/decisions`, body);
-export const decidedUrl = (runId) => `${BASE}/runs/${runId}/decisions/bvh`;
+// `item` is "interval" (a twist interval) or "swap"; the decided take is BVH or C3D.
+export const addDecision = (runId, itemId, body, item = "interval") => request("POST", `/runs/${runId}/${item === "swap" ? "swaps" : "intervals"}/${itemId}/decisions`, body);
+export const decidedUrl = (runId, format = "bvh") => `${BASE}/runs/${runId}/decisions/${format}`;
 export const listFilters = () => request("GET", "/filters");
 export const getRunOptions = () => request("GET", "/run-options");
 export const downloadUrl = (runId, kind) => `${BASE}/runs/${runId}/download/${kind}`;

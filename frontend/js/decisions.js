@@ -1,13 +1,44 @@
-// Accept / reject per twist interval in the findings table. A decision shows at once and is
-// saved as a row of the run's decision history (the newest per interval counts). Each row says
-// what the reviewed download does with the interval: an accepted one is corrected, a rejected
-// one left as recorded, an undecided one follows the run's own choice ("run: applied").
+// Accept / reject per correction in the findings table: the twist intervals of a motion take,
+// the swaps of a marker take. A decision shows at once and is saved as a row of the run's
+// decision history (the newest per item counts). Each row says what the reviewed download does
+// with the item: an accepted one is corrected, a rejected one left as recorded, an undecided one
+// follows the run's own choice ("run: applied").
 import * as api from "./api.js";
 import { badge, h, toast } from "./dom.js";
 
-export const DECISION_KEYS = { y: "accept", x: "reject" }; // on the focused or last opened twist row
+export const DECISION_KEYS = { y: "accept", x: "reject" }; // on the focused or last opened decidable row
 const LABELS = { accept: "accepted", reject: "rejected" };
 const BADGE = { accept: "approved", reject: "rejected" };
+
+// Per finding kind that can be decided: the API's item, its name, the run's choice for an
+// undecided one, the decided download's format, and what that download is.
+const DECIDED = {
+  twist: {
+    item: "interval", name: "twist interval", format: "bvh",
+    applied: "the run's twist_apply choice, in its corrected BVH",
+    explain: "The reviewed take is the raw take with the intervals marked \u201c\u2192 corrected\u201d removed: every accepted one, and each undecided one the run applied; rejected ones are left as recorded. No motion filter. The run's own \u201ccorrected BVH\u201d (Downloads) is its choice before review.",
+  },
+  swap: {
+    item: "swap", name: "swap", format: "c3d",
+    applied: "the run's confident rule, in its corrected C3D",
+    explain: "The reviewed take (C3D) is the raw take with the swaps marked \u201c\u2192 corrected\u201d repaired: every accepted one, and each undecided one the run repaired; rejected ones are left as recorded. Its gaps are then filled as the run fills them (the confident fills, chosen again on that take), filled samples marked (residual 0). No filter. The run's own corrected C3D (Downloads) is its choice before review.",
+  },
+};
+
+/** What a run's findings let a reviewer decide: `{ kind, items }` (the finding kind, "twist"
+ * or "swap", and its items by id order), or null when there is nothing to decide. */
+export function decidable(result) {
+  const twist = result.kind === "motion" && result.series && result.series.twist;
+  if (twist && twist.intervals.length) return { kind: "twist", items: twist.intervals };
+  const swaps = result.kind === "keypoints" ? (result.findings || []).filter((f) => f.kind === "swap") : [];
+  return swaps.length ? { kind: "swap", items: swaps } : null;
+}
+
+/** How a decided item is named, as its findings row shows it (the id is internal). */
+export function itemLabel(kind, item) {
+  const frames = `frames ${item.start_frame}–${item.end_frame}`;
+  return kind === "swap" ? `${item.markers.join(" ↔ ")} ${frames}` : `${item.joint} ${frames}`;
+}
 
 /** The newest other finished run of `take` whose decision history is not empty, with that
  * history's length, or null; `getDecisions` is api.getDecisions (a parameter for tests). */
@@ -22,24 +53,24 @@ export async function decidedElsewhere(take, run, getDecisions = api.getDecision
 
 /** Decision cells for the findings rows of `run` and the panel parts below the table. */
 export function intervalDecisions(run, result, take = null) {
-  // Only a take with twist intervals has anything to accept or reject.
-  const series = result.kind === "motion" && result.series && result.series.twist;
-  const twist = series && series.intervals.length ? series : null;
-  const latest = new Map(); // interval id -> "accept" | "reject"
-  const cells = new Map(); // interval id -> the row's decision cell
-  let current = null; // the last opened twist interval
+  // Only a take with twist intervals or swaps has anything to accept or reject.
+  const found = decidable(result);
+  const kind = found ? found.kind : null;
+  const spec = kind ? DECIDED[kind] : null;
+  const latest = new Map(); // item id -> "accept" | "reject"
+  const cells = new Map(); // item id -> the row's decision cell
+  let current = null; // the last opened decidable item
   let lastKind = null; // the kind of the last opened finding
   const message = h("span", { id: "decision-message", class: "muted" });
   // Decisions belong to a run: a re-run starts undecided, and says where earlier ones are.
   const elsewhere = h("p", { id: "decisions-elsewhere", class: "notice", hidden: true });
   const note = h("input", { id: "decision-note", placeholder: "note for the next decision", "aria-label": "decision note" });
   const history = h("ul", { id: "decision-history" });
-  const byId = new Map((twist ? twist.intervals : []).map((i) => [i.id, i]));
+  const byId = new Map((found ? found.items : []).map((i) => [i.id, i]));
 
-  // An interval is named as its findings row shows it (joint and frames): the id is internal.
   const label = (id) => {
     const i = byId.get(id);
-    return i ? `${i.joint} frames ${i.start_frame}–${i.end_frame}` : `interval ${id}`;
+    return i ? itemLabel(kind, i) : `${spec ? spec.item : "item"} ${id}`;
   };
   const showHistory = (rows) => history.replaceChildren(...rows.map((r) =>
     h("li", {}, `${new Date(r.created_at).toLocaleString()} · ${r.reviewer}: `, badge(LABELS[r.decision], BADGE[r.decision]),
@@ -64,9 +95,9 @@ export function intervalDecisions(run, result, take = null) {
     // The read-out wraps on the left; the buttons keep to the cell's right, side by side.
     cell.replaceChildren(h("div", { class: "decision-cell" },
       h("span", { class: "decision-state" },
-        h("span", { class: "applied muted", title: "the run's twist_apply choice, in its corrected BVH" }, f.applied ? "run: applied" : "run: not applied"), " · ",
+        h("span", { class: "applied muted", title: spec.applied }, f.applied ? "run: applied" : "run: not applied"), " · ",
         decision ? badge(LABELS[decision], BADGE[decision]) : h("span", { class: "muted" }, "undecided"),
-        h("span", { class: "outcome muted", title: "what the reviewed download does with this interval" }, corrected ? " → corrected" : " → left as recorded")),
+        h("span", { class: "outcome muted", title: `what the reviewed download does with this ${spec.name}` }, corrected ? " → corrected" : " → left as recorded")),
       h("span", { class: "decision-buttons" }, ...buttons)));
     if (focused) buttons.find((b) => b.dataset.decision === focused)?.focus();
   };
@@ -78,7 +109,7 @@ export function intervalDecisions(run, result, take = null) {
     current = id;
     try {
       // The server records the signed-in user as the reviewer.
-      await api.addDecision(run.id, id, { decision, note: note.value });
+      await api.addDecision(run.id, id, { decision, note: note.value }, spec.item);
       note.value = "";
       message.textContent = `${label(id)} ${LABELS[decision]}`; message.className = "muted";
       toast(message.textContent);
@@ -91,35 +122,39 @@ export function intervalDecisions(run, result, take = null) {
     }
   }
 
-  const loaded = twist ? api.getDecisions(run.id).then(async (body) => {
-    for (const i of body.intervals) if (i.decision) latest.set(i.id, i.decision);
+  const loaded = found ? api.getDecisions(run.id).then(async (body) => {
+    for (const i of kind === "swap" ? body.swaps : body.intervals) if (i.decision) latest.set(i.id, i.decision);
     for (const id of cells.keys()) fill(id);
     showHistory(body.history);
     if (body.history.length || !take) return;
-    const found = await decidedElsewhere(take, run);
-    if (!found) return;
-    elsewhere.replaceChildren(`Run ${found.number} holds ${found.count} decision${found.count === 1 ? "" : "s"} on its twist intervals; this run has none yet (decisions belong to the run they were made on). `,
-      h("a", { href: api.takeLink(take.id, found.run.id), id: "decisions-elsewhere-link" }, `open run ${found.number}`));
+    const other = await decidedElsewhere(take, run);
+    if (!other) return;
+    elsewhere.replaceChildren(`Run ${other.number} holds ${other.count} decision${other.count === 1 ? "" : "s"} on its ${spec.name}s; this run has none yet (decisions belong to the run they were made on). `,
+      h("a", { href: api.takeLink(take.id, other.run.id), id: "decisions-elsewhere-link" }, `open run ${other.number}`));
     elsewhere.hidden = false;
   }).catch((e) => { message.textContent = e.message; message.className = "error"; }) : Promise.resolve();
 
+  // A marker take's reviewed download is C3D, for a take the run wrote a corrected C3D of.
+  const downloadable = !spec || spec.format !== "c3d" || (result.downloads || []).includes("c3d");
   return {
-    enabled: Boolean(twist),
+    enabled: Boolean(found),
+    /** The finding kind whose rows are decided ("twist" or "swap"), null for none. */
+    kind,
     loaded,
     /** The decision cell of a findings row (empty for a limits finding). */
     cell(f) {
       const cell = h("td", { class: "decision" });
-      if (twist && f.kind === "twist" && byId.has(f.id)) { cells.set(f.id, cell); fill(f.id); }
+      if (found && f.kind === kind && byId.has(f.id)) { cells.set(f.id, cell); fill(f.id); }
       return cell;
     },
-    /** The last opened finding: Y/X act on it when it is a twist interval, and on none after
-     * a spin or limits finding (never on an interval opened before it). */
-    opened(f) { current = f && f.kind === "twist" ? f.id : null; lastKind = f ? f.kind : null; },
-    /** Y / X on the focused (else the last opened) twist row; true when the key was used. */
+    /** The last opened finding: Y/X act on it when it is a twist interval (a swap), and on
+     * none after another finding (never on an item opened before it). */
+    opened(f) { current = f && f.kind === kind ? f.id : null; lastKind = f ? f.kind : null; },
+    /** Y / X on the focused (else the last opened) decidable row; true when the key was used. */
     onKey(e) {
       const decision = DECISION_KEYS[e.key.toLowerCase()];
       if (!decision) return false;
-      if (!twist) { toast("this run has no twist intervals to accept or reject"); return true; }
+      if (!found) { toast("this run has no twist intervals or swaps to accept or reject"); return true; }
       const focused = document.activeElement && document.activeElement.closest && document.activeElement.closest("tr.finding");
       if (focused && !focused.dataset.interval) {
         message.textContent = `a ${focused.dataset.kind} finding is reported, not corrected: nothing to accept or reject`;
@@ -129,9 +164,9 @@ export function intervalDecisions(run, result, take = null) {
       }
       const id = focused ? Number(focused.dataset.interval) : current;
       if (id == null || !byId.has(id)) {
-        message.textContent = lastKind && lastKind !== "twist"
+        message.textContent = lastKind && lastKind !== kind
           ? `a ${lastKind} finding is reported, not corrected: nothing to accept or reject`
-          : "open or focus a twist finding first";
+          : `open or focus a ${kind} finding first`;
         message.className = "muted";
         toast(message.textContent);
         return true;
@@ -141,13 +176,15 @@ export function intervalDecisions(run, result, take = null) {
     },
     /** Below the table: the download, a note for the next decision and the history. */
     footer() {
-      if (!twist) return null;
+      if (!found) return null;
       return h("div", { id: "decisions" },
         elsewhere,
         h("div", { class: "controls" },
-          h("a", { href: api.decidedUrl(run.id), download: "", id: "download-decided", class: "download" }, "Download reviewed take"),
+          downloadable
+            ? h("a", { href: api.decidedUrl(run.id, spec.format), download: "", id: "download-decided", class: "download" }, "Download reviewed take")
+            : h("span", { class: "muted", id: "download-decided-none" }, "no reviewed download: it is written as C3D, for C3D takes"),
           note, message),
-        h("p", { class: "muted" }, "The reviewed take is the raw take with the intervals marked \u201c\u2192 corrected\u201d removed: every accepted one, and each undecided one the run applied; rejected ones are left as recorded. No motion filter. The run's own \u201ccorrected BVH\u201d (Downloads) is its choice before review."),
+        h("p", { class: "muted" }, spec.explain),
         history);
     },
   };

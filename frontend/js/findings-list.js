@@ -11,7 +11,7 @@ const unitOf = (f) => UNITS[f.unit] ?? f.unit ?? "";
 
 /**
  * @param findings  the run's findings
- * @param decided   the interval decisions (cells of twist rows, footer)
+ * @param decided   the decisions (cells of twist or swap rows, footer)
  * @param onOpen    called with a finding opened by a click or Enter
  * @param initial   the filter to start with ({kinds, joint, minValue, text}, as filterFromParams)
  * @param onFilter  called with the filter's link parameters (filterParams) when it changes
@@ -57,7 +57,7 @@ export function findingsList(findings, decided, onOpen, initial = null, onFilter
 
   const row = (f) => activatable(h("tr", {
     class: `clickable finding${f === current ? " current" : ""}`, "data-start": f.start_frame, "data-joint": f.joint, "data-kind": f.kind,
-    "data-interval": f.kind === "twist" ? f.id : null, "aria-current": f === current ? "true" : null,
+    "data-interval": f.kind === decided.kind ? f.id : null, "aria-current": f === current ? "true" : null,
   },
   h("td", {}, f.kind), h("td", {}, f.joint, f.readout ? h("div", { class: "muted readout" }, f.readout) : null), h("td", { class: "frames" }, `${f.start_frame}–${f.end_frame}`), h("td", {}, f.end_frame - f.start_frame + 1),
   h("td", { class: "value" }, f.value == null ? "–" : `${fmt(f.value, 1)} ${unitOf(f)}`), h("td", {}, f.kind === "twist" ? `${fmt(100 * f.confidence, 0)} %` : fmt(f.confidence, 2)),

@@ -159,8 +159,12 @@ def test_decision_errors_name_the_problem(
     trc = corpus_dir / "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d"
     created = upload(client, trc / "S00_P00_T01_BalancingTrial_0-100.trc")
     assert wait_for_run(client, created["run_id"])["status"] == "done"
+    # A marker take's decisions are on its swaps (tests/api/test_swap_decisions.py).
+    listed = client.get(f"/api/v1/runs/{created['run_id']}/decisions")
+    assert listed.status_code == 200, listed.text
+    assert listed.json()["item"] == "swap"
+    assert listed.json()["intervals"] == []
     for answer in (
-        client.get(f"/api/v1/runs/{created['run_id']}/decisions"),
         client.get(f"/api/v1/runs/{created['run_id']}/decisions/bvh"),
         client.post(
             f"/api/v1/runs/{created['run_id']}/intervals/0/decisions", json={"decision": "accept"}

@@ -1,6 +1,6 @@
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { decidedElsewhere } from "../../frontend/js/decisions.js";
+import { decidable, decidedElsewhere, itemLabel } from "../../frontend/js/decisions.js";
 
 const take = { runs: [{ id: "r1", status: "done" }, { id: "r2", status: "failed" }, { id: "r3", status: "done" }, { id: "r4", status: "done" }] };
 const histories = { r1: 2, r2: 5, r3: 0, r4: 0 };
@@ -19,4 +19,17 @@ test("nothing to point at: no other run has decisions, or the request fails", as
   const failing = async () => { throw new Error("offline"); };
   assert.equal(await decidedElsewhere(take, { id: "r4" }, failing), null);
   assert.equal(await decidedElsewhere(null, { id: "r4" }, getDecisions), null);
+});
+
+test("a motion run decides its twist intervals, a marker run its swaps, others nothing", () => {
+  const intervals = [{ id: 0, joint: "LeftLeg", start_frame: 3, end_frame: 9 }];
+  assert.deepEqual(decidable({ kind: "motion", series: { twist: { intervals } }, findings: [] }), { kind: "twist", items: intervals });
+  assert.equal(decidable({ kind: "motion", series: { twist: { intervals: [] } }, findings: [] }), null);
+  assert.equal(decidable({ kind: "motion", series: {}, findings: [] }), null);
+  const swap = { kind: "swap", id: 0, markers: ["LFHD", "LBHD"], start_frame: 400, end_frame: 429 };
+  const findings = [{ kind: "gap", id: 0 }, swap];
+  assert.deepEqual(decidable({ kind: "keypoints", series: {}, findings }), { kind: "swap", items: [swap] });
+  assert.equal(decidable({ kind: "keypoints", series: {}, findings: [{ kind: "gap" }] }), null);
+  assert.equal(itemLabel("swap", swap), "LFHD ↔ LBHD frames 400–429");
+  assert.equal(itemLabel("twist", intervals[0]), "LeftLeg frames 3–9");
 });

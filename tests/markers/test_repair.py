@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from tests.markers.conftest import Take
 
+from mocapqa.errors import InputError
 from mocapqa.markers.inject import inject_swaps
 from mocapqa.markers.params import MarkerParams
 from mocapqa.markers.repair import repair_markers
@@ -48,3 +50,27 @@ def test_a_swap_is_repaired_before_the_gap_beside_it_is_filled(
     assert np.array_equal(untouched.positions, hidden, equal_nan=True)
     assert np.array_equal(untouched.residuals, residuals)
     assert [s["applied"] for s in untouched.to_json(take.names, "mm")["swaps"]] == [False]
+
+
+def test_a_chosen_set_of_swaps_replaces_the_rule_for_swaps_only(
+    clean_takes: dict[str, Take],
+) -> None:
+    take = clean_takes["cmu/cmu_02_05.c3d"]
+    clean = take.positions[:600]
+    stats = pair_stats(clean, take.length_unit, MarkerParams())
+    swapped, _ = inject_swaps(clean, np.random.default_rng(3), stats, take.fps)
+    residuals = np.where(np.isnan(swapped).any(axis=-1), -1.0, 0.5)
+    args = (swapped, residuals, take.names, take.fps, take.length_unit)
+
+    ruled = repair_markers(*args)
+    assert ruled.repaired
+    chosen = repair_markers(*args, swaps={0})
+    assert chosen.swaps == ruled.swaps  # found again, in the same order
+    assert chosen.repaired == (ruled.swaps[0],)
+    assert np.array_equal(chosen.positions, ruled.positions, equal_nan=True)
+    none = repair_markers(*args, swaps=())
+    assert none.repaired == ()
+    kept = ~none.filled  # the fills still follow the rule
+    assert np.array_equal(none.positions[kept], swapped[kept], equal_nan=True)
+    with pytest.raises(InputError, match="swap ids"):
+        repair_markers(*args, swaps={len(ruled.swaps)})

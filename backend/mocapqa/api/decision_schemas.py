@@ -1,21 +1,20 @@
-"""Request and response models of the twist-interval decisions (``routes/decisions.py``)."""
+"""Request and response models of the decisions on twist intervals and swaps
+(``routes/decisions.py``)."""
 
 from __future__ import annotations
 
 from datetime import datetime
-from typing import Literal
 
 from pydantic import BaseModel, Field
 
 from mocapqa.api.request_model import RequestModel
+from mocapqa.store.decisions import DecidedItem, Decision
 
-__all__ = ["DecisionIn", "DecisionOut", "DecisionsOut", "IntervalOut"]
-
-Decision = Literal["accept", "reject"]
+__all__ = ["DecisionIn", "DecisionOut", "DecisionsOut", "IntervalOut", "SwapOut"]
 
 
 class DecisionIn(RequestModel):
-    """A reviewer's decision on one twist interval."""
+    """A reviewer's decision on one twist interval or swap."""
 
     decision: Decision
     note: str = Field("", max_length=10_000)
@@ -27,7 +26,8 @@ class DecisionOut(BaseModel):
 
     id: int
     run_id: str
-    interval_id: int
+    item: DecidedItem = Field(description="What ``interval_id`` names: a twist interval or a swap")
+    interval_id: int = Field(description="The id of the interval or swap within its run")
     decision: Decision
     note: str
     reviewer: str
@@ -54,10 +54,30 @@ class IntervalOut(BaseModel):
     )
 
 
+class SwapOut(BaseModel):
+    """A swap of a marker run (two labels exchanging trajectories) with its newest decision."""
+
+    id: int = Field(description="Its position in the run's swap findings")
+    markers: tuple[str, str]
+    start_frame: int
+    end_frame: int
+    confidence: float
+    applied: bool = Field(description="Whether the run's own corrected take repairs it")
+    decision: Decision | None = Field(description="The newest decision, None without one")
+    corrected: bool = Field(
+        description="Whether the decided take repairs it: accepted, or undecided and applied"
+    )
+
+
 class DecisionsOut(BaseModel):
-    """A run's twist intervals with their decisions, and the decision history."""
+    """A run's twist intervals or swaps with their decisions, and the decision history."""
 
     run_id: str
-    apply: str = Field(description="The run's twist_apply choice (for undecided intervals)")
-    intervals: list[IntervalOut]
+    item: DecidedItem = Field(description="What the run's decisions are on")
+    apply: str = Field(
+        description="The run's rule for undecided items: its twist_apply choice, or "
+        "'confident' for swaps"
+    )
+    intervals: list[IntervalOut] = Field(description="A motion run's twist intervals")
+    swaps: list[SwapOut] = Field(description="A marker run's swaps")
     history: list[DecisionOut] = Field(description="Every decision, newest first")

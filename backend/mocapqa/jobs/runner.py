@@ -32,6 +32,7 @@ from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.fair_queue import FairQueue
 from mocapqa.jobs.rendered import render_thumbnail
 from mocapqa.limits.catalog import ModelCatalog
+from mocapqa.markers.repair import MarkerRepair
 from mocapqa.pipeline.analyze import AnalysisResult, analyze
 from mocapqa.pipeline.loading import (
     READING_FILE,
@@ -52,12 +53,13 @@ __all__ = ["JobRunner", "read_options", "run_summary", "write_corrected_c3d", "w
 log = logging.getLogger(__name__)
 
 
-def write_corrected_c3d(path: Path, source: Path, result: AnalysisResult) -> None:
+def write_corrected_c3d(path: Path, source: Path, repair: MarkerRepair | None) -> None:
     """Write a marker run's corrected take as C3D: the source's points with the repaired swaps
     and the applied fills (no filter), residuals and camera masks exchanged with the swaps,
     residual 0 and no cameras on every filled sample (C3D's mark of an interpolated sample);
     the source's analogs, force plates, events and other groups unchanged, or (a source ezc3d
-    cannot open) the markers alone.
+    cannot open) the markers alone. ``repair`` is the run's (``AnalysisResult.markers``) or a
+    reviewer's choice of it (:func:`mocapqa.jobs.accepted.decided_c3d`).
 
     Raises
     ------
@@ -69,7 +71,6 @@ def write_corrected_c3d(path: Path, source: Path, result: AnalysisResult) -> Non
     from mocapqa.errors import UnsupportedFormatError
     from mocapqa.io.c3d import read_c3d, write_c3d
 
-    repair = result.markers
     if repair is None:
         raise InputError("Expected a run of the markers step to write a corrected C3D, got none")
     take = read_c3d(source)
@@ -139,7 +140,7 @@ def write_outputs(
                 log.info("no %s output for run %s: %s", suffix, run_id, e)
     if result.markers is not None and source is not None and source.suffix.lower() == ".c3d":
         try:
-            write_corrected_c3d(folder / "corrected.c3d", source, result)
+            write_corrected_c3d(folder / "corrected.c3d", source, result.markers)
             kinds.append("c3d")
         except MocapQAError as e:
             log.info("no c3d output for run %s: %s", run_id, e)

@@ -4,20 +4,24 @@ Swaps are repaired before any gap is filled (a fill uses the samples either side
 which a swap has put on the wrong label), then gaps are filled by the method with the lowest
 cross-validated error (:func:`mocapqa.markers.fill.fill_gaps`). ``apply`` decides both: the
 confident swaps and fills ("confident", the default), all, or none (everything is listed, as
-found, and nothing changes). Every filled sample gets residual 0 (the C3D convention for an
-interpolated sample); a repaired swap exchanges the residuals with the positions. Samples that
-neither touches are bit-identical to the input.
+found, and nothing changes). A reviewer's choice of swaps (``swaps``: their ids, the positions
+in the check's list, which the check finds again in the same order from the same take) replaces
+the rule for the swaps; the fills still follow ``apply``, on the take those swaps repair.
+Every filled sample gets residual 0 (the C3D convention for an interpolated sample); a
+repaired swap exchanges the residuals with the positions. Samples that neither touches are
+bit-identical to the input.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray
+from mocapqa.errors import InputError
 from mocapqa.markers.check import check_markers
 from mocapqa.markers.fill import FillParams, FillResult, fill_gaps
 from mocapqa.markers.params import MarkerParams, unit_scale
@@ -95,6 +99,7 @@ def repair_markers(
     apply: Literal["confident", "all", "none"] = "confident",
     params: MarkerParams | None = None,
     fill_params: FillParams | None = None,
+    swaps: Collection[int] | None = None,
 ) -> MarkerRepair:
     """Repair the swaps, then fill the gaps, of a marker take.
 
@@ -114,6 +119,9 @@ def repair_markers(
         Which swaps and fills change the take.
     params, fill_params : optional
         Check and fill settings (defaults when None).
+    swaps : collection of int, optional
+        The ids of the swaps to repair (positions in the check's list of swaps, ``swaps`` of
+        the result), instead of those ``apply`` selects; ``apply`` still decides the fills.
 
     Returns
     -------
@@ -123,9 +131,21 @@ def repair_markers(
     ------
     OptionError
         If ``apply`` is not one of the three.
+    InputError
+        If ``swaps`` names an id the check did not find.
     """
     report = check_markers(positions, names, fps, length_unit, params)
-    chosen = tuple(select_swaps(report.swaps, apply, params))
+    ruled = select_swaps(report.swaps, apply, params)  # also checks ``apply``
+    if swaps is None:
+        chosen = tuple(ruled)
+    else:
+        unknown = sorted(set(swaps) - set(range(len(report.swaps))))
+        if unknown:
+            raise InputError(
+                f"Expected swap ids in 0..{len(report.swaps) - 1}, got {unknown[:5]} "
+                f"({len(report.swaps)} swap(s) found)"
+            )
+        chosen = tuple(s for k, s in enumerate(report.swaps) if k in swaps)
     swapped = repair_swaps(positions, chosen)
     fills = fill_gaps(swapped, fps, fill_params, apply, units_per_mm=unit_scale(length_unit))
     repair = MarkerRepair(

@@ -13,6 +13,8 @@ marker's label, frames 0-based and inclusive):
   when no method could be tried), ``method`` None when no method fills it within the limit;
 * ``swap`` — two labels exchanging trajectories (``markers``, ``joint`` the first);
   ``confidence`` 0–1, ``applied`` whether the corrected take has it repaired, ``value`` frames;
+  ``id`` its position in the check's list, which the check finds again in the same order from
+  the same take (the id a reviewer's decision names: :func:`decided_repair`);
 * ``spike`` — ``value`` how far the sample leaves its smooth path;
 * ``static marker``, ``absent marker`` — ``value`` the positions' spread (None when absent);
   ``unlabelled marker``, ``duplicate label`` — ``value`` None; all over the whole take.
@@ -25,7 +27,8 @@ a one-line ``readout`` for the findings list.
 from __future__ import annotations
 
 import dataclasses
-from typing import Any
+from collections.abc import Collection
+from typing import Any, Literal
 
 import numpy as np
 
@@ -40,7 +43,9 @@ from mocapqa.markers.swaps import repair_swaps
 from mocapqa.pipeline.steps import Plot, StepOutcome
 
 __all__ = [
+    "MARKER_APPLY",
     "MARKER_FINDING_KINDS",
+    "decided_repair",
     "marker_findings",
     "run_markers",
     "segment_sticks",
@@ -57,6 +62,8 @@ MARKER_FINDING_KINDS = (
     "duplicate label",
 )
 """The kinds of finding the marker step reports."""
+MARKER_APPLY: Literal["confident"] = "confident"
+"""The rule by which the run step repairs swaps and fills gaps (an undecided swap's)."""
 
 
 def _length(value: float | None, unit: str) -> tuple[float | None, str]:
@@ -170,6 +177,39 @@ def segment_sticks(stats: PairStats, segments: list[list[int]]) -> list[list[int
     return sticks
 
 
+def _repair(
+    sequence: KeypointSequence, params: MarkerParams, swaps: Collection[int] | None = None
+) -> MarkerRepair:
+    """:func:`~mocapqa.markers.repair.repair_markers` of a take as the run step does it."""
+    # A keypoint take carries no residuals: -1 where missing, 1 (measured) elsewhere.
+    residuals = np.where(sequence.missing, -1.0, 1.0)
+    return repair_markers(
+        sequence.positions,
+        residuals,
+        sequence.names,
+        sequence.fps,
+        sequence.length_unit,
+        MARKER_APPLY,
+        params,
+        swaps=swaps,
+    )
+
+
+def decided_repair(
+    sequence: KeypointSequence, swaps: Collection[int], params: MarkerParams | None = None
+) -> MarkerRepair:
+    """The repair of a marker take with a reviewer's choice of swaps: exactly the swaps
+    ``swaps`` names (ids as in the ``swap`` findings) exchanged, then the gaps of that take
+    filled by the run's own rule (the confident fills, chosen again on it).
+
+    Raises
+    ------
+    InputError
+        If ``swaps`` names an id the check does not find.
+    """
+    return _repair(sequence, params or MarkerParams(), swaps)
+
+
 def run_markers(sequence: KeypointSequence, params: MarkerParams | None = None) -> StepOutcome:
     """Check a marker take, repair its confident swaps, then fill its confident gaps.
 
@@ -184,11 +224,7 @@ def run_markers(sequence: KeypointSequence, params: MarkerParams | None = None) 
     p = params or MarkerParams()
     unit = sequence.length_unit
     report = check_markers(sequence.positions, sequence.names, sequence.fps, unit, p)
-    # A keypoint take carries no residuals: -1 where missing, 1 (measured) elsewhere.
-    residuals = np.where(sequence.missing, -1.0, 1.0)
-    repair = repair_markers(
-        sequence.positions, residuals, sequence.names, sequence.fps, unit, "confident", p
-    )
+    repair = _repair(sequence, p)
     exchanged = repair_swaps(sequence.confidence, repair.repaired)
     corrected = dataclasses.replace(
         sequence, positions=repair.positions, confidence=np.where(repair.filled, 1.0, exchanged)

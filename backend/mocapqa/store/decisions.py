@@ -1,12 +1,14 @@
-"""Reviewers' accept / reject decisions on a run's twist intervals, kept as history.
+"""Reviewers' accept / reject decisions on the corrections of a run, kept as history.
 
-Every decision is a row (when, from where, who, an optional note); the newest row of an
-interval is its decision. Rows go with their run (``ON DELETE CASCADE``).
+A run's decisions are on one kind of correction (:data:`DECIDED_ITEMS`): the twist intervals
+of a motion take, or the swaps of a marker take; ``interval_id`` is the item's id within its
+run. Every decision is a row (when, from where, who, an optional note); the newest row of an
+item is its decision. Rows go with their run (``ON DELETE CASCADE``).
 """
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal, get_args
 
 from sqlalchemy import Engine, func, insert, select
 
@@ -15,10 +17,23 @@ from mocapqa.store.repository import utc_now
 from mocapqa.store.rows import plain
 from mocapqa.store.tables import interval_decisions
 
-__all__ = ["INTERVAL_DECISIONS", "IntervalDecisions"]
+__all__ = [
+    "DECIDED_ITEMS",
+    "INTERVAL_DECISIONS",
+    "DecidedItem",
+    "Decision",
+    "IntervalDecisions",
+]
 
-INTERVAL_DECISIONS = ("accept", "reject")
-"""What a reviewer can decide about one twist interval."""
+Decision = Literal["accept", "reject"]
+"""What a reviewer can decide about one correction (a twist interval or a swap)."""
+INTERVAL_DECISIONS: tuple[Decision, ...] = get_args(Decision)
+"""The values of :data:`Decision`."""
+DecidedItem = Literal["interval", "swap"]
+"""The corrections a reviewer decides on: a motion take's twist intervals, a marker take's
+swaps."""
+DECIDED_ITEMS: tuple[DecidedItem, ...] = get_args(DecidedItem)
+"""The values of :data:`DecidedItem`."""
 
 
 class IntervalDecisions:
@@ -62,7 +77,7 @@ class IntervalDecisions:
             return plain(result.mappings().one())
 
     def history(self, run_id: str) -> list[dict[str, Any]]:
-        """Every decision on a run's intervals, newest first."""
+        """Every decision on a run's items, newest first."""
         table = interval_decisions
         with self.engine.connect() as conn:
             rows = conn.execute(
@@ -71,7 +86,7 @@ class IntervalDecisions:
             return [plain(r) for r in rows]
 
     def latest(self, run_id: str) -> dict[int, str]:
-        """Interval id → its newest decision, for the intervals that have one."""
+        """Item id → its newest decision, for the items (intervals or swaps) that have one."""
         table = interval_decisions
         newest = (
             select(func.max(table.c.id).label("id"))

@@ -1,4 +1,5 @@
-"""Reviewers' accept / reject decisions on a run's twist intervals, and the decided take."""
+"""Reviewers' accept / reject decisions on a run's twist intervals or swaps, and the decided
+take."""
 
 from __future__ import annotations
 
@@ -14,9 +15,18 @@ from mocapqa.api.disposition import attachment, download_stem
 from mocapqa.api.errors import responses
 from mocapqa.core.text import display_name
 from mocapqa.errors import NotFoundError
-from mocapqa.jobs.accepted import decided_bvh, decided_motion, run_intervals, with_decisions
+from mocapqa.jobs.accepted import (
+    decided_bvh,
+    decided_c3d,
+    decided_motion,
+    run_intervals,
+    run_items,
+    run_swaps,
+    with_decisions,
+)
+from mocapqa.pipeline.marker_step import MARKER_APPLY
 from mocapqa.pipeline.options import AnalysisOptions
-from mocapqa.store.decisions import IntervalDecisions
+from mocapqa.store.decisions import DecidedItem, IntervalDecisions
 from mocapqa.store.roles import Action
 
 __all__ = ["router"]
@@ -40,22 +50,53 @@ def _done_run(run_id: str, services: ServicesDep) -> dict[str, Any]:
 DoneRunDep = Annotated[dict[str, Any], Depends(_done_run)]
 
 
-def _out(row: dict[str, Any]) -> DecisionOut:
-    return DecisionOut.model_validate({**row, "reviewer": display_name(str(row["reviewer"]))})
+def _out(row: dict[str, Any], item: DecidedItem) -> DecisionOut:
+    reviewer = display_name(str(row["reviewer"]))
+    return DecisionOut.model_validate({**row, "item": item, "reviewer": reviewer})
+
+
+def _record(
+    request: Request,
+    principal: Principal,
+    decisions: IntervalDecisions,
+    run_id: str,
+    item: DecidedItem,
+    item_id: int,
+    body: DecisionIn,
+) -> DecisionOut:
+    """Append a decision by who is signed in (a body's ``reviewer`` is ignored), from the
+    request's address (not the run-quota key, ``user:N`` for a signed-in user), and audit it."""
+    address = client_address(request)
+    row = decisions.add(run_id, item_id, body.decision, body.note, principal.name, address)
+    audit(request, principal, "decision", run_id, f"{item} {item_id}: {body.decision}")
+    return _out(row, item)
+
+
+def _require_id(run_id: str, item: DecidedItem, item_id: int, items: list[dict[str, Any]]) -> None:
+    known = {int(i["id"]) for i in items}
+    if item_id not in known:
+        name = "twist interval" if item == "interval" else "swap"
+        raise NotFoundError(
+            f"Expected a {name} id of run {run_id} ({len(known)} {name}(s)), got {item_id}"
+        )
 
 
 @router.get("/decisions", responses=responses(401, 404, 409))
 def list_decisions(run: DoneRunDep, services: ServicesDep, decisions: DecisionsDep) -> DecisionsOut:
-    """The run's twist intervals with their newest decision, and every decision (newest
-    first). 409 for a keypoint take or a run without the twist check."""
+    """The run's twist intervals (a motion take) or swaps (a marker take) with their newest
+    decision, and every decision (newest first). 409 for a run with neither check."""
     run_id = str(run["id"])
-    intervals = run_intervals(services.files, run_id)
+    item, items = run_items(services.files, run_id)
+    decided = with_decisions(items, decisions.latest(run_id))
+    twist_apply = AnalysisOptions.from_json(run["options"]).twist_apply
     return DecisionsOut.model_validate(
         {
             "run_id": run_id,
-            "apply": AnalysisOptions.from_json(run["options"]).twist_apply,
-            "intervals": with_decisions(intervals, decisions.latest(run_id)),
-            "history": [_out(r) for r in decisions.history(run_id)],
+            "item": item,
+            "apply": twist_apply if item == "interval" else MARKER_APPLY,
+            "intervals": decided if item == "interval" else [],
+            "swaps": decided if item == "swap" else [],
+            "history": [_out(r, item) for r in decisions.history(run_id)],
         }
     )
 
@@ -77,18 +118,29 @@ def add_decision(
     """Accept or reject one twist interval; the newest decision per interval counts, every
     one is kept, with the reviewer and the client's address (as the audit log has it)."""
     run_id = str(run["id"])
-    known = {int(i["id"]) for i in run_intervals(services.files, run_id)}
-    if interval_id not in known:
-        raise NotFoundError(
-            f"Expected a twist interval id of run {run_id} ({len(known)} interval(s)), "
-            f"got {interval_id}"
-        )
-    # The reviewer is who is signed in; a body's ``reviewer`` is ignored. The client is the
-    # request's address (not the run-quota key, ``user:N`` for a signed-in user).
-    address = client_address(request)
-    row = decisions.add(run_id, interval_id, body.decision, body.note, principal.name, address)
-    audit(request, principal, "decision", run_id, f"interval {interval_id}: {body.decision}")
-    return _out(row)
+    _require_id(run_id, "interval", interval_id, run_intervals(services.files, run_id))
+    return _record(request, principal, decisions, run_id, "interval", interval_id, body)
+
+
+@router.post(
+    "/swaps/{swap_id}/decisions",
+    status_code=201,
+    responses=responses(401, 403, 404, 409, 413),
+)
+def add_swap_decision(
+    request: Request,
+    principal: Annotated[Principal, Depends(require(Action.REVIEW))],
+    run: DoneRunDep,
+    swap_id: Annotated[int, Path(ge=0, le=2**31 - 1)],
+    body: DecisionIn,
+    services: ServicesDep,
+    decisions: DecisionsDep,
+) -> DecisionOut:
+    """Accept or reject one swap of a marker run (its ``id`` in the run's findings), kept as
+    the interval decisions are."""
+    run_id = str(run["id"])
+    _require_id(run_id, "swap", swap_id, run_swaps(services.files, run_id))
+    return _record(request, principal, decisions, run_id, "swap", swap_id, body)
 
 
 @router.get(
@@ -112,4 +164,30 @@ def download_decided(run: DoneRunDep, services: ServicesDep, decisions: Decision
         decided_bvh(motion),
         media_type="text/plain",
         headers=attachment(f"{download_stem(take)}.decided.bvh"),
+    )
+
+
+@router.get(
+    "/decisions/c3d",
+    response_class=Response,
+    responses={200: {"content": {"application/octet-stream": {}}}, **responses(401, 404, 409)},
+)
+def download_decided_c3d(
+    run: DoneRunDep, services: ServicesDep, decisions: DecisionsDep
+) -> Response:
+    """The C3D of a marker take with exactly the accepted swaps repaired (an undecided swap
+    follows the run's ``applied``), then its gaps filled by the run's rule (the confident
+    fills), as the run's ``corrected.c3d`` is written. No filter."""
+    take = services.repository.get_take(str(run["take_id"]))
+    content = decided_c3d(
+        services.files,
+        run,
+        take,
+        decisions.latest(str(run["id"])),
+        services.settings.read_limits,
+    )
+    return Response(
+        content,
+        media_type="application/octet-stream",
+        headers=attachment(f"{download_stem(take)}.decided.c3d"),
     )

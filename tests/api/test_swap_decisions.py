@@ -1,0 +1,213 @@
+"""Accept / reject per swap of a marker take: history, the decided C3D, errors."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from mocapqa.io.c3d import MarkerTake, read_c3d, write_c3d
+
+Waiter = Callable[[TestClient, str], dict[str, Any]]
+Uploader = Callable[[TestClient, Path], dict[str, Any]]
+
+SOURCE = Path("c3d/optitrack/kinematics_tennis_serve.c3d")
+SWAPS = (("Derrick:LBHD", "Derrick:LFHD", 400, 429), ("Derrick:LASI", "Derrick:LPSI", 700, 729))
+"""The injected swaps: two markers of one segment exchanged over 30 frames, ends inclusive."""
+
+
+def exchanged(take: MarkerTake, swaps: tuple[tuple[str, str, int, int], ...]) -> MarkerTake:
+    """``take`` with each swap's two labels' samples (positions and residuals) exchanged."""
+    positions, residuals = take.points.positions.copy(), take.residuals.copy()
+    names = list(take.points.names)
+    for a, b, start, end in swaps:
+        pair, frames = [names.index(a), names.index(b)], slice(start, end + 1)
+        positions[frames, pair] = positions[frames, pair[::-1]]
+        residuals[frames, pair] = residuals[frames, pair[::-1]]
+    return replace(take, points=replace(take.points, positions=positions), residuals=residuals)
+
+
+@pytest.fixture
+def swapped(corpus_dir: Path, tmp_path: Path) -> Path:
+    """The tennis serve (no gaps, no swaps) with :data:`SWAPS` injected."""
+    source = corpus_dir / SOURCE
+    path = tmp_path / "tennis_serve_swapped.c3d"
+    write_c3d(path, exchanged(read_c3d(source), SWAPS), source=source)
+    return path
+
+
+@pytest.fixture
+def swap_run(
+    client: TestClient, swapped: Path, upload: Uploader, wait_for_run: Waiter
+) -> dict[str, Any]:
+    """The swapped take uploaded and checked with the default options."""
+    done = wait_for_run(client, upload(client, swapped)["run_id"])
+    assert done["status"] == "done", done["error"]
+    return done
+
+
+def take_files(client: TestClient, take_id: str) -> dict[str, str]:
+    """The take's stored files by name, as content hashes."""
+    folder = client.app.state.services.files.take_dir(take_id)  # type: ignore[attr-defined]
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in folder.iterdir()}
+
+
+def decide(client: TestClient, run_id: str, swap: int, decision: str, note: str = "") -> Any:
+    response = client.post(
+        f"/api/v1/runs/{run_id}/swaps/{swap}/decisions", json={"decision": decision, "note": note}
+    )
+    assert response.status_code == 201, response.text
+    return response.json()
+
+
+def decided_positions(client: TestClient, run_id: str, tmp_path: Path) -> np.ndarray:
+    response = client.get(f"/api/v1/runs/{run_id}/decisions/c3d")
+    assert response.status_code == 200, response.text
+    assert "decided.c3d" in response.headers["content-disposition"]
+    path = tmp_path / "decided.c3d"
+    path.write_bytes(response.content)
+    return read_c3d(path).points.positions
+
+
+def test_swap_decisions_are_history_and_the_download_repairs_exactly_the_accepted(
+    client: TestClient, corpus_dir: Path, swapped: Path, swap_run: dict[str, Any], tmp_path: Path
+) -> None:
+    run_id, take_id = swap_run["id"], swap_run["take_id"]
+    body = client.get(f"/api/v1/runs/{run_id}/decisions").json()
+    assert body["item"] == "swap"
+    assert body["intervals"] == []
+    assert body["history"] == []
+    swaps = body["swaps"]
+    found = [(*s["markers"], s["start_frame"], s["end_frame"]) for s in swaps]
+    assert found == list(SWAPS)
+    assert all(s["applied"] and s["corrected"] and s["decision"] is None for s in swaps)
+    assert all(s["confidence"] >= 0.8 for s in swaps)
+    # The ids are the findings' ids of the run.
+    result = client.get(f"/api/v1/runs/{run_id}/result").json()
+    listed = {f["id"]: f["markers"] for f in result["findings"] if f["kind"] == "swap"}
+    assert listed == {s["id"]: s["markers"] for s in swaps}
+
+    # The take is approved first: decisions change the decided download only.
+    approved = client.post(f"/api/v1/takes/{take_id}/reviews", json={"status": "approved"})
+    assert approved.status_code == 201, approved.text
+    stored = client.get(f"/api/v1/runs/{run_id}/download/c3d").content
+    raw = take_files(client, take_id)
+
+    clean = read_c3d(corpus_dir / SOURCE).points.positions
+    injected = read_c3d(swapped).points.positions
+    # Undecided: both follow the run (repaired), as its own corrected take has them.
+    np.testing.assert_array_equal(decided_positions(client, run_id, tmp_path), clean)
+
+    first, second = swaps[0]["id"], swaps[1]["id"]
+    decide(client, run_id, first, "reject", "first look")
+    decide(client, run_id, second, "reject")
+    last = decide(client, run_id, first, "accept", "labels are exchanged")
+    assert last["item"] == "swap"
+    assert last["interval_id"] == first
+    assert last["reviewer"] == "anonymous"
+    assert last["client"] == "testclient"
+
+    body = client.get(f"/api/v1/runs/{run_id}/decisions").json()
+    assert [(h["interval_id"], h["decision"]) for h in body["history"]] == [
+        (first, "accept"),
+        (second, "reject"),
+        (first, "reject"),
+    ]
+    assert {h["item"] for h in body["history"]} == {"swap"}
+    assert body["history"][0]["note"] == "labels are exchanged"
+    by_id = {s["id"]: s for s in body["swaps"]}
+    assert by_id[first]["decision"] == "accept"
+    assert by_id[first]["corrected"]
+    assert by_id[second]["decision"] == "reject"
+    assert not by_id[second]["corrected"]
+
+    # The accepted swap repaired, the rejected one left as recorded, nothing else changed.
+    a, b, start, end = SWAPS[1]
+    names = list(read_c3d(swapped).points.names)
+    pair, frames = [names.index(a), names.index(b)], slice(start, end + 1)
+    expected = clean.copy()
+    expected[frames, pair] = injected[frames, pair]
+    np.testing.assert_array_equal(decided_positions(client, run_id, tmp_path), expected)
+
+    decide(client, run_id, first, "reject")
+    np.testing.assert_array_equal(decided_positions(client, run_id, tmp_path), injected)
+
+    # The approved take, its file and the run's own corrected C3D are as they were.
+    reviews = client.get(f"/api/v1/takes/{take_id}/reviews").json()
+    assert [r["status"] for r in reviews] == ["approved"]
+    assert client.get(f"/api/v1/runs/{run_id}/download/c3d").content == stored
+    assert take_files(client, take_id) == raw
+
+
+def test_swap_decision_errors_name_the_problem(
+    client: TestClient,
+    corpus_dir: Path,
+    swap_run: dict[str, Any],
+    upload: Uploader,
+    wait_for_run: Waiter,
+) -> None:
+    run_id = swap_run["id"]
+    url = f"/api/v1/runs/{run_id}"
+    assert client.post(f"{url}/swaps/2/decisions", json={"decision": "accept"}).status_code == 404
+    bad = client.post(f"{url}/swaps/0/decisions", json={"decision": "maybe"})
+    assert bad.status_code == 422
+    # A marker run has swaps, not twist intervals, and no decided BVH.
+    for answer in (
+        client.post(f"{url}/intervals/0/decisions", json={"decision": "accept"}),
+        client.get(f"{url}/decisions/bvh"),
+    ):
+        assert answer.status_code == 409
+        assert "swaps" in answer.json()["detail"]
+
+    # Swaps the check no longer finds as the run listed them are not repaired by id.
+    report_path = client.app.state.services.files.run_dir(run_id) / "report.json"  # type: ignore[attr-defined]
+    report = json.loads(report_path.read_text())
+    for finding in report["findings"]:
+        if finding["kind"] == "swap":
+            finding["start_frame"] += 1
+    report_path.write_text(json.dumps(report) + " ")  # another size: read again
+    answer = client.get(f"{url}/decisions/c3d")
+    assert answer.status_code == 409
+    assert "start a new run" in answer.json()["detail"]
+
+    # A motion run has twist intervals, not swaps, and no decided C3D.
+    bvh = upload(client, corpus_dir / "bvh" / "cmu" / "iclone" / "005_05.bvh")
+    motion_id = bvh["run_id"]
+    assert wait_for_run(client, motion_id)["status"] == "done"
+    for answer in (
+        client.post(f"/api/v1/runs/{motion_id}/swaps/0/decisions", json={"decision": "accept"}),
+        client.get(f"/api/v1/runs/{motion_id}/decisions/c3d"),
+    ):
+        assert answer.status_code == 409
+        assert "twist intervals" in answer.json()["detail"]
+
+    # A marker run without the markers check has nothing to decide.
+    filtered = client.post(
+        f"/api/v1/takes/{swap_run['take_id']}/runs", json={"checks": ["filter"]}
+    ).json()
+    assert wait_for_run(client, filtered["id"])["status"] == "done"
+    answer = client.get(f"/api/v1/runs/{filtered['id']}/decisions")
+    assert answer.status_code == 409
+    assert "markers check" in answer.json()["detail"]
+
+
+def test_undecided_the_decided_c3d_is_the_runs_corrected_take_gaps_filled_alike(
+    client: TestClient, corpus_dir: Path, upload: Uploader, wait_for_run: Waiter, tmp_path: Path
+) -> None:
+    gapped = corpus_dir / "c3d/optitrack/kinematics_tennis_serve_nan.c3d"
+    run = wait_for_run(client, upload(client, gapped)["run_id"])
+    assert run["status"] == "done", run["error"]
+    corrected = tmp_path / "corrected.c3d"
+    corrected.write_bytes(client.get(f"/api/v1/runs/{run['id']}/download/c3d").content)
+    ours, decided = read_c3d(corrected), decided_positions(client, run["id"], tmp_path)
+    raw = read_c3d(gapped).points.positions
+    assert np.isnan(raw).any()
+    assert (np.isnan(raw) & ~np.isnan(decided)).any()  # some gaps filled
+    np.testing.assert_array_equal(decided, ours.points.positions)
