@@ -12,8 +12,11 @@ import pytest
 
 from mocapqa.jobs.take_task import analyse_path
 from mocapqa.pipeline.options import AnalysisOptions
-from mocapqa.store.repository import Repository, new_id
-from mocapqa.store.shoots import DoneTake, ShootStore, TakeFilter
+from mocapqa.store.repository import Repository
+from mocapqa.store.shoot_pages import TakeFilter
+from mocapqa.store.shoots import ShootStore
+from mocapqa.store.stamps import new_id
+from mocapqa.store.take_writer import DoneTake
 
 WALK = "bvh/cmu/cmu_12_01_walk.bvh"
 N_TAKES = 41

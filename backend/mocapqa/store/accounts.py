@@ -19,13 +19,13 @@ from typing import Any
 from pwdlib import PasswordHash
 from sqlalchemy import Engine, func, insert, select, update
 
-from mocapqa.core.text import display_name
 from mocapqa.errors import AuthenticationError, ConflictError, InputError, NotFoundError
+from mocapqa.store.audit_log import AuditLog
 from mocapqa.store.last_use import LastUse
-from mocapqa.store.repository import new_id, utc_now
 from mocapqa.store.roles import Role
-from mocapqa.store.rows import plain, utc
-from mocapqa.store.tables import audit, tokens, users
+from mocapqa.store.rows import read_rows, utc
+from mocapqa.store.stamps import new_id, utc_now
+from mocapqa.store.tables import tokens, users
 
 __all__ = [
     "LINK_TTL",
@@ -129,11 +129,12 @@ def _user(row: Any) -> User:
     )
 
 
-class Accounts:
-    """Users, credentials and the audit log on a database engine (the repository's)."""
+class Accounts(AuditLog):
+    """Users, credentials and the audit log (:class:`~mocapqa.store.audit_log.AuditLog`) on a
+    database engine (the repository's)."""
 
     def __init__(self, engine: Engine) -> None:
-        self.engine = engine
+        super().__init__(engine)
         self.last_use = LastUse(engine)
         """Coalesced writes of credentials' ``last_used_at`` (:meth:`verify` notes)."""
 
@@ -393,8 +394,7 @@ class Accounts:
         if user_id is not None:
             query = query.where(tokens.c.user_id == user_id)
         with self.engine.connect() as conn:
-            rows = conn.execute(query).mappings()
-            return [plain(r) for r in rows]
+            return read_rows(conn, query)
 
     def token_owner(self, token_id: str) -> int:
         """The user id of a personal token (:class:`NotFoundError` when missing)."""
@@ -417,41 +417,3 @@ class Accounts:
                 .where(tokens.c.id == token_id, tokens.c.revoked_at.is_(None))
                 .values(revoked_at=utc_now())
             )
-
-    # audit -----------------------------------------------------------------------------
-    def record(
-        self,
-        action: str,
-        user: User | None,
-        client: str,
-        target: str = "",
-        detail: str = "",
-    ) -> None:
-        """Append an audit entry (who, now, what, from where).
-
-        Client-given text (a file name, a note) is stored as the API echoes it, without control
-        or format characters: PostgreSQL refuses NUL in text, and the log is read by people.
-        """
-        target, detail = display_name(target, 255), display_name(detail, 2000)
-        with self.engine.begin() as conn:
-            conn.execute(
-                insert(audit).values(
-                    at=utc_now(),
-                    user_id=user.id if user else None,
-                    user_name=user.name if user else None,
-                    action=action[:32],
-                    target=target,
-                    detail=detail,
-                    client=client[:64],
-                )
-            )
-
-    def list_audit(self, limit: int, offset: int) -> tuple[list[dict[str, Any]], int]:
-        """A page of audit entries, newest first, and their total."""
-        with self.engine.connect() as conn:
-            total = int(conn.execute(select(func.count()).select_from(audit)).scalar_one())
-            rows = conn.execute(
-                select(audit).order_by(audit.c.id.desc()).limit(limit).offset(offset)
-            ).mappings()
-            items = [plain(r) for r in rows]
-        return items, total

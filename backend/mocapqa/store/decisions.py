@@ -10,11 +10,12 @@ from __future__ import annotations
 
 from typing import Any, Literal, get_args
 
-from sqlalchemy import Engine, func, insert, select
+from sqlalchemy import func, insert, select
 
 from mocapqa.errors import InputError
-from mocapqa.store.repository import utc_now
-from mocapqa.store.rows import plain
+from mocapqa.store.access import TableAccess
+from mocapqa.store.rows import plain, read_rows
+from mocapqa.store.stamps import utc_now
 from mocapqa.store.tables import interval_decisions
 
 __all__ = [
@@ -36,17 +37,8 @@ DECIDED_ITEMS: tuple[DecidedItem, ...] = get_args(DecidedItem)
 """The values of :data:`DecidedItem`."""
 
 
-class IntervalDecisions:
-    """Reads and writes of :data:`~mocapqa.store.tables.interval_decisions`.
-
-    Parameters
-    ----------
-    engine : Engine
-        The repository's engine (the table is part of its schema).
-    """
-
-    def __init__(self, engine: Engine) -> None:
-        self.engine = engine
+class IntervalDecisions(TableAccess):
+    """Reads and writes of :data:`~mocapqa.store.tables.interval_decisions`."""
 
     def add(
         self, run_id: str, interval_id: int, decision: str, note: str, reviewer: str, client: str
@@ -80,10 +72,9 @@ class IntervalDecisions:
         """Every decision on a run's items, newest first."""
         table = interval_decisions
         with self.engine.connect() as conn:
-            rows = conn.execute(
-                select(table).where(table.c.run_id == run_id).order_by(table.c.id.desc())
-            ).mappings()
-            return [plain(r) for r in rows]
+            return read_rows(
+                conn, select(table).where(table.c.run_id == run_id).order_by(table.c.id.desc())
+            )
 
     def latest(self, run_id: str) -> dict[int, str]:
         """Item id → its newest decision, for the items (intervals or swaps) that have one."""

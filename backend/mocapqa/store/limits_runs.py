@@ -1,23 +1,62 @@
 """Takes of a shoot whose latest run checked joint limits with another model than the shoot's.
 
 A run records the limits model it used in its options (``limits_model``, set when the run is
-recorded: :meth:`mocapqa.store.repository.Repository.add_run`). When an admin chooses another
-model for a shoot, the runs already made keep theirs; these queries find the motion takes whose
-latest run (the one the shoot's table shows) used another model, so that the shoot's summary
-can count them and an admin can run them again. Keypoint takes are not counted: they have no
-joint limits. Runs recorded before models could be chosen (no ``limits_model``) used the
-default choice.
+recorded: :func:`run_limits_model`). When an admin chooses another model for a shoot, the runs
+already made keep theirs; these queries find the motion takes whose latest run (the one the
+shoot's table shows) used another model, so that the shoot's summary can count them and an
+admin can run them again. Keypoint takes are not counted: they have no joint limits. Runs
+recorded before models could be chosen (no ``limits_model``) used the default choice.
+
+A new run's model is chosen here too, for the server's runs and a batch's alike
+(:func:`run_limits_model`): the one its options name, else its shoot's, else the catalog's
+default.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from sqlalchemy import Engine, Select, func, select
+from sqlalchemy import Connection, Engine, Select, func, select
 
+from mocapqa.errors import NotFoundError
 from mocapqa.store.tables import runs, shoots, take_qa
 
-__all__ = ["stale_limits_counts", "stale_limits_runs"]
+__all__ = ["run_limits_model", "shoot_limits_model", "stale_limits_counts", "stale_limits_runs"]
+
+
+def shoot_limits_model(conn: Connection, shoot_id: str) -> str:
+    """The name of a shoot's limits model.
+
+    Raises
+    ------
+    NotFoundError
+        When no shoot has that id.
+    """
+    found = conn.execute(select(shoots.c.limits_model).where(shoots.c.id == shoot_id)).scalar()
+    if found is None:
+        raise NotFoundError(f"Expected shoot {shoot_id!r} to exist, got none")
+    return str(found)
+
+
+def run_limits_model(conn: Connection, requested: str | None, shoot_id: str | None) -> str:
+    """The limits model a new run of a take checks with: ``requested`` when the run's options
+    name one, else the model of the take's shoot, else (a take outside any shoot) the catalog's
+    default. The name is recorded with the run, so its options say which model it used.
+
+    Raises
+    ------
+    NotFoundError
+        When ``shoot_id`` names no shoot.
+    """
+    if requested is not None:
+        return requested
+    if shoot_id:
+        return shoot_limits_model(conn, shoot_id)
+    # Imported here: the catalog loads the limits stack, which the batch client (it records
+    # runs through this store) never needs otherwise.
+    from mocapqa.limits.catalog import DEFAULT_MODEL
+
+    return DEFAULT_MODEL
 
 
 def _stale(shoot_id: str | None) -> Select[Any]:

@@ -1,11 +1,14 @@
 """The ``take_qa`` rows: one per take, rebuilt from the take, its latest run and latest review.
 
-The repository calls :func:`sync_take` in the same transaction as every write that changes one
-of them (a new take or run, a run's status, a review), so the row is never stale.
+A new take's row is built from the values at hand (:func:`qa_row`, by the take writer,
+``store/take_writer.py``); after that the store calls :func:`sync_take` in the same transaction
+as every write that changes one of its inputs (a new run, a run's status, a review, a move to
+another shoot), so the row is never stale.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 from sqlalchemy import delete, insert, select
@@ -14,25 +17,54 @@ from sqlalchemy.engine import Connection
 from mocapqa.pipeline.summary import SUMMARY_FIELDS
 from mocapqa.store.tables import reviews, runs, take_qa, takes
 
-__all__ = ["QA_COLUMNS", "lock_take", "qa_values", "sync_take"]
+__all__ = ["QA_COLUMNS", "lock_take", "qa_row", "qa_values", "sync_take"]
 
 QA_COLUMNS = (*SUMMARY_FIELDS, "joint_violations")
 """Columns of ``take_qa`` copied from a done run's ``summary["qa"]``."""
 
 
-def qa_values(take: dict[str, Any], run: dict[str, Any] | None) -> dict[str, Any]:
+def qa_values(take: Mapping[str, Any], run: Mapping[str, Any] | None) -> dict[str, Any]:
     """The summary columns of a take's row, from its latest run (None until it is done)."""
     values: dict[str, Any] = dict.fromkeys(QA_COLUMNS)
     values["n_frames"] = take["n_frames"]
     values["duration_s"] = take["n_frames"] / take["fps"] if take["fps"] else None
     values["n_findings"] = None
-    if run is not None and run["status"] == "done" and isinstance(run["summary"], dict):
+    if run is not None and run["status"] == "done" and isinstance(run.get("summary"), dict):
         qa = run["summary"].get("qa") or {}
         for column in QA_COLUMNS:
             if column in qa:
                 values[column] = qa[column]
         values["n_findings"] = run["summary"].get("n_findings")
     return values
+
+
+def qa_row(
+    take: Mapping[str, Any], run: Mapping[str, Any] | None, review: Mapping[str, Any] | None
+) -> dict[str, Any]:
+    """A take's ``take_qa`` row.
+
+    Parameters
+    ----------
+    take : mapping
+        The ``takes`` row (``id``, ``shoot_id``, ``name``, ``kind``, ``created_at``,
+        ``n_frames``, ``fps``).
+    run : mapping, optional
+        Its latest run (``id``, ``status``, ``summary``); None when it has none.
+    review : mapping, optional
+        Its latest review (``status``, ``reviewer``); None when it has none.
+    """
+    return {
+        "take_id": take["id"],
+        "shoot_id": take.get("shoot_id"),
+        "name": take["name"],
+        "kind": take["kind"],
+        "created_at": take["created_at"],
+        "run_id": run["id"] if run is not None else None,
+        "status": run["status"] if run is not None else None,
+        "review_status": review["status"] if review is not None else "unreviewed",
+        "reviewer": review["reviewer"] if review is not None else None,
+        **qa_values(take, run),
+    }
 
 
 def lock_take(conn: Connection, take_id: str) -> Any:
@@ -79,18 +111,6 @@ def sync_take(conn: Connection, take_id: str) -> None:
         .mappings()
         .first()
     )
-    run_row = dict(run) if run is not None else None
-    conn.execute(
-        insert(take_qa).values(
-            take_id=take_id,
-            shoot_id=take["shoot_id"],
-            name=take["name"],
-            kind=take["kind"],
-            created_at=take["created_at"],
-            run_id=run_row["id"] if run_row else None,
-            status=run_row["status"] if run_row else None,
-            review_status=review["status"] if review is not None else "unreviewed",
-            reviewer=review["reviewer"] if review is not None else None,
-            **qa_values(dict(take), run_row),
-        )
-    )
+    latest_run = dict(run) if run is not None else None
+    latest_review = dict(review) if review is not None else None
+    conn.execute(insert(take_qa).values(**qa_row(take, latest_run, latest_review)))

@@ -1,40 +1,37 @@
 """The repository: every read and write of takes, runs and reviews goes through here.
 
-Rows come back as plain dicts (JSON-ready apart from datetimes). A run's life is
-``queued → running → done | failed``; :meth:`Repository.recover_interrupted` puts runs that a
-stopped server left queued or running back in the queue (their outputs are only published
-after they are complete, so nothing half-written is ever marked done).
+New takes and runs are written by the store's one writer (``store/take_writer.py``), takes are
+listed from their ``take_qa`` rows (``store/take_listing.py``). Rows come back as plain dicts
+(JSON-ready apart from datetimes). A run's life is ``queued → running → done | failed``;
+:meth:`Repository.recover_interrupted` puts runs that a stopped server left queued or running
+back in the queue (their outputs are only published after they are complete, so nothing
+half-written is ever marked done).
 """
 
 from __future__ import annotations
 
 import logging
-import sqlite3
-import time
-import uuid
-from datetime import UTC, datetime
 from typing import Any, Literal, get_args
 
 from sqlalchemy import (
     Engine,
-    create_engine,
     delete,
-    event,
     func,
     insert,
     select,
     update,
 )
-from sqlalchemy.engine import Connection
 from sqlalchemy.exc import IntegrityError
-from sqlalchemy.sql.elements import ColumnElement
 
-from mocapqa import __version__
 from mocapqa.core.text import display_name
 from mocapqa.errors import ConflictError, InputError, NotFoundError
+from mocapqa.store.connect import open_engine
 from mocapqa.store.qa import lock_take, sync_take
-from mocapqa.store.rows import plain
-from mocapqa.store.tables import reviews, runs, shoots, take_qa, takes
+from mocapqa.store.rows import plain, read_rows
+from mocapqa.store.stamps import new_id, utc_now
+from mocapqa.store.tables import reviews, runs, take_qa, takes
+from mocapqa.store.take_listing import REVIEW_STATUS, TAKE_ROWS, checked_choice
+from mocapqa.store.take_writer import add_run, queued_run, write_takes
 from mocapqa.store.upgrade import upgrade_database
 
 __all__ = [
@@ -43,7 +40,7 @@ __all__ = [
     "Repository",
     "ReviewStatus",
     "RunStatus",
-    "new_id",
+    "new_id",  # of store/stamps.py, still imported from here outside the store
     "utc_now",
 ]
 
@@ -59,93 +56,19 @@ REVIEW_STATUSES: tuple[ReviewStatus, ...] = get_args(ReviewStatus)
 """The review decisions a take can have."""
 
 
-SQLITE_BUSY_MS = 10_000
-"""How long a SQLite connection waits for another's write lock before "database is locked"."""
-SPARE_CONNECTIONS = 5
-"""Connections beyond one per thread: a thread may hold a second for a nested read."""
-
-
-_REVIEW_STATUS = func.coalesce(take_qa.c.review_status, "unreviewed")
-_TAKE_ROWS = (
-    select(
-        takes,
-        take_qa.c.run_id.label("latest_run_id"),
-        take_qa.c.status,
-        runs.c.summary,
-        _REVIEW_STATUS.label("review_status"),
-    )
-    .outerjoin(take_qa, take_qa.c.take_id == takes.c.id)
-    .outerjoin(runs, runs.c.id == take_qa.c.run_id)
-)
-"""A take with its latest run and review: read from its ``take_qa`` row (kept in step with
-every write, ``store/qa.py``), built once (making the statement cost more than running it)."""
-
-
-def new_id() -> str:
-    """A new 32-character hex id."""
-    return uuid.uuid4().hex
-
-
-def utc_now() -> datetime:
-    """The current time, UTC."""
-    return datetime.now(UTC)
-
-
-def _sqlite_pragmas(dbapi_connection: Any, connection_record: Any) -> None:
-    del connection_record
-    cursor = dbapi_connection.cursor()
-    cursor.execute(f"PRAGMA busy_timeout={SQLITE_BUSY_MS}")
-    cursor.execute("PRAGMA foreign_keys=ON")
-    _switch_to_wal(cursor)
-    cursor.close()
-
-
-def _switch_to_wal(cursor: Any) -> None:
-    """Put the database in WAL mode (kept in the file: once is enough). Switching needs the
-    file alone, and SQLite answers "database is locked" at once, without its busy wait, when
-    another connection opening the same new file is switching or migrating it: tried again
-    for up to :data:`SQLITE_BUSY_MS`."""
-    deadline = time.monotonic() + SQLITE_BUSY_MS / 1000
-    while True:
-        try:
-            mode = cursor.execute("PRAGMA journal_mode").fetchone()[0]
-            if str(mode).lower() != "wal":
-                cursor.execute("PRAGMA journal_mode=WAL")
-            return
-        except sqlite3.OperationalError as e:
-            if "locked" not in str(e) or time.monotonic() > deadline:
-                raise
-            time.sleep(0.01)
-
-
 class Repository:
     """Database access for takes, runs and reviews.
 
     Parameters
     ----------
-    database_url : str
-        SQLAlchemy URL (``sqlite:///...`` or ``postgresql+psycopg://...``).
-    threads : int
-        Threads that use the database at once (a server's request threads and job workers).
-        The pool keeps that many connections and :data:`SPARE_CONNECTIONS` more, so that no
-        request waits for a connection another holds, or pays for opening one (the library's
-        default of 5 kept + 10 more made 40 parallel requests queue for 30 s, and opened and
-        closed a SQLite connection, with its pragmas, on most requests). Connections are
-        opened when first needed.
+    database_url, threads
+        The database and the threads that use it at once
+        (:func:`~mocapqa.store.connect.open_engine`).
     """
 
     def __init__(self, database_url: str, threads: int = 10) -> None:
         self.database_url = database_url
-        sqlite = database_url.startswith("sqlite")
-        self.engine: Engine = create_engine(
-            database_url,
-            # A SQLite file cannot drop a connection as a server can: no ping per checkout.
-            pool_pre_ping=not sqlite,
-            pool_size=threads + SPARE_CONNECTIONS,
-            max_overflow=SPARE_CONNECTIONS,
-        )
-        if self.engine.dialect.name == "sqlite":
-            event.listen(self.engine, "connect", _sqlite_pragmas)
+        self.engine: Engine = open_engine(database_url, threads)
         self.upgrades = upgrade_database(self.engine)
         """What opening the database did to its schema (empty when it was up to date)."""
         for step in self.upgrades:
@@ -174,19 +97,19 @@ class Repository:
             When ``values`` names a shoot that no longer exists (deleted during an import).
         """
         take_id = str(values.get("id") or new_id())
+        take = {**values, "id": take_id}
+        now = utc_now()
         try:
             with self.engine.begin() as conn:
-                row = {**values, "id": take_id, "created_at": utc_now()}
-                conn.execute(insert(takes).values(**row))
-                run_id = self._insert_run(conn, take_id, str(values["sha256"]), options)
-                sync_take(conn, take_id)
+                run = queued_run(conn, take, new_id(), options, now)
+                write_takes(conn, [(take, run)], now)
         except IntegrityError as e:
             shoot_id = values.get("shoot_id")
             if shoot_id is not None:
                 # The shoot was deleted while its import ran.
                 raise NotFoundError(f"Expected shoot {shoot_id!r} to exist, got none") from e
             raise
-        return take_id, run_id
+        return take_id, str(run["id"])
 
     def same_content(self, take_id: str) -> str | None:
         """The name of another take of the same shoot with byte-identical content (the same
@@ -212,10 +135,11 @@ class Repository:
         ------
         NotFoundError
         """
-        items, _ = self._query_takes(take_id=take_id)
-        if not items:
+        with self.engine.connect() as conn:
+            found = read_rows(conn, TAKE_ROWS.where(takes.c.id == take_id))
+        if not found:
             raise NotFoundError(f"Expected take {take_id!r} to exist, got none")
-        return items[0]
+        return found[0]
 
     def list_takes(
         self,
@@ -225,39 +149,19 @@ class Repository:
         review_status: str | None = None,
     ) -> tuple[list[dict[str, Any]], int]:
         """A page of takes, newest first, and the total count after filtering."""
-        if status is not None and status not in RUN_STATUSES:
-            raise InputError(f"Expected status in {list(RUN_STATUSES)}, got {status!r}")
-        if review_status is not None and review_status not in REVIEW_STATUSES:
-            raise InputError(
-                f"Expected review_status in {list(REVIEW_STATUSES)}, got {review_status!r}"
-            )
-        return self._query_takes(limit, offset, status, review_status)
-
-    def _query_takes(
-        self,
-        limit: int = 50,
-        offset: int = 0,
-        status: str | None = None,
-        review_status: str | None = None,
-        take_id: str | None = None,
-    ) -> tuple[list[dict[str, Any]], int]:
-        clauses: list[ColumnElement[bool]] = []
-        if take_id is not None:
-            clauses.append(takes.c.id == take_id)
-        if status is not None:
-            clauses.append(take_qa.c.status == status)
-        if review_status is not None:
-            clauses.append(_REVIEW_STATUS == review_status)  # noqa: SIM300 - an SQL expression
+        chosen = (
+            (take_qa.c.status, checked_choice("status", status, RUN_STATUSES)),
+            (REVIEW_STATUS, checked_choice("review_status", review_status, REVIEW_STATUSES)),
+        )
+        clauses = [column == value for column, value in chosen if value is not None]
         page = (
-            _TAKE_ROWS.where(*clauses)
+            TAKE_ROWS.where(*clauses)
             .order_by(takes.c.created_at.desc(), takes.c.id)
             .limit(limit)
             .offset(offset)
         )
         with self.engine.connect() as conn:
-            rows = [plain(r) for r in conn.execute(page).mappings()]
-            if take_id is not None:
-                return rows, len(rows)
+            rows = read_rows(conn, page)
             total = conn.execute(
                 select(func.count())
                 .select_from(takes.outerjoin(take_qa, take_qa.c.take_id == takes.c.id))
@@ -287,47 +191,14 @@ class Repository:
         return run_ids
 
     # runs ------------------------------------------------------------------------------
-    def _insert_run(
-        self, conn: Connection, take_id: str, sha256: str, options: dict[str, Any]
-    ) -> str:
-        if options.get("limits_model") is None:
-            # Imported here: the catalog loads the limits stack, which the batch client
-            # (it records runs through this store) never needs otherwise.
-            from mocapqa.limits.catalog import DEFAULT_MODEL
-
-            # A run of a take in a shoot checks limits with the shoot's model; the name is
-            # recorded with the run, so its options say which model it used.
-            query = (
-                select(shoots.c.limits_model)
-                .select_from(takes.join(shoots, takes.c.shoot_id == shoots.c.id))
-                .where(takes.c.id == take_id)
-            )
-            chosen = conn.execute(query).scalar()
-            options = {**options, "limits_model": chosen or DEFAULT_MODEL}
-        run_id = new_id()
-        conn.execute(
-            insert(runs).values(
-                id=run_id,
-                take_id=take_id,
-                status="queued",
-                progress=0,
-                step="queued",
-                options=options,
-                input_sha256=sha256,
-                version=__version__,
-                created_at=utc_now(),
-            )
-        )
-        return run_id
-
     def add_run(self, take_id: str, options: dict[str, Any]) -> str:
         """Queue a new run of a take with the given options; earlier runs are kept."""
         take = self.get_take(take_id)
+        run_id = new_id()
         with self.engine.begin() as conn:
             lock_take(conn, take_id)
-            run_id = self._insert_run(conn, take_id, str(take["sha256"]), options)
-            sync_take(conn, take_id)
-            return run_id
+            add_run(conn, take, run_id, options, utc_now())
+        return run_id
 
     def get_run(self, run_id: str) -> dict[str, Any]:
         """One run.
@@ -345,10 +216,9 @@ class Repository:
     def list_runs(self, take_id: str) -> list[dict[str, Any]]:
         """All runs of a take, oldest first."""
         with self.engine.connect() as conn:
-            rows = conn.execute(
-                select(runs).where(runs.c.take_id == take_id).order_by(runs.c.created_at)
-            ).mappings()
-            return [plain(r) for r in rows]
+            return read_rows(
+                conn, select(runs).where(runs.c.take_id == take_id).order_by(runs.c.created_at)
+            )
 
     def require_done(self, run_id: str) -> dict[str, Any]:
         """The run, if it finished; :class:`ConflictError` otherwise."""
@@ -359,20 +229,14 @@ class Repository:
 
     def mark_running(self, run_id: str) -> None:
         """Move a run from queued to running."""
-        with self.engine.begin() as conn:
-            self._lock_run_take(conn, run_id)
-            conn.execute(
-                update(runs)
-                .where(runs.c.id == run_id)
-                .values(
-                    status="running",
-                    progress=1,
-                    step="starting",
-                    started_at=utc_now(),
-                    attempts=runs.c.attempts + 1,
-                )
-            )
-            self._sync_run_take(conn, run_id)
+        self._change_run(
+            run_id,
+            status="running",
+            progress=1,
+            step="starting",
+            started_at=utc_now(),
+            attempts=runs.c.attempts + 1,
+        )
 
     def set_progress(self, run_id: str, percent: int, step: str) -> None:
         """Record a running run's progress (0–100) and current step."""
@@ -391,32 +255,28 @@ class Repository:
         server_time_s: float,
     ) -> None:
         """Mark a run done (``error`` None) or failed."""
+        self._change_run(
+            run_id,
+            status="failed" if error else "done",
+            progress=100,
+            step="failed" if error else "done",
+            error=error,
+            summary=summary,
+            server_time_s=server_time_s,
+            finished_at=utc_now(),
+        )
+
+    def _change_run(self, run_id: str, **values: Any) -> None:
+        """Set a run's ``values`` and rebuild its take's ``take_qa`` row, in one transaction
+        (the take locked first, :func:`~mocapqa.store.qa.lock_take`)."""
         with self.engine.begin() as conn:
-            self._lock_run_take(conn, run_id)
-            conn.execute(
-                update(runs)
-                .where(runs.c.id == run_id)
-                .values(
-                    status="failed" if error else "done",
-                    progress=100,
-                    step="failed" if error else "done",
-                    error=error,
-                    summary=summary,
-                    server_time_s=server_time_s,
-                    finished_at=utc_now(),
-                )
-            )
-            self._sync_run_take(conn, run_id)
-
-    def _lock_run_take(self, conn: Connection, run_id: str) -> None:
-        take_id = conn.execute(select(runs.c.take_id).where(runs.c.id == run_id)).scalar()
-        if take_id is not None:
-            lock_take(conn, str(take_id))
-
-    def _sync_run_take(self, conn: Connection, run_id: str) -> None:
-        take_id = conn.execute(select(runs.c.take_id).where(runs.c.id == run_id)).scalar()
-        if take_id is not None:
-            sync_take(conn, str(take_id))
+            found = conn.execute(select(runs.c.take_id).where(runs.c.id == run_id)).scalar()
+            take_id = None if found is None else str(found)
+            if take_id is not None:
+                lock_take(conn, take_id)
+            conn.execute(update(runs).where(runs.c.id == run_id).values(**values))
+            if take_id is not None:
+                sync_take(conn, take_id)
 
     def recover_interrupted(self, max_attempts: int = 2) -> list[str]:
         """Re-queue the runs a stopped server left queued or running; returns their ids.
@@ -489,7 +349,7 @@ class Repository:
         """A take's review history, newest first."""
         self.get_take(take_id)
         with self.engine.connect() as conn:
-            rows = conn.execute(
-                select(reviews).where(reviews.c.take_id == take_id).order_by(reviews.c.id.desc())
-            ).mappings()
-            return [plain(r) for r in rows]
+            return read_rows(
+                conn,
+                select(reviews).where(reviews.c.take_id == take_id).order_by(reviews.c.id.desc()),
+            )
