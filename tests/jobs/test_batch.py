@@ -22,11 +22,11 @@ import pytest
 from fastapi.testclient import TestClient
 
 from mocapqa.api.app import create_app
-from mocapqa.bench.batch_client import separate_cluster
 from mocapqa.config import Settings
-from mocapqa.jobs.batch import CHUNK_TAKES, chunk_size, run_batch
+from mocapqa.jobs.batch import run_batch
+from mocapqa.jobs.batch_dask import CHUNK_TAKES, chunk_size
 from mocapqa.jobs.engine import WORKER_CONFIG, Engine
-from mocapqa.jobs.runner import write_outputs
+from mocapqa.jobs.run_folder import write_outputs
 from mocapqa.jobs.take_task import analyse_path
 from mocapqa.limits.catalog import DEFAULT_MODEL
 from mocapqa.pipeline.analyze import analyze
@@ -36,6 +36,7 @@ from mocapqa.pipeline.summary import qa_summary
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
 from mocapqa.store.shoots import ShootStore
+from mocapqa_bench.batch_client import separate_cluster
 
 TAKES = (
     "bvh/bandai/dataset-1_bow_not-confident_001.bvh",
@@ -218,7 +219,7 @@ def test_chunked_tasks_fail_only_the_take_at_fault(
 ) -> None:
     """Several takes to a task: a take whose task raises fails alone, and a take that kills
     its worker has its chunk sent again one take per task, so only it fails."""
-    monkeypatch.setattr("mocapqa.jobs.batch.chunk_size", lambda n_pending, in_flight: 3)
+    monkeypatch.setattr("mocapqa.jobs.batch_dask.chunk_size", lambda n_pending, in_flight: 3)
     repository, shoots = _store(tmp_path)
     rows: list[dict[str, Any]] = []
     counts = run_batch(

@@ -3,7 +3,9 @@ results table whole or not at all."""
 
 from __future__ import annotations
 
+import csv
 import errno
+import json
 import os
 import re
 import shutil
@@ -112,9 +114,9 @@ def test_the_results_table_is_replaced_whole_or_not_at_all(
     out = tmp_path / f"results{suffix}"
     out.write_bytes(b"an earlier table")
     with ResultWriter(out) as writer:
-        writer.write({"source": "a.bvh", "status": "done"})
+        writer.write({"source": "a.bvh", "status": "done", "n_frames": 524})
         assert out.read_bytes() == b"an earlier table"  # rows go to a temporary meanwhile
-    assert out.read_bytes() != b"an earlier table"
+    assert table_rows(out) == [("a.bvh", "done", 524)]
     assert sorted(p.name for p in tmp_path.iterdir()) == [out.name]
 
     # A disk that fills up on the last rows: the earlier table stays, no temporary is left.
@@ -129,6 +131,20 @@ def test_the_results_table_is_replaced_whole_or_not_at_all(
     assert caught.value.filename == str(out)
     assert out.read_bytes() == b"an earlier table"
     assert sorted(p.name for p in tmp_path.iterdir()) == [out.name]
+
+
+def table_rows(path: Path) -> list[tuple[str, str, int]]:
+    """The ``source``, ``status`` and ``n_frames`` of each row of a results table."""
+    if path.suffix == ".parquet":
+        import pyarrow.parquet as pq
+
+        rows = pq.read_table(path).to_pylist()
+    elif path.suffix == ".csv":
+        with path.open(newline="", encoding="utf-8") as handle:
+            rows = list(csv.DictReader(handle))
+    else:
+        rows = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()]
+    return [(row["source"], row["status"], int(row["n_frames"])) for row in rows]
 
 
 def _full() -> None:

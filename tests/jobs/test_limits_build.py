@@ -12,7 +12,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mocapqa.bench.limits import canonical_takes, rig_takes
 from mocapqa.cli.main import main
 from mocapqa.errors import InputError
 from mocapqa.jobs.engine import Engine
@@ -22,6 +21,7 @@ from mocapqa.limits.build import DEFAULT_BUILD, build_canonical_model, build_mod
 from mocapqa.limits.discriminator import DiscriminatorParams
 from mocapqa.limits.model import LimitsModel
 from mocapqa.limits.storage import load_model, model_bytes
+from mocapqa_bench.limits import canonical_takes, rig_takes
 
 # Five Bandai clips of two rigs (dataset-1 and dataset-2 joint frames; the second clip is held
 # back by the split), two Character Creator takes (the second held back), the single CMU-style

@@ -11,7 +11,7 @@ multipart body the parser refuses was Starlette's bare 400 ("Invalid multipart d
 * a route that reads a form gets only the parts it declares: another part is refused naming
   it, and a second part for a field that takes one (``file``) too; a field declared as a list
   (``files`` of a shoot import) takes every part;
-* an uploaded file's name is at most :data:`~mocapqa.jobs.intake.MAX_NAME_CHARS` characters;
+* an uploaded file's name is at most :data:`~mocapqa.jobs.take_reading.MAX_NAME_CHARS` characters;
   one too long for the parser to read (a part header over python-multipart's limit, 4224
   bytes in 0.0.34) is refused naming the route's file field;
 * a route that reads JSON refuses form fields (run options sent as a form), naming each
@@ -33,7 +33,7 @@ from starlette.exceptions import HTTPException
 from starlette.formparsers import MultiPartException
 from starlette.requests import HTTPConnection
 
-from mocapqa.jobs.intake import MAX_NAME_CHARS, name_too_long
+from mocapqa.jobs.take_reading import MAX_NAME_CHARS, name_too_long
 
 __all__ = [
     "FORM_TYPES",

@@ -15,22 +15,12 @@ from pathlib import Path
 import numpy as np
 
 from mocapqa.errors import InputError
+from mocapqa.jobs.run_folder import POINT_ARRAYS
 
 __all__ = ["MAX_WINDOW_VALUES", "Window", "read_window", "window_json", "window_packed"]
 
 MAX_WINDOW_VALUES = 3_000_000
 """Most values (frames × points × components, over every array) one window may hold."""
-
-ARRAYS = (
-    "raw",
-    "corrected",
-    "raw_rotations",
-    "corrected_rotations",
-    "confidence",
-    "bridged",
-    "filled",
-)
-"""The stored arrays a window carries, in this order (those a run has)."""
 
 
 @dataclass(frozen=True)
@@ -68,7 +58,7 @@ def read_window(path: Path, start: int, stop: int | None, step: int, max_frames:
         When ``start ≥ stop`` or the window would exceed :data:`MAX_WINDOW_VALUES`.
     """
     with np.load(path) as data:
-        stored = {name: data[name] for name in ARRAYS if name in data}
+        stored = {name: data[name] for name in POINT_ARRAYS if name in data}
     n_frames = int(stored["raw"].shape[0])
     stop = n_frames if stop is None else min(stop, n_frames)
     if start >= stop:

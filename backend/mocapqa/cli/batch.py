@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -23,6 +24,11 @@ from mocapqa.cli.app import app
 
 if TYPE_CHECKING:
     from rich.console import Console
+    from rich.progress import Progress
+
+    from mocapqa.jobs.batch import BatchCounts
+    from mocapqa.jobs.batch_output import ResultWriter
+    from mocapqa.pipeline.options import AnalysisOptions
 
 __all__ = ["DASK_LOGGERS", "batch", "quiet_dask_logging"]
 
@@ -94,25 +100,12 @@ def batch(
     listed on stderr with its reason (the first 50; the full list is in --output).
     """
     from rich.console import Console
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
 
     from mocapqa.cli.outputs import FolderReads, check_outputs
     from mocapqa.config import get_settings
-    from mocapqa.errors import ClusterError
-    from mocapqa.jobs.batch import MOTION_SUFFIXES, run_batch
+    from mocapqa.jobs.batch import MOTION_SUFFIXES
     from mocapqa.jobs.batch_output import ResultWriter
-    from mocapqa.jobs.engine import Engine
     from mocapqa.limits.catalog import ModelCatalog
-    from mocapqa.store.files import FileStore
-    from mocapqa.store.repository import Repository
-    from mocapqa.store.shoots import ShootStore
 
     quiet_dask_logging()
     read = [FolderReads(p, MOTION_SUFFIXES, recursive=True) if p.is_dir() else p for p in paths]
@@ -122,15 +115,36 @@ def batch(
     if run_options.limits_model is not None:  # refused before any take is read
         ModelCatalog.of_data_folder(settings.data_dir).require(run_options.limits_model)
     writer = ResultWriter(output) if output is not None else None
-    settings.data_dir.mkdir(parents=True, exist_ok=True)
-    FileStore(settings.data_dir)
-    repository = Repository(settings.resolved_database_url)
-    shoots = ShootStore(repository.engine)
-    shoot_id = str(shoots.ensure(shoot)["id"]) if shoot else None
     address = scheduler or os.environ.get("MOCAPQA_DASK_SCHEDULER") or None
-    engine = Engine(address, workers or None)
     console = Console(stderr=True)
-    progress = Progress(
+    tally = _Tally(_progress_bar(console), writer)
+    try:
+        counts = _run(paths, shoot, run_options, address, workers, tally)
+    finally:
+        if writer is not None:
+            writer.close()
+    console.print(
+        f"{counts.total} file(s): {counts.done} done, {counts.failed} failed, "
+        f"{counts.skipped} skipped; {counts.frames} frames"
+        + (f"; results in {output}" if output is not None else "")
+    )
+    _print_failed(console, tally.failed, counts.failed)
+    if counts.failed:
+        raise typer.Exit(2)
+
+
+def _progress_bar(console: Console) -> Progress:
+    """The batch's progress line: bar, count, tally, frame rate, elapsed time and ETA."""
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    return Progress(
         TextColumn("[bold]batch"),
         BarColumn(),
         MofNCompleteColumn(),
@@ -141,67 +155,98 @@ def batch(
         TimeRemainingColumn(),
         console=console,
     )
-    task = progress.add_task("batch", total=None, tally="", rate="")
-    state = {"done": 0, "failed": 0, "skipped": 0, "frames": 0, "started": 0.0}
-    failed: list[tuple[str, str]] = []  # (source, reason) of the first MAX_FAILED_LINES
 
-    def on_total(total: int) -> None:
-        import time
 
-        state["started"] = time.perf_counter()
-        progress.update(task, total=total)
+class _Tally:
+    """The batch's rows as they come: counted on the progress line, written to the results
+    table, and the first :data:`MAX_FAILED_LINES` failures kept to be listed."""
 
-    def on_row(row: dict[str, Any]) -> None:
-        import time
+    def __init__(self, progress: Progress, writer: ResultWriter | None) -> None:
+        self.progress = progress
+        self.writer = writer
+        self.task = progress.add_task("batch", total=None, tally="", rate="")
+        self.state = {"done": 0, "failed": 0, "skipped": 0, "frames": 0}
+        self.started = 0.0
+        self.failed: list[tuple[str, str]] = []  # (source, reason)
 
+    def on_total(self, total: int) -> None:
+        """The number of rows to come: the clock starts."""
+        self.started = time.perf_counter()
+        self.progress.update(self.task, total=total)
+
+    def on_row(self, row: dict[str, Any]) -> None:
+        """One result row."""
+        state = self.state
         state[row["status"]] += 1
-        if row["status"] == "failed" and len(failed) < MAX_FAILED_LINES:
+        if row["status"] == "failed" and len(self.failed) < MAX_FAILED_LINES:
             reason = " ".join(str(row.get("error") or "no reason given").split("\n"))
-            failed.append((str(row["source"]), reason))
+            self.failed.append((str(row["source"]), reason))
         if row["status"] == "done":
             state["frames"] += int(row.get("n_frames") or 0)
-        elapsed = max(time.perf_counter() - state["started"], 1e-9)
-        progress.update(
-            task,
+        elapsed = max(time.perf_counter() - self.started, 1e-9)
+        self.progress.update(
+            self.task,
             advance=1,
             tally=f"done {state['done']} · failed {state['failed']} · skipped {state['skipped']}",
             rate=f"{state['frames'] / elapsed:,.0f} frames/s",
         )
-        if writer is not None:
-            writer.write(row)
+        if self.writer is not None:
+            self.writer.write(row)
 
+
+def _run(
+    paths: list[Path],
+    shoot: str | None,
+    run_options: AnalysisOptions,
+    address: str | None,
+    workers: int,
+    tally: _Tally,
+) -> BatchCounts:
+    """Run the batch into the dashboard's database and data folder, on the cluster at
+    ``address`` (a local one of ``workers`` processes when None).
+
+    Raises
+    ------
+    ClusterError
+        When the scheduler is lost, saying how many takes were stored before.
+    """
+    from mocapqa.config import get_settings
+    from mocapqa.errors import ClusterError
+    from mocapqa.jobs.batch import run_batch
+    from mocapqa.jobs.engine import Engine
+    from mocapqa.store.files import FileStore
+    from mocapqa.store.repository import Repository
+    from mocapqa.store.shoots import ShootStore
+
+    settings = get_settings()
+    settings.data_dir.mkdir(parents=True, exist_ok=True)
+    FileStore(settings.data_dir)
+    repository = Repository(settings.resolved_database_url)
+    shoots = ShootStore(repository.engine)
+    engine = Engine(address, workers or None)
     try:
-        with progress:
-            counts = run_batch(
+        shoot_id = str(shoots.ensure(shoot)["id"]) if shoot else None
+        with tally.progress:
+            return run_batch(
                 paths,
                 shoots,
                 run_options,
-                on_row,
+                tally.on_row,
                 engine=engine,
                 data_dir=settings.data_dir,
                 shoot_id=shoot_id,
-                on_total=on_total,
+                on_total=tally.on_total,
             )
     except ClusterError as e:
         for name in DASK_LOGGERS:  # closing the lost client logs its reconnect loop's end
             logging.getLogger(name).setLevel(logging.CRITICAL)
         raise ClusterError(
-            f"{e}; {state['done']} take(s) analysed and stored, "
+            f"{e}; {tally.state['done']} take(s) analysed and stored, "
             "the same command finishes the rest once the scheduler is back"
         ) from e
     finally:
-        if writer is not None:
-            writer.close()
         engine.close()
         repository.close()
-    console.print(
-        f"{counts.total} file(s): {counts.done} done, {counts.failed} failed, "
-        f"{counts.skipped} skipped; {counts.frames} frames"
-        + (f"; results in {output}" if output is not None else "")
-    )
-    _print_failed(console, failed, counts.failed)
-    if counts.failed:
-        raise typer.Exit(2)
 
 
 def _print_failed(console: Console, failed: list[tuple[str, str]], n_failed: int) -> None:

@@ -18,7 +18,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
-import numpy as np
 import typer
 from rich.console import Console
 from rich.progress import Progress
@@ -100,9 +99,9 @@ def analyze_take(
     from mocapqa.core.motion import Motion
     from mocapqa.io.bvh_root import explain_root_translation
     from mocapqa.io.formats import require_frames
+    from mocapqa.jobs.rendered import tracks_of
     from mocapqa.pipeline.analyze import analyze
     from mocapqa.pipeline.options import AnalysisOptions
-    from mocapqa.render.scene import track_from_points
 
     take = read_input(path, root_translation=root_translation)
     require_frames(take, path)
@@ -110,8 +109,6 @@ def analyze_take(
     if isinstance(take, Motion):
         reason = explain_root_translation(take, root_translation)
         result.report["summary"]["root_translation_reason"] = reason
-    points = result.report["points"]
-    fps = float(result.report["summary"]["fps"])
     raw_positions = result.raw_points
     corrected_positions = result.corrected_points
     if isinstance(take, KeypointSequence):
@@ -119,35 +116,18 @@ def analyze_take(
         raw_positions = take.positions
         if result.filtered_keypoints is not None:
             corrected_positions = result.filtered_keypoints.positions
-    raw = track_from_points(points["names"], points["parents"], raw_positions, fps)
-    corrected = track_from_points(
-        points["names"], points["parents"], corrected_positions, fps, raw.up_axis
-    )
+    raw, corrected = tracks_of(result.report, raw_positions, corrected_positions)
     return TakeRun(result.report, raw, corrected)
 
 
 def load_run(folder: Path) -> TakeRun:
-    """Read a stored run's folder (``report.json`` and ``points.npz``) without re-analysing."""
-    from mocapqa.render.scene import track_from_points
+    """Read a stored run's folder (its report and points) without re-analysing."""
+    from mocapqa.jobs.rendered import run_tracks
+    from mocapqa.jobs.run_folder import read_run
 
-    try:
-        analysis = json.loads((folder / "report.json").read_text(encoding="utf-8"))
-        with np.load(folder / "points.npz") as data:
-            raw_positions = np.asarray(data["raw"], dtype=np.float64)
-            corrected_positions = np.asarray(data["corrected"], dtype=np.float64)
-    except FileNotFoundError as e:
-        raise NotFoundError(
-            f"Expected a run folder with report.json and points.npz, got {e.filename}"
-        ) from e
-    except (ValueError, KeyError) as e:
-        raise InputError(f"{folder}: Expected a readable run report and points, got {e}") from e
-    points = analysis["points"]
-    fps = float(analysis["summary"]["fps"])
-    raw = track_from_points(points["names"], points["parents"], raw_positions, fps)
-    corrected = track_from_points(
-        points["names"], points["parents"], corrected_positions, fps, raw.up_axis
-    )
-    return TakeRun(analysis, raw, corrected)
+    stored = read_run(folder)
+    raw, corrected = run_tracks(stored)
+    return TakeRun(stored.report, raw, corrected)
 
 
 def sheet_tiles(run: TakeRun, max_tiles: int = MAX_TILES) -> list[SheetTile]:
@@ -257,6 +237,7 @@ def report(
 ) -> None:
     """Write a self-contained HTML QA report: summary, findings, timelines, contact sheet."""
     from mocapqa.io.atomic import write_bytes, write_text
+    from mocapqa.jobs.run_folder import RunFolder
     from mocapqa.render.service import RenderService
 
     if not input_path.exists():
@@ -264,7 +245,7 @@ def report(
     require_suffix("-o", output, (".html", ".htm"), "an HTML report")
     if pdf is not None:
         require_suffix("--pdf", pdf, (".pdf",), "a PDF report")
-    stored = [run / "report.json", run / "points.npz"] if run is not None else []
+    stored = [RunFolder(run).report, RunFolder(run).points] if run is not None else []
     check_outputs({"-o": output, "--pdf": pdf}, [take_input(input_path), options, mapping, *stored])
     option_values = None
     if options is not None:

@@ -10,7 +10,7 @@ own choice (its ``applied`` flag: ``twist_apply`` for intervals, the confident r
 * The decided marker take is the raw take with exactly the swaps kept corrected exchanged, then
   its gaps filled by the run's rule (the confident fills, chosen again on that take:
   :func:`mocapqa.pipeline.marker_step.decided_repair`), written as C3D like the run's
-  ``corrected.c3d`` (:func:`mocapqa.jobs.runner.write_corrected_c3d`). No filter.
+  ``corrected.c3d`` (:func:`mocapqa.jobs.run_folder.write_corrected_c3d`). No filter.
 
 Neither touches the stored take, the run's own files or the take's review.
 """
@@ -27,9 +27,8 @@ from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import ConflictError, NotFoundError
 from mocapqa.io.bvh_write import format_bvh
-from mocapqa.jobs.intake import reading_of
-from mocapqa.jobs.runner import write_corrected_c3d
-from mocapqa.pipeline.loading import ReadLimits, ReadOptions, read_take_file
+from mocapqa.jobs.run_folder import RunFolder, read_options_of, write_corrected_c3d
+from mocapqa.pipeline.loading import ReadLimits, read_take_file
 from mocapqa.pipeline.marker_step import decided_repair
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.decisions import DecidedItem
@@ -61,7 +60,7 @@ def run_items(files: FileStore, run_id: str) -> tuple[DecidedItem, list[dict[str
     ConflictError
         For a run without the twist check (motion) or the markers check (keypoints).
     """
-    path = files.existing(files.run_dir(run_id) / "report.json", "the report")
+    path = files.existing(RunFolder.of(files, run_id).report, "the report")
     stat = path.stat()
     kind, intervals, swaps = _report_items(str(path), stat.st_mtime_ns, stat.st_size)
     if kind == "motion":
@@ -188,8 +187,7 @@ def _raw_take(
     path = files.take_dir(str(take["id"])) / str(take["file_name"])
     if not path.is_file():
         raise NotFoundError(f"Expected the file of take {take['id']}, got none")
-    reading = reading_of(files, str(take["id"])) or {}
-    options = ReadOptions.from_json(reading.get("read_options"))
+    options = read_options_of(path.parent)
     return path, read_take_file(path, str(take["format"]), str(take["name"]), options, limits)
 
 

@@ -28,6 +28,7 @@ the directory's declared size is used up, whatever count the end record gives.
 from __future__ import annotations
 
 import bz2
+import functools
 import gzip
 import io
 import lzma
@@ -214,6 +215,46 @@ def _check_zip_directory(path: Path, max_members: int) -> None:
             handle.seek(lengths, io.SEEK_CUR)
 
 
+_ZIP_DAMAGE = (zipfile.BadZipFile, OSError, EOFError, ValueError)
+"""What reading a damaged zip member raises."""
+_TAR_DAMAGE = (tarfile.TarError, OSError, EOFError, ValueError)
+"""What reading a damaged tar member raises."""
+
+
+def _extract(
+    name: str,
+    target: Path,
+    opened: Callable[[], IO[bytes] | None],
+    damaged: tuple[type[Exception], ...],
+    budget: list[int],
+    limits: tuple[int, int],
+) -> Member:
+    """A member (its name found safe) copied to ``target`` from the stream ``opened`` gives
+    (None: not a regular file), within ``budget`` and ``limits`` (the archive's unpacked
+    bytes, the member's); a member whose read raises one of ``damaged`` is unreadable.
+
+    Raises
+    ------
+    TooLargeError
+        When the archive unpacks to more than its limit.
+    """
+    max_bytes, max_member_bytes = limits
+    try:
+        source = opened()
+        if source is None:
+            return Member(name, None, "not a regular file")
+        with source:
+            whole = _copy(source, target, budget, max_bytes, max_member_bytes)
+    except TooLargeError:
+        raise
+    except damaged as e:
+        target.unlink(missing_ok=True)
+        return Member(name, None, f"unreadable member: {e}")
+    if not whole:
+        return Member(name, None, _member_too_large(max_member_bytes))
+    return Member(name, target)
+
+
 def _zip_members(
     path: Path,
     dest: Path,
@@ -233,7 +274,7 @@ def _zip_members(
         declared = sum(i.file_size for i in infos)
         _check_totals(len(entries), declared, max_members, max_bytes)
         before_extract(declared)
-        budget = [0]
+        budget, limits = [0], (max_bytes, max_member_bytes)
         for index, info in enumerate(infos):
             mode = info.external_attr >> 16
             problem = _unsafe_name(info.filename)
@@ -243,19 +284,8 @@ def _zip_members(
                 yield Member(info.filename, None, problem)
                 continue
             target = dest / f"{index:06d}"
-            try:
-                with archive.open(info) as source:
-                    whole = _copy(source, target, budget, max_bytes, max_member_bytes)
-            except TooLargeError:
-                raise
-            except (zipfile.BadZipFile, OSError, EOFError, ValueError) as e:
-                target.unlink(missing_ok=True)
-                yield Member(info.filename, None, f"unreadable member: {e}")
-                continue
-            if not whole:
-                yield Member(info.filename, None, _member_too_large(max_member_bytes))
-                continue
-            yield Member(info.filename, target)
+            opened = functools.partial(archive.open, info)
+            yield _extract(info.filename, target, opened, _ZIP_DAMAGE, budget, limits)
 
 
 def _decompressed(path: Path) -> io.BufferedIOBase:
@@ -358,7 +388,7 @@ def _tar_members(
         except (tarfile.TarError, OSError, EOFError) as e:
             raise InputError(f"Expected a readable .tar.gz archive, got {e}") from e
         before_extract(declared)
-        budget = [0]
+        budget, limits = [0], (max_bytes, max_member_bytes)
         for index, info in enumerate(infos):
             problem = _unsafe_name(info.name)
             if problem is None and info.issym():
@@ -371,23 +401,8 @@ def _tar_members(
                 yield Member(info.name, None, problem)
                 continue
             target = dest / f"{index:06d}"
-            try:
-                source = archive.extractfile(info)
-                if source is None:
-                    yield Member(info.name, None, "not a regular file")
-                    continue
-                with source:
-                    whole = _copy(source, target, budget, max_bytes, max_member_bytes)
-            except TooLargeError:
-                raise
-            except (tarfile.TarError, OSError, EOFError, ValueError) as e:
-                target.unlink(missing_ok=True)
-                yield Member(info.name, None, f"unreadable member: {e}")
-                continue
-            if not whole:
-                yield Member(info.name, None, _member_too_large(max_member_bytes))
-                continue
-            yield Member(info.name, target)
+            opened = functools.partial(archive.extractfile, info)
+            yield _extract(info.name, target, opened, _TAR_DAMAGE, budget, limits)
 
 
 def _nothing(declared: int) -> None:

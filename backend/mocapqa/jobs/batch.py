@@ -7,7 +7,8 @@ content, options and mocapqa version already have a done run, sends the rest to 
 finishes, stores its take and done run in one transaction and writes its result row.
 Workers that cannot read the client's files or the data folder (another machine) are sent
 each take's bytes and send the run's files back (:mod:`mocapqa.jobs.sent_files`), with at
-most :data:`SENT_BYTES_IN_FLIGHT` of takes on their way at once.
+most :data:`~mocapqa.jobs.batch_dask.SENT_BYTES_IN_FLIGHT` of takes on their way at once
+(:mod:`mocapqa.jobs.batch_dask`).
 Nothing is stored for a take until its run is complete, so an interrupted batch (Ctrl-C, a
 lost scheduler) leaves no half-made rows, and running it again finishes the rest without
 duplicates (an interrupted task may leave an orphan output folder behind, never a row).
@@ -25,30 +26,29 @@ from typing import TYPE_CHECKING, Any, Literal
 
 from mocapqa.errors import InputError, MocapQAError
 from mocapqa.io.keypoint_csv import is_csv_sidecar
+from mocapqa.jobs.batch_dask import Task, run_chunks
 from mocapqa.jobs.engine import Engine
-from mocapqa.jobs.sent_files import SentFiles, pack
+from mocapqa.jobs.sent_files import SentFiles
 from mocapqa.jobs.take_task import (
     RETURNED_FILES,
     analyse_path,
-    analyse_sent,
     content_sha256,
+    copy_take,
     sent_models,
 )
-from mocapqa.store.repository import new_id
-from mocapqa.store.shoots import DoneTake, ShootStore
+from mocapqa.store.shoots import ShootStore
+from mocapqa.store.stamps import new_id
+from mocapqa.store.take_writer import DoneTake
 
 if TYPE_CHECKING:
     from mocapqa.pipeline.options import AnalysisOptions
 
 __all__ = [
-    "CHUNK_TAKES",
     "MOTION_SUFFIXES",
-    "SENT_BYTES_IN_FLIGHT",
     "SIDECAR_REASON",
     "STORE_EVERY_S",
     "STORE_EVERY_TAKES",
     "BatchCounts",
-    "chunk_size",
     "discover",
     "run_batch",
     "skip_reason",
@@ -71,21 +71,11 @@ def skip_reason(name: str | Path) -> str | None:
     return None
 
 
-CHUNK_TAKES = 4
-"""Takes per Dask task in a large batch. A task costs the client, scheduler and worker about
-9 ms of CPU beyond the take's own work (about 95 ms): one take per task made the Dask path
-about 10 % dearer than a loop, four per task make it about 2 % (docs/batch.md)."""
-
 STORE_EVERY_TAKES = 64
 """Done takes stored per transaction in a batch."""
 STORE_EVERY_S = 1.0
 """Seconds after a store from which the next done take is stored at once (with any held)."""
-SENT_BYTES_IN_FLIGHT = 256 * 1024 * 1024
-"""Most bytes of takes sent to workers and not yet answered, when the workers do not share
-the client's files (one take larger than this is still sent, alone)."""
-
 Row = dict[str, Any]
-Task = Callable[[str, dict[str, Any], str, str, str | None], dict[str, Any]]
 Send = Literal["auto", "paths", "bytes"]
 
 
@@ -223,70 +213,118 @@ def run_batch(
         When the Dask scheduler cannot be reached or is lost mid-batch; the takes finished
         before are stored and have their rows, the others have neither.
     """
-    from mocapqa.limits.catalog import DEFAULT_MODEL
-
     counts = BatchCounts()
     if options.limits_model is None:  # the shoot's model, as for the server's runs
-        chosen = shoots.limits_model(shoot_id) if shoot_id else DEFAULT_MODEL
+        chosen = shoots.run_limits_model(None, shoot_id)
         options = dataclasses.replace(options, limits_model=chosen)
     options_json = options.to_json()
-    items = list(discover(paths))
-    counts.total = len(items)
-    if on_total is not None:
-        on_total(len(items))
+    batch = _Batch(shoots, options_json, data_dir, shoot_id, counts, on_row)
+    pending = batch.pending(list(discover(paths)), on_total)
+    try:
+        if engine is None:
+            batch.run_here(pending, task)
+        elif pending:  # a finished batch never starts (or connects to) a cluster
+            batch.run_on_dask(engine, pending, task, send, options.limits_model)
+    finally:  # takes finished before an interruption are stored, with their rows
+        batch.stores.flush()
+    return counts
 
-    def emit(row: Row) -> None:
-        counts.add(row)
-        on_row(row)
 
-    todo: list[tuple[Path, str]] = []
-    seen: dict[str, Path] = {}
-    takes = [path for path, reason in items if reason is None]
-    known = shoots.known_hashes([str(p.resolve()) for p in takes])
-    learned: list[dict[str, Any]] = []
-    for path, reason in items:
-        if reason is not None:
-            emit({"source": str(path), "status": "skipped", "error": reason})
-            continue
-        sha = _content_hash(path, known, learned)
-        if sha in seen:
-            emit(
-                {"source": str(path), "status": "skipped", "error": f"same content as {seen[sha]}"}
+class _Batch:
+    """One batch's steps: which takes are left to analyse, where they run, and what is
+    stored and emitted for each (``on_row`` receives each row once counted)."""
+
+    def __init__(
+        self,
+        shoots: ShootStore,
+        options_json: dict[str, Any],
+        data_dir: Path | None,
+        shoot_id: str | None,
+        counts: BatchCounts,
+        on_row: Callable[[Row], None],
+    ) -> None:
+        self.shoots = shoots
+        self.options_json = options_json
+        self.data_dir = data_dir
+        self.folder = str(data_dir) if data_dir is not None else None
+        self.shoot_id = shoot_id
+        self.counts = counts
+        self.on_row = on_row
+        self.stores = _StoreInBatches(shoots, self.emit)
+
+    def emit(self, row: Row) -> None:
+        """Count a result row and pass it on."""
+        self.counts.add(row)
+        self.on_row(row)
+
+    def failed(self, path: Path, error: str) -> None:
+        """Emit the row of a take that failed."""
+        self.emit({"source": str(path), "status": "failed", "error": error})
+
+    def pending(
+        self, items: list[tuple[Path, str | None]], on_total: Callable[[int], None] | None
+    ) -> list[tuple[Path, str]]:
+        """The takes to analyse, with their hashes; the others are emitted as skipped."""
+        self.counts.total = len(items)
+        if on_total is not None:
+            on_total(len(items))
+        return self._unfinished(self._distinct(items))
+
+    def _distinct(self, items: list[tuple[Path, str | None]]) -> list[tuple[Path, str]]:
+        """The takes of ``items`` with their hashes, the first of each content only (files
+        skipped by name and later copies are emitted as skipped)."""
+        todo: list[tuple[Path, str]] = []
+        seen: dict[str, Path] = {}
+        takes = [path for path, reason in items if reason is None]
+        known = self.shoots.known_hashes([str(p.resolve()) for p in takes])
+        learned: list[dict[str, Any]] = []
+        for path, reason in items:
+            if reason is not None:
+                self.emit({"source": str(path), "status": "skipped", "error": reason})
+                continue
+            sha = _content_hash(path, known, learned)
+            if sha in seen:
+                same = f"same content as {seen[sha]}"
+                self.emit({"source": str(path), "status": "skipped", "error": same})
+                continue
+            seen[sha] = path
+            todo.append((path, sha))
+        self.shoots.remember_hashes(learned)
+        return todo
+
+    def _unfinished(self, todo: list[tuple[Path, str]]) -> list[tuple[Path, str]]:
+        """The takes of ``todo`` without a done run of these options and this version (the
+        others are emitted as skipped, with their stored QA columns)."""
+        finished = self.shoots.finished([sha for _, sha in todo], self.options_json)
+        stored = self.shoots.qa_rows(list(finished.values()))
+        pending: list[tuple[Path, str]] = []
+        for path, sha in todo:
+            take_id = finished.get(sha)
+            if take_id is None:
+                pending.append((path, sha))
+                continue
+            self.emit(
+                {
+                    **_summary_row(stored.get(take_id, {})),
+                    "source": str(path),
+                    "status": "skipped",
+                    "error": "already analysed with these options and this version",
+                    "take_id": take_id,
+                }
             )
-            continue
-        seen[sha] = path
-        todo.append((path, sha))
-    shoots.remember_hashes(learned)
+        return pending
 
-    finished = shoots.finished([sha for _, sha in todo], options_json)
-    stored = shoots.qa_rows(list(finished.values()))
-    pending: list[tuple[Path, str]] = []
-    for path, sha in todo:
-        take_id = finished.get(sha)
-        if take_id is None:
-            pending.append((path, sha))
-            continue
-        emit(
-            {
-                **_summary_row(stored.get(take_id, {})),
-                "source": str(path),
-                "status": "skipped",
-                "error": "already analysed with these options and this version",
-                "take_id": take_id,
-            }
-        )
-
-    folder = str(data_dir) if data_dir is not None else None
-
-    def finish(path: Path, sha: str, take_id: str, run_id: str, outcome: dict[str, Any]) -> None:
+    def finish(self, path: Path, sha: str, take_id: str, run_id: str, outcome: Row) -> None:
+        """Hold a done take to be stored (its row emitted once stored), or emit a failure."""
         if outcome["status"] != "done":
-            emit({"source": str(path), "status": "failed", "error": outcome["error"]})
+            self.failed(path, outcome["error"])
             return
-        values = {**outcome["take"], "sha256": sha, "shoot_id": shoot_id}
-        if RETURNED_FILES in outcome and data_dir is not None:
-            _store_returned(data_dir, outcome[RETURNED_FILES], path, take_id, values)
+        values = {**outcome["take"], "sha256": sha, "shoot_id": self.shoot_id}
+        if RETURNED_FILES in outcome and self.data_dir is not None:
+            returned = outcome[RETURNED_FILES]
+            _store_returned(self.data_dir, returned, path, (take_id, run_id), values)
         summary = outcome["summary"]
-        done = DoneTake(values, run_id, options_json, summary, float(outcome["time_s"]))
+        done = DoneTake(values, run_id, self.options_json, summary, float(outcome["time_s"]))
         row = {
             **_summary_row(summary["qa"]),
             "source": str(path),
@@ -295,24 +333,30 @@ def run_batch(
             "take_id": take_id,
             "review_status": "unreviewed",
         }
-        stores.add(done, row)
+        self.stores.add(done, row)
 
-    stores = _StoreInBatches(shoots, emit)
-    try:
-        if engine is None:
-            for path, sha in pending:
-                take_id, run_id = new_id(), new_id()
-                outcome = task(str(path), options_json, take_id, run_id, folder)
-                finish(path, sha, take_id, run_id, outcome)
-        elif pending:  # a finished batch never starts (or connects to) a cluster
-            sent = None
-            sample = _sample_file(pending[0][0])
-            if send == "bytes" or (send == "auto" and not engine.shares_disk(sample, data_dir)):
-                sent = sent_models(data_dir, options.limits_model)
-            _run_on_dask(engine, pending, options_json, folder, task, sent, finish, emit)
-    finally:  # takes finished before an interruption are stored, with their rows
-        stores.flush()
-    return counts
+    def run_here(self, pending: list[tuple[Path, str]], task: Task) -> None:
+        """Analyse the takes one after another in this process."""
+        for path, sha in pending:
+            take_id, run_id = new_id(), new_id()
+            outcome = task(str(path), self.options_json, take_id, run_id, self.folder)
+            self.finish(path, sha, take_id, run_id, outcome)
+
+    def run_on_dask(
+        self,
+        engine: Engine,
+        pending: list[tuple[Path, str]],
+        task: Task,
+        send: Send,
+        model: str | None,
+    ) -> None:
+        """Analyse the takes on the cluster: as paths, or as bytes (with the registered
+        limits ``model``'s file) to workers that do not share the client's files."""
+        sent = None
+        sample = _sample_file(pending[0][0])
+        if send == "bytes" or (send == "auto" and not engine.shares_disk(sample, self.data_dir)):
+            sent = sent_models(self.data_dir, model)
+        run_chunks(engine, pending, self, task, sent)
 
 
 class _StoreInBatches:
@@ -354,165 +398,22 @@ def _sample_file(path: Path) -> Path:
 
 
 def _store_returned(
-    data_dir: Path, files: SentFiles, source: Path, take_id: str, values: dict[str, Any]
+    data_dir: Path,
+    files: SentFiles,
+    source: Path,
+    ids: tuple[str, str],
+    values: dict[str, Any],
 ) -> None:
     """Write what a worker that shares nothing sent back (the run's files, the take's reading
-    facts) into the data folder, and copy the take there from the client's own disk."""
-    import shutil
-
+    record: ``ids`` are the take's and the run's) into the data folder, and copy the take
+    there from the client's own disk."""
     from mocapqa.store.files import FileStore
 
+    take_id, run_id = ids
     store = FileStore(data_dir)
-    allowed = (store.root / "runs", store.take_dir(take_id))
+    allowed = (store.run_dir(run_id), store.take_dir(take_id))
     for target, data in files.targets(store.root):
         if not any(target.is_relative_to(folder) for folder in allowed):
             raise InputError(f"Expected a worker to return its run's files only, got {target}")
         store.write_bytes(target, data)
-    copy = store.take_dir(take_id) / str(values["file_name"])
-    if source.is_dir():
-        shutil.copytree(source, copy, dirs_exist_ok=True)
-    else:
-        shutil.copyfile(source, copy)
-
-
-def _run_on_dask(
-    engine: Engine,
-    pending: list[tuple[Path, str]],
-    options_json: dict[str, Any],
-    folder: str | None,
-    task: Task,
-    sent: SentFiles | None,
-    finish: Callable[[Path, str, str, str, dict[str, Any]], None],
-    emit: Callable[[Row], None],
-) -> None:
-    from distributed.comm.core import CommClosedError
-
-    try:
-        _submit_and_collect(engine, pending, options_json, folder, task, sent, finish, emit)
-    except CommClosedError as e:  # a call to the scheduler found it gone
-        raise engine.lost_connection(e) from e
-    except OSError as e:  # a timeout while the client reconnects; a full disk stays itself
-        lost = engine.lost(e)
-        if lost is None:
-            raise
-        raise lost from e
-
-
-def _analyse_chunk(
-    task: Callable[..., dict[str, Any]], items: list[tuple[Any, ...]]
-) -> list[tuple[bool, Any]]:
-    """Run ``task`` on each argument tuple of ``items`` (one Dask task for several takes):
-    ``(True, outcome)``, or ``(False, "Name: message")`` for a take whose task raised, so that
-    one take's bug fails that take only."""
-    results: list[tuple[bool, Any]] = []
-    for arguments in items:
-        try:
-            results.append((True, task(*arguments)))
-        except Exception as e:  # reported per take, as a single-take task's would be
-            results.append((False, f"{type(e).__name__}: {e}"))
-    return results
-
-
-def chunk_size(n_pending: int, in_flight: int) -> int:
-    """Takes per Dask task: :data:`CHUNK_TAKES` when there are enough takes to keep every
-    slot in flight busy with whole chunks, fewer for a small batch (one take per task below
-    ``2 · in_flight`` takes), so that small batches still spread over every worker."""
-    return max(1, min(CHUNK_TAKES, n_pending // (2 * in_flight)))
-
-
-def _submit_and_collect(
-    engine: Engine,
-    pending: list[tuple[Path, str]],
-    options_json: dict[str, Any],
-    folder: str | None,
-    task: Task,
-    sent: SentFiles | None,
-    finish: Callable[[Path, str, str, str, dict[str, Any]], None],
-    emit: Callable[[Row], None],
-) -> None:
-    """Send the pending takes in chunks, a bounded number in flight; with ``sent`` (the data
-    folder's files the runs read) as bytes (:func:`analyse_sent`), else as paths (``task``)."""
-    from collections import deque
-
-    from distributed import as_completed
-
-    client = engine.client()
-    in_flight = max(8, 4 * max(1, engine.n_workers()))
-    size = chunk_size(len(pending), in_flight)
-    units: deque[list[tuple[Path, str]]] = deque(
-        pending[start : start + size] for start in range(0, len(pending), size)
-    )
-    meta: dict[str, list[tuple[Path, str, str, str]]] = {}
-    sizes: dict[str, int] = {}
-
-    def submit() -> Any:
-        if not units:
-            return None
-        unit = [(path, sha, new_id(), new_id()) for path, sha in units.popleft()]
-        size = 0
-        if sent is None:
-            items: list[tuple[Any, ...]] = [
-                (str(path), options_json, take_id, run_id, folder)
-                for path, _, take_id, run_id in unit
-            ]
-        else:
-            items = [
-                (pack(path.parent, [path]), options_json, take_id, run_id, sent)
-                for path, _, take_id, run_id in unit
-            ]
-            size = sum(item[0].size_bytes for item in items)
-        _, sha, _, run_id = unit[0]
-        future = client.submit(
-            _analyse_chunk,
-            task if sent is None else analyse_sent,
-            items,
-            key=f"analyse-{len(unit)}-{sha[:16]}-{run_id[:8]}",
-            pure=False,
-        )
-        meta[future.key] = unit
-        sizes[future.key] = size
-        return future
-
-    def room() -> bool:
-        """Whether another chunk may be sent: slots left, and bytes left when sending bytes."""
-        return len(meta) < in_flight and (not meta or sum(sizes.values()) < SENT_BYTES_IN_FLIGHT)
-
-    first: list[Any] = []
-    while room() and (following := submit()) is not None:
-        first.append(following)
-    waiting = as_completed(first)  # type: ignore[no-untyped-call]
-    for future in waiting:
-        unit = meta.pop(future.key)
-        sizes.pop(future.key, None)
-        try:
-            results = future.result()
-        except Exception as e:  # a crashed worker (KilledWorker) or a lost scheduler
-            lost = engine.lost_after_settling(e)
-            if lost is not None:  # every task in flight is cancelled: stop, store nothing
-                raise lost from e
-            name = type(e).__name__
-            if name == "KilledWorker" and len(unit) > 1:
-                # Which take killed the workers is not known: each is sent again alone, so
-                # only the one that kills two more fails (ALLOWED_FAILURES).
-                units.extendleft([(path, sha)] for path, sha, _, _ in reversed(unit))
-            else:
-                reason = (
-                    f"worker died while analysing this take ({name}: {e})"
-                    if name == "KilledWorker"
-                    else f"internal error: {name}: {e}"
-                )
-                for path, _, _, _ in unit:
-                    emit({"source": str(path), "status": "failed", "error": reason})
-        else:
-            for (path, sha, take_id, run_id), (ran, outcome) in zip(unit, results, strict=True):
-                if ran:
-                    finish(path, sha, take_id, run_id, outcome)
-                else:
-                    error = f"internal error: {outcome}"
-                    emit({"source": str(path), "status": "failed", "error": error})
-        future.release()
-        while room():
-            following = submit()
-            if following is None:
-                break
-            waiting.add(following)  # type: ignore[no-untyped-call]
+    copy_take(source, store.take_dir(take_id) / str(values["file_name"]))

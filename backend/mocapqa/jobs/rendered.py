@@ -13,7 +13,6 @@ stored ``report.json`` and ``points.npz`` (so it shows exactly that run) and kep
 
 from __future__ import annotations
 
-import json
 import logging
 from collections.abc import Mapping
 from typing import Any
@@ -22,6 +21,7 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray
 from mocapqa.errors import InputError, MocapQAError
+from mocapqa.jobs.run_folder import REPORT_HTML, THUMBNAIL_PNG, RunFolder, StoredRun, read_run
 from mocapqa.render.scene import SkeletonTrack, track_from_points
 from mocapqa.render.service import RenderService
 from mocapqa.render.sheet import tiles_from_intervals
@@ -35,12 +35,10 @@ __all__ = [
     "THUMBNAIL_PNG",
     "html_report",
     "render_thumbnail",
+    "run_tracks",
+    "tracks_of",
 ]
 
-THUMBNAIL_PNG = "thumbnail.png"
-"""File name of a run's rendered thumbnail."""
-REPORT_HTML = "report.html"
-"""File name of a run's HTML report."""
 MAX_SHEET_TILES = 8
 """Contact-sheet tiles in the HTML report: twist intervals first, then the worst limits."""
 
@@ -53,6 +51,36 @@ def _track(
     points = report["points"]
     fps = float(report["summary"]["fps"])
     return track_from_points(points["names"], points["parents"], positions, fps, up_axis)
+
+
+def tracks_of(
+    report: Mapping[str, Any], raw: FloatArray, corrected: FloatArray
+) -> tuple[SkeletonTrack, SkeletonTrack]:
+    """A run's raw and corrected positions, shape (F, P, 3), as tracks to draw, named and
+    joined as its report's ``points`` say, at its ``summary.fps`` (the corrected track in
+    the raw one's up axis).
+
+    Raises
+    ------
+    KeyError
+        When the report lacks the points' names or parents, or the frame rate.
+    """
+    raw_track = _track(report, raw)
+    return raw_track, _track(report, corrected, raw_track.up_axis)
+
+
+def run_tracks(run: StoredRun) -> tuple[SkeletonTrack, SkeletonTrack]:
+    """A stored run's raw and corrected tracks (:func:`tracks_of`).
+
+    Raises
+    ------
+    InputError
+        When its report does not describe its points.
+    """
+    try:
+        return tracks_of(run.report, run.raw, run.corrected)
+    except (KeyError, ValueError, TypeError) as e:
+        raise InputError(f"{run.folder}: Expected a readable run report and points, got {e}") from e
 
 
 def render_thumbnail(
@@ -88,7 +116,7 @@ def render_thumbnail(
     except MocapQAError as e:
         log.info("no rendered thumbnail for run %s: %s", run_id, e)
         return False
-    files.write_bytes(files.run_dir(run_id) / THUMBNAIL_PNG, png)
+    files.write_bytes(RunFolder.of(files, run_id).thumbnail, png)
     return True
 
 
@@ -122,21 +150,15 @@ def html_report(
     InputError
         If they cannot be read.
     """
-    folder = files.run_dir(run_id)
-    cached = folder / REPORT_HTML
+    folder = RunFolder.of(files, run_id)
+    cached = folder.report_html
     if cached.is_file():
         return cached.read_bytes()
-    report_path = files.existing(folder / "report.json", "the report")
-    points_path = files.existing(folder / "points.npz", "the points")
-    try:
-        analysis = json.loads(report_path.read_text(encoding="utf-8"))
-        with np.load(points_path) as data:
-            raw_positions = np.asarray(data["raw"], dtype=np.float64)
-            corrected_positions = np.asarray(data["corrected"], dtype=np.float64)
-        raw = _track(analysis, raw_positions)
-        corrected = _track(analysis, corrected_positions, raw.up_axis)
-    except (OSError, ValueError, KeyError) as e:
-        raise InputError(f"{folder}: Expected a readable run report and points, got {e}") from e
+    files.existing(folder.report, "the report")
+    files.existing(folder.points, "the points")
+    stored = read_run(folder.path)
+    analysis = stored.report
+    raw, corrected = run_tracks(stored)
     unavailable: dict[str, str] = {}
     sheet: bytes | None = None
     tiles = _sheet_tiles(analysis, raw, corrected)

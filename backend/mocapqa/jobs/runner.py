@@ -11,167 +11,40 @@ file I/O release the GIL for most of the work, so the event loop stays responsiv
 
 from __future__ import annotations
 
-import io
-import json
 import logging
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from concurrent.futures import Future
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from mocapqa.errors import InputError, MocapQAError
-from mocapqa.io.bvh_write import format_bvh
 from mocapqa.io.guards import ReadLimits
-from mocapqa.io.keypoint_csv import csv_sidecar_path
 from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.fair_queue import FairQueue
 from mocapqa.jobs.rendered import render_thumbnail
-from mocapqa.limits.catalog import ModelCatalog
-from mocapqa.markers.repair import MarkerRepair
-from mocapqa.pipeline.analyze import AnalysisResult, analyze
-from mocapqa.pipeline.loading import (
-    READING_FILE,
-    ReadOptions,
-    Take,
-    read_take_file,
-    write_keypoints_file,
+from mocapqa.jobs.run_folder import (
+    RunFolder,
+    load_points,
+    load_report,
+    read_options_of,
+    run_summary,
+    write_outputs,
 )
+from mocapqa.jobs.sent_files import SentFiles
+from mocapqa.limits.catalog import ModelCatalog
+from mocapqa.pipeline.analyze import analyze
+from mocapqa.pipeline.loading import ReadOptions, Take, read_take_file
 from mocapqa.pipeline.options import AnalysisOptions
-from mocapqa.pipeline.summary import qa_summary
-from mocapqa.render.layouts import bones_for_keypoints
 from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
 
-__all__ = ["JobRunner", "read_options", "run_summary", "write_corrected_c3d", "write_outputs"]
+__all__ = ["JobRunner"]
 
 log = logging.getLogger(__name__)
-
-
-def write_corrected_c3d(path: Path, source: Path, repair: MarkerRepair | None) -> None:
-    """Write a marker run's corrected take as C3D: the source's points with the repaired swaps
-    and the applied fills (no filter), residuals and camera masks exchanged with the swaps,
-    residual 0 and no cameras on every filled sample (C3D's mark of an interpolated sample);
-    the source's analogs, force plates, events and other groups unchanged, or (a source ezc3d
-    cannot open) the markers alone. ``repair`` is the run's (``AnalysisResult.markers``) or a
-    reviewer's choice of it (:func:`mocapqa.jobs.accepted.decided_c3d`).
-
-    Raises
-    ------
-    MocapQAError
-        When the source cannot be read or the take written.
-    """
-    from dataclasses import replace
-
-    from mocapqa.errors import UnsupportedFormatError
-    from mocapqa.io.c3d import read_c3d, write_c3d
-
-    if repair is None:
-        raise InputError("Expected a run of the markers step to write a corrected C3D, got none")
-    take = read_c3d(source)
-    residuals = repair.carry(take.residuals, 0.0)
-    masks = repair.carry(take.camera_masks, 0)
-    points = replace(take.points, positions=repair.positions)
-    corrected = replace(take, points=points, residuals=residuals, camera_masks=masks)
-    try:
-        write_c3d(path, corrected, source=source)
-    except UnsupportedFormatError:
-        write_c3d(path, corrected)
-
-
-def write_outputs(
-    files: FileStore, run_id: str, result: AnalysisResult, source: Path | None = None
-) -> list[str]:
-    """Write a run's files (report, points, corrected BVH or filtered keypoints; for a C3D
-    marker take, ``corrected.c3d``: :func:`write_corrected_c3d`).
-
-    Parameters
-    ----------
-    files : FileStore
-    run_id : str
-    result : AnalysisResult
-    source : Path, optional
-        The take's stored file (a C3D's is opened again for its residuals and other groups).
-
-    Returns
-    -------
-    list of str
-        The download kinds written (``"report"``, ``"bvh"``, ``"csv"``, ``"trc"``, ``"c3d"``).
-    """
-    folder = files.run_dir(run_id)
-    kinds = ["report"]
-    buffer = io.BytesIO()
-    arrays: dict[str, Any] = {
-        "raw": result.raw_points.astype(np.float32),
-        "corrected": result.corrected_points.astype(np.float32),
-    }
-    if result.raw_rotations is not None and result.corrected_rotations is not None:
-        # Half precision (about 1e-3 per component) is finer than a drawn bone can show.
-        arrays["raw_rotations"] = result.raw_rotations.astype(np.float16)
-        arrays["corrected_rotations"] = result.corrected_rotations.astype(np.float16)
-    if result.confidence is not None:
-        arrays["confidence"] = result.confidence.astype(np.float16)
-    if result.bridged is not None:
-        arrays["bridged"] = result.bridged
-    if result.markers is not None:
-        arrays["filled"] = result.markers.filled
-    np.savez(buffer, **arrays)
-    files.write_bytes(folder / "points.npz", buffer.getvalue())
-    if result.corrected_motion is not None:
-        files.write_bytes(folder / "corrected.bvh", format_bvh(result.corrected_motion).encode())
-        kinds.append("bvh")
-    if result.filtered_keypoints is not None:
-        for suffix in ("csv", "trc"):
-            try:
-                target = folder / f"filtered.{suffix}"
-                temporary = folder / f".filtered.{run_id}.{suffix}"
-                write_keypoints_file(temporary, result.filtered_keypoints)
-                temporary.replace(target)
-                sidecar = csv_sidecar_path(temporary)  # the CSV's fps and unit
-                if sidecar.is_file():
-                    sidecar.replace(csv_sidecar_path(target))
-                kinds.append(suffix)
-            except MocapQAError as e:
-                log.info("no %s output for run %s: %s", suffix, run_id, e)
-    if result.markers is not None and source is not None and source.suffix.lower() == ".c3d":
-        try:
-            write_corrected_c3d(folder / "corrected.c3d", source, result.markers)
-            kinds.append("c3d")
-        except MocapQAError as e:
-            log.info("no c3d output for run %s: %s", run_id, e)
-    points = result.report["points"]
-    if result.report["kind"] == "keypoints":
-        # The 3D views join the keypoints of a known layout (BODY_25B, MediaPipe 33, Pose2Sim);
-        # markers of no known layout by the sticks of their inferred segments, when checked.
-        layout = bones_for_keypoints(tuple(points["names"])).tolist()
-        if layout or "bones" not in points:
-            points = {**points, "bones": layout}
-    report = {**result.report, "points": points, "downloads": kinds}
-    files.write_bytes(folder / "report.json", json.dumps(report, allow_nan=False).encode())
-    return kinds
-
-
-def read_options(folder: Path) -> ReadOptions:
-    """The read options chosen at upload (recorded beside the take), else the defaults."""
-    try:
-        data = json.loads((folder / READING_FILE).read_text(encoding="utf-8"))
-        return ReadOptions.from_json(data.get("read_options"))
-    except (OSError, ValueError, AttributeError, InputError):
-        return ReadOptions()
-
-
-def run_summary(result: AnalysisResult) -> dict[str, Any]:
-    """What a run stores as its summary: the report's summary, step states and QA summary."""
-    return {
-        **result.report["summary"],
-        "steps": {k: v["state"] for k, v in result.report["steps"].items()},
-        "qa": qa_summary(result),
-    }
 
 
 class _RunCancelledError(Exception):
@@ -356,34 +229,14 @@ class JobRunner:
             options = AnalysisOptions.from_json(run["options"])
             with self._lock:
                 preloaded = self._preloaded.pop(run_id, None)
-            reading = read_options(path.parent)
+            reading = read_options_of(path.parent)
             if self.engine is not None:
-                self._execute_on_dask(self.engine, run_id, run, take, path, started)
-                return
-            motion_or_keypoints = preloaded or read_take_file(
-                path, str(take["format"]), str(take["name"]), reading, self.read_limits
-            )
-            last = [0.0]
-
-            def progress(percent: int, step: str) -> None:
-                with self._lock:
-                    if run_id in self._cancelled:
-                        raise _RunCancelledError(run_id)
-                now = time.perf_counter()
-                if now - last[0] > 0.2 or percent >= 95:
-                    last[0] = now
-                    self.repository.set_progress(run_id, percent, step)
-
-            catalog = ModelCatalog.of_data_folder(self.files.root)
-            result = analyze(motion_or_keypoints, options, progress, catalog)
-            progress(96, "writing the outputs")
-            write_outputs(self.files, run_id, result, path)
-            if self.renderer is not None:
-                progress(97, "rendering the thumbnail")
-                render_thumbnail(
-                    self.files, run_id, result.report, result.raw_points, self.renderer
+                summary = self._execute_on_dask(self.engine, run_id, run, take, path, reading)
+            else:
+                read = preloaded or read_take_file(
+                    path, str(take["format"]), str(take["name"]), reading, self.read_limits
                 )
-            summary = run_summary(result)
+                summary = self._execute_here(run_id, read, options, path)
             self.repository.finish_run(run_id, summary, None, time.perf_counter() - started)
         except _RunCancelledError:
             log.info("run %s cancelled: its take was deleted", run_id)
@@ -393,34 +246,64 @@ class JobRunner:
             log.exception("run %s failed", run_id)
             self._fail(run_id, f"internal error: {type(e).__name__}: {e}", started)
 
+    def _progress(self, run_id: str) -> Callable[[int, str], None]:
+        """A run's progress report: recorded at most every 0.2 s (and from 95 %), and where
+        the run's take was deleted, :class:`_RunCancelledError`."""
+        last = [0.0]
+
+        def progress(percent: int, step: str) -> None:
+            with self._lock:
+                if run_id in self._cancelled:
+                    raise _RunCancelledError(run_id)
+            now = time.perf_counter()
+            if now - last[0] > 0.2 or percent >= 95:
+                last[0] = now
+                self.repository.set_progress(run_id, percent, step)
+
+        return progress
+
+    def _execute_here(
+        self, run_id: str, take: Take, options: AnalysisOptions, path: Path
+    ) -> dict[str, Any]:
+        """Analyse on this thread, write the run's files and thumbnail; returns the summary."""
+        progress = self._progress(run_id)
+        catalog = ModelCatalog.of_data_folder(self.files.root)
+        result = analyze(take, options, progress, catalog)
+        progress(96, "writing the outputs")
+        write_outputs(self.files, run_id, result, path)
+        if self.renderer is not None:
+            progress(97, "rendering the thumbnail")
+            render_thumbnail(self.files, run_id, result.report, result.raw_points, self.renderer)
+        return run_summary(result)
+
     def _execute_on_dask(
         self,
         engine: Engine,
         run_id: str,
         run: dict[str, Any],
         take: dict[str, Any],
-        path: Any,
-        started: float,
-    ) -> None:
+        path: Path,
+        reading: ReadOptions,
+    ) -> dict[str, Any]:
+        """Analyse on the cluster (the take's path, or its bytes to workers that do not share
+        the data folder), with the read options read here; returns the summary."""
         from mocapqa.jobs.sent_files import pack
         from mocapqa.jobs.take_task import analyse_stored, analyse_stored_sent, sent_models
 
         self.repository.set_progress(run_id, 10, "analysing on the Dask cluster")
         if self._shares_disk is None:  # asked once: the cluster's workers keep their disks
             self._shares_disk = engine.shares_disk(path, self.files.root)
-        format_name, name = str(take["format"]), str(take["name"])
+        format_name, name, read = str(take["format"]), str(take["name"]), reading.to_json()
         if self._shares_disk:
             future = engine.client().submit(
                 analyse_stored, str(path), format_name, name, run["options"], run_id,
-                str(self.files.root), key=f"run-{run_id}", pure=False,
+                str(self.files.root), read, key=f"run-{run_id}", pure=False,
             )  # fmt: skip
         else:
-            facts = [p for p in (path, path.parent / READING_FILE) if p.is_file()]
-            sent = pack(path.parent, facts)
             models = sent_models(self.files.root, run["options"].get("limits_model"))
             future = engine.client().submit(
-                analyse_stored_sent, sent, path.name, format_name, name, run["options"],
-                run_id, models, key=f"run-{run_id}", pure=False,
+                analyse_stored_sent, pack(path.parent, [path]), path.name, format_name, name,
+                run["options"], run_id, models, read, key=f"run-{run_id}", pure=False,
             )  # fmt: skip
         try:
             answer = future.result()
@@ -429,23 +312,37 @@ class JobRunner:
             if lost is not None:
                 raise lost from e
             raise
+        written: dict[Path, bytes] = {}
         if self._shares_disk:
-            summary = answer
+            summary: dict[str, Any] = answer
         else:
             summary, returned = answer
-            run_folder = self.files.run_dir(run_id)
-            for target, data in returned.targets(self.files.root):
-                if not target.is_relative_to(run_folder):
-                    raise InputError(f"Expected a worker to return its run's files, got {target}")
-                self.files.write_bytes(target, data)
+            written = self._write_returned(run_id, returned)
         if self.renderer is not None:
             self.repository.set_progress(run_id, 97, "rendering the thumbnail")
-            folder = self.files.run_dir(run_id)
-            report = json.loads((folder / "report.json").read_bytes())
-            with np.load(folder / "points.npz") as points:
-                raw = points["raw"].astype(np.float64)
-            render_thumbnail(self.files, run_id, report, raw, self.renderer)
-        self.repository.finish_run(run_id, summary, None, time.perf_counter() - started)
+            self._render_written(run_id, written)
+        return summary
+
+    def _write_returned(self, run_id: str, returned: SentFiles) -> dict[Path, bytes]:
+        """Write the run's files a worker sent back; returns them by path."""
+        folder = self.files.run_dir(run_id)
+        written = {}
+        for target, data in returned.targets(self.files.root):
+            if not target.is_relative_to(folder):
+                raise InputError(f"Expected a worker to return its run's files, got {target}")
+            self.files.write_bytes(target, data)
+            written[target] = data
+        return written
+
+    def _render_written(self, run_id: str, written: dict[Path, bytes]) -> None:
+        """The thumbnail of a run analysed on the cluster, from the report and points the
+        worker sent back (``written``), else from the files it wrote in the data folder."""
+        if self.renderer is None:
+            return
+        run = RunFolder.of(self.files, run_id)
+        report = load_report(written.get(run.report, run.report))
+        raw = load_points(written.get(run.points, run.points), ("raw",))["raw"]
+        render_thumbnail(self.files, run_id, report, raw, self.renderer)
 
     def _fail(self, run_id: str, message: str, started: float) -> None:
         try:

@@ -20,11 +20,12 @@ from pathlib import Path, PurePosixPath
 from typing import Any, BinaryIO
 
 from mocapqa.errors import InputError, MocapQAError, NotFoundError, TooLargeError
-from mocapqa.jobs.archive import archive_kind, unpack
+from mocapqa.jobs.archive import Member, archive_kind, unpack
 from mocapqa.jobs.batch import SIDECAR_REASON, skip_reason
-from mocapqa.jobs.intake import CHUNK_BYTES, MAX_NAME_CHARS, ingest_take
+from mocapqa.jobs.intake import ingest_take, receive
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.jobs.staging import StagingHold
+from mocapqa.jobs.take_reading import MAX_NAME_CHARS
 from mocapqa.pipeline.loading import ReadLimits
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
@@ -63,18 +64,6 @@ class ImportReport:
     failed: list[dict[str, str]] = field(default_factory=list)
 
 
-def _receive(source: BinaryIO, target: Path, name: str, max_bytes: int) -> None:
-    size = 0
-    with target.open("wb") as out:
-        while chunk := source.read(CHUNK_BYTES):
-            size += len(chunk)
-            if size > max_bytes:
-                raise TooLargeError(
-                    f"Expected an upload of at most {max_bytes} bytes, got more ({name!r})"
-                )
-            out.write(chunk)
-
-
 def _label(archive: str, member: str) -> str:
     """How a member is named in the report: ``archive:member``, a name longer than any file
     system keeps cut (a zip member's name may hold 65,535 bytes, echoed per member)."""
@@ -109,6 +98,101 @@ def _skip_reason(name: str) -> str | None:
     return IMPORT_SIDECAR_REASON if reason == SIDECAR_REASON else reason
 
 
+@dataclass
+class _Import:
+    """One import's places and limits, and its report so far."""
+
+    shoot_id: str
+    repository: Repository
+    files: FileStore
+    runner: JobRunner
+    limits: ImportLimits
+    client: str
+    owner_id: int | None
+    staging: StagingHold | None
+    report: ImportReport = field(default_factory=ImportReport)
+
+    def ingest(self, source: BinaryIO, name: str, label: str | None = None) -> None:
+        """Store one take (as an upload) and list it as created, or as failed."""
+        try:
+            take_id, run_id = ingest_take(
+                source,
+                name,
+                self.repository,
+                self.files,
+                self.runner,
+                self.limits.max_upload_bytes,
+                limits=self.limits.read,
+                client=self.client,
+                shoot_id=self.shoot_id,
+                owner_id=self.owner_id,
+            )
+        except NotFoundError:
+            raise  # the shoot itself is gone: the import stops (404)
+        except MocapQAError as e:
+            self.report.failed.append({"name": label or name, "error": str(e)})
+        else:
+            created = {"name": name, "take_id": take_id, "run_id": run_id}
+            same = self.repository.same_content(take_id)
+            if same is not None:  # kept (a reviewer may want both), but said
+                created["duplicate_of"] = same
+            self.report.created.append(created)
+
+    def file(self, source: BinaryIO, name: str) -> None:
+        """A file sent alone: a take, or skipped by the rule of an archive's members (a
+        notes.txt beside the takes of a folder chosen in the browser is not a failed take)."""
+        reason = _skip_reason(name)
+        if reason is None:
+            self.ingest(source, name)
+        else:
+            self.report.skipped.append({"name": name, "reason": reason})
+
+    def archive(self, source: BinaryIO, name: str) -> None:
+        """An archive: received, unpacked in a scratch folder (its declared size held in the
+        staging allowance meanwhile) and each member taken as a file."""
+        scratch = Path(tempfile.mkdtemp(prefix="archive-", dir=self.files.root / "incoming"))
+        held = [0]
+        try:
+            received = scratch / "archive"
+            receive(source, received, name, self.limits.max_upload_bytes)
+            members = scratch / "members"
+            members.mkdir()
+            try:
+                unpacked = unpack(
+                    received,
+                    name,
+                    members,
+                    self.limits.max_members,
+                    self.limits.max_unpacked_bytes,
+                    max_member_bytes=self.limits.max_upload_bytes,
+                    before_extract=_holder(self.staging, name, held),
+                )
+            except TooLargeError:
+                raise
+            except InputError as e:  # unreadable: listed as failed, the other uploads go on
+                self.report.failed.append({"name": name, "error": str(e)})
+                return
+            for member in unpacked:
+                self.member(name, member)
+        finally:
+            shutil.rmtree(scratch, ignore_errors=True)
+            if self.staging is not None:
+                self.staging.release(held[0])
+
+    def member(self, archive: str, member: Member) -> None:
+        """One unpacked member of ``archive``: failed, skipped or ingested (then removed)."""
+        label = _label(archive, member.name)
+        if member.path is None:
+            self.report.failed.append({"name": label, "error": str(member.problem)})
+        elif (reason := _skip_reason(member.name)) is not None:
+            self.report.skipped.append({"name": label, "reason": reason})
+        else:
+            with member.path.open("rb") as handle:
+                base = PurePosixPath(member.name.replace("\\", "/")).name
+                self.ingest(handle, base, label)
+            member.path.unlink(missing_ok=True)
+
+
 def import_uploads(
     uploads: list[tuple[BinaryIO, str]],
     shoot_id: str,
@@ -136,78 +220,10 @@ def import_uploads(
     NotFoundError
         When the shoot is deleted while the import runs (the take being stored is removed).
     """
-    report = ImportReport()
-
-    def ingest(source: BinaryIO, name: str, label: str | None = None) -> None:
-        try:
-            take_id, run_id = ingest_take(
-                source,
-                name,
-                repository,
-                files,
-                runner,
-                limits.max_upload_bytes,
-                limits=limits.read,
-                client=client,
-                shoot_id=shoot_id,
-                owner_id=owner_id,
-            )
-        except NotFoundError:
-            raise  # the shoot itself is gone: the import stops (404)
-        except MocapQAError as e:
-            report.failed.append({"name": label or name, "error": str(e)})
-        else:
-            created = {"name": name, "take_id": take_id, "run_id": run_id}
-            same = repository.same_content(take_id)
-            if same is not None:  # kept (a reviewer may want both), but said
-                created["duplicate_of"] = same
-            report.created.append(created)
-
+    run = _Import(shoot_id, repository, files, runner, limits, client, owner_id, staging)
     for source, name in uploads:
         if archive_kind(name) is None:
-            # The rule of an archive's members, for files sent one by one (a folder chosen in
-            # the browser): a notes.txt beside the takes is skipped, not a failed take.
-            reason = _skip_reason(name)
-            if reason is None:
-                ingest(source, name)
-            else:
-                report.skipped.append({"name": name, "reason": reason})
-            continue
-        scratch = Path(tempfile.mkdtemp(prefix="archive-", dir=files.root / "incoming"))
-        held = [0]
-        try:
-            received = scratch / "archive"
-            _receive(source, received, name, limits.max_upload_bytes)
-            members = scratch / "members"
-            members.mkdir()
-            try:
-                unpacked = unpack(
-                    received,
-                    name,
-                    members,
-                    limits.max_members,
-                    limits.max_unpacked_bytes,
-                    max_member_bytes=limits.max_upload_bytes,
-                    before_extract=_holder(staging, name, held),
-                )
-            except TooLargeError:
-                raise
-            except InputError as e:  # unreadable: listed as failed, the other uploads go on
-                report.failed.append({"name": name, "error": str(e)})
-                continue
-            for member in unpacked:
-                label = _label(name, member.name)
-                if member.path is None:
-                    report.failed.append({"name": label, "error": str(member.problem)})
-                elif (reason := _skip_reason(member.name)) is not None:
-                    report.skipped.append({"name": label, "reason": reason})
-                else:
-                    with member.path.open("rb") as handle:
-                        base = PurePosixPath(member.name.replace("\\", "/")).name
-                        ingest(handle, base, label)
-                    member.path.unlink(missing_ok=True)
-        finally:
-            shutil.rmtree(scratch, ignore_errors=True)
-            if staging is not None:
-                staging.release(held[0])
-    return report
+            run.file(source, name)
+        else:
+            run.archive(source, name)
+    return run.report

@@ -16,15 +16,18 @@ memory (docs/batch.md).
 from __future__ import annotations
 
 import hashlib
-import json
 import shutil
 import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
-from mocapqa.errors import MocapQAError, ParseError
+from mocapqa.errors import MocapQAError
+from mocapqa.jobs.run_folder import relative_folder, run_summary, write_outputs, write_reading
 from mocapqa.jobs.sent_files import SentFiles, pack, pack_tree
+from mocapqa.jobs.take_reading import CheckedTake, read_checked_take
+from mocapqa.pipeline.loading import Take
+from mocapqa.store.files import FileStore
 
 __all__ = [
     "RETURNED_FILES",
@@ -33,8 +36,8 @@ __all__ = [
     "analyse_stored",
     "analyse_stored_sent",
     "content_sha256",
+    "copy_take",
     "sent_models",
-    "stored_name",
 ]
 
 RETURNED_FILES = "files"
@@ -55,11 +58,48 @@ def content_sha256(path: Path) -> str:
     return digest.hexdigest()
 
 
-def stored_name(path: Path) -> str:
-    """The name a take is stored under (its file or folder name, made safe)."""
-    from mocapqa.jobs.intake import safe_file_name
+def _size_bytes(source: Path) -> int:
+    """Bytes of a take file, or of a frame folder's files."""
+    if source.is_dir():
+        return sum(p.stat().st_size for p in source.iterdir() if p.is_file())
+    return source.stat().st_size
 
-    return safe_file_name(path.name)
+
+def copy_take(source: Path, target: Path) -> None:
+    """Copy a take file, or a frame folder with its files, to ``target``."""
+    if source.is_dir():
+        shutil.copytree(source, target, dirs_exist_ok=True)
+    else:
+        shutil.copyfile(source, target)
+
+
+def _store_take(
+    source: Path, checked: CheckedTake, take_id: str, data_dir: str, copy: bool
+) -> None:
+    """The take's reading record in its folder, and (``copy``) a copy of it."""
+    files = FileStore(Path(data_dir))
+    folder = files.take_dir(take_id)
+    folder.mkdir(parents=True, exist_ok=True)
+    if copy:
+        copy_take(source, folder / checked.file_name)
+    write_reading(files, take_id, checked.facts())
+
+
+def _analyse(
+    take: Take, options: dict[str, Any], data_dir: str | None, run_id: str, source: Path | None
+) -> dict[str, Any]:
+    """Analyse a read take with the data folder's limits models, write the run's files there
+    (with ``data_dir``; ``source`` is the take's file, None for a frame folder) and return
+    the run summary."""
+    from mocapqa.limits.catalog import ModelCatalog
+    from mocapqa.pipeline.analyze import analyze
+    from mocapqa.pipeline.options import AnalysisOptions
+
+    catalog = ModelCatalog.of_data_folder(data_dir)
+    result = analyze(take, AnalysisOptions.from_json(options), catalog=catalog)
+    if data_dir is not None:
+        write_outputs(FileStore(Path(data_dir)), run_id, result, source)
+    return run_summary(result)
 
 
 def analyse_path(
@@ -70,7 +110,12 @@ def analyse_path(
     data_dir: str | None,
     copy_take: bool = True,
 ) -> dict[str, Any]:
-    """Read, analyse and (with ``data_dir``) store one take.
+    """Read, check, analyse and (with ``data_dir``) store one take.
+
+    The take is read and checked as an upload is
+    (:func:`~mocapqa.jobs.take_reading.read_checked_take`: a name too long refused, a
+    reader's unforeseen error a parse error naming the file) and described the same way
+    (its shown name included).
 
     Parameters
     ----------
@@ -79,13 +124,12 @@ def analyse_path(
     options : dict
         Run options as JSON.
     take_id, run_id : str
-        Ids chosen by the client (outputs go to ``runs/<run_id>``, the copy to
-        ``takes/<take_id>``).
+        Ids chosen by the client (outputs go to the run's folder, the copy to the take's).
     data_dir : str, optional
         The data folder; None analyses without writing anything.
     copy_take : bool
-        Copy the take into ``takes/<take_id>`` (False when the client, which holds the take,
-        copies it: :func:`analyse_sent`).
+        Copy the take into its folder (False when the client, which holds the take, copies
+        it: :func:`analyse_sent`).
 
     Returns
     -------
@@ -93,101 +137,49 @@ def analyse_path(
         ``{"status": "done", "take": row values, "summary": run summary, "time_s"}`` or
         ``{"status": "failed", "error": message}`` for a file the readers reject.
     """
-    from mocapqa.core.motion import Motion
-    from mocapqa.io.formats import require_frames
-    from mocapqa.jobs.runner import run_summary, write_outputs
-    from mocapqa.limits.catalog import ModelCatalog
-    from mocapqa.pipeline.analyze import analyze
-    from mocapqa.pipeline.loading import (
-        READING_FILE,
-        ReadOptions,
-        detect_take_format,
-        read_take_file,
-        reading_facts,
-    )
-    from mocapqa.pipeline.options import AnalysisOptions
-    from mocapqa.store.files import FileStore
-
     started = time.perf_counter()
     source = Path(path)
     try:
-        format_name = detect_take_format(source)
-        try:
-            take = read_take_file(source, format_name, str(source))
-        except MocapQAError:
-            raise
-        except (ValueError, LookupError, TypeError, OverflowError, EOFError, OSError) as e:
-            raise ParseError(
-                f"Expected a readable {format_name} file, got {type(e).__name__}: {e}", source
-            ) from e
-        require_frames(take, source)
-        catalog = ModelCatalog.of_data_folder(data_dir)
-        result = analyze(take, AnalysisOptions.from_json(options), catalog=catalog)
+        checked = read_checked_take(source, source.name, label=str(source))
+        file = source if source.is_file() else None
+        summary = _analyse(checked.take, options, data_dir, run_id, file)
     except MocapQAError as e:
         return {"status": "failed", "error": str(e)}
-    if isinstance(take, Motion):
-        kind, n_points, fps = "motion", take.skeleton.n_joints, take.fps
-    else:
-        kind, n_points, fps = "keypoints", take.n_keypoints, take.fps
-    name = stored_name(source)
     if data_dir is not None:
-        files = FileStore(Path(data_dir))
-        folder = files.take_dir(take_id)
-        folder.mkdir(parents=True, exist_ok=True)
-        if copy_take and source.is_dir():
-            shutil.copytree(source, folder / name, dirs_exist_ok=True)
-        elif copy_take:
-            shutil.copyfile(source, folder / name)
-        facts = reading_facts(take, ReadOptions())
-        files.write_bytes(folder / READING_FILE, json.dumps(facts).encode())
-        write_outputs(files, run_id, result, source if source.is_file() else None)
-    size = (
-        sum(p.stat().st_size for p in source.iterdir() if p.is_file())
-        if source.is_dir()
-        else source.stat().st_size
-    )
+        _store_take(source, checked, take_id, data_dir, copy_take)
     return {
         "status": "done",
-        "take": {
-            "id": take_id,
-            "name": source.name[:255],
-            "format": format_name,
-            "kind": kind,
-            "size_bytes": size,
-            "n_frames": take.n_frames,
-            "fps": fps,
-            "n_joints": n_points,
-            "file_name": name,
-        },
-        "summary": run_summary(result),
+        "take": {**checked.row(), "id": take_id, "size_bytes": _size_bytes(source)},
+        "summary": summary,
         "time_s": time.perf_counter() - started,
     }
 
 
 def analyse_stored(
-    path: str, format_name: str, name: str, options: dict[str, Any], run_id: str, data_dir: str
+    path: str,
+    format_name: str,
+    name: str,
+    options: dict[str, Any],
+    run_id: str,
+    data_dir: str,
+    read: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """A server run on a Dask worker: read a stored take, analyse it, write the run's files.
+
+    ``read`` is the take's read options as JSON (the server read them from the take's
+    reading record, so the worker does not).
 
     Returns
     -------
     dict
-        The run summary (as :func:`mocapqa.jobs.runner.run_summary`). Errors the readers or
-        the analysis raise on purpose travel back as themselves.
+        The run summary (as :func:`mocapqa.jobs.run_folder.run_summary`). Errors the readers
+        or the analysis raise on purpose travel back as themselves.
     """
-    from mocapqa.jobs.runner import read_options, run_summary, write_outputs
-    from mocapqa.limits.catalog import ModelCatalog
-    from mocapqa.pipeline.analyze import analyze
-    from mocapqa.pipeline.loading import read_take_file
-    from mocapqa.pipeline.options import AnalysisOptions
-    from mocapqa.store.files import FileStore
+    from mocapqa.pipeline.loading import ReadOptions, read_take_file
 
     stored = Path(path)
-    take = read_take_file(stored, format_name, name, read_options(stored.parent))
-    catalog = ModelCatalog.of_data_folder(data_dir)
-    result = analyze(take, AnalysisOptions.from_json(options), catalog=catalog)
-    write_outputs(FileStore(Path(data_dir)), run_id, result, stored)
-    return run_summary(result)
+    take = read_take_file(stored, format_name, name, ReadOptions.from_json(read))
+    return _analyse(take, options, data_dir, run_id, stored)
 
 
 def sent_models(data_dir: Path | None, model: str | None) -> SentFiles:
@@ -235,7 +227,9 @@ def analyse_sent(
         name = take.files[0][0].split("/")[0]
         outcome = analyse_path(str(inbox / name), options, take_id, run_id, str(data), False)
         if outcome["status"] == "done":
-            outcome[RETURNED_FILES] = pack_tree(data, [f"runs/{run_id}", f"takes/{take_id}"])
+            files = FileStore(data)
+            folders = [files.run_dir(run_id), files.take_dir(take_id)]
+            outcome[RETURNED_FILES] = pack_tree(data, [relative_folder(files, f) for f in folders])
     return outcome
 
 
@@ -247,13 +241,14 @@ def analyse_stored_sent(
     options: dict[str, Any],
     run_id: str,
     models: SentFiles,
+    read: dict[str, Any] | None = None,
 ) -> tuple[dict[str, Any], SentFiles]:
     """:func:`analyse_stored` on a worker that cannot read the server's data folder.
 
     Parameters
     ----------
     take : SentFiles
-        The take's stored file and its reading facts (the files of its take folder).
+        The take's stored file.
     file_name : str
         The stored file's name among them.
     format_name, name : str
@@ -264,6 +259,8 @@ def analyse_stored_sent(
         The run.
     models : SentFiles
         Files of the data folder the run reads, relative to it.
+    read : dict, optional
+        The take's read options as JSON (from its reading record, read by the server).
 
     Returns
     -------
@@ -275,6 +272,7 @@ def analyse_stored_sent(
         take.unpack(inbox)
         models.unpack(data)
         summary = analyse_stored(
-            str(inbox / file_name), format_name, name, options, run_id, str(data)
+            str(inbox / file_name), format_name, name, options, run_id, str(data), read
         )
-        return summary, pack_tree(data, [f"runs/{run_id}"])
+        files = FileStore(data)
+        return summary, pack_tree(data, [relative_folder(files, files.run_dir(run_id))])

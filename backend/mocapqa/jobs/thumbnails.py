@@ -8,11 +8,11 @@ has finished the thumbnail is a neutral placeholder.
 
 from __future__ import annotations
 
-import json
 from html import escape
 
 import numpy as np
 
+from mocapqa.jobs.run_folder import RunFolder, load_points, load_report
 from mocapqa.store.files import FileStore
 
 __all__ = ["placeholder_svg", "thumbnail_svg"]
@@ -34,17 +34,16 @@ def thumbnail_svg(files: FileStore, run_id: str | None, label: str) -> str:
     """The skeleton of a run's middle frame, or a placeholder while there is none."""
     if run_id is None:
         return placeholder_svg(label)
-    folder = files.run_dir(run_id)
+    folder = RunFolder.of(files, run_id)
     try:
-        with np.load(folder / "points.npz") as data:
-            points = data["raw"]
-        report = json.loads((folder / "report.json").read_text())
+        points = load_points(folder.points, ("raw",))["raw"]
+        report = load_report(folder.report)
     except (OSError, ValueError, KeyError):
         return placeholder_svg("analysing…")
     if points.shape[0] == 0:
         return placeholder_svg(label)
     frame = points[points.shape[0] // 2, :, :2].astype(np.float64)
-    seen = np.isfinite(frame).all(axis=1)
+    seen = np.asarray(np.isfinite(frame).all(axis=1), dtype=bool)
     if not seen.any():
         return placeholder_svg(label)
     parents = report.get("points", {}).get("parents", [])

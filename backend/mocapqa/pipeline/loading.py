@@ -25,7 +25,6 @@ from mocapqa.io.guards import ReadLimits
 from mocapqa.kinematics.bindpose import leading_bind_pose
 
 __all__ = [
-    "READING_FILE",
     "ReadLimits",
     "ReadOptions",
     "Take",
@@ -37,10 +36,6 @@ __all__ = [
 
 Take = Motion | KeypointSequence
 """What a take file holds: a BVH motion or a keypoint sequence."""
-
-
-READING_FILE = ".reading.json"
-"""File in a take's folder recording how it was read (no stored take name starts with ".")."""
 
 
 @dataclass(frozen=True, slots=True)

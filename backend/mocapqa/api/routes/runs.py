@@ -12,12 +12,12 @@ from mocapqa.api.auth import Principal, audit, require
 from mocapqa.api.deps import ClientDep, Services, ServicesDep, TakeDep, run_places
 from mocapqa.api.disposition import attachment, download_stem
 from mocapqa.api.errors import responses
-from mocapqa.api.frame_windows import read_window, window_json, window_packed
+from mocapqa.api.frame_windows import Window, read_window, window_json, window_packed
 from mocapqa.api.schemas import AnalysisOptionsIn, RunOut
 from mocapqa.api.views import run_out
 from mocapqa.errors import NotFoundError
-from mocapqa.jobs.intake import joint_parents_of, joints_of
 from mocapqa.jobs.rendered import html_report
+from mocapqa.jobs.run_folder import RunFolder, joint_parents_of, joints_of
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.roles import Action
 
@@ -26,13 +26,15 @@ __all__ = ["router"]
 router = APIRouter(tags=["runs"])
 """Routes of this resource, included under ``/api/v1``."""
 
-DOWNLOADS = {
-    "bvh": ("corrected.bvh", "text/plain", "corrected.bvh"),
-    "csv": ("filtered.csv", "text/csv", "filtered.csv"),
-    "trc": ("filtered.trc", "text/plain", "filtered.trc"),
-    "c3d": ("corrected.c3d", "application/octet-stream", "corrected.c3d"),
-    "report": ("report.json", "application/json", "report.json"),
+MEDIA_TYPES = {
+    "bvh": "text/plain",
+    "csv": "text/csv",
+    "trc": "text/plain",
+    "c3d": "application/octet-stream",
+    "report": "application/json",
 }
+"""The media type of each download kind (its file:
+:data:`~mocapqa.jobs.run_folder.DOWNLOAD_FILES`)."""
 MAX_FRAME = 2**31 - 1
 """Largest frame index or step a query may name (the schema refuses more with 422)."""
 
@@ -77,7 +79,7 @@ def get_run(run_id: str, services: ServicesDep) -> RunOut:
 def get_result(run_id: str, services: ServicesDep) -> Response:
     """The report: summary, steps, findings and the plotted series (409 until done)."""
     services.repository.require_done(run_id)
-    path = services.files.existing(services.files.run_dir(run_id) / "report.json", "the report")
+    path = services.files.existing(RunFolder.of(services.files, run_id).report, "the report")
     return Response(path.read_bytes(), media_type="application/json")
 
 
@@ -87,18 +89,26 @@ FrameStep = Annotated[int, Query(ge=1, le=MAX_FRAME)]
 MaxFrames = Annotated[int, Query(ge=1, le=20_000)]
 
 
-@router.get(
-    "/runs/{run_id}/frames",
-    responses={200: {"content": {"application/json": {}}}, **responses(401, 404, 409)},
-)
-def get_frames(
+def frame_window(
     run_id: str,
     services: ServicesDep,
     start: FrameStart = 0,
     stop: FrameStop = None,
     step: FrameStep = 1,
     max_frames: MaxFrames = 1500,
-) -> Response:
+) -> Window:
+    """The frames a window route asks for, of a finished run's points (:func:`read_window`)."""
+    return read_window(points_path(services, run_id), start, stop, step, max_frames)
+
+
+WindowDep = Annotated[Window, Depends(frame_window)]
+
+
+@router.get(
+    "/runs/{run_id}/frames",
+    responses={200: {"content": {"application/json": {}}}, **responses(401, 404, 409)},
+)
+def get_frames(window: WindowDep) -> Response:
     """Raw and corrected point positions for frames ``start:stop:step`` (file units).
 
     Motion takes also carry ``raw_rotations`` and ``corrected_rotations``: each point's world
@@ -113,7 +123,6 @@ def get_frames(
     The step grows so that at most ``max_frames`` frames come back; the answer states the
     frame indices it holds.
     """
-    window = read_window(points_path(services, run_id), start, stop, step, max_frames)
     return Response(window_json(window), media_type="application/json")
 
 
@@ -121,14 +130,7 @@ def get_frames(
     "/runs/{run_id}/frames.f32",
     responses={200: {"content": {"application/octet-stream": {}}}, **responses(401, 404, 409)},
 )
-def get_frames_packed(
-    run_id: str,
-    services: ServicesDep,
-    start: FrameStart = 0,
-    stop: FrameStop = None,
-    step: FrameStep = 1,
-    max_frames: MaxFrames = 1500,
-) -> Response:
+def get_frames_packed(window: WindowDep) -> Response:
     """The window of ``/frames`` as packed little-endian float32, for the 3D views.
 
     A uint32 ``n``, an ``n``-byte JSON header (``start``, ``step``, ``count``, ``n_frames``,
@@ -137,14 +139,13 @@ def get_frames_packed(
     ``filled`` 0 or 1.
     A quarter of the bytes of the JSON and no parsing in the browser.
     """
-    window = read_window(points_path(services, run_id), start, stop, step, max_frames)
     return Response(window_packed(window), media_type="application/octet-stream")
 
 
 def points_path(services: Services, run_id: str) -> Path:
     """``points.npz`` of a finished run (404 for an unknown run, 409 until it is done)."""
     services.repository.require_done(run_id)
-    return services.files.existing(services.files.run_dir(run_id) / "points.npz", "the points")
+    return services.files.existing(RunFolder.of(services.files, run_id).points, "the points")
 
 
 @router.get(
@@ -184,11 +185,10 @@ def download(
     marker take's swaps repaired and gaps filled, filled samples with residual 0),
     ``report``."""
     run = services.repository.require_done(run_id)
-    file_name, media_type, suffix = DOWNLOADS[kind]
-    path = services.files.run_dir(run_id) / file_name
+    path = RunFolder.of(services.files, run_id).download(kind)
     if not path.is_file():
         raise NotFoundError(f"Expected a {kind} output for run {run_id}, got none for this take")
     take = services.repository.get_take(str(run["take_id"]))
     return FileResponse(
-        path, media_type=media_type, headers=attachment(f"{download_stem(take)}.{suffix}")
+        path, media_type=MEDIA_TYPES[kind], headers=attachment(f"{download_stem(take)}.{path.name}")
     )

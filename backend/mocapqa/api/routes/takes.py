@@ -13,8 +13,8 @@ from mocapqa.api.schemas import TakeCreatedOut, TakeDetailOut, TakeOut, TakePage
 from mocapqa.api.views import review_out, run_out, take_fields
 from mocapqa.core.bounds import MAX_FPS, MIN_FPS
 from mocapqa.core.keypoints import LENGTH_UNITS
-from mocapqa.jobs.intake import ingest_take, reading_of
-from mocapqa.jobs.rendered import THUMBNAIL_PNG
+from mocapqa.jobs.intake import ingest_take
+from mocapqa.jobs.run_folder import RunFolder, reading_of
 from mocapqa.jobs.thumbnails import thumbnail_svg
 from mocapqa.pipeline.loading import ReadOptions
 from mocapqa.store.repository import ReviewStatus, RunStatus
@@ -148,7 +148,7 @@ def thumbnail(take: TakeDep, services: ServicesDep) -> Response:
     placeholder until a run has points; a line drawing when rendering is unavailable)."""
     run_id = take.get("latest_run_id")
     if run_id:
-        png = services.files.run_dir(str(run_id)) / THUMBNAIL_PNG
+        png = RunFolder.of(services.files, str(run_id)).thumbnail
         if png.is_file():
             return Response(
                 png.read_bytes(), media_type="image/png", headers={"Cache-Control": "max-age=60"}
