@@ -22,10 +22,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from mocapqa.bench.corpus import find_corpus
-from mocapqa.bench.natural import natural_jumps
+from mocapqa.corpus import find_corpus
 from mocapqa.io.bvh import read_bvh
 from mocapqa.twist.analysis import analyze_twist
+from mocapqa_bench.natural import natural_jumps
 
 PANELS = (
     ("CC_Base_R_Calf", 190, 330, "twist-005_05-right-knee.png"),

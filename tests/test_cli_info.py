@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib
 import json
 import shutil
 import subprocess
@@ -12,13 +11,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mocapqa.bench.io import timed_in_turns
 from mocapqa.cli.app import app
-from mocapqa.cli.main import COMMAND_MODULES, main, modules_for
+from mocapqa.cli.main import COMMAND_MODULES, import_command_module, main, modules_for
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.io.bvh import read_bvh
 from mocapqa.io.bvh_write import channel_values
 from mocapqa.io.formats import read_take
+from mocapqa_bench.io import timed_in_turns
 
 OPENPOSE = "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose/cam01_json"
 TRC = "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d/S00_P00_T01_BalancingTrial_0-100.trc"
@@ -223,7 +222,7 @@ def test_help_exits_0(capsys: pytest.CaptureFixture[str]) -> None:
 
 def test_the_command_table_names_every_command_s_module() -> None:
     for module in {m for modules in COMMAND_MODULES.values() for m in modules}:
-        importlib.import_module(f"mocapqa.cli.{module}")
+        import_command_module(module)
     commands = {}
     groups = [("", app), *((f"{g.name} ", g.typer_instance) for g in app.registered_groups)]
     for prefix, group in groups:

@@ -18,8 +18,8 @@ from pathlib import Path
 import pytest
 
 from headless_chromium import CHROMIUM_ARGS, CHROMIUM_PATH
-from mocapqa.bench.api_load import ServerProcess
 from mocapqa.cli.main import main
+from mocapqa_bench.api_load import ServerProcess
 
 ROOT = Path(__file__).resolve().parents[1]
 BOUND_S = 900

@@ -18,8 +18,8 @@ import httpx
 import pytest
 from tests.api.conftest import make_settings
 
-from mocapqa.bench.api_load import API, LoadResult, run_load
-from mocapqa.cli.bench_api import admin_token, load_clients, loaded_server, seed_take
+from mocapqa_bench.api_load import API, LoadResult, run_load
+from mocapqa_bench.cli.bench_api import admin_token, load_clients, loaded_server, seed_take
 
 CLIENTS = 100
 ROUNDS = 2

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import sys
 
-from mocapqa.bench.watch import run_watched
+from mocapqa_bench.watch import run_watched
 
 CHILD = """
 import time

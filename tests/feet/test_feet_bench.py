@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mocapqa.bench.feet import BenchTake, clean_flags, run_trials
 from mocapqa.feet.params import FeetParams
 from mocapqa.io.bvh import read_bvh
 from mocapqa.pipeline.feet import motion_foot_points
+from mocapqa_bench.feet import BenchTake, clean_flags, run_trials
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mocapqa.bench.feet import cleanup_trials
 from mocapqa.cli.main import main
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
@@ -32,6 +31,7 @@ from mocapqa.io.formats import read_take
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.kinematics.quaternion import rotate
 from mocapqa.pipeline.feet import check_take_feet, motion_foot_points
+from mocapqa_bench.feet_cleanup import cleanup_trials
 
 TRC = "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d/S00_P00_T01_BalancingTrial_0-100.trc"
 WALK = "bvh/bandai/dataset-1_walk_normal_001.bvh"  # centimetres, 30 fps

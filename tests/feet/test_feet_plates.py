@@ -9,18 +9,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mocapqa.bench.feet import (
-    PlateTrial,
-    marker_params_by_leave_one_out,
-    plate_trial,
-    score_plate_trial,
-)
 from mocapqa.cli.main import main
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import InputError
 from mocapqa.feet.markers import MARKER_PARAMS, marker_foot_points
 from mocapqa.feet.plates import over_plates, plate_contacts
 from mocapqa.io.c3d_plates import read_force_plates
+from mocapqa_bench.feet_plates import (
+    PlateTrial,
+    marker_params_by_leave_one_out,
+    plate_trial,
+    score_plate_trial,
+)
 
 PIG = "c3d/btk/PiG_Motion-FlatFoot-Full.c3d"
 GAIT = (PIG, "c3d/btk/Eb015pr.c3d", "c3d/btk/DEC_INT.C3D")

@@ -10,8 +10,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from mocapqa.bench.filters import Take
-from mocapqa.bench.rotation_filters import clean_change_table
 from mocapqa.errors import InputError
 from mocapqa.filters.butterworth import ButterworthParams, butterworth_quats
 from mocapqa.filters.euler_pd import euler_pd_filter, vector_pd_filter
@@ -24,6 +22,8 @@ from mocapqa.filters.quat_pd import (
 )
 from mocapqa.io.bvh import read_bvh
 from mocapqa.kinematics.quaternion import geodesic_angle, unwrap
+from mocapqa_bench.filters import Take
+from mocapqa_bench.rotation_filters import clean_change_table
 
 
 def _noisy_walk(n: int, joints: int, seed: int) -> tuple[np.ndarray, np.ndarray]:

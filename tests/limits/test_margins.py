@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mocapqa.bench.limits_margins import MARGINS_DEG, MarginCounts, choose_margins, widened
 from mocapqa.limits.occupancy import OccupancyParams, build_occupancy, evaluate
+from mocapqa_bench.limits_margins import MARGINS_DEG, MarginCounts, choose_margins, widened
 
 
 @pytest.mark.parametrize("margin", [0.0, 40.0, 90.0])

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from tests.markers.conftest import load_take
 
-from mocapqa.bench.marker_fill import fill_table
+from mocapqa.core.arrays import column_runs
 from mocapqa.errors import OptionError, ShapeError
 from mocapqa.markers.fill import FillContext, FillParams, fill_gaps, plan_gap
-from mocapqa.markers.take import column_runs
+from mocapqa_bench.marker_fill import fill_table
 
 CMU = "c3d/cmu/cmu_02_05.c3d"
 TENNIS = "c3d/optitrack/kinematics_tennis_serve.c3d"

@@ -7,14 +7,14 @@ from pathlib import Path
 
 import numpy as np
 
-from mocapqa.bench.markers import (
+from mocapqa.markers.params import MarkerParams
+from mocapqa_bench.markers import (
     Counts,
     clean_flags,
     load_takes,
     swap_trials,
     tiled_take,
 )
-from mocapqa.markers.params import MarkerParams
 
 
 def test_trials_count_found_and_false_swaps(corpus_dir: Path) -> None:

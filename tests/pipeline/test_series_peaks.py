@@ -7,12 +7,12 @@ from pathlib import Path
 
 import numpy as np
 
-from mocapqa.bench.natural import natural_jumps
 from mocapqa.core.decimate import sample_frames
 from mocapqa.io.bvh import read_bvh
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.twist.analysis import analyze_twist
+from mocapqa_bench.natural import natural_jumps
 
 
 def test_a_long_take_keeps_every_reported_flip_at_full_resolution(corpus_dir: Path) -> None:

@@ -22,8 +22,8 @@ MODULES = [
     "mocapqa.twist.outside",
     "mocapqa.twist.analysis",
     "mocapqa.metrics.twist",
-    "mocapqa.bench.twist",
-    "mocapqa.bench.unpaired",
+    "mocapqa_bench.twist",
+    "mocapqa_bench.unpaired",
     "mocapqa.cli.twist",
 ]
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,7 @@ from mocapqa.twist.confidence import (
     has_evidence,
 )
 from mocapqa.twist.detect import DetectedInterval, RobustParams, detect_robust
-from mocapqa.twist.intervals import FEATURES, chain_intervals
+from mocapqa.twist.intervals import FEATURES, ChainSettings, chain_intervals
 
 FPS = 60.0
 
@@ -64,19 +65,18 @@ def test_a_tail_never_reaches_past_its_length_or_into_the_next_interval() -> Non
     small[17:30] = np.deg2rad(-0.5)  # steps in the release's direction for 13 frames
     increments = small.copy()
     increments[frames] = jumps
+    settings = ChainSettings(np.deg2rad(2.0), np.deg2rad(0.1), FPS, 0.2, 0.5, 0.01, 2.0, 0.1)
     offsets, found = chain_intervals(
-        frames, jumps, np.zeros(4), increments, np.zeros(n), np.deg2rad(2.0),
-        np.deg2rad(0.1), FPS, 0.2, 0.5, 0.01, 2.0, small, 0.1,
-    )  # fmt: skip
+        frames, jumps, np.zeros(4), increments, np.zeros(n), settings, small
+    )
     assert [(f.start_frame, f.end_frame) for f in found] == [(10, 12), (14, 21)]
     assert np.allclose(np.rad2deg(offsets[10:14]), [40.0, 40.0, 3.0, 0.0])
     # The second flip's tail: at most round(0.1 s × 60) = 6 frames.
     assert np.allclose(np.rad2deg(offsets[16:22]), [3.0, 2.5, 2.0, 1.5, 1.0, 0.5])
     assert np.all(offsets[22:] == 0.0)
     without, _ = chain_intervals(
-        frames, jumps, np.zeros(4), increments, np.zeros(n), np.deg2rad(2.0),
-        np.deg2rad(0.1), FPS, 0.2, 0.5, 0.01, 2.0, small, 0.0,
-    )  # fmt: skip
+        frames, jumps, np.zeros(4), increments, np.zeros(n), replace(settings, tail_s=0.0), small
+    )
     assert np.all(without[12:14] == 0.0)
     assert np.all(without[16:] == 0.0)
 
@@ -293,8 +293,8 @@ def test_chain_intervals_take_each_jumps_uncertainty() -> None:
     jumps = np.deg2rad([-9.0, 11.6])  # net 2.6° against a tolerance of 2.32°
     increments = np.zeros(n)
     increments[frames] = jumps
-    args = (frames, jumps, np.zeros(2), increments, np.zeros(n), np.deg2rad(2.0),
-            np.deg2rad(0.1), FPS, 0.2, 0.5, 0.1, 2.0, None, 0.0)  # fmt: skip
+    settings = ChainSettings(np.deg2rad(2.0), np.deg2rad(0.1), FPS, 0.2, 0.5, 0.1, 2.0)
+    args = (frames, jumps, np.zeros(2), increments, np.zeros(n), settings, None)
     without, none = chain_intervals(*args)
     assert none == []
     assert np.all(without == 0.0)
@@ -328,8 +328,8 @@ def test_a_large_shift_closes_across_small_steps_that_look_like_a_burst() -> Non
     jumps = np.deg2rad([-122.6, -5.8, -3.3, -4.2, 122.2])
     increments = np.zeros(n)
     increments[frames] = jumps
-    args = (frames, jumps, np.zeros(5), increments, np.zeros(n), np.deg2rad(2.0),
-            np.deg2rad(0.5), 30.0, 0.2, 0.5, 0.1, 2.0)  # fmt: skip
+    settings = ChainSettings(np.deg2rad(2.0), np.deg2rad(0.5), 30.0, 0.2, 0.5, 0.1, 2.0)
+    args = (frames, jumps, np.zeros(5), increments, np.zeros(n), settings)
     offsets, (found,) = chain_intervals(*args)
     assert (found.start_frame, found.end_frame) == (202, 218)
     assert np.all(np.rad2deg(offsets[202:219]) < -110.0)
@@ -359,10 +359,12 @@ def test_the_outside_roll_overrules_the_jumps_only_beyond_its_own_scatter() -> N
     jumps = np.deg2rad([-10.0, 10.0])
 
     def levels(increments: np.ndarray, precision: float) -> np.ndarray:
+        settings = ChainSettings(
+            np.deg2rad(2.0), np.deg2rad(0.1), FPS, 0.2, 0.5, 0.1, 2.0, precision=precision
+        )
         offsets, _ = chain_intervals(
-            frames, jumps, np.zeros(2), increments, np.zeros(100), np.deg2rad(2.0),
-            np.deg2rad(0.1), FPS, 0.2, 0.5, 0.1, 2.0, None, 0.0, None, precision,
-        )  # fmt: skip
+            frames, jumps, np.zeros(2), increments, np.zeros(100), settings
+        )
         return np.rad2deg(offsets)
 
     # Inside, the roll swings by 26° from frame to frame: its mean (1.7°) contradicts the
@@ -380,8 +382,8 @@ def test_the_outside_roll_overrules_the_jumps_only_beyond_its_own_scatter() -> N
 
 
 def test_the_disagreement_limit_is_chosen_without_the_rig_it_is_checked_on() -> None:
-    from mocapqa.bench.calibration import disagreement_loro
-    from mocapqa.bench.twist import IntervalRecord
+    from mocapqa_bench.calibration import disagreement_loro
+    from mocapqa_bench.twist import IntervalRecord
 
     def record(rig: str, disagreement: float, right: bool) -> IntervalRecord:
         features = (5.0, 0.1, 0.0, disagreement, -2.0, float(np.log(20.0)))
@@ -416,16 +418,11 @@ def test_an_onset_with_a_small_step_beside_it_is_still_closed_by_its_release() -
     jumps = np.deg2rad([-85.0, -3.0, 83.0])
     increments = np.zeros(n)
     increments[frames] = jumps
-    offsets, found = chain_intervals(
-        frames, jumps, np.zeros(3), increments, np.zeros(n), np.deg2rad(2.0),
-        np.deg2rad(0.5), 30.0, 0.2, 0.5, 0.1, 2.0,
-    )  # fmt: skip
+    settings = ChainSettings(np.deg2rad(2.0), np.deg2rad(0.5), 30.0, 0.2, 0.5, 0.1, 2.0)
+    offsets, found = chain_intervals(frames, jumps, np.zeros(3), increments, np.zeros(n), settings)
     assert [(f.start_frame, f.end_frame) for f in found] == [(32, 46)]
     assert np.allclose(np.rad2deg(offsets[34:47]), -88.0, atol=3.5)
     # Two comparable flips stay one burst that a lone event far away may not end.
     flips = np.deg2rad([-85.0, 60.0, 25.0])
-    _, bursts = chain_intervals(
-        frames, flips, np.zeros(3), increments, np.zeros(n), np.deg2rad(2.0),
-        np.deg2rad(0.5), 30.0, 0.2, 0.5, 0.1, 2.0,
-    )  # fmt: skip
+    _, bursts = chain_intervals(frames, flips, np.zeros(3), increments, np.zeros(n), settings)
     assert all(f.end_frame < 47 for f in bursts)

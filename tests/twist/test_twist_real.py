@@ -9,8 +9,6 @@ import numpy as np
 import pytest
 from tests.rigs import rerig
 
-from mocapqa.bench.calibration import reliability
-from mocapqa.bench.natural import clean_figures_at_rates, natural_error_figures, wilson_interval
 from mocapqa.cli.main import main
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
@@ -23,6 +21,8 @@ from mocapqa.twist.angles import chain_geometry
 from mocapqa.twist.confidence import Calibration, default_calibration, fit_calibration
 from mocapqa.twist.intervals import FEATURES
 from mocapqa.twist.refine import refine_quats
+from mocapqa_bench.calibration import reliability
+from mocapqa_bench.natural import clean_figures_at_rates, natural_error_figures, wilson_interval
 
 
 @pytest.fixture(scope="module")
@@ -253,7 +253,7 @@ def test_wilson_interval_matches_the_formula() -> None:
 
 
 def test_the_real_error_take_is_never_injected_or_fitted_on(corpus_dir: Path) -> None:
-    from mocapqa.bench.twist import REAL_ERROR_TAKES, find_bench_files
+    from mocapqa_bench.twist import REAL_ERROR_TAKES, find_bench_files
 
     files = find_bench_files(corpus_dir / "bvh")
     assert "005_05.bvh" in REAL_ERROR_TAKES

@@ -8,9 +8,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mocapqa.bench.natural import natural_error_figures
-from mocapqa.bench.twist import IntervalRecord, find_bench_files
-from mocapqa.bench.unpaired import run_unpaired_bench
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.errors import InputError
@@ -21,6 +18,9 @@ from mocapqa.twist.confidence import default_calibration
 from mocapqa.twist.detect import RobustParams, detect_robust
 from mocapqa.twist.inject_unpaired import UnpairedShape, inject_unpaired_bursts
 from mocapqa.twist.intervals import FEATURES
+from mocapqa_bench.natural import natural_error_figures
+from mocapqa_bench.twist import IntervalRecord, find_bench_files
+from mocapqa_bench.unpaired import run_unpaired_bench
 
 FPS = 60.0
 

@@ -1,4 +1,4 @@
-"""``mocapqa filter`` and ``mocapqa bench filters``."""
+"""``mocapqa filter`` (the benchmark: :mod:`mocapqa_bench.cli.bench_filters`)."""
 
 from __future__ import annotations
 
@@ -9,15 +9,14 @@ from typing import Annotated, Any
 
 import typer
 from rich.console import Console
-from rich.table import Table
 
-from mocapqa.cli.app import app, bench_app
+from mocapqa.cli.app import app
 from mocapqa.cli.outputs import check_outputs, require_suffix, take_input
 from mocapqa.cli.reading import read_input
 from mocapqa.cli.roles import FpsOption, MappingOption, load_mapping, missing_roles
 from mocapqa.errors import InputError
 
-__all__ = ["bench_filters", "filter_command", "parse_overrides"]
+__all__ = ["filter_command", "parse_overrides"]
 
 console = Console(highlight=False)
 
@@ -59,6 +58,7 @@ def filter_command(
         write_keypoints,
     )
     from mocapqa.metrics.smoothness import MIN_FRAMES, lag_frames, mean_abs_jerk
+    from mocapqa.pipeline.options import DEFAULT_OPTIONS
 
     if fps is not None:
         check_fps(fps, "--fps")
@@ -92,7 +92,7 @@ def filter_command(
         result = filter_keypoints(take, method, preset, overrides)
         # The report is made before anything is written: a metric that fails must not leave
         # an output behind and then exit with an error.
-        summary = result.to_json(max_points=2000)
+        summary = result.to_json(max_points=DEFAULT_OPTIONS.max_points)
         per_key = []
         for k, name in enumerate(take.names):
             raw, out = take.positions[:, k], result.sequence.positions[:, k]
@@ -129,69 +129,3 @@ def _metric_notes(n_frames: int, min_frames: int, rows: list[dict[str, Any]]) ->
     if any(value is None for row in rows for value in row.values()):
         return ["a null jerk or lag is not available: the keypoint has too few samples or is still"]
     return []
-
-
-def _table(title: str, rows: list[dict[str, Any]]) -> Table:
-    table = Table(title=title)
-    if not rows:
-        return table
-    keys = list(dict.fromkeys(k for r in rows for k in r))
-    for k in keys:
-        table.add_column(k)
-    for r in rows:
-        table.add_row(*(_fmt(r.get(k, "")) for k in keys))
-    return table
-
-
-def _fmt(value: Any) -> str:
-    if isinstance(value, float):
-        return f"{value:.4g}"
-    if hasattr(value, "tolist"):
-        return " ".join(f"{v:.3g}" for v in value.tolist())
-    return str(value)
-
-
-@bench_app.command("filters")
-def bench_filters(
-    data: Annotated[Path | None, typer.Option(help="Corpus folder (shared/data).")] = None,
-    seed: Annotated[int, typer.Option(help="Noise seed.")] = 0,
-    limit: Annotated[int | None, typer.Option(help="Use only the first N takes.")] = None,
-) -> None:
-    """Keypoint and rotation filters on real takes with seeded noise; prints tables."""
-    from mocapqa.bench.filters import (
-        keypoint_cases,
-        keypoint_table,
-        load_takes,
-        note_table,
-        pose2sim_table,
-        speed_table,
-        split_takes,
-    )
-    from mocapqa.bench.rotation_filters import (
-        clean_change_table,
-        quamo_table,
-        rotation_cases,
-        rotation_table,
-        tune_quat_pd,
-    )
-    from mocapqa.corpus import require_corpus
-
-    root = require_corpus(data)
-    if not (root / "bvh" / "bandai").is_dir():
-        raise InputError(f"Expected a corpus folder with bvh/bandai (--data), got {root}")
-    train, test = split_takes(load_takes(root, limit))
-    console.print(f"Bandai takes: {len(train)} training, {len(test)} test; seed {seed}")
-    k_train, k_test = keypoint_cases(train, seed), keypoint_cases(test, seed)
-    console.print(_table("Keypoints (cm; test takes)", keypoint_table(k_train, k_test)))
-    console.print(_table("The note's table (note preset; test takes)", note_table(k_test)))
-    r_train, r_test = rotation_cases(train, seed), rotation_cases(test, seed)
-    tuned = tune_quat_pd(r_train)
-    console.print(_table("Rotations (test takes)", rotation_table(r_test, tuned)))
-    console.print(_table("QuaMo ablation (tuned gains; test takes)", quamo_table(r_test, tuned)))
-    console.print(
-        _table(
-            "Rotation filters on the test takes as recorded (no noise)", clean_change_table(test)
-        )
-    )
-    console.print(_table("Pose2Sim raw TRC vs its Butterworth file", pose2sim_table(root)))
-    console.print(_table("Speed", speed_table()))

@@ -1,4 +1,4 @@
-"""``mocapqa limits build|check|show`` (the benchmark: :mod:`mocapqa.cli.bench_limits`)."""
+"""``mocapqa limits build|check|show`` (the benchmark: :mod:`mocapqa_bench.cli.bench_limits`)."""
 
 from __future__ import annotations
 
@@ -51,6 +51,30 @@ def _build_params(
     return settings
 
 
+HiddenOption = Annotated[
+    list[int] | None,
+    typer.Option(
+        help="Hidden units of a network tried per joint (repeatable; default 32 and 16); "
+        "the best by validation is kept."
+    ),
+]
+SchedulerOption = Annotated[
+    str | None,
+    typer.Option(
+        help="Read and chart the takes as tasks of this Dask scheduler (tcp://host:8786), "
+        "with or without --rig; the maps and networks are trained here."
+    ),
+]
+WorkersOption = Annotated[
+    int,
+    typer.Option(
+        min=0,
+        help="Read and chart the takes on a local Dask cluster of N worker processes "
+        "(0: in this process, the default).",
+    ),
+]
+
+
 @limits_app.command("build")
 def limits_build(
     corpus_dir: Annotated[Path, typer.Argument(help="Folder searched recursively for BVH takes.")],
@@ -80,28 +104,9 @@ def limits_build(
     exclude: Annotated[
         list[str] | None, typer.Option(help="Take file names to leave out (repeatable).")
     ] = None,
-    hidden: Annotated[
-        list[int] | None,
-        typer.Option(
-            help="Hidden units of a network tried per joint (repeatable; default 32 and 16); "
-            "the best by validation is kept."
-        ),
-    ] = None,
-    scheduler: Annotated[
-        str | None,
-        typer.Option(
-            help="Read and chart the takes as tasks of this Dask scheduler (tcp://host:8786), "
-            "with or without --rig; the maps and networks are trained here."
-        ),
-    ] = None,
-    workers: Annotated[
-        int,
-        typer.Option(
-            min=0,
-            help="Read and chart the takes on a local Dask cluster of N worker processes "
-            "(0: in this process, the default).",
-        ),
-    ] = 0,
+    hidden: HiddenOption = None,
+    scheduler: SchedulerOption = None,
+    workers: WorkersOption = 0,
     mapping: MappingOption = None,
 ) -> None:
     """Build a joint-limits model from a folder of BVH takes.
@@ -116,15 +121,6 @@ def limits_build(
     hold other rigs too), and the model stores those roles with the rig's frames, so its takes
     are checked the same way. A per-rig build (--rig) matches joints by name and takes none.
     """
-    from dataclasses import replace
-    from functools import partial
-
-    from rich.progress import Progress
-
-    from mocapqa.bench.limits import canonical_takes, rig_takes
-    from mocapqa.core.rig import require_mapped
-    from mocapqa.limits.build import build_canonical_model, build_model
-
     require_suffix("-o", output, (".npz",), "a limits model")
     check_outputs({"-o": output}, [FolderReads(corpus_dir, (".bvh",), recursive=True), mapping])
     roles = load_mapping(mapping)
@@ -133,19 +129,52 @@ def limits_build(
             f"--mapping {mapping}: a per-rig model (--rig {rig}) matches its joints by name; "
             "leave out --rig for a canonical model that uses the mapping"
         )
-    settings = _build_params(bin_deg, dilation, margin_deg, paper, networks)
-    if n_valid is not None and settings.discriminator is not None:
-        settings = replace(settings, discriminator=replace(settings.discriminator, n_valid=n_valid))
-    if hidden and settings.discriminator is not None:
-        networks_asked = replace(settings.discriminator, hidden_sizes=tuple(hidden))
-        settings = replace(settings, discriminator=networks_asked)
+    settings = _network_params(
+        _build_params(bin_deg, dilation, margin_deg, paper, networks), n_valid, hidden
+    )
     left_out = set(exclude or ())
     if scheduler or workers > 0:
         model = _build_on_dask(
             corpus_dir, rig, settings, all_takes, left_out, scheduler, workers, roles
         )
-        _write_model(model, output)
-        return
+    else:
+        model = _build_here(corpus_dir, rig, settings, all_takes, left_out, roles)
+    _write_model(model, output)
+
+
+def _network_params(
+    settings: BuildParams, n_valid: int | None, hidden: list[int] | None
+) -> BuildParams:
+    """``settings`` with the discriminators' sample count and hidden sizes asked for."""
+    from dataclasses import replace
+
+    if settings.discriminator is None:
+        return settings
+    networks = settings.discriminator
+    if n_valid is not None:
+        networks = replace(networks, n_valid=n_valid)
+    if hidden:
+        networks = replace(networks, hidden_sizes=tuple(hidden))
+    return replace(settings, discriminator=networks)
+
+
+def _build_here(
+    corpus_dir: Path,
+    rig: str | None,
+    settings: BuildParams,
+    all_takes: bool,
+    left_out: set[str],
+    roles: dict[str, str] | None,
+) -> LimitsModel:
+    """Read the takes and build the model in this process, with a progress line per joint."""
+    from functools import partial
+
+    from rich.progress import Progress
+
+    from mocapqa.core.rig import require_mapped
+    from mocapqa.jobs.limits_takes import canonical_takes, rig_takes
+    from mocapqa.limits.build import build_canonical_model, build_model
+
     builder: Callable[..., LimitsModel]
     if rig is None:
         takes = canonical_takes(corpus_dir, all_takes, left_out, roles)
@@ -165,8 +194,7 @@ def limits_build(
             progress.update(task, completed=n_done[0], description=f"built {name}")
             _log_role(f"built {name}")
 
-        model = builder([m for _, m in takes], [n for n, _ in takes], settings, advance)
-    _write_model(model, output)
+        return builder([m for _, m in takes], [n for n, _ in takes], settings, advance)
 
 
 def _log_role(line: str) -> None:

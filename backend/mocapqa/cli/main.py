@@ -11,7 +11,7 @@ from rich.markup import escape
 from mocapqa.cli.app import app, err_console, exit_code_for
 from mocapqa.errors import InputError, MocapQAError
 
-__all__ = ["COMMAND_MODULES", "main", "modules_for"]
+__all__ = ["COMMAND_MODULES", "import_command_module", "main", "modules_for"]
 
 COMMAND_MODULES: dict[str, tuple[str, ...]] = {
     "info": ("info",),
@@ -33,13 +33,14 @@ COMMAND_MODULES: dict[str, tuple[str, ...]] = {
     "bench batch": ("bench_batch",),
     "bench feet": ("bench_feet",),
     "bench io": ("bench_io",),
-    "bench filters": ("filters",),
+    "bench filters": ("bench_filters",),
     "bench limits": ("bench_limits",),
     "bench markers": ("bench_markers",),
-    "bench render": ("render",),
-    "bench twist": ("twist",),
+    "bench render": ("bench_render",),
+    "bench twist": ("bench_twist",),
 }
-"""The modules of :mod:`mocapqa.cli` that register each command (a test checks the table)."""
+"""The modules that register each command (a test checks the table): those of
+:mod:`mocapqa.cli`, and for ``bench …`` (``bench_*``) those of :mod:`mocapqa_bench.cli`."""
 _ALL_MODULES = tuple(sorted({m for modules in COMMAND_MODULES.values() for m in modules}))
 
 
@@ -55,6 +56,20 @@ def modules_for(argv: Sequence[str]) -> tuple[str, ...]:
     return COMMAND_MODULES.get(key, _ALL_MODULES)
 
 
+def import_command_module(module: str) -> None:
+    """Import a module of :data:`COMMAND_MODULES`, registering its commands.
+
+    The ``bench_*`` modules are the benchmarks' (:mod:`mocapqa_bench.cli`): this is the one
+    place the product imports the benchmarks (an import contract checks it).
+    """
+    if module.startswith("bench_"):
+        from mocapqa_bench.cli import load
+
+        load(module)
+    else:
+        importlib.import_module(f"mocapqa.cli.{module}")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; user errors print one line and exit non-zero, without a traceback.
 
@@ -64,7 +79,7 @@ def main(argv: list[str] | None = None) -> int:
     """
     args = sys.argv[1:] if argv is None else argv
     for module in modules_for(args):
-        importlib.import_module(f"mocapqa.cli.{module}")
+        import_command_module(module)
     try:
         app(args=args, prog_name="mocapqa")
     except SystemExit as e:

@@ -1,24 +1,22 @@
-"""``mocapqa render`` (stills, clips, contact sheets) and ``mocapqa bench render``."""
+"""``mocapqa render`` (stills, clips, contact sheets; the benchmark:
+:mod:`mocapqa_bench.cli.bench_render`)."""
 
 from __future__ import annotations
 
-import tempfile
-import time
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import numpy as np
 import typer
 from rich.console import Console
 from rich.progress import Progress
-from rich.table import Table
 
-from mocapqa.cli.app import app, bench_app
+from mocapqa.cli.app import app
 from mocapqa.cli.outputs import check_outputs, require_suffix, take_input
 from mocapqa.cli.reading import read_input
-from mocapqa.cli.report import TakeRun, analyze_take, build_take_report, sheet_tiles
+from mocapqa.cli.report import TakeRun, analyze_take, sheet_tiles
 from mocapqa.cli.roles import (
     MappingOption,
     RootTranslationOption,
@@ -28,7 +26,11 @@ from mocapqa.cli.roles import (
 )
 from mocapqa.errors import InputError, NotFoundError, OptionError, ShapeError
 
-__all__ = ["bench_render", "flagged_at", "parse_interval", "raw_run", "render"]
+if TYPE_CHECKING:
+    from mocapqa.render.service import RenderService
+    from mocapqa.render.still import StillOptions
+
+__all__ = ["flagged_at", "parse_interval", "raw_run", "render"]
 
 console = Console(highlight=False)
 
@@ -107,8 +109,65 @@ def render(
 ) -> None:
     """Render a still (--frame), a clip (--interval) or a contact sheet (--contact-sheet)."""
     from mocapqa.io.atomic import write_bytes
-    from mocapqa.render.clip import CLIP_FORMATS
     from mocapqa.render.service import RenderService
+
+    options = _checked_request(
+        input_path, output, frame, interval, contact_sheet, mapping, width, height
+    )
+    with Progress(console=console, transient=True) as bar, RenderService() as service:
+        task = bar.add_task("reading", total=100)
+
+        def step(percent: int, text: str) -> None:
+            bar.update(task, completed=percent, description=text)
+
+        run = _read_run(input_path, analyze, mapping, root_translation, up_axis, step)
+        tick: Callable[[int, int], None] = lambda done, total: bar.update(  # noqa: E731
+            task, completed=100 * done / total, description=f"rendering {done}/{total}"
+        )
+        if frame is not None:
+            flags = flagged_at(run, frame) if 0 <= frame < run.raw.n_frames else None
+            step(0, "rendering")
+            if compare:
+                data = service.side_by_side(run.raw, run.corrected, frame, flags, options)
+            else:
+                data = service.still(run.raw, frame, flags, options=options)
+        elif interval is not None:
+            data = _clip(service, run, interval, output, tick)
+        else:
+            tiles = sheet_tiles(run)
+            if not tiles:
+                raise InputError(
+                    f"Expected flagged intervals for a contact sheet, got none in {input_path}"
+                )
+            data = service.contact_sheet(run.raw, tiles, run.corrected, progress=tick)
+    write_bytes(output, data)
+    console.print(f"{output} ({len(data) / 1e3:.0f} kB)")
+
+
+def _checked_request(
+    input_path: Path,
+    output: Path,
+    frame: int | None,
+    interval: str | None,
+    contact_sheet: bool,
+    mapping: Path | None,
+    width: int,
+    height: int,
+) -> StillOptions:
+    """The image size as still options, once the request is found sound: one of --frame,
+    --interval and --contact-sheet, an existing take, an output suffix that suits what is
+    drawn, outputs that do not overwrite the inputs (all before the take is read).
+
+    Raises
+    ------
+    OptionError
+        For a width or height out of range.
+    InputError
+        For none or several of the three, or an output suffix that does not suit.
+    NotFoundError
+        For a take file that does not exist.
+    """
+    from mocapqa.render.clip import CLIP_FORMATS
     from mocapqa.render.still import StillOptions
 
     try:  # checked before the take is read
@@ -129,128 +188,48 @@ def render(
         what = "a still (--frame)" if frame is not None else "a contact sheet"
         require_suffix("-o", output, (".png",), what)
     check_outputs({"-o": output}, [take_input(input_path), mapping])
-    with Progress(console=console, transient=True) as bar, RenderService() as service:
-        task = bar.add_task("reading", total=100)
+    return options
 
-        def step(percent: int, text: str) -> None:
-            bar.update(task, completed=percent, description=text)
 
-        roles = load_mapping(mapping)
-        if analyze:
-            chosen_options = {"mapping": roles} if roles else None
-            run = analyze_take(input_path, chosen_options, step, root_translation)
-        else:
-            run = raw_run(input_path, roles, root_translation)
-        warn_missing(run.analysis.get("summary", {}).get("missing_roles") or [])
-        if up_axis is not None:
-            run = TakeRun(
-                run.analysis,
-                replace(run.raw, up_axis=up_axis),
-                replace(run.corrected, up_axis=up_axis),
-            )
-        tick: Callable[[int, int], None] = lambda done, total: bar.update(  # noqa: E731
-            task, completed=100 * done / total, description=f"rendering {done}/{total}"
+def _read_run(
+    input_path: Path,
+    analyze: bool,
+    mapping: Path | None,
+    root_translation: Literal["auto", "add", "replace"],
+    up_axis: str | None,
+    step: Callable[[int, str], None],
+) -> TakeRun:
+    """The take, analysed or read as it is, with its up axis overridden when one is given;
+    warns of the roles not found."""
+    roles = load_mapping(mapping)
+    if analyze:
+        chosen_options = {"mapping": roles} if roles else None
+        run = analyze_take(input_path, chosen_options, step, root_translation)
+    else:
+        run = raw_run(input_path, roles, root_translation)
+    warn_missing(run.analysis.get("summary", {}).get("missing_roles") or [])
+    if up_axis is not None:
+        run = TakeRun(
+            run.analysis,
+            replace(run.raw, up_axis=up_axis),
+            replace(run.corrected, up_axis=up_axis),
         )
-        if frame is not None:
-            flags = flagged_at(run, frame) if 0 <= frame < run.raw.n_frames else None
-            step(0, "rendering")
-            if compare:
-                data = service.side_by_side(run.raw, run.corrected, frame, flags, options)
-            else:
-                data = service.still(run.raw, frame, flags, options=options)
-        elif interval is not None:
-            joint, start, end = parse_interval(interval)
-            if joint not in run.raw.names:
-                raise InputError(f"Expected a joint of the take in --interval, got {joint!r}")
-            fmt = output.suffix.lower().lstrip(".")
-            flags = np.zeros(len(run.raw.names), dtype=bool)
-            flags[run.raw.names.index(joint)] = True
-            data = service.clip(run.raw, start, end, run.corrected, flags, fmt, tick)
-        else:
-            tiles = sheet_tiles(run)
-            if not tiles:
-                raise InputError(
-                    f"Expected flagged intervals for a contact sheet, got none in {input_path}"
-                )
-            data = service.contact_sheet(run.raw, tiles, run.corrected, progress=tick)
-    write_bytes(output, data)
-    console.print(f"{output} ({len(data) / 1e3:.0f} kB)")
+    return run
 
 
-def _long_take(source: Path, n_frames: int, folder: Path) -> Path:
-    """A BVH of ``n_frames`` frames made by repeating a real take end to end."""
-    from mocapqa.io.bvh import read_bvh
-    from mocapqa.io.bvh_write import write_bvh
-
-    motion = read_bvh(source)
-    index = np.arange(n_frames) % motion.n_frames
-    hint = motion.euler_hint_deg
-    longer = replace(
-        motion,
-        quats=motion.quats[index],
-        translations=motion.translations[index],
-        euler_hint_deg=None if hint is None else hint[index],
-    )
-    path = folder / f"{source.stem}_x{n_frames}.bvh"
-    write_bvh(path, longer)
-    return path
-
-
-@bench_app.command("render")
-def bench_render(
-    take: Annotated[Path, typer.Argument(help="A BVH take to draw.")],
-    long_take: Annotated[
-        Path | None, typer.Option(help="BVH repeated to --report-frames for the report timing.")
-    ] = None,
-    stills: Annotated[int, typer.Option(help="Stills to time.")] = 10,
-    clip_frames: Annotated[int, typer.Option(help="Frames in the timed GIF.")] = 30,
-    report_frames: Annotated[int, typer.Option(help="Frames of the timed report's take.")] = 2000,
-) -> None:
-    """Time stills, side-by-side images, a GIF and a full report; prints a table."""
-    from mocapqa.render.service import RenderService
-
-    rows: list[tuple[str, str, str]] = []
-    run = analyze_take(take)
-    n = run.raw.n_frames
-    frames = np.linspace(0, n - 1, stills).round().astype(int)
-    with RenderService() as service:
-        started = time.perf_counter()
-        service.still(run.raw, int(frames[0]))
-        rows.append(("first still (VTK start-up)", "1", f"{time.perf_counter() - started:.2f}"))
-        started = time.perf_counter()
-        for f in frames:
-            service.still(run.raw, int(f), flagged_at(run, int(f)))
-        per = (time.perf_counter() - started) / len(frames)
-        rows.append(("still 640×480, per image", str(len(frames)), f"{per:.3f}"))
-        started = time.perf_counter()
-        for f in frames:
-            service.side_by_side(run.raw, run.corrected, int(f), flagged_at(run, int(f)))
-        per = (time.perf_counter() - started) / len(frames)
-        rows.append(("raw | corrected 1280×480, per image", str(len(frames)), f"{per:.3f}"))
-        started = time.perf_counter()
-        service.thumbnail(run.raw)
-        rows.append(("thumbnail 192×144", "1", f"{time.perf_counter() - started:.3f}"))
-        end = min(n - 1, clip_frames - 1)
-        started = time.perf_counter()
-        gif = service.clip(run.raw, 0, end, run.corrected, None, "gif")
-        rows.append(
-            (f"GIF raw | corrected, {end + 1} frames ({len(gif) / 1e3:.0f} kB)", "1",
-             f"{time.perf_counter() - started:.2f}")
-        )  # fmt: skip
-        with tempfile.TemporaryDirectory() as folder:
-            source = _long_take(long_take or take, report_frames, Path(folder))
-            started = time.perf_counter()
-            html = build_take_report(source, service)
-            elapsed = time.perf_counter() - started
-            external = html.count('src="http') + html.count("src='http")
-            rows.append(
-                (f"report, {report_frames} frames ({len(html) / 1e6:.1f} MB, "
-                 f"{external} external sources)", "1", f"{elapsed:.2f}")
-            )  # fmt: skip
-    table = Table(title=f"mocapqa bench render · {take.name}")
-    table.add_column("what")
-    table.add_column("n", justify="right")
-    table.add_column("seconds", justify="right")
-    for row in rows:
-        table.add_row(*row)
-    console.print(table)
+def _clip(
+    service: RenderService,
+    run: TakeRun,
+    interval: str,
+    output: Path,
+    tick: Callable[[int, int], None],
+) -> bytes:
+    """The clip of ``--interval`` (raw | corrected, its joint flagged), in the output's
+    format."""
+    joint, start, end = parse_interval(interval)
+    if joint not in run.raw.names:
+        raise InputError(f"Expected a joint of the take in --interval, got {joint!r}")
+    fmt = output.suffix.lower().lstrip(".")
+    flags = np.zeros(len(run.raw.names), dtype=bool)
+    flags[run.raw.names.index(joint)] = True
+    return service.clip(run.raw, start, end, run.corrected, flags, fmt, tick)

@@ -2,7 +2,7 @@
 
 Both builds start with one round of tasks, :func:`take_summary` per BVH file (its split group,
 whether it has roles, its rig key, frame count and skeleton), from which the client picks the
-build takes by the fixed split (:mod:`mocapqa.bench.limits`); :func:`build_on_engine` runs
+build takes by the fixed split (:mod:`mocapqa.limits.split`); :func:`build_on_engine` runs
 either build.
 
 A per-rig build (:func:`mocapqa.limits.build.build_model`) then needs one more round:
@@ -16,7 +16,7 @@ their own files (paths on storage the workers share), in three rounds, each retu
 results:
 
 1. :func:`take_summary` per BVH file, from which the client picks the build takes (every
-   take with roles; :func:`mocapqa.bench.limits.held_back_names`);
+   take with roles; :func:`mocapqa.limits.split.held_back_names`);
 2. :func:`world_sample` per build take: its world poses at the frames the frame estimate of
    its rig keeps (:func:`mocapqa.limits.canonical.pose_sample` over the rig's pooled frames,
    at most 4,000 per rig), from which the client frames every rig as
@@ -93,7 +93,7 @@ class TakeSummary:
     ----------
     path : str
     group : tuple or None
-        :func:`mocapqa.bench.limits.split_group`.
+        :func:`mocapqa.limits.split.split_group`.
     has_roles : bool
         Whether the skeleton has limb roles (a rig fingerprint).
     rig : str
@@ -231,8 +231,8 @@ def build_on_engine(
 ) -> LimitsModel:
     """The model of ``mocapqa limits build``, with the per-take work on ``engine``: without
     ``rig`` the canonical model of :func:`mocapqa.limits.build.build_canonical_model` over
-    :func:`mocapqa.bench.limits.canonical_takes`; with it, the per-rig model of
-    :func:`mocapqa.limits.build.build_model` over :func:`mocapqa.bench.limits.rig_takes`.
+    :func:`mocapqa.jobs.limits_takes.canonical_takes`; with it, the per-rig model of
+    :func:`mocapqa.limits.build.build_model` over :func:`mocapqa.jobs.limits_takes.rig_takes`.
 
     Parameters
     ----------
@@ -292,7 +292,7 @@ def _canonical_takes(
     corpus_dir: Path, summaries: Sequence[TakeSummary], all_takes: bool,
     exclude: frozenset[str] | set[str],
 ) -> list[TakeSummary]:  # fmt: skip
-    """The takes of :func:`mocapqa.bench.limits.canonical_takes` among ``summaries``."""
+    """The takes of :func:`mocapqa.jobs.limits_takes.canonical_takes` among ``summaries``."""
     held = set() if all_takes else held_back_names([(s.name, s.group) for s in summaries])
     takes = [s for s in summaries if s.has_roles and s.name not in held and s.name not in exclude]
     if not takes:

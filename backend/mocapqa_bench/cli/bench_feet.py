@@ -2,8 +2,9 @@
 speeds chosen leaving each trial out), threshold choice on the fit takes, then recall of
 injected slides and penetrations and false skate flags on the held-back takes, and speed
 and the foot lock on held-back takes with slides injected through the leg
-(:mod:`mocapqa.bench.feet`). ``--plates-only`` stops after the force plates, ``--cleanup-only``
-runs only the foot lock's table (with the default parameters)."""
+(:mod:`mocapqa_bench.feet`, :mod:`mocapqa_bench.feet_plates`,
+:mod:`mocapqa_bench.feet_cleanup`). ``--plates-only`` stops after the force plates,
+``--cleanup-only`` runs only the foot lock's table (with the default parameters)."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from mocapqa.cli.app import bench_app
 
 if TYPE_CHECKING:
     from rich.console import Console
+    from rich.table import Table
 
     from mocapqa.core.arrays import FloatArray
 
@@ -39,8 +41,8 @@ def _plates_table(console: Console, root: Path) -> None:
     import numpy as np
     from rich.table import Table
 
-    from mocapqa.bench.feet import marker_params_by_leave_one_out, plate_trials
     from mocapqa.feet.plates import PLATE_THRESHOLD_N
+    from mocapqa_bench.feet_plates import marker_params_by_leave_one_out, plate_trials
 
     with console.status("reading the force-plate trials"):
         trials = plate_trials(root)
@@ -109,7 +111,7 @@ def _cleanup_table(console: Console, root: Path, takes: list[Any], params: Any, 
     import numpy as np
     from rich.table import Table
 
-    from mocapqa.bench.feet import CLEANUP_SLIDES_CM, held_back_cleanup
+    from mocapqa_bench.feet_cleanup import CLEANUP_SLIDES_CM, held_back_cleanup
 
     with console.status("locking feet on the held-back takes"):
         trials = held_back_cleanup(root, takes, params, seed)
@@ -165,6 +167,69 @@ def _cleanup_table(console: Console, root: Path, takes: list[Any], params: Any, 
     console.print(table)
 
 
+def _choice_table(choice: Any) -> Table:
+    """The skate parameters tried on the fit takes, with their recall and false flags."""
+    from rich.table import Table
+
+    from mocapqa_bench.feet import CLEAN_FAMILIES, MAX_FLAGS_PER_MINUTE
+
+    grid = Table(
+        title=f"Choice on the fit takes (false flags ≤ {MAX_FLAGS_PER_MINUTE}/min on "
+        f"{', '.join(CLEAN_FAMILIES)})",
+        title_justify="left",
+    )
+    for column in ("plant_height", "plant_speed", "skate_travel", "recall ≥ 2 cm", "flags/min"):
+        grid.add_column(column, justify="right")
+    for height, speed, travel, recall, flags in choice.candidates:
+        grid.add_row(f"{height:g}", f"{speed:g}", f"{travel:g}", f"{recall:.3f}", f"{flags:.2f}")
+    grid.caption = f"fit takes: {', '.join(choice.fit_takes)}"
+    return grid
+
+
+def _clean_table(root: Path, rows: list[Any]) -> Table:
+    """Contacts and skate findings per minute per family and split, on the takes as they are."""
+    from rich.table import Table
+
+    from mocapqa_bench.feet import CLEAN_FAMILIES
+
+    clean_table = Table(title=f"Clean takes ({root})", title_justify="left")
+    for column in ("family", "split", "takes", "minutes", "contacts", "skate/min"):
+        clean_table.add_column(column, justify="left" if column in ("family", "split") else "right")
+    for row in rows:
+        clean_table.add_row(
+            row.family + (" (clean)" if row.family in CLEAN_FAMILIES else ""), row.split,
+            str(row.takes), f"{row.minutes:.2f}", str(row.contacts),
+            f"{row.skate_per_minute:.2f}",
+        )  # fmt: skip
+    clean_table.caption = "skate/min: skate findings per minute on the takes as they are"
+    return clean_table
+
+
+def _recall_table(rows: list[Any], seed: int) -> Table:
+    """The injected slides and sinks found per family and split."""
+    from rich.table import Table
+
+    from mocapqa_bench.feet import DEPTHS_CM, SLIDES_CM
+
+    recall_table = Table(title=f"Injected errors found, seed {seed}", title_justify="left")
+    recall_table.add_column("injected")
+    for row in rows:
+        recall_table.add_column(f"{row.family}\n{row.split}", justify="right")
+    for size in SLIDES_CM:
+        recall_table.add_row(f"slide {size:g} cm", *(_share(r.slide_recall[size]) for r in rows))
+    for size in DEPTHS_CM:
+        recall_table.add_row(
+            f"sink {size:g} cm", *(_share(r.penetration_recall[size]) for r in rows)
+        )
+    recall_table.add_row("slide error cm", *(f"{r.slide_error_cm:.2f}" for r in rows))
+    recall_table.caption = (
+        "found/tried; slides over the contact's middle (at most 1 s), sinks over its middle "
+        "half (at most 0.5 s) where the foot stands on the floor; slide error: median "
+        "|measured − injected| of the slides found"
+    )
+    return recall_table
+
+
 @bench_app.command("feet")
 def bench_feet(
     data: Annotated[
@@ -191,20 +256,10 @@ def bench_feet(
     """Contacts against force plates; injected slide and penetration recall, false skate flags
     per minute, foot-frames/s."""
     from rich.console import Console
-    from rich.table import Table
 
-    from mocapqa.bench.feet import (
-        CLEAN_FAMILIES,
-        DEPTHS_CM,
-        MAX_FLAGS_PER_MINUTE,
-        SLIDES_CM,
-        bench_takes,
-        choose_params,
-        family_figures,
-        feet_speed,
-    )
     from mocapqa.corpus import require_corpus
     from mocapqa.feet.params import FeetParams
+    from mocapqa_bench.feet import bench_takes, choose_params, family_figures, feet_speed
 
     console = Console()
     root = require_corpus(data)
@@ -222,19 +277,7 @@ def bench_feet(
         with console.status("choosing the skate parameters on the fit takes"):
             choice = choose_params(takes, seed)
         params = choice.params
-        grid = Table(
-            title=f"Choice on the fit takes (false flags ≤ {MAX_FLAGS_PER_MINUTE}/min on "
-            f"{', '.join(CLEAN_FAMILIES)})",
-            title_justify="left",
-        )
-        for column in ("plant_height", "plant_speed", "skate_travel", "recall ≥ 2 cm", "flags/min"):
-            grid.add_column(column, justify="right")
-        for height, speed, travel, recall, flags in choice.candidates:
-            grid.add_row(
-                f"{height:g}", f"{speed:g}", f"{travel:g}", f"{recall:.3f}", f"{flags:.2f}"
-            )
-        grid.caption = f"fit takes: {', '.join(choice.fit_takes)}"
-        console.print(grid)
+        console.print(_choice_table(choice))
     console.print(
         f"parameters: skate_travel={params.skate_travel:g}, plant_height="
         f"{params.plant_height:g}, plant_speed={params.plant_speed:g} (leg lengths), "
@@ -243,34 +286,8 @@ def bench_feet(
     )
     with console.status("injecting slides and penetrations"):
         rows = family_figures(takes, params, seed)
-    clean_table = Table(title=f"Clean takes ({root})", title_justify="left")
-    for column in ("family", "split", "takes", "minutes", "contacts", "skate/min"):
-        clean_table.add_column(column, justify="left" if column in ("family", "split") else "right")
-    for row in rows:
-        clean_table.add_row(
-            row.family + (" (clean)" if row.family in CLEAN_FAMILIES else ""), row.split,
-            str(row.takes), f"{row.minutes:.2f}", str(row.contacts),
-            f"{row.skate_per_minute:.2f}",
-        )  # fmt: skip
-    clean_table.caption = "skate/min: skate findings per minute on the takes as they are"
-    console.print(clean_table)
-    recall_table = Table(title=f"Injected errors found, seed {seed}", title_justify="left")
-    recall_table.add_column("injected")
-    for row in rows:
-        recall_table.add_column(f"{row.family}\n{row.split}", justify="right")
-    for size in SLIDES_CM:
-        recall_table.add_row(f"slide {size:g} cm", *(_share(r.slide_recall[size]) for r in rows))
-    for size in DEPTHS_CM:
-        recall_table.add_row(
-            f"sink {size:g} cm", *(_share(r.penetration_recall[size]) for r in rows)
-        )
-    recall_table.add_row("slide error cm", *(f"{r.slide_error_cm:.2f}" for r in rows))
-    recall_table.caption = (
-        "found/tried; slides over the contact's middle (at most 1 s), sinks over its middle "
-        "half (at most 0.5 s) where the foot stands on the floor; slide error: median "
-        "|measured − injected| of the slides found"
-    )
-    console.print(recall_table)
+    console.print(_clean_table(root, rows))
+    console.print(_recall_table(rows, seed))
     _cleanup_table(console, root, takes, params, seed)
     with console.status("timing"):
         rate = feet_speed(takes, params)

@@ -1,7 +1,7 @@
 """Rotation filters on real takes with seeded rotation noise, and QuaMo's ablation.
 
 Ground truth is the Bandai takes' local joint rotations; the noise is
-:func:`mocapqa.bench.noise.rotation_noise` on every joint (root translation kept true, so the
+:func:`mocapqa_bench.noise.rotation_noise` on every joint (root translation kept true, so the
 figures measure rotations only). MPJPE and Accel use forward-kinematics joint positions
 (millimetres; the takes are in centimetres). Gains are tuned on the training takes.
 """
@@ -16,8 +16,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mocapqa.bench.filters import Row, Take
-from mocapqa.bench.noise import rotation_noise
 from mocapqa.core.arrays import FloatArray
 from mocapqa.filters.apply import filter_motion
 from mocapqa.filters.butterworth import ButterworthParams, butterworth_quats
@@ -28,6 +26,8 @@ from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.kinematics.forward import world_from_local
 from mocapqa.kinematics.quaternion import geodesic_angle
 from mocapqa.metrics.smoothness import acceleration_error, mean_distance
+from mocapqa_bench.filters import Row, Take
+from mocapqa_bench.noise import rotation_noise
 
 __all__ = [
     "RotationCase",

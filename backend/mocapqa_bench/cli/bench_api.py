@@ -14,7 +14,7 @@ import typer
 from mocapqa.cli.app import bench_app
 
 if TYPE_CHECKING:
-    from mocapqa.bench.api_load import Client, LoadResult, Seed, ServerProcess
+    from mocapqa_bench.api_load import Client, LoadResult, Seed, ServerProcess
 
 __all__ = [
     "LOAD_SETTINGS",
@@ -43,11 +43,11 @@ def load_clients(
 ) -> list[Client]:
     """Make ``count`` users (a share ``writers`` of them reviewers, the rest viewers) with a
     personal token each, and an admin named ``load_admin``; the clients, in user order."""
-    from mocapqa.bench.api_load import Client
     from mocapqa.errors import NotFoundError
     from mocapqa.store.accounts import Accounts
     from mocapqa.store.repository import Repository
     from mocapqa.store.roles import Role
+    from mocapqa_bench.api_load import Client
 
     repository = Repository(database_url)
     try:
@@ -89,8 +89,8 @@ def admin_token(database_url: str) -> str:
 def seed_take(base: str, token: str) -> tuple[Seed, bytes]:
     """Upload the demo take with twist errors, wait for its run; the seed and the short take
     the clients upload."""
-    from mocapqa.bench.api_load import Connection, Seed, short_take, wait_until
     from mocapqa.jobs.demo import demo_paths
+    from mocapqa_bench.api_load import Connection, Seed, short_take, wait_until
 
     path = next(p for p in demo_paths() if p.name == SEED_FILE)
     http = Connection(base, token)
@@ -117,7 +117,7 @@ def seed_take(base: str, token: str) -> tuple[Seed, bytes]:
 def loaded_server(data_dir: Path, database_url: str | None) -> Iterator[ServerProcess]:
     """A ``mocapqa serve`` child on ``data_dir`` (and ``database_url``) with
     :data:`LOAD_SETTINGS`; stopped after."""
-    from mocapqa.bench.api_load import ServerProcess
+    from mocapqa_bench.api_load import ServerProcess
 
     environ = dict(LOAD_SETTINGS)
     if database_url:
@@ -155,7 +155,7 @@ def fresh_server(database_url: str | None) -> Iterator[tuple[ServerProcess, str,
 def _table(result: LoadResult, what: str) -> object:
     from rich.table import Table
 
-    from mocapqa.bench.api_load import route_figures
+    from mocapqa_bench.api_load import route_figures
 
     table = Table(
         title=f"{what}: {len(result.samples)} requests in {result.seconds:.1f} s",
@@ -214,8 +214,8 @@ def bench_api(
     import numpy as np
     from rich.console import Console
 
-    from mocapqa.bench.api_load import run_load, run_streams
-    from mocapqa.bench.api_load import stream_frames as frame_messages
+    from mocapqa_bench.api_load import run_load, run_streams
+    from mocapqa_bench.api_load import stream_frames as frame_messages
 
     counts: Sequence[int] = clients or [1, 10, 50, 100]
     pauses: Sequence[float] = think if think is not None else [1.0, 0.0]

@@ -13,7 +13,7 @@ retargets) and ``bandai``. Within each rig, files at even positions of the sorte
 *fit* set (the one the confidence calibration is fitted on) and those at odd positions the
 *held-out* set; results are reported for both and overall. The takes of
 :data:`REAL_ERROR_TAKES` carry real twist errors and are never injected into (they are
-evaluation data only, see :mod:`mocapqa.bench.natural`).
+evaluation data only, see :mod:`mocapqa_bench.natural`).
 
 Every interval a method reports, on injected and on clean takes, is recorded with its
 confidence features and whether it is *right*: applying it alone removes at least 80 % of the
@@ -23,9 +23,10 @@ a clean take is never right). Those records feed the calibration fit and reliabi
 
 from __future__ import annotations
 
+import functools
 import time
 import zlib
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -36,7 +37,6 @@ from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
-from mocapqa.limits.rig import rig_family
 from mocapqa.metrics.twist import (
     CleanChange,
     TwistAccuracy,
@@ -48,24 +48,20 @@ from mocapqa.twist.analysis import TwistAnalysis, analyze_twist, detect_chains
 from mocapqa.twist.angles import chain_geometry, wrap_angle
 from mocapqa.twist.detect import PaperParams, RobustParams
 from mocapqa.twist.inject import InjectionTruth, inject_twist_errors
-from mocapqa.twist.natural_roll import NaturalRoll, event_jumps_deg, natural_key
 from mocapqa.twist.refine import refine_quats
 
 __all__ = [
-    "OFFSET_BANDS",
     "REAL_ERROR_TAKES",
     "RIGS",
     "BenchFile",
     "IntervalRecord",
     "MethodResult",
-    "SmallOffsetRow",
     "TwistBenchResult",
-    "clean_event_jumps",
     "find_bench_files",
     "interval_records",
     "rig_of",
     "run_twist_bench",
-    "small_offset_rows",
+    "seeded_injections",
     "speed_frames_per_s",
 ]
 
@@ -387,6 +383,67 @@ def _count_ends(
         counts[2] += int(after.sum() <= 0.2 * before.sum())
 
 
+def seeded_injections(
+    motion: Motion,
+    bench_file: BenchFile,
+    seed: int,
+    repeats: int,
+    inject: Callable[[Motion, np.random.Generator], tuple[Motion, InjectionTruth]],
+) -> Iterator[tuple[int, Motion, InjectionTruth]]:
+    """Errors injected into a take ``repeats`` times by ``inject``, each seeded by ``(seed,
+    crc32(file name), repeat)``: ``(repeat, corrupted, truth)``; an injection the take is too
+    short for (an InputError) is left out."""
+    name_key = zlib.crc32(bench_file.path.name.encode())
+    for repeat in range(repeats):
+        rng = np.random.default_rng((seed, name_key, repeat))
+        try:
+            corrupted, truth = inject(motion, rng)
+        except InputError:
+            continue
+        yield repeat, corrupted, truth
+
+
+def _score_targets(
+    result: MethodResult, bench_file: BenchFile, corrupted: Motion, truth: InjectionTruth,
+    refined: Motion, counts: list[int],
+) -> None:  # fmt: skip
+    """Add the rotation errors of each injected target before and after the refinement, the
+    corrected frames (``counts``: [corrected, error frames] of the take) and the largest change
+    outside the errors to ``result``."""
+    group = (bench_file.rig, bench_file.held_out)
+    for k, target in enumerate(truth.targets):
+        rows = truth.error_mask[:, target]
+        key = (bench_file.rig, bench_file.held_out, truth.sides[k], truth.segments[k])
+        clean_rows = truth.clean_quats[rows, target]
+        before = rotation_errors_deg(clean_rows, corrupted.quats[rows, target])
+        after = rotation_errors_deg(clean_rows, refined.quats[rows, target])
+        result.before.setdefault(key, []).append(before)
+        result.after.setdefault(key, []).append(after)
+        counts[0] += int(np.sum(after <= 0.2 * before))
+        counts[1] += len(before)
+        spill = rotation_errors_deg(truth.clean_quats[~rows, target], refined.quats[~rows, target])
+        result.spill[group] = max(result.spill.get(group, 0.0), float(spill.max(initial=0.0)))
+
+
+def _score_clean(
+    result: MethodResult, bench_file: BenchFile, motion: Motion, method: str,
+    params: RobustParams | PaperParams | None, apply: str,
+) -> None:  # fmt: skip
+    """Add the method's intervals, time and change on the take as recorded to ``result``."""
+    group = (bench_file.rig, bench_file.held_out)
+    start = time.perf_counter()
+    analysis = analyze_twist(motion, method, params=params, apply=apply)
+    elapsed = time.perf_counter() - start
+    result.records += interval_records(analysis, None, bench_file)
+    result.seconds[bench_file.rig] = result.seconds.get(bench_file.rig, 0.0) + elapsed
+    result.frames[bench_file.rig] = result.frames.get(bench_file.rig, 0) + motion.n_frames
+    has_rotation = np.array([bool(motion.skeleton.rotation_order(j)) for j in
+                             range(motion.skeleton.n_joints)])  # fmt: skip
+    mask = np.broadcast_to(has_rotation, motion.quats.shape[:2])
+    change = clean_change(motion.quats, analysis.refined.quats, 1.0, mask)
+    result.clean.setdefault(group, []).append(change)
+
+
 def run_twist_bench(
     files: Sequence[BenchFile],
     methods: dict[str, tuple[str, RobustParams | PaperParams | None]],
@@ -428,17 +485,12 @@ def run_twist_bench(
     n_injections = 0
     for bench_file in files:
         motion = read_bvh(bench_file.path)
-        name_key = zlib.crc32(bench_file.path.name.encode())
-        injected = []
-        for repeat in range(repeats):
-            rng = np.random.default_rng((seed, name_key, repeat))
-            try:
-                injected.append(inject_twist_errors(motion, rng, kind=kind, ends=ends))
-            except InputError:
-                continue
+        inject = functools.partial(inject_twist_errors, kind=kind, ends=ends)
+        injected = [
+            (corrupted, truth)
+            for _, corrupted, truth in seeded_injections(motion, bench_file, seed, repeats, inject)
+        ]
         n_injections += len(injected)
-        has_rotation = np.array([bool(motion.skeleton.rotation_order(j)) for j in
-                                 range(motion.skeleton.n_joints)])  # fmt: skip
         take_key = (bench_file.rig, bench_file.held_out, bench_file.path.name)
         group = (bench_file.rig, bench_file.held_out)
         for label, (method, params) in methods.items():
@@ -446,180 +498,12 @@ def run_twist_bench(
             counts = result.per_take.setdefault(take_key, [0, 0])
             for corrupted, truth in injected:
                 analysis = analyze_twist(corrupted, method, params=params, apply=apply)
-                refined = analysis.refined
                 result.records += interval_records(analysis, truth.offsets_rad, bench_file)
                 if ends:
                     _count_ends(result.ends.setdefault(group, [0, 0, 0]), analysis, truth,
                                 corrected=corrupted, ends=ends)  # fmt: skip
-                for k, target in enumerate(truth.targets):
-                    rows = truth.error_mask[:, target]
-                    key = (bench_file.rig, bench_file.held_out, truth.sides[k], truth.segments[k])
-                    clean_rows = truth.clean_quats[rows, target]
-                    before = rotation_errors_deg(clean_rows, corrupted.quats[rows, target])
-                    after = rotation_errors_deg(clean_rows, refined.quats[rows, target])
-                    result.before.setdefault(key, []).append(before)
-                    result.after.setdefault(key, []).append(after)
-                    counts[0] += int(np.sum(after <= 0.2 * before))
-                    counts[1] += len(before)
-                    spill = rotation_errors_deg(
-                        truth.clean_quats[~rows, target], refined.quats[~rows, target]
-                    )
-                    result.spill[group] = max(
-                        result.spill.get(group, 0.0), float(spill.max(initial=0.0))
-                    )
-            start = time.perf_counter()
-            analysis = analyze_twist(motion, method, params=params, apply=apply)
-            elapsed = time.perf_counter() - start
-            result.records += interval_records(analysis, None, bench_file)
-            result.seconds[bench_file.rig] = result.seconds.get(bench_file.rig, 0.0) + elapsed
-            result.frames[bench_file.rig] = result.frames.get(bench_file.rig, 0) + motion.n_frames
-            mask = np.broadcast_to(has_rotation, motion.quats.shape[:2])
-            change = clean_change(motion.quats, analysis.refined.quats, 1.0, mask)
-            result.clean.setdefault(group, []).append(change)
+                _score_targets(result, bench_file, corrupted, truth, analysis.refined, counts)
+            _score_clean(result, bench_file, motion, method, params, apply)
         if on_file is not None:
             on_file(bench_file)
     return TwistBenchResult(results, len(files), n_injections)
-
-
-OFFSET_BANDS = ((5.0, 10.0), (10.0, 15.0), (15.0, 20.0), (20.0, 180.0))
-"""Bands of injected offset magnitude, degrees, of the small-offset table (the last is > 20°)."""
-
-
-def clean_event_jumps(files: Sequence[BenchFile]) -> dict[str, FloatArray]:
-    """Absolute jumps of the robust detector's events on the clean takes ``files``, degrees.
-
-    Returns
-    -------
-    dict
-        :func:`mocapqa.twist.natural_roll.natural_key` (rig family, segment) → jumps; keys with
-        no event are absent.
-    """
-    out: dict[str, list[FloatArray]] = {}
-    for bench_file in files:
-        motion = read_bvh(bench_file.path)
-        geometries = tuple(
-            chain_geometry(motion.skeleton, c) for c in limb_chains(find_roles(motion.skeleton))
-        )
-        detection = detect_chains(motion.quats, geometries, motion.fps)
-        family = rig_family(motion.skeleton)
-        for segment, jumps in event_jumps_deg(detection, geometries).items():
-            out.setdefault(natural_key(family, segment), []).append(jumps)
-    return {k: np.concatenate(v) for k, v in out.items()}
-
-
-@dataclass(frozen=True, slots=True)
-class SmallOffsetRow:
-    """Injected level shifts of one rig and offset band (:func:`small_offset_rows`).
-
-    Parameters
-    ----------
-    rig : str
-    band : tuple of float
-        Offset magnitude band, degrees ``[low, high)``.
-    injected : int
-        Intervals injected.
-    distinguishable : int
-        Of them, those larger than the natural roll level of their rig segment.
-    found : int
-        Intervals that a reported interval of their joint overlaps.
-    applied_before, applied : int
-        Intervals that an interval applied by default overlaps, without and with the natural
-        roll rule.
-    hidden_applied_before, hidden_applied : int
-        The same among the intervals that are not distinguishable.
-    frames, corrected_before, corrected : int
-        Injected frames and those corrected (at most 20 % of the rotation error left), without
-        and with the natural roll rule.
-    """
-
-    rig: str
-    band: tuple[float, float]
-    injected: int
-    distinguishable: int
-    found: int
-    applied_before: int
-    applied: int
-    hidden_applied_before: int
-    hidden_applied: int
-    frames: int
-    corrected_before: int
-    corrected: int
-
-
-def small_offset_rows(
-    files: Sequence[BenchFile],
-    natural: NaturalRoll,
-    seed: int = 0,
-    repeats: int = 2,
-) -> list[SmallOffsetRow]:
-    """Injected level shifts by offset band and rig: found, applied by default and corrected,
-    without and with the natural roll rule, and how many are larger than their rig segment's
-    natural roll level.
-
-    The injections are those of :func:`run_twist_bench` (``kind="level"``, same seeds), so the
-    rows split its level-shift figures of the same takes.
-
-    Parameters
-    ----------
-    files : sequence of BenchFile
-        Takes to inject (the bench passes the held-out ones).
-    natural : NaturalRoll
-        The levels of the rule (and of "distinguishable").
-    seed, repeats : int
-        As in :func:`run_twist_bench`.
-
-    Returns
-    -------
-    list of SmallOffsetRow
-        Per rig of ``files`` (in :data:`RIGS` order) and band of :data:`OFFSET_BANDS`.
-    """
-    counts: dict[tuple[str, int], np.ndarray] = {}
-    for bench_file in files:
-        motion = read_bvh(bench_file.path)
-        family = rig_family(motion.skeleton)
-        name_key = zlib.crc32(bench_file.path.name.encode())
-        for repeat in range(repeats):
-            rng = np.random.default_rng((seed, name_key, repeat))
-            try:
-                corrupted, truth = inject_twist_errors(motion, rng)
-            except InputError:
-                continue
-            analyses = [analyze_twist(corrupted, natural_roll=NaturalRoll()),
-                        analyze_twist(corrupted, natural_roll=natural)]  # fmt: skip
-            names = list(corrupted.skeleton.names)
-            for injected in truth.intervals:
-                size = abs(injected.offset_deg)
-                band = next(
-                    (k for k, (low, high) in enumerate(OFFSET_BANDS) if low <= size < high),
-                    len(OFFSET_BANDS) - 1,
-                )
-                target = names.index(injected.joint)
-                rows = slice(injected.start_frame, injected.end_frame + 1)
-                level = natural.level_deg(family, injected.segment)
-                overlap = [
-                    [i for i in a.intervals if i.joint == injected.joint
-                     and i.start_frame <= injected.end_frame
-                     and i.end_frame >= injected.start_frame]
-                    for a in analyses
-                ]  # fmt: skip
-                before = rotation_errors_deg(truth.clean_quats[rows, target],
-                                             corrupted.quats[rows, target])  # fmt: skip
-                fixed = [
-                    int(np.sum(rotation_errors_deg(truth.clean_quats[rows, target],
-                                                   a.refined.quats[rows, target])
-                               <= 0.2 * before))
-                    for a in analyses
-                ]  # fmt: skip
-                hidden = size <= level
-                applied = [any(i.applied for i in o) for o in overlap]
-                counts.setdefault((bench_file.rig, band), np.zeros(10, dtype=np.int64))[:] += [
-                    1, int(not hidden), int(bool(overlap[1])), int(applied[0]), int(applied[1]),
-                    int(hidden and applied[0]), int(hidden and applied[1]),
-                    len(before), fixed[0], fixed[1],
-                ]  # fmt: skip
-    return [
-        SmallOffsetRow(rig, OFFSET_BANDS[band], *(int(v) for v in counts[rig, band]))
-        for rig in RIGS
-        for band in range(len(OFFSET_BANDS))
-        if (rig, band) in counts
-    ]

@@ -16,15 +16,17 @@ child is flagged; and check speed in joint-frames per second for the map and the
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
+from mocapqa.jobs.limits_takes import canonical_takes, rig_takes, split_takes
 from mocapqa.limits.analysis import check_limits, limit_params
 from mocapqa.limits.build import DEFAULT_BUILD, BuildParams, build_model
 from mocapqa.limits.model import LimitsModel
@@ -57,6 +59,7 @@ __all__ = [
     "role_takes",
     "split_group",
     "split_positions",
+    "tiled_take",
 ]
 
 
@@ -140,7 +143,7 @@ def corpus_rigs(corpus_dir: Path, families: tuple[str, ...] | None = None) -> li
     list of RigTakes
         Groups of two or more takes, sorted by family label.
     """
-    read = _split_takes(corpus_dir, families)
+    read = split_takes(corpus_dir, families)
     rigs = [
         RigTakes(
             str(key[0]),
@@ -150,38 +153,6 @@ def corpus_rigs(corpus_dir: Path, families: tuple[str, ...] | None = None) -> li
         for key, (build, back) in split_positions([key for _, key, _ in read]).items()
     ]
     return sorted(rigs, key=lambda r: r.family)
-
-
-def _split_takes(
-    corpus_dir: Path, families: tuple[str, ...] | None
-) -> list[tuple[str, tuple[object, ...], Motion]]:
-    """Name, split group and motion of every take of ``families`` (all families but
-    "other" when None), in :func:`corpus_files` order."""
-    read = []
-    for path in corpus_files(corpus_dir):
-        motion = read_bvh(path)
-        key = split_group(motion.skeleton)
-        if key is not None and (families is None or key[0] in families):
-            read.append((path.name, key, motion))
-    return read
-
-
-def rig_takes(
-    corpus_dir: Path, family: str, all_takes: bool = False,
-    exclude: set[str] | frozenset[str] = frozenset(),
-) -> tuple[tuple[str, Motion], ...]:  # fmt: skip
-    """The takes (names and motions) a per-rig model of ``family`` is built from
-    (:func:`rig_positions`).
-
-    Raises
-    ------
-    InputError
-        As :func:`rig_positions`, or if a file cannot be read (naming it).
-    """
-    check_rig_family(family)
-    read = _split_takes(corpus_dir, (family,))
-    chosen = rig_positions([(n, key) for n, key, _ in read], family, corpus_dir, all_takes, exclude)
-    return tuple((read[i][0], read[i][2]) for i in chosen)
 
 
 def role_takes(corpus_dir: Path) -> list[tuple[str, Motion]]:
@@ -200,37 +171,22 @@ def role_takes(corpus_dir: Path) -> list[tuple[str, Motion]]:
     return takes
 
 
-def canonical_takes(
-    corpus_dir: Path,
-    all_takes: bool = False,
-    exclude: set[str] | frozenset[str] = frozenset(),
-    mapping: Mapping[str, str] | None = None,
-) -> tuple[tuple[str, Motion], ...]:
-    """The takes a canonical model is built from: every take with roles, of any rig.
-
-    Takes of a rig family with two or more takes follow the fixed split (only the build
-    takes, unless ``all_takes``); single takes of other rigs are all used. Names in
-    ``exclude`` are left out. ``mapping`` gives roles to the takes whose skeleton has the
-    joints it names (:func:`mocapqa.core.rig.mapped_roles`).
-    """
-    read = [(path.name, read_bvh(path)) for path in corpus_files(corpus_dir)]
-    held = set() if all_takes else held_back_names([(n, split_group(m.skeleton)) for n, m in read])
-    return tuple(
-        (n, m) for n, m in read
-        if rig_fingerprint(m.skeleton, mapping) and n not in held and n not in exclude
-    )  # fmt: skip
-
-
-def _speed(model: LimitsModel, motion: Motion, method: str, repeats: int) -> float:
-    """Joint-frames per second of a full check ("map", "network") or of the lookup alone."""
-    # A long take (the held-back take tiled to ≥ 50,000 frames) so fixed costs do not dominate.
-    tiles = max(1, -(-50_000 // motion.n_frames))
-    motion = Motion(
+def tiled_take(motion: Motion, min_frames: int = 50_000) -> Motion:
+    """``motion`` repeated end to end to at least ``min_frames`` frames (a take long enough
+    for a check's fixed costs not to dominate its speed)."""
+    tiles = max(1, -(-min_frames // motion.n_frames))
+    return Motion(
         motion.skeleton,
         np.tile(motion.quats, (tiles, 1, 1)),
         np.tile(motion.translations, (tiles, 1, 1)),
         motion.fps,
     )
+
+
+def _speed(model: LimitsModel, motion: Motion, method: str, repeats: int) -> float:
+    """Joint-frames per second of a full check ("map", "network") or of the lookup alone."""
+    # A long take (the held-back take tiled to ≥ 50,000 frames) so fixed costs do not dominate.
+    motion = tiled_take(motion)
 
     def run() -> None:
         if method == "lookup":
@@ -246,6 +202,45 @@ def _speed(model: LimitsModel, motion: Motion, method: str, repeats: int) -> flo
         run()
     elapsed = time.perf_counter() - start
     return repeats * motion.n_frames * len(model.joints) / max(elapsed, 1e-9)
+
+
+def _injected_hits(
+    model: LimitsModel, motion: Motion, rng: np.random.Generator, min_offset_deg: float
+) -> tuple[int, int]:
+    """Twist errors injected into ``motion`` (offsets from ``min_offset_deg`` to 180°): the
+    error frames flagged on the target joint or its child, and the error frames."""
+    corrupted, truth = inject_twist_errors(
+        motion, rng, min_offset_deg=min_offset_deg, max_offset_deg=180.0
+    )
+    bad = check_limits(corrupted, model)
+    column = {name: k for k, name in enumerate(bad.joint_names)}
+    names = motion.skeleton.names
+    hits, injected = 0, 0
+    for target, child in zip(truth.targets, truth.children, strict=True):
+        error_frames = np.flatnonzero(truth.error_mask[:, target])
+        flagged = np.zeros(error_frames.size, dtype=bool)
+        for joint in (target, child):
+            if names[joint] in column:
+                flagged |= ~bad.valid[error_frames, column[names[joint]]]
+        hits += int(flagged.sum())
+        injected += int(error_frames.size)
+    return hits, injected
+
+
+def _joint_figures(model: LimitsModel, flags: FloatArray, frames: int) -> tuple[JointFigures, ...]:
+    """Each joint's discriminator scores and its share of flagged held-back frames
+    (``flags``: flagged frames per joint, shape (n_joints,); ``frames``: held-back frames)."""
+    return tuple(
+        JointFigures(
+            name=j.name,
+            accuracy=j.scores.accuracy if j.scores else float("nan"),
+            precision=j.scores.precision if j.scores else float("nan"),
+            recall=j.scores.recall if j.scores else float("nan"),
+            hidden_size=j.scores.hidden_size if j.scores else 0,
+            false_flag_rate=float(flags[k] / max(frames, 1)),
+        )
+        for k, j in enumerate(model.joints)
+    )
 
 
 def bench_rig(
@@ -295,32 +290,11 @@ def bench_rig(
         if all(j.network is not None for j in model.joints):
             network_flags += float((~check_limits(motion, model, "network").valid).sum())
         frames += motion.n_frames
-        corrupted, truth = inject_twist_errors(
-            motion, rng, min_offset_deg=min_offset_deg, max_offset_deg=180.0
-        )
-        bad = check_limits(corrupted, model)
-        column = {name: k for k, name in enumerate(bad.joint_names)}
-        names = motion.skeleton.names
-        for target, child in zip(truth.targets, truth.children, strict=True):
-            error_frames = np.flatnonzero(truth.error_mask[:, target])
-            flagged = np.zeros(error_frames.size, dtype=bool)
-            for joint in (target, child):
-                if names[joint] in column:
-                    flagged |= ~bad.valid[error_frames, column[names[joint]]]
-            hits += int(flagged.sum())
-            injected += int(error_frames.size)
+        take_hits, take_injected = _injected_hits(model, motion, rng, min_offset_deg)
+        hits += take_hits
+        injected += take_injected
     longest = max((m for _, m in rig.held_back), key=lambda m: m.n_frames)
-    joints = tuple(
-        JointFigures(
-            name=j.name,
-            accuracy=j.scores.accuracy if j.scores else float("nan"),
-            precision=j.scores.precision if j.scores else float("nan"),
-            recall=j.scores.recall if j.scores else float("nan"),
-            hidden_size=j.scores.hidden_size if j.scores else 0,
-            false_flag_rate=float(flags[k] / max(frames, 1)),
-        )
-        for k, j in enumerate(model.joints)
-    )
+    joints = _joint_figures(model, flags, frames)
     has_network = all(j.network is not None for j in model.joints)
     figures = RigFigures(
         family=rig.family,

@@ -4,7 +4,7 @@ Swaps injected between neighbouring markers of real takes (precision and recall 
 thresholds chosen leaving each file out; false swaps and spikes per 10,000 frames of the clean
 takes; injected-spike recall; check speed of a 10,000-frame, 60-marker take), then gap filling
 (gaps of 0.05–2 s injected alone and as occlusions of a segment; fill RMSE in mm per method and
-gap length, :mod:`mocapqa.bench.marker_fill`). ``--fill-only`` and ``--swaps-only`` run one
+gap length, :mod:`mocapqa_bench.marker_fill`). ``--fill-only`` and ``--swaps-only`` run one
 part.
 """
 
@@ -104,14 +104,14 @@ def bench_markers(
     corpus = require_corpus(data)
     console = Console()
     if not fill_only:
-        from mocapqa.bench.markers import swap_figures
+        from mocapqa_bench.markers import swap_figures
 
         with console.status(f"swaps: {swap_seeds} seeds per file, each file held out in turn"):
             figures = swap_figures(corpus, range(swap_seeds))
         for table in _swap_tables(figures):
             console.print(table)
     if not swaps_only:
-        from mocapqa.bench.marker_fill import fill_table
+        from mocapqa_bench.marker_fill import fill_table
 
         with console.status(f"gap fill: {fill_seeds} seeds, {events_per_bin} gaps per bin"):
             rows = fill_table(corpus, range(fill_seeds), events_per_bin=events_per_bin)

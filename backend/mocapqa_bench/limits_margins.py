@@ -12,7 +12,7 @@ own margin, chosen without ever looking at the rig it is tested on:
   is at most ``target`` (1 %: the issue's target, fixed beforehand), else the margin with the
   fewest false flags. The smallest such margin keeps the most injected errors flagged;
 * the map built on every rig but ``R`` (margin 0) then gets those margins and is checked on
-  ``R``: clean false flags and injected-error recall, as :func:`~mocapqa.bench.limits_canonical.
+  ``R``: clean false flags and injected-error recall, as :func:`~mocapqa_bench.limits_canonical.
   count_takes` counts them, beside the uniform 40° on the same map.
 
 The margin is the last step of :func:`~mocapqa.limits.occupancy.build_occupancy` (``half =
@@ -26,13 +26,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mocapqa.bench.limits_canonical import EVALUATION_ONLY
 from mocapqa.core.motion import Motion
 from mocapqa.limits.analysis import charted
 from mocapqa.limits.build import DEFAULT_BUILD, BuildParams, build_canonical_model
 from mocapqa.limits.model import LimitsModel
 from mocapqa.limits.occupancy import OccupancyMap, evaluate
 from mocapqa.twist.inject import inject_twist_errors
+from mocapqa_bench.limits_canonical import EVALUATION_ONLY
 
 __all__ = ["MARGINS_DEG", "FoldResult", "MarginCounts", "count_margins", "nested_margins"]
 
@@ -107,7 +107,7 @@ def count_margins(
     model: LimitsModel, takes: Takes, seed: int = 0, min_offset_deg: float = 60.0
 ) -> MarginCounts:
     """Clean flags and injected-error validity of a margin-0 ``model`` at every margin (the
-    same takes, seed and injected errors as :func:`mocapqa.bench.limits_canonical.count_takes`).
+    same takes, seed and injected errors as :func:`mocapqa_bench.limits_canonical.count_takes`).
     """
     roles = tuple(j.role for j in model.joints)
     rng = np.random.default_rng(seed)

@@ -1,11 +1,11 @@
 """``mocapqa bench filters``: keypoint filters on real takes with seeded vision-like noise.
 
 Ground truth is the forward-kinematics joint positions of the Bandai Namco takes (centimetres,
-30 fps); the noise is :func:`mocapqa.bench.noise.keypoint_noise`. Every third take (sorted by
+30 fps); the noise is :func:`mocapqa_bench.noise.keypoint_noise`. Every third take (sorted by
 name) is the training subset on which each method's parameters are tuned by a small grid
 search on RMSE; the figures are reported on the other takes. The real Pose2Sim raw TRC files
 (no truth) are compared with the Butterworth-filtered files beside them. Rotation filters are in
-:mod:`mocapqa.bench.rotation_filters`.
+:mod:`mocapqa_bench.rotation_filters`.
 """
 
 from __future__ import annotations
@@ -20,7 +20,6 @@ from typing import Any
 
 import numpy as np
 
-from mocapqa.bench.noise import NoisyKeypoints, keypoint_noise
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
@@ -33,6 +32,7 @@ from mocapqa.filters.registry import FILTERS, DataScale
 from mocapqa.io.bvh import read_bvh
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.metrics.smoothness import lag_frames, mean_abs_jerk, rmse
+from mocapqa_bench.noise import NoisyKeypoints, keypoint_noise
 
 __all__ = [
     "KeypointCase",

@@ -12,12 +12,19 @@ import contextlib
 import socket
 import subprocess
 import sys
+import time
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-__all__ = ["ClientCost", "empty_analysis", "separate_cluster"]
+__all__ = [
+    "ClientCost",
+    "client_cost",
+    "empty_analysis",
+    "print_client_figures",
+    "separate_cluster",
+]
 
 
 def empty_analysis(
@@ -123,3 +130,64 @@ def separate_cluster(
                 process.wait(timeout=30)
             except subprocess.TimeoutExpired:
                 process.kill()
+
+
+def client_cost(folder: Path, summary: dict[str, Any], scratch: Path, engine: Any = None) -> Any:
+    """Run a batch of ``folder`` with :func:`empty_analysis` into a new SQLite store.
+
+    Parameters
+    ----------
+    folder : Path
+        The takes (hashed and stored as a real batch would).
+    summary : dict
+        The run summary every take gets.
+    scratch : Path
+        A new folder for the store.
+    engine : Engine, optional
+        A Dask engine (its local cluster's scheduler runs in this process, so its CPU is
+        counted); None runs the empty tasks in this process.
+    """
+    import functools
+
+    from mocapqa.jobs.batch import run_batch
+    from mocapqa.pipeline.options import AnalysisOptions
+    from mocapqa.store.repository import Repository
+    from mocapqa.store.shoots import ShootStore
+
+    scratch.mkdir(parents=True, exist_ok=True)
+    repository = Repository(f"sqlite:///{scratch / 'db.sqlite3'}")
+    task = functools.partial(empty_analysis, summary)
+    try:
+        clock, cpu = time.perf_counter(), time.process_time()
+        counts = run_batch(
+            [folder], ShootStore(repository.engine), AnalysisOptions(), lambda row: None,
+            engine, None, task=task,
+        )  # fmt: skip
+        return ClientCost(counts.done, time.process_time() - cpu, time.perf_counter() - clock)
+    finally:
+        repository.close()
+
+
+def print_client_figures(console: Any, folder: Path, sample: str, root: Path) -> None:
+    """Print the client's CPU per take with an empty analysis, alone and on 2 Dask workers."""
+    from mocapqa.jobs.engine import Engine
+    from mocapqa.jobs.take_task import analyse_path, content_sha256
+    from mocapqa.pipeline.options import AnalysisOptions
+
+    summary = analyse_path(sample, AnalysisOptions().to_json(), "0" * 32, "1" * 32, None)
+    alone = client_cost(folder, summary["summary"], root / "client-alone")
+    with separate_cluster(workers=2) as address, Engine(scheduler=address) as engine:
+        engine.client().wait_for_workers(2, timeout=120)
+        on_dask = client_cost(folder, summary["summary"], root / "client-dask", engine)
+    cpu = time.process_time()
+    for path in sorted(folder.iterdir()):
+        content_sha256(path)
+    hashing_ms = 1000 * (time.process_time() - cpu) / max(1, alone.takes)
+    console.print(
+        f"client CPU per take, empty analysis ({alone.takes} takes; hash, store, row; of which "
+        f"hashing the take's bytes {hashing_ms:.2f} ms): "
+        f"tasks in the client's process {alone.cpu_ms_per_take:.2f} ms; sent to 2 Dask "
+        f"workers (scheduler and workers in processes of their own) "
+        f"{on_dask.cpu_ms_per_take:.2f} ms (target ≤ 1 ms)",
+        highlight=False,
+    )

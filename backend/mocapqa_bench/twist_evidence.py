@@ -21,25 +21,15 @@ Nothing here chooses a parameter; :func:`injected_rows` takes ``min_deg``, ``max
 
 from __future__ import annotations
 
-import zlib
+import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
-from mocapqa.bench.calibration import real_interval_records, reliability
-from mocapqa.bench.natural import natural_error_figures
-from mocapqa.bench.twist import (
-    REAL_ERROR_TAKES,
-    BenchFile,
-    find_bench_files,
-    interval_records,
-    rig_of,
-)
 from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.motion import Motion
-from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.limits.rig import rig_family
 from mocapqa.metrics.twist import rotation_errors_deg
@@ -58,6 +48,16 @@ from mocapqa.twist.inject import InjectionTruth, inject_twist_errors
 from mocapqa.twist.inject_unpaired import inject_unpaired_bursts
 from mocapqa.twist.natural_roll import default_natural_roll
 from mocapqa.twist.refine import refine_quats
+from mocapqa_bench.calibration import real_interval_records, reliability
+from mocapqa_bench.natural import natural_error_figures
+from mocapqa_bench.twist import (
+    REAL_ERROR_TAKES,
+    BenchFile,
+    find_bench_files,
+    interval_records,
+    rig_of,
+    seeded_injections,
+)
 
 __all__ = [
     "EVIDENCE_KINDS",
@@ -205,7 +205,7 @@ def clean_take_rows(paths: Sequence[Path]) -> list[Row]:
     ]
 
 
-def _inject(motion: Motion, kind: str, rng: np.random.Generator) -> tuple[Motion, InjectionTruth]:
+def _inject(motion: Motion, rng: np.random.Generator, kind: str) -> tuple[Motion, InjectionTruth]:
     if kind == "unpaired":
         return inject_unpaired_bursts(motion, rng)
     return inject_twist_errors(motion, rng, kind=kind)
@@ -272,53 +272,62 @@ def injected_rows(
     totals: dict[str, np.ndarray] = {k: np.zeros(12, dtype=np.float64) for k in kinds}
     for bench_file in files:
         motion = read_bvh(bench_file.path)
-        name_key = zlib.crc32(bench_file.path.name.encode())
         for kind in kinds:
-            t = totals[kind]
-            for repeat in range(repeats):
-                rng = np.random.default_rng((seed, name_key, repeat))
-                try:
-                    corrupted, truth = _inject(motion, kind, rng)
-                except InputError:
-                    continue
+            inject = functools.partial(_inject, kind=kind)
+            injections = seeded_injections(motion, bench_file, seed, repeats, inject)
+            for _, corrupted, truth in injections:
                 decisions = take_decisions(corrupted, min_deg, max_mismatch, max_s, min_family)
-                labels = interval_records(decisions.analysis, truth.offsets_rad, bench_file)
-                right = np.array([r.right for r in labels], dtype=bool).reshape(-1)
-                if records is not None:
-                    records += [
-                        (kind, r.confidence, rule, r.right)
-                        for r, rule in zip(labels, decisions.rules, strict=True)
-                    ]
-                t[8:12] += [
-                    np.sum(decisions.before & right), np.sum(decisions.before & ~right),
-                    np.sum(decisions.after & right), np.sum(decisions.after & ~right),
-                ]  # fmt: skip
-                for k, chosen in enumerate((decisions.before, decisions.after)):
-                    refined = decisions.refined(corrupted, chosen)
-                    if kind == "unpaired":
-                        f = natural_error_figures(corrupted, refined)
-                        t[4 * k : 4 * k + 3] += [f.n_removed, f.n_jumps, f.n_far_moved]
-                        t[4 * k + 3] = max(t[4 * k + 3], f.max_far_move_deg)
-                    else:
-                        good, total, spill = _fsr_counts(corrupted, truth, refined.refined.quats)
-                        t[4 * k : 4 * k + 2] += [good, total]
-                        t[4 * k + 3] = max(t[4 * k + 3], spill)
+                _add_injection(totals[kind], kind, bench_file, corrupted, truth, decisions, records)
         if on_file is not None:
             on_file(bench_file)
-    out: list[Row] = []
-    for kind, t in totals.items():
-        row: Row = {"kind": kind}
-        for k, label in enumerate(("before", "after")):
-            if kind == "unpaired":
-                row[f"jumps removed {label}"] = f"{int(t[4 * k])} / {int(t[4 * k + 1])}"
-                row[f"far cells > 5° {label}"] = f"{int(t[4 * k + 2])} (max {t[4 * k + 3]:.1f}°)"
-            else:
-                row[f"FSR {label} %"] = round(100.0 * t[4 * k] / max(t[4 * k + 1], 1.0), 2)
-                row[f"spill {label} °"] = round(float(t[4 * k + 3]), 1)
-        row["applied right / wrong before"] = f"{int(t[8])} / {int(t[9])}"
-        row["applied right / wrong after"] = f"{int(t[10])} / {int(t[11])}"
-        out.append(row)
-    return out
+    return [_injected_row(kind, t) for kind, t in totals.items()]
+
+
+def _add_injection(
+    t: np.ndarray, kind: str, bench_file: BenchFile, corrupted: Motion, truth: InjectionTruth,
+    decisions: TakeDecisions, records: list[tuple[str, float, str, bool]] | None,
+) -> None:  # fmt: skip
+    """Add one injected take's figures to the totals ``t`` of its kind (shape (12,), laid out
+    as :func:`_injected_row` reads them), and its intervals to ``records`` when given."""
+    labels = interval_records(decisions.analysis, truth.offsets_rad, bench_file)
+    right = np.array([r.right for r in labels], dtype=bool).reshape(-1)
+    if records is not None:
+        records += [
+            (kind, r.confidence, rule, r.right)
+            for r, rule in zip(labels, decisions.rules, strict=True)
+        ]
+    t[8:12] += [
+        np.sum(decisions.before & right), np.sum(decisions.before & ~right),
+        np.sum(decisions.after & right), np.sum(decisions.after & ~right),
+    ]  # fmt: skip
+    for k, chosen in enumerate((decisions.before, decisions.after)):
+        refined = decisions.refined(corrupted, chosen)
+        if kind == "unpaired":
+            f = natural_error_figures(corrupted, refined)
+            t[4 * k : 4 * k + 3] += [f.n_removed, f.n_jumps, f.n_far_moved]
+            t[4 * k + 3] = max(t[4 * k + 3], f.max_far_move_deg)
+        else:
+            good, total, spill = _fsr_counts(corrupted, truth, refined.refined.quats)
+            t[4 * k : 4 * k + 2] += [good, total]
+            t[4 * k + 3] = max(t[4 * k + 3], spill)
+
+
+def _injected_row(kind: str, t: np.ndarray) -> Row:
+    """The row of one kind from its totals: per before and after (``4 * k`` on), FSR frames
+    good and all and the largest spill, or for unpaired bursts jumps removed, jumps, far cells
+    moved and the largest far move; then intervals applied right and wrong before and after
+    (``t[8:12]``)."""
+    row: Row = {"kind": kind}
+    for k, label in enumerate(("before", "after")):
+        if kind == "unpaired":
+            row[f"jumps removed {label}"] = f"{int(t[4 * k])} / {int(t[4 * k + 1])}"
+            row[f"far cells > 5° {label}"] = f"{int(t[4 * k + 2])} (max {t[4 * k + 3]:.1f}°)"
+        else:
+            row[f"FSR {label} %"] = round(100.0 * t[4 * k] / max(t[4 * k + 1], 1.0), 2)
+            row[f"spill {label} °"] = round(float(t[4 * k + 3]), 1)
+    row["applied right / wrong before"] = f"{int(t[8])} / {int(t[9])}"
+    row["applied right / wrong after"] = f"{int(t[10])} / {int(t[11])}"
+    return row
 
 
 def reliability_rows(records: Sequence[tuple[str, float, str, bool]], label: str) -> list[Row]:
@@ -350,7 +359,7 @@ def reliability_rows(records: Sequence[tuple[str, float, str, bool]], label: str
 
 def real_reliability_records(motion: Motion, take: str) -> list[tuple[str, float, str, bool]]:
     """``(take, calibrated probability, rule, right)`` of every interval on a take with real
-    errors, right by :func:`mocapqa.bench.calibration.real_interval_records`' rule."""
+    errors, right by :func:`mocapqa_bench.calibration.real_interval_records`' rule."""
     labels = real_interval_records(motion, take, "real")
     rules = take_decisions(motion).rules
     return [(take, r.confidence, rule, r.right) for r, rule in zip(labels, rules, strict=True)]

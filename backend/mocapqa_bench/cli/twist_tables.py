@@ -1,5 +1,6 @@
-"""Tables of ``mocapqa bench twist`` beyond the paper's: real errors, clean takes, calibration,
-leave-one-rig-out figures, each rate with its confidence interval."""
+"""Tables of ``mocapqa bench twist``: the paper's Tables 1 and 2, the ablation, and beyond the
+paper's: real errors, clean takes, calibration, leave-one-rig-out figures, each rate with its
+confidence interval."""
 
 from __future__ import annotations
 
@@ -11,6 +12,8 @@ from typing import Any
 from rich.table import Table
 
 __all__ = [
+    "SEGMENTS",
+    "ablation_table",
     "calibration_table",
     "clean_takes_table",
     "disagreement_table",
@@ -19,10 +22,93 @@ __all__ = [
     "loro_variants",
     "natural_levels_table",
     "natural_table",
+    "paper_table1",
+    "paper_table2",
     "rates_table",
+    "rows_table",
     "small_offsets_table",
     "unpaired_table",
 ]
+
+
+SEGMENTS = ("clavicle", "upper_arm", "forearm", "upper_leg", "lower_leg")
+"""The segments of the per side × segment figures, in table order."""
+
+
+def paper_table1(methods: dict[str, Any]) -> Table:
+    """The paper's Table 1: rotation error of the target joints per rig and set, per method."""
+    from mocapqa_bench.twist import RIGS
+
+    groups: list[tuple[str, tuple[str, ...], bool | None]] = [
+        *[(rig, (rig,), None) for rig in RIGS],
+        ("all", RIGS, None),
+        ("all: fit set", RIGS, False),
+        ("all: held-out", RIGS, True),
+    ]
+    table = Table(title="Table 1: rotation error of the target joints on the error frames")
+    for column in ("set", "method", "frames", "MAE before °", "MAE after °", "RMSE before °",
+                   "RMSE after °", "FSR %", "clean >1° %", "clean max °", "frames/s"):  # fmt: skip
+        table.add_column(column, justify="left" if column in ("set", "method") else "right")
+    for name, rigs, held in groups:
+        for label, res in methods.items():
+            acc = res.accuracy(rigs, held)
+            clean = res.clean_figure(rigs, held)
+            table.add_row(
+                name, label, str(acc.n_frames), f"{acc.mae_before_deg:.2f}",
+                f"{acc.mae_after_deg:.2f}", f"{acc.rmse_before_deg:.2f}",
+                f"{acc.rmse_after_deg:.2f}", f"{100 * acc.fsr:.2f}", f"{100 * clean.share:.4f}",
+                f"{clean.max_change_deg:.1f}",
+                "" if held is not None else f"{res.speed(rigs):,.0f}",
+            )  # fmt: skip
+    return table
+
+
+def paper_table2(label: str, res: Any) -> Table:
+    """The paper's Table 2 for one method: MAE after, RER and FSR per side × segment."""
+    from mocapqa_bench.twist import RIGS
+
+    table = Table(title=f"Table 2 ({label}): per side × segment — MAE after ° / RER / FSR %")
+    table.add_column("segment")
+    table.add_column("side")
+    sets = [("all", RIGS), *[(rig, (rig,)) for rig in RIGS]]
+    for name, _ in sets:
+        table.add_column(name, justify="right")
+    for segment in SEGMENTS:
+        for side in ("left", "right"):
+            cells = []
+            for _, rigs in sets:
+                acc = res.accuracy(rigs, None, side, segment)
+                cells.append(
+                    f"{acc.mae_after_deg:.2f} / {acc.rer:.3f} / {100 * acc.fsr:.1f}"
+                    if acc.n_frames
+                    else "–"
+                )
+            table.add_row(segment, side, *cells)
+    return table
+
+
+def ablation_table(methods: dict[str, Any]) -> Table:
+    """The robust method with one idea changed per row, over all rigs."""
+    table = Table(title="Ablation (all rigs): the robust method with one idea changed")
+    for column in ("variant", "FSR %", "fit FSR %", "held-out FSR %", "worst side×segment FSR %",
+                   "MAE after °", "RMSE after °", "clean >1° %", "clean max °"):  # fmt: skip
+        table.add_column(column, justify="left" if column == "variant" else "right")
+    for label, res in methods.items():
+        acc = res.accuracy()
+        per_segment = [
+            res.accuracy(side=side, segment=segment)
+            for side in ("left", "right")
+            for segment in SEGMENTS
+        ]
+        worst = min((100 * a.fsr for a in per_segment if a.n_frames), default=float("nan"))
+        clean = res.clean_figure()
+        table.add_row(
+            label, f"{100 * acc.fsr:.2f}", f"{100 * res.accuracy(held_out=False).fsr:.2f}",
+            f"{100 * res.accuracy(held_out=True).fsr:.2f}", f"{worst:.1f}",
+            f"{acc.mae_after_deg:.2f}", f"{acc.rmse_after_deg:.2f}",
+            f"{100 * clean.share:.4f}", f"{clean.max_change_deg:.1f}",
+        )  # fmt: skip
+    return table
 
 
 def _pct(low: float, high: float) -> str:
@@ -31,7 +117,7 @@ def _pct(low: float, high: float) -> str:
 
 def rates_table(methods: dict[str, Any]) -> Table:
     """FSR with a 95 % bootstrap interval over takes, MAE, clean changes and spill per set."""
-    from mocapqa.bench.twist import RIGS
+    from mocapqa_bench.twist import RIGS
 
     table = Table(title="FSR with 95 % bootstrap intervals over takes; spill onto clean frames")
     for column in ("set", "method", "takes", "FSR %", "95 % CI", "MAE after °",
@@ -64,7 +150,7 @@ def ends_table(rows: Sequence[tuple[str, str, Any]]) -> Table:
     then all held-out and all fit takes. FSR is over every injected error frame of those takes;
     an end interval is detected when an interval found on its joint covers half of its frames,
     corrected when at most 20 % of its rotation error is left."""
-    from mocapqa.bench.twist import RIGS
+    from mocapqa_bench.twist import RIGS
 
     table = Table(title="Errors at the take's ends (one level shift per target starts on the first "
                   "frame of motion, head, or ends on the last frame, tail)")  # fmt: skip
@@ -97,7 +183,7 @@ def ends_table(rows: Sequence[tuple[str, str, Any]]) -> Table:
 
 def natural_table(rows: Sequence[tuple[str, Any]]) -> Table:
     """Real-error figures per (label, NaturalErrorFigures)."""
-    from mocapqa.bench.natural import wilson_interval
+    from mocapqa_bench.natural import wilson_interval
 
     table = Table(title="Real errors (005_05): counter-rotated roll jumps over 20°")
     for column in ("refinement", "jumps", "removed (step < 20°)", "95 % Wilson",
@@ -161,7 +247,7 @@ def loro_variants() -> dict[str, Any]:
 
 def loro_table(grid: dict[str, Any]) -> Table:
     """Per held-out rig: the variant with the best FSR on the other two, and its FSR there."""
-    from mocapqa.bench.twist import RIGS
+    from mocapqa_bench.twist import RIGS
 
     table = Table(title="Leave one rig out: parameters chosen on two rigs, FSR on the third")
     for column in ("held-out rig", "chosen on", "variant chosen", "FSR on the two %",
@@ -198,9 +284,9 @@ def disagreement_table(rows: Sequence[Any]) -> Table:
 
 def unpaired_table(figures: dict[Any, Any]) -> Table:
     """Unpaired bursts after a natural step: jumps removed and far cells moved, per set."""
-    from mocapqa.bench.natural import wilson_interval
-    from mocapqa.bench.twist import RIGS
-    from mocapqa.bench.unpaired import unpaired_totals
+    from mocapqa_bench.natural import wilson_interval
+    from mocapqa_bench.twist import RIGS
+    from mocapqa_bench.unpaired import unpaired_totals
 
     table = Table(
         title="Unpaired bursts after a natural roll step (injected; figures as on 005_05)"

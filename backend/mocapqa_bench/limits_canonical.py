@@ -5,7 +5,7 @@ frames of one take are not independent, so takes are resampled, not frames):
 
 * **per rig** — the shipped canonical model (built on the build split of every rig with roles,
   ``005_05`` left out) on each rig's held-back takes (the fixed split of
-  :func:`mocapqa.bench.limits.corpus_rigs`): false flags (share of joint-frames outside the
+  :func:`mocapqa_bench.limits.corpus_rigs`): false flags (share of joint-frames outside the
   limits on the clean takes), injected-error recall (share of injected error frames, offsets
   ≥ 60°, flagged on the target joint or its compensating child), per joint false flags; and
   beside it the same rig's own map (per-rig frame, map only) built on its build split;
@@ -38,6 +38,7 @@ from mocapqa.limits.model import LimitsModel
 from mocapqa.twist.analysis import analyze_twist
 from mocapqa.twist.inject import inject_twist_errors
 from mocapqa.twist.spin import find_limb_spins
+from mocapqa_bench.limits import tiled_take
 
 __all__ = [
     "EVALUATION_ONLY",
@@ -214,13 +215,7 @@ def canonical_speed(
     inputs; ``method`` "network": the discriminators decide), on ``motion`` tiled to at least
     50,000 frames: the best of ``repeats`` runs.
     """
-    tiles = max(1, -(-50_000 // motion.n_frames))
-    long = Motion(
-        motion.skeleton,
-        np.tile(motion.quats, (tiles, 1, 1)),
-        np.tile(motion.translations, (tiles, 1, 1)),
-        motion.fps,
-    )
+    long = tiled_take(motion)
     n_joints = check_limits(long, model, method=method).valid.shape[1]
     # CPU time of this process: the check is single-threaded numpy, and on a shared, loaded
     # machine wall-clock time measures the other jobs more than the check. Even CPU time grows

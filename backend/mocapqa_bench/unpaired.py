@@ -3,26 +3,28 @@
 Each bench take gets :func:`mocapqa.twist.inject_unpaired.inject_unpaired_bursts` (seeded like
 the level-shift injections, from ``(seed, crc32(file name), repeat)``) and is refined; the
 figures are those measured on the real errors of ``005_05``
-(:func:`mocapqa.bench.natural.natural_error_figures`): counter-rotated roll jumps over 20°
+(:func:`mocapqa_bench.natural.natural_error_figures`): counter-rotated roll jumps over 20°
 removed, and frame × chain cells farther than 0.25 s from every such jump whose roll was moved
 by more than 5°.
 """
 
 from __future__ import annotations
 
-import zlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-import numpy as np
-
-from mocapqa.bench.natural import natural_error_figures
-from mocapqa.bench.twist import RIGS, BenchFile, IntervalRecord, interval_records
-from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.twist.analysis import analyze_twist
 from mocapqa.twist.detect import RobustParams
 from mocapqa.twist.inject_unpaired import inject_unpaired_bursts
+from mocapqa_bench.natural import natural_error_figures
+from mocapqa_bench.twist import (
+    RIGS,
+    BenchFile,
+    IntervalRecord,
+    interval_records,
+    seeded_injections,
+)
 
 __all__ = ["UnpairedTotals", "run_unpaired_bench", "unpaired_totals"]
 
@@ -95,13 +97,8 @@ def run_unpaired_bench(
     out: dict[Key, UnpairedTotals] = {}
     for bench_file in files:
         motion = read_bvh(bench_file.path)
-        name_key = zlib.crc32(bench_file.path.name.encode())
-        for repeat in range(repeats):
-            rng = np.random.default_rng((seed, name_key, repeat))
-            try:
-                corrupted, truth = inject_unpaired_bursts(motion, rng)
-            except InputError:
-                continue
+        injections = seeded_injections(motion, bench_file, seed, repeats, inject_unpaired_bursts)
+        for repeat, corrupted, truth in injections:
             analysis = analyze_twist(corrupted, "robust", params=params, apply=apply)
             if records is not None:
                 records += interval_records(analysis, truth.offsets_rad, bench_file)

@@ -21,13 +21,13 @@ from pathlib import Path
 
 import numpy as np
 
-from mocapqa.bench.natural import natural_error_figures, natural_jumps
-from mocapqa.bench.twist import IntervalRecord
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
 from mocapqa.twist.analysis import analyze_twist, detect_chains
 from mocapqa.twist.confidence import APPLY_THRESHOLD, MIN_LEVEL_DEG, Calibration, fit_calibration
 from mocapqa.twist.intervals import FEATURES
+from mocapqa_bench.natural import natural_error_figures, natural_jumps
+from mocapqa_bench.twist import IntervalRecord
 
 __all__ = [
     "CALIBRATION_KINDS",
