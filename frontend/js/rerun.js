@@ -1,5 +1,5 @@
-// Re-run with other options: a form grouped by check (twist, joint limits, filter, advanced),
-// every field from the server's one definition of the run options (GET /run-options, from
+// Re-run with other options: a form grouped by check as the server groups them, every group
+// and field from the server's one definition of the run options (GET /run-options, from
 // pipeline/options.py) and the filter registry (GET /filters), every number with its unit, the
 // named presets, and the values checked in the page before anything is sent.
 import * as api from "./api.js";
@@ -38,120 +38,124 @@ function rolesGroup(roleKeys, joints, summary, mapping, onJoint) {
   return { box, chosen };
 }
 
-export function rerunPanel(take, run, filters, described, context = {}) {
+// The controls of the form's own fields by their served type; the filter's fields ("filter",
+// "filter_preset") are the filter controls below. Numbers are typed as text and checked here (a
+// number input would hide a typo as "").
+function choiceControl(field, run) {
+  const current = run.options[field.name] ?? field.default;
+  const choices = field.choices.includes(current) ? field.choices : [...field.choices, current]; // e.g. interval ids "0,3"
+  return h("select", { id: `option-${field.name}`, name: field.name, title: field.help }, choices.map((c) => h("option", { value: c, selected: c === current }, c)));
+}
+const numberControl = (field, run) => h("input", {
+  type: "text", inputmode: field.type === "int" ? "numeric" : "decimal", id: `option-${field.name}`, name: field.name, size: 8,
+  placeholder: String(field.default), value: run.options[field.name] ?? "", title: field.help,
+});
+const CONTROLS = { choice: choiceControl, int: numberControl, float: numberControl };
+
+// A parameter of the chosen filter (GET /filters): a yes/no menu or a text box, with its unit.
+function paramRow(p, given) {
+  const input = p.type === "bool"
+    ? h("select", { "data-param": p.name }, h("option", { value: "" }, `default (${p.default})`), ["true", "false"].map((v) => h("option", { value: v, selected: String(given[p.name]) === v }, v)))
+    : h("input", { type: "text", inputmode: p.type === "str" ? "text" : "decimal", size: 8, "data-param": p.name, placeholder: String(p.default), value: given[p.name] ?? "" });
+  return h("label", { class: "option-field", title: p.name }, h("span", { class: "option-name" }, paramLabel(p.name)), input, unitText(p.unit));
+}
+
+// The filter: its method (the registry's filters for this kind of take), the filter's presets and
+// its parameters (with units; past the first few, folded), refilled when the method changes.
+function filterControls(take, run, filters) {
   const target = take.kind === "motion" ? "rotations" : "keypoints";
   const usable = filters.filter((f) => f.applies_to.includes(target));
-  const available = checksFor(take, described).filter((c) => described.checks.includes(c));
-  const fields = Object.fromEntries(described.groups.flatMap((g) => g.fields).map((f) => [f.name, f]));
-  const inputs = {}; // option name -> its control
-  const checks = {}; // check name -> its box
-
-  const choiceControl = (field) => {
-    const current = run.options[field.name] ?? field.default;
-    const choices = field.choices.includes(current) ? field.choices : [...field.choices, current]; // e.g. interval ids "0,3"
-    return h("select", { id: `option-${field.name}`, name: field.name }, choices.map((c) => h("option", { value: c, selected: c === current }, c)));
-  };
-  // Numbers are typed as text and checked here (a number input would hide a typo as "").
-  const numberControl = (field) => h("input", {
-    type: "text", inputmode: field.type === "int" ? "numeric" : "decimal", id: `option-${field.name}`, name: field.name, size: 8,
-    placeholder: String(field.default), value: run.options[field.name] ?? "",
-  });
-
-  // Filter: method, the filter's preset, its parameters (with units; past the first few, folded).
   const method = h("select", { id: "filter-method", "aria-label": "filter" }, h("option", { value: "" }, take.kind === "motion" ? "no filter" : "adaptive (default)"),
     usable.map((f) => h("option", { value: f.name, selected: f.name === run.options.filter_method }, f.label)));
   const preset = h("select", { id: "filter-preset", "aria-label": "filter preset" });
   const params = h("div", { id: "filter-params", class: "option-fields" });
   let paramFields = [];
-  const fillParams = () => {
+  const fill = () => {
     const entry = usable.find((f) => f.name === method.value) || (take.kind === "keypoints" ? usable.find((f) => f.name === "adaptive") : null);
     preset.replaceChildren(...(entry ? entry.presets : []).map((p) => h("option", { value: p, selected: p === run.options.filter_preset }, p)));
     paramFields = entry ? entry.parameters : [];
     const given = method.value === (run.options.filter_method || "") ? run.options.filter_params || {} : {};
-    const rows = paramFields.map((p) => {
-      const input = p.type === "bool"
-        ? h("select", { "data-param": p.name }, h("option", { value: "" }, `default (${p.default})`), ["true", "false"].map((v) => h("option", { value: v, selected: String(given[p.name]) === v }, v)))
-        : h("input", { type: "text", inputmode: p.type === "str" ? "text" : "decimal", size: 8, "data-param": p.name, placeholder: String(p.default), value: given[p.name] ?? "" });
-      return h("label", { class: "option-field", title: p.name }, h("span", { class: "option-name" }, paramLabel(p.name)), input, unitText(p.unit));
-    });
+    const rows = paramFields.map((p) => paramRow(p, given));
     const more = rows.length > SHOWN_PARAMS
       ? [h("details", { class: "more-params" }, h("summary", {}, `${rows.length - SHOWN_PARAMS} more parameters`), h("div", { class: "option-fields" }, rows.slice(SHOWN_PARAMS)))]
       : [];
     params.replaceChildren(...rows.slice(0, SHOWN_PARAMS), ...more);
   };
-  method.addEventListener("change", fillParams);
-  fillParams();
+  method.addEventListener("change", fill);
+  fill();
+  const values = () => ({
+    filter_method: method.value, filter_preset: preset.value,
+    params: [...params.querySelectorAll("[data-param]")].map((input) => [paramFields.find((p) => p.name === input.dataset.param), input.value]),
+  });
+  return { method, preset, params, fill, values, controls: { filter: method, filter_preset: preset } };
+}
 
-  const group = (g) => {
-    const check = g.check && available.includes(g.check) ? h("input", { type: "checkbox", name: "check", value: g.check, checked: run.options.checks.includes(g.check) }) : null;
-    if (g.check && !check) return null; // a check this kind of take cannot run
-    if (check) checks[g.check] = check;
-    const body = g.name === "filter"
-      ? [h("div", { class: "option-fields" },
-        h("label", { class: "option-field" }, h("span", { class: "option-name" }, "filter"), method),
-        h("label", { class: "option-field" }, h("span", { class: "option-name" }, "preset"), preset)), params]
-      : g.fields.length ? h("div", { class: "option-fields" }, g.fields.map((f) => {
-        inputs[f.name] = f.type === "choice" ? choiceControl(f) : numberControl(f);
-        return h("label", { class: "option-field" }, h("span", { class: "option-name" }, f.label), inputs[f.name], unitText(f.unit));
-      })) : h("p", { class: "muted" }, g.name === "limits" ? "the rig's joint-limit model; no settings"
-        : g.name === "markers" ? "swaps repaired, then confident gap fills applied; no settings" : "");
-    const legend = h("legend", {}, check ? h("label", {}, check, ` ${g.label}`) : g.label);
-    const set = h("fieldset", { class: "option-group", "data-group": g.name }, g.advanced ? null : legend, body);
-    return g.advanced ? h("details", { class: "option-advanced", id: `options-${g.name}` }, h("summary", {}, g.label), set) : set;
-  };
-  const groups = described.groups.map(group);
-  const joints = (take.reading && take.reading.joints) || [];
-  const roles = take.kind === "motion" && context.summary && joints.length && described.role_keys
-    ? rolesGroup(described.role_keys, joints, context.summary, run.options.mapping || {}, context.onJoint || (() => {}))
-    : null;
+// One group of the form as served: its check's box (only for a check this take can run), its
+// fields' controls (kept in `form.inputs` by option name) and, with no fields, the group's note.
+function groupBox(g, form) {
+  const check = g.check && form.available.includes(g.check)
+    ? h("input", { type: "checkbox", name: "check", value: g.check, checked: form.run.options.checks.includes(g.check) }) : null;
+  if (g.check && !check) return null; // a check this kind of take cannot run
+  if (check) form.checks[g.check] = check;
+  const rows = g.fields.map((f) => {
+    const control = form.filter.controls[f.type] || (form.inputs[f.name] = CONTROLS[f.type](f, form.run));
+    return h("label", { class: "option-field", title: f.help }, h("span", { class: "option-name" }, f.label), control, unitText(f.unit));
+  });
+  const hasFilter = g.fields.some((f) => f.type in form.filter.controls);
+  const body = rows.length ? [h("div", { class: "option-fields" }, rows), hasFilter ? form.filter.params : null] : h("p", { class: "muted" }, g.note || "");
+  const legend = h("legend", {}, check ? h("label", {}, check, ` ${g.label}`) : g.label);
+  const set = h("fieldset", { class: "option-group", "data-group": g.name }, g.advanced ? null : legend, body);
+  return g.advanced ? h("details", { class: "option-advanced", id: `options-${g.name}` }, h("summary", {}, g.label), set) : set;
+}
 
-  // Presets fill the form; every field stays editable.
-  const presets = usablePresets(described.presets, available);
-  const presetPick = h("select", { id: "run-preset", "aria-label": "options preset" }, h("option", { value: "" }, "— as this run —"),
+// Presets fill the form; every field stays editable.
+function presetPicker(described, form) {
+  const presets = usablePresets(described.presets, form.available);
+  const pick = h("select", { id: "run-preset", "aria-label": "options preset" }, h("option", { value: "" }, "— as this run —"),
     presets.map(([name]) => h("option", { value: name }, name)));
-  presetPick.addEventListener("change", () => {
-    const chosen = presets.find(([name]) => name === presetPick.value);
+  pick.addEventListener("change", () => {
+    const chosen = presets.find(([name]) => name === pick.value);
     if (!chosen) return;
     const options = chosen[1];
-    for (const [name, box] of Object.entries(checks)) box.checked = options.checks.includes(name);
-    for (const [name, control] of Object.entries(inputs)) control.value = options[name] ?? "";
-    if ([...method.options].some((o) => o.value === (options.filter_method || ""))) { method.value = options.filter_method || ""; fillParams(); }
+    for (const [name, box] of Object.entries(form.checks)) box.checked = options.checks.includes(name);
+    for (const [name, control] of Object.entries(form.inputs)) control.value = options[name] ?? "";
+    const { method } = form.filter;
+    if ([...method.options].some((o) => o.value === (options.filter_method || ""))) { method.value = options.filter_method || ""; form.filter.fill(); }
   });
+  return pick;
+}
 
-  const message = h("span", { class: "muted", id: "rerun-message", role: "status" });
-  const start = h("button", { class: "primary", id: "rerun", onclick: async () => {
-    for (const el of document.querySelectorAll("#rerun-panel [aria-invalid]")) el.removeAttribute("aria-invalid");
-    const paramInputs = [...params.querySelectorAll("[data-param]")];
-    const values = {
-      checks: Object.entries(checks).filter(([, box]) => box.checked).map(([name]) => name),
-      twist_method: take.kind === "motion" && inputs.twist_method ? inputs.twist_method.value : undefined,
-      twist_apply: take.kind === "motion" && inputs.twist_apply ? inputs.twist_apply.value : undefined,
-      filter_method: method.value, filter_preset: preset.value, max_points: inputs.max_points ? inputs.max_points.value : "",
-      params: paramInputs.map((input) => [paramFields.find((p) => p.name === input.dataset.param), input.value]),
-      mapping: roles ? roles.chosen() : undefined,
-    };
-    const built = formOptions(values, fields);
-    if (built.errors) {
-      for (const error of built.errors) {
-        const name = error.split(":")[0];
-        const bad = params.querySelector(`[data-param="${CSS.escape(name)}"]`) || inputs[name];
-        if (bad) bad.setAttribute("aria-invalid", "true");
-      }
-      message.textContent = built.errors.join(" · "); message.className = "error";
-      // The first field at fault takes the focus, so the keyboard is where the fix goes.
-      document.querySelector("#rerun-panel [aria-invalid='true']")?.focus();
-      return;
+// The form's values checked in the page: refused, the fields at fault are marked and the first
+// takes the focus; else the run starts and the page goes to it.
+async function startRun(take, form, fields, message) {
+  for (const el of document.querySelectorAll("#rerun-panel [aria-invalid]")) el.removeAttribute("aria-invalid");
+  const values = {
+    checks: Object.entries(form.checks).filter(([, box]) => box.checked).map(([name]) => name),
+    ...Object.fromEntries(Object.entries(form.inputs).map(([name, control]) => [name, control.value])),
+    ...form.filter.values(),
+    mapping: form.roles ? form.roles.chosen() : undefined,
+  };
+  const built = formOptions(values, fields);
+  if (built.errors) {
+    for (const error of built.errors) {
+      const name = error.split(":")[0];
+      const bad = form.filter.params.querySelector(`[data-param="${CSS.escape(name)}"]`) || form.inputs[name];
+      if (bad) bad.setAttribute("aria-invalid", "true");
     }
-    try {
-      const created = await api.startRun(take.id, built.options);
-      location.hash = api.takeLink(take.id, created.id);
-    } catch (e) { message.textContent = e.message; message.className = "error"; }
-  } }, "re-run");
-  const panel = h("div", { class: "panel", id: "rerun-panel" }, h("h2", {}, "Re-run with other options (earlier runs are kept)"),
-    h("div", { class: "controls" }, h("label", {}, "preset ", presetPick)),
-    h("div", { class: "option-groups" }, groups, roles ? roles.box : null), h("div", { class: "controls" }, start, message));
-  // A change to the form answers an earlier refusal: its message and marks go (they named
-  // fields that may be gone, e.g. after choosing a preset).
+    message.textContent = built.errors.join(" · "); message.className = "error";
+    // The first field at fault takes the focus, so the keyboard is where the fix goes.
+    document.querySelector("#rerun-panel [aria-invalid='true']")?.focus();
+    return;
+  }
+  try {
+    const created = await api.startRun(take.id, built.options);
+    location.hash = api.takeLink(take.id, created.id);
+  } catch (e) { message.textContent = e.message; message.className = "error"; }
+}
+
+// A change to the form answers an earlier refusal: its message and marks go (they named fields
+// that may be gone, e.g. after choosing a preset).
+function clearOnChange(panel, message) {
   const clear = () => {
     if (message.className !== "error") return;
     message.textContent = ""; message.className = "muted";
@@ -159,5 +163,28 @@ export function rerunPanel(take, run, filters, described, context = {}) {
   };
   panel.addEventListener("change", clear);
   panel.addEventListener("input", clear);
+}
+
+/** The re-run panel of a take: `described` is GET /run-options, `filters` GET /filters. */
+export function rerunPanel(take, run, filters, described, context = {}) {
+  const available = checksFor(take, described).filter((c) => described.checks.includes(c));
+  const fields = Object.fromEntries(described.groups.flatMap((g) => g.fields).map((f) => [f.name, f]));
+  const joints = (take.reading && take.reading.joints) || [];
+  const form = {
+    run, available, filter: filterControls(take, run, filters),
+    inputs: {}, // option name -> its control
+    checks: {}, // check name -> its box
+    roles: take.kind === "motion" && context.summary && joints.length && described.role_keys
+      ? rolesGroup(described.role_keys, joints, context.summary, run.options.mapping || {}, context.onJoint || (() => {}))
+      : null,
+  };
+  const groups = described.groups.map((g) => groupBox(g, form));
+  const presetPick = presetPicker(described, form);
+  const message = h("span", { class: "muted", id: "rerun-message", role: "status" });
+  const start = h("button", { class: "primary", id: "rerun", onclick: () => startRun(take, form, fields, message) }, "re-run");
+  const panel = h("div", { class: "panel", id: "rerun-panel" }, h("h2", {}, "Re-run with other options (earlier runs are kept)"),
+    h("div", { class: "controls" }, h("label", {}, "preset ", presetPick)),
+    h("div", { class: "option-groups" }, groups, form.roles ? form.roles.box : null), h("div", { class: "controls" }, start, message));
+  clearOnChange(panel, message);
   return panel;
 }

@@ -33,13 +33,23 @@ export function usablePresets(presets, available) {
     .filter(([, options]) => options.checks.length);
 }
 
+// How each type of run-option field served by GET /run-options reads its control's value into
+// a run's options; "filter" and "filter_preset" fields go with the filter's parameters.
+const FIELD_VALUES = {
+  choice: (field, text) => ({ value: text || undefined }),
+  int: checkValue,
+  float: checkValue,
+};
+
 /**
  * The options of a new run from the form's values.
  *
- * @param values  {checks: [..], twist_method?, twist_apply?, filter_method, filter_preset,
- *                 max_points?: text, params: [[field, text], ...], mapping?: {role: joint}}
- *                 (field as the registry's; mapping: the roles named by hand, BVH takes)
- * @param fields  the run-option fields by name (for max_points' bounds)
+ * @param values  {checks: [..], filter_method, filter_preset, params: [[field, text], ...],
+ *                 mapping?: {role: joint}, and each other form field's text by its name, e.g.
+ *                 twist_method, max_points} (params: the registry's field of each filter
+ *                 parameter; mapping: the roles named by hand, BVH takes)
+ * @param fields  the run-option fields of the form by name (GET /run-options): their types,
+ *                choices and bounds
  * @returns {options} or {errors: [message, ...]}
  */
 export function formOptions(values, fields) {
@@ -55,12 +65,12 @@ export function formOptions(values, fields) {
     filter_method: values.filter_method || null, filter_preset: values.filter_preset || null, filter_params: filterParams,
   };
   if (values.mapping && Object.keys(values.mapping).length) options.mapping = { ...values.mapping };
-  if (values.twist_method) options.twist_method = values.twist_method;
-  if (values.twist_apply) options.twist_apply = values.twist_apply;
-  if (fields.max_points) {
-    const checked = checkValue(fields.max_points, values.max_points);
+  for (const field of Object.values(fields)) {
+    const read = FIELD_VALUES[field.type];
+    if (!read || values[field.name] === undefined) continue;
+    const checked = read(field, values[field.name]);
     if (checked.error) errors.push(checked.error);
-    else if (checked.value !== undefined) options.max_points = checked.value;
+    else if (checked.value !== undefined) options[field.name] = checked.value;
   }
   if (!values.checks.length) errors.push("checks: tick at least one check");
   return errors.length ? { errors } : { options };

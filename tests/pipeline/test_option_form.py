@@ -1,9 +1,10 @@
-"""The run options as the re-run form gets them: derived from AnalysisOptions, presets valid."""
+"""The run options' one declaration (``AnalysisOptions`` in pipeline/options.py), written out
+here: the JSON form and the re-run form's description follow it, presets are valid."""
 
 from __future__ import annotations
 
-import dataclasses
 import re
+from typing import Any
 
 import pytest
 
@@ -12,29 +13,89 @@ from mocapqa.filters.apply import resolve_params
 from mocapqa.filters.registry import DataScale
 from mocapqa.pipeline.options import (
     CHECKS,
-    MAX_POINTS_RANGE,
+    DEFAULT_OPTIONS,
     RUN_PRESETS,
-    TWIST_APPLY_CHOICES,
-    TWIST_METHODS,
     AnalysisOptions,
     describe_options,
+    option_fields,
 )
 
+DECLARED: dict[str, tuple[str, Any, str | None, tuple[str, ...], tuple[int, int] | None]] = {
+    "checks": ("names", ("twist", "limits", "filter", "markers", "feet"), None,
+               ("twist", "limits", "filter", "markers", "feet"), None),
+    "twist_method": ("text", "robust", "twist", ("robust", "paper"), None),
+    "twist_apply": ("text", "confident", "twist", ("confident", "all", "none"), None),
+    "filter_method": ("text", None, "filter", (), None),
+    "filter_preset": ("text", None, "filter", (), None),
+    "filter_params": ("params", {}, None, (), None),
+    "max_points": ("int", 2000, "advanced", (), (10, 100_000)),
+    "mapping": ("mapping", {}, None, (), None),
+    "limits_model": ("text", None, None, (), None),
+}  # fmt: skip
+"""Each option written out: (JSON kind, default, form group, choices, bounds), in order."""
+CHANGED: dict[str, Any] = {
+    "checks": ["feet", "twist"],
+    "twist_method": "paper",
+    "twist_apply": "0,3",
+    "filter_method": "butterworth",
+    "filter_preset": "default",
+    "filter_params": {"cutoff_hz": 4.0, "order": 2},
+    "max_points": 10,
+    "mapping": {"left_upper_arm": "LeftArm"},
+    "limits_model": "walks",
+}
+"""A value other than the default for every option, as JSON."""
 
-def test_every_field_of_the_form_is_an_option_with_its_default() -> None:
+
+def test_the_declaration_is_the_options_written_out() -> None:
+    declared = {
+        f.name: (f.spec.kind, f.default, f.spec.group, f.spec.choices, f.spec.bounds)
+        for f in option_fields()
+    }
+    assert list(declared) == list(DECLARED)
+    assert declared == DECLARED
+    assert [f.name for f in option_fields() if not f.spec.requested] == ["limits_model"]
+    assert all(f.spec.help for f in option_fields())
+    assert AnalysisOptions() == DEFAULT_OPTIONS
+    assert DEFAULT_OPTIONS.to_json() == {
+        name: list(default) if isinstance(default, tuple) else default
+        for name, (_, default, *_) in DECLARED.items()
+    }
+
+
+def test_every_option_goes_through_the_json_form_and_back() -> None:
+    options = AnalysisOptions.from_json(CHANGED)
+    assert options.to_json() == CHANGED
+    assert AnalysisOptions.from_json(options.to_json()) == options
+    assert options.request_json() == {k: v for k, v in CHANGED.items() if k != "limits_model"}
+    for name, value in CHANGED.items():  # each alone (with its filter), the others default
+        sent = {"filter_method": "butterworth", name: value} if "filter" in name else {name: value}
+        alone = AnalysisOptions.from_json(sent)
+        assert alone.to_json() == {**DEFAULT_OPTIONS.to_json(), **sent}, name
+    wrong = {"checks": "twist", "max_points": 2000.0, "twist_method": 1, "filter_params": ["x"]}
+    for name, value in wrong.items():
+        with pytest.raises(OptionError, match="^" + name + ": Expected") as raised:
+            AnalysisOptions.from_json({name: value})
+        assert raised.value.field == name
+
+
+def test_the_form_shows_the_declared_fields_with_their_defaults() -> None:
     described = describe_options()
     fields = {f["name"]: f for g in described["groups"] for f in g["fields"]}
-    option_names = {f.name for f in dataclasses.fields(AnalysisOptions)}
-    # Every field is an option (checks are the groups' own boxes; mapping is set per take, the
-    # limits model per shoot).
-    assert set(fields) <= option_names
-    assert option_names - set(fields) == {"checks", "filter_params", "mapping", "limits_model"}
-    default = AnalysisOptions()
-    for name, field in fields.items():
-        assert field["default"] == getattr(default, name), name
-    assert fields["twist_method"]["choices"] == list(TWIST_METHODS)
-    assert fields["twist_apply"]["choices"] == list(TWIST_APPLY_CHOICES)
-    assert (fields["max_points"]["minimum"], fields["max_points"]["maximum"]) == MAX_POINTS_RANGE
+    # Checks are the groups' own boxes; filter parameters come from the filter registry,
+    # mapping is set per take, the limits model per shoot.
+    shown = {name for name, (_, _, group, _, _) in DECLARED.items() if group is not None}
+    assert set(fields) == shown
+    for name, (_, default, group, choices, bounds) in DECLARED.items():
+        if group is None:
+            continue
+        assert fields[name]["default"] == default, name
+        assert fields[name].get("choices", []) == list(choices), name
+        assert (fields[name].get("minimum"), fields[name].get("maximum")) == (bounds or (None,) * 2)
+        assert (
+            next(g for g in described["groups"] if name in [f["name"] for f in g["fields"]])["name"]
+            == group
+        )
     assert fields["max_points"]["unit"] == "samples"
     assert described["checks"] == list(CHECKS)
     assert {g["check"] for g in described["groups"]} - {None} == set(CHECKS)
@@ -45,9 +106,10 @@ def test_presets_are_valid_options_and_the_bounds_are_enforced() -> None:
     assert set(presets) == set(RUN_PRESETS)
     for name, options in presets.items():
         assert AnalysisOptions.from_json(options) == RUN_PRESETS[name]
-    low, high = MAX_POINTS_RANGE
-    with pytest.raises(InputError, match=rf"^max_points: Expected {low} to {high}"):
-        AnalysisOptions(max_points=high + 1)
+    with pytest.raises(InputError, match=r"^max_points: Expected 10 to 100000"):
+        AnalysisOptions(max_points=100_001)
+    with pytest.raises(InputError, match=r"^twist_method: Expected one of \['robust', 'paper'\]"):
+        AnalysisOptions(twist_method="spin")
 
 
 @pytest.mark.parametrize(

@@ -3,21 +3,14 @@
 from __future__ import annotations
 
 from datetime import datetime
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, Field, create_model, field_validator
 
 from mocapqa.api.request_model import RequestModel
-from mocapqa.core.rig import ROLE_KEYS
-from mocapqa.errors import InputError
-from mocapqa.pipeline.options import (
-    CHECKS,
-    MAX_POINTS_RANGE,
-    Check,
-    TwistMethod,
-    check_checks,
-    check_mapping,
-)
+from mocapqa.errors import InputError, OptionError
+from mocapqa.pipeline.option_fields import OptionField, json_value
+from mocapqa.pipeline.options import AnalysisOptions, ParamValue, option_fields
 from mocapqa.store.repository import ReviewStatus, RunStatus
 
 __all__ = [
@@ -33,6 +26,7 @@ __all__ = [
     "TakeDetailOut",
     "TakeOut",
     "TakePageOut",
+    "options_request_model",
 ]
 
 
@@ -62,50 +56,75 @@ class HealthOut(BaseModel):
     database: str
 
 
-class AnalysisOptionsIn(RequestModel):
-    """Options of a new run; omitted fields take their defaults."""
+def _request_type(field: OptionField) -> Any:
+    """The type a request gives the option ``field``, from its kind and choices."""
+    spec = field.spec
+    names: Any = Literal.__getitem__(spec.choices) if spec.choices else str
+    kinds: dict[str, Any] = {
+        "names": list.__class_getitem__(names),
+        "text": str if spec.open_choices else names,
+        "int": int,
+        "params": dict[str, ParamValue],
+        "mapping": dict[str, str],
+    }
+    value = kinds[spec.kind]
+    return value | None if spec.nullable else value
 
-    model_config = ConfigDict(extra="forbid")
 
-    checks: list[Check] = Field(
-        list(CHECKS),
-        max_length=len(CHECKS),
-        json_schema_extra={"uniqueItems": True},
-        description="The checks to run, each at most once",
-    )
-    twist_method: TwistMethod = "robust"
-    twist_apply: str = Field(
-        "confident",
-        description="Twist intervals to remove: confident, all, none, or interval ids ('0,3'); "
-        "checked by the run options (pipeline/options.py)",
-    )
-    filter_method: str | None = None
-    filter_preset: str | None = None
-    filter_params: dict[str, float | int | bool | str] = Field(default_factory=dict, max_length=64)
-    max_points: int = Field(2000, ge=MAX_POINTS_RANGE[0], le=MAX_POINTS_RANGE[1])
-    mapping: dict[str, str] = Field(
-        default_factory=dict,
-        max_length=len(ROLE_KEYS),
-        description='Rig roles by hand, role key → joint name ({"left_upper_arm": "LeftArm"}); '
-        "roles not named are found from the joint names and the skeleton's structure.",
-    )
+def _request_field(field: OptionField) -> Any:
+    """The pydantic field of the option ``field``: its default, bounds and help."""
+    spec = field.spec
+    limits: dict[str, Any] = {"description": spec.help}
+    if spec.bounds is not None:
+        limits["ge"], limits["le"] = spec.bounds
+    if spec.max_items is not None:
+        limits["max_length"] = spec.max_items
+    if spec.kind == "names":
+        limits["json_schema_extra"] = {"uniqueItems": True}
+    if isinstance(field.default, dict):
+        return Field(default_factory=dict, **limits)
+    return Field(json_value(field.default), **limits)
 
-    @field_validator("checks")
-    @classmethod
-    def _checks_once(cls, value: list[Check]) -> list[Check]:
+
+def _request_check(field: OptionField) -> Any:
+    """A validator running the option's own check in the request model (a 422 naming it)."""
+    check = field.spec.check
+
+    def checked(cls: type[BaseModel], value: Any) -> Any:
+        del cls
         try:
-            check_checks(value)
+            kept = check(value) if check is not None else value
+        except OptionError as e:
+            raise ValueError(e.message) from e
         except InputError as e:
             raise ValueError(str(e)) from e
-        return value
+        return type(value)(kept)
 
-    @field_validator("mapping")
-    @classmethod
-    def _roles_are_known(cls, value: dict[str, str]) -> dict[str, str]:
-        try:
-            return check_mapping(value)
-        except InputError as e:
-            raise ValueError(str(e)) from e
+    return field_validator(field.name)(classmethod(checked))
+
+
+def options_request_model(cls: type[AnalysisOptions] = AnalysisOptions) -> type[RequestModel]:
+    """The request model of a new run's options, generated from the options ``cls`` declares
+    (:func:`mocapqa.pipeline.options.option_fields`): every option a run request carries, with
+    its type, default, bounds and help; the checks that need no registry nor take run here."""
+    fields = [f for f in option_fields(cls) if f.spec.requested]
+    checks = {f"_check_{f.name}": _request_check(f) for f in fields if f.spec.check_in_request}
+    definitions: dict[str, Any] = {f.name: (_request_type(f), _request_field(f)) for f in fields}
+    return create_model(
+        "AnalysisOptionsIn",
+        __base__=RequestModel,
+        __module__=__name__,
+        __doc__="Options of a new run; omitted fields take their defaults.",
+        __validators__=checks,
+        **definitions,
+    )
+
+
+if TYPE_CHECKING:
+    AnalysisOptionsIn = RequestModel
+else:
+    AnalysisOptionsIn = options_request_model()
+    """Options of a new run (``POST /takes/{id}/runs``), generated from the declaration."""
 
 
 class RunOut(BaseModel):

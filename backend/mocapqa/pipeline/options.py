@@ -7,22 +7,42 @@ round-trips. Angles are degrees only at this edge (names end in ``_deg``).
 
 from __future__ import annotations
 
-import dataclasses
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal, get_args
+from typing import Any, Self
 
-from mocapqa.core.rig import ROLE_KEYS, normalise_mapping
+from mocapqa.core.rig import ROLE_KEYS
 from mocapqa.errors import InputError, OptionError
-from mocapqa.filters.apply import apply_overrides
-from mocapqa.filters.registry import FILTERS, DataScale
-from mocapqa.limits.catalog import check_model_name
+from mocapqa.filters.registry import FILTERS
+from mocapqa.pipeline.option_checks import (
+    CHECKS,
+    Check,
+    apply_option,
+    check_checks,
+    check_filter_params,
+    check_mapping,
+    checks_option,
+    filter_option,
+    model_option,
+)
+from mocapqa.pipeline.option_fields import (
+    FormGroup,
+    OptionField,
+    OptionSpec,
+    check_field,
+    declare,
+    declared_fields,
+    describe_field,
+    json_value,
+    read_field,
+)
 from mocapqa.twist.analysis import METHODS, Method
-from mocapqa.twist.choice import APPLY_CHOICES, parse_apply
+from mocapqa.twist.choice import APPLY_CHOICES
 
 __all__ = [
     "CHECKS",
+    "DEFAULT_OPTIONS",
+    "FORM_GROUPS",
     "MARKER_FORMATS",
     "MAX_POINTS_RANGE",
     "RUN_PRESETS",
@@ -35,16 +55,13 @@ __all__ = [
     "check_checks",
     "check_mapping",
     "describe_options",
+    "option_fields",
     "take_checks",
 ]
 
 ParamValue = float | int | bool | str
 """Value of one filter parameter override."""
 
-Check = Literal["twist", "limits", "filter", "markers", "feet"]
-"""A check a run can do."""
-CHECKS: tuple[Check, ...] = get_args(Check)
-"""The checks a run can do."""
 MARKER_FORMATS = ("c3d", "trc")
 """Formats whose points are optical markers (the ``markers`` check runs on them); the points of
 every other keypoint format are detections from video."""
@@ -73,20 +90,14 @@ MAX_POINTS_RANGE = (10, 100_000)
 """Smallest and largest ``max_points`` (time samples per plotted series)."""
 
 
-def _same_kind(value: Any, current: Any) -> bool:
-    """Whether an override ``value`` can stand in for a parameter's ``current`` value."""
-    if isinstance(value, str):
-        return not dataclasses.is_dataclass(current)  # converted (and checked) by the filter
-    if isinstance(current, bool) or isinstance(value, bool):
-        return isinstance(current, bool) and isinstance(value, bool)
-    if isinstance(current, int | float) and isinstance(value, int | float):
-        return math.isfinite(value) and (isinstance(current, float) or isinstance(value, int))
-    return False
-
-
 @dataclass(frozen=True, slots=True)
 class AnalysisOptions:
     """What one analysis run does.
+
+    Every field is declared once, here, with an :class:`~mocapqa.pipeline.option_fields.OptionSpec`:
+    its default, JSON kind, choices or bounds, help and place in the re-run form. The checks,
+    ``to_json``/``from_json``, :func:`describe_options`, the API's request model and the CLI
+    defaults read the declaration (:func:`~mocapqa.pipeline.option_fields.declared_fields`).
 
     Parameters
     ----------
@@ -117,70 +128,137 @@ class AnalysisOptions:
         form; whether it exists, when the run is recorded and when it runs.
     """
 
-    checks: tuple[str, ...] = CHECKS
-    twist_method: str = "robust"
-    twist_apply: str = "confident"
-    filter_method: str | None = None
-    filter_preset: str | None = None
-    filter_params: dict[str, ParamValue] = field(default_factory=dict)
-    max_points: int = 2000
-    mapping: dict[str, str] = field(default_factory=dict)
-    limits_model: str | None = None
+    checks: tuple[str, ...] = field(
+        default=CHECKS,
+        metadata=declare(
+            OptionSpec(
+                "names",
+                "The checks to run, each at most once",
+                choices=CHECKS,
+                max_items=len(CHECKS),
+                check=checks_option,
+                check_in_request=True,
+            )
+        ),
+    )
+    twist_method: str = field(
+        default="robust",
+        metadata=declare(
+            OptionSpec(
+                "text",
+                "Twist detection method: the robust detector, or the published rule as written "
+                "(paper)",
+                label="detection method",
+                group="twist",
+                form="choice",
+                choices=TWIST_METHODS,
+            )
+        ),
+    )
+    twist_apply: str = field(
+        default="confident",
+        metadata=declare(
+            OptionSpec(
+                "text",
+                "Twist intervals to remove: confident, all, none, or interval ids ('0,3'); "
+                "checked by the run options (pipeline/options.py)",
+                label="intervals removed in the corrected take",
+                group="twist",
+                form="choice",
+                choices=TWIST_APPLY_CHOICES,
+                open_choices=True,
+                check=apply_option,
+            )
+        ),
+    )
+    filter_method: str | None = field(
+        default=None,
+        metadata=declare(
+            OptionSpec(
+                "text",
+                "A filter of the registry (GET /filters); none: adaptive for keypoint takes, no "
+                "filtering of a BVH take",
+                label="filter",
+                group="filter",
+                form="filter",
+                nullable=True,
+                check=filter_option,
+            )
+        ),
+    )
+    filter_preset: str | None = field(
+        default=None,
+        metadata=declare(
+            OptionSpec(
+                "text",
+                "A preset of the filter (GET /filters); none: its default",
+                label="filter preset",
+                group="filter",
+                form="filter_preset",
+                nullable=True,
+            )
+        ),
+    )
+    filter_params: dict[str, ParamValue] = field(
+        default_factory=dict,
+        metadata=declare(
+            OptionSpec(
+                "params",
+                "Parameter overrides of the filter by dotted name, in the registry's units "
+                "(GET /filters)",
+                max_items=64,
+            )
+        ),
+    )
+    max_points: int = field(
+        default=2000,
+        metadata=declare(
+            OptionSpec(
+                "int",
+                "Most time samples per plotted series (the result is decimated to it)",
+                label="samples per plotted series",
+                group="advanced",
+                form="int",
+                bounds=MAX_POINTS_RANGE,
+                unit="samples",
+            )
+        ),
+    )
+    mapping: dict[str, str] = field(
+        default_factory=dict,
+        metadata=declare(
+            OptionSpec(
+                "mapping",
+                'Rig roles by hand, role key → joint name ({"left_upper_arm": "LeftArm"}); '
+                "roles not named are found from the joint names and the skeleton's structure.",
+                max_items=len(ROLE_KEYS),
+                check=check_mapping,
+                check_in_request=True,
+            )
+        ),
+    )
+    limits_model: str | None = field(
+        default=None,
+        metadata=declare(
+            OptionSpec(
+                "text",
+                "The limits model by name; none: the take's shoot's model, else the default",
+                nullable=True,
+                requested=False,
+                check=model_option,
+            )
+        ),
+    )
 
     def __post_init__(self) -> None:
-        try:
-            check_checks(self.checks)
-        except InputError as e:
-            raise OptionError("checks", str(e)) from e
-        if self.twist_method not in TWIST_METHODS:
-            raise OptionError(
-                "twist_method",
-                f"Expected one of {list(TWIST_METHODS)}, got {self.twist_method!r}",
-            )
-        try:
-            parse_apply(self.twist_apply)
-        except InputError as e:
-            raise OptionError("twist_apply", str(e)) from e
-        if self.filter_method is not None and self.filter_method not in FILTERS:
-            raise OptionError(
-                "filter_method",
-                f"Expected one of {sorted(FILTERS)}, got {self.filter_method!r}",
-            )
-        low, high = MAX_POINTS_RANGE
-        if not low <= self.max_points <= high:
-            raise OptionError("max_points", f"Expected {low} to {high}, got {self.max_points}")
-        object.__setattr__(self, "checks", tuple(self.checks))
-        object.__setattr__(self, "mapping", check_mapping(self.mapping))
-        if self.limits_model is not None:
-            check_model_name(self.limits_model)
-        self._check_filter(self.filter_method or "adaptive")
-
-    def _check_filter(self, method: str) -> None:
-        entry = FILTERS[method]
-        if self.filter_preset is not None and self.filter_preset not in entry.presets:
-            raise OptionError(
-                "filter_preset",
-                f"Expected a preset of {method!r} in {sorted(entry.presets)}, "
-                f"got {self.filter_preset!r}",
-            )
-        base = entry.preset(self.filter_preset or "default", DataScale())
-        for name, value in self.filter_params.items():
-            try:
-                apply_overrides(base, {name: value})
-            except OptionError as e:  # the message without the dotted name it starts with
-                field_name = f"filter_params.{name}"
-                raise OptionError(field_name, f"{e.message} (filter {method!r})") from e
-            except (InputError, TypeError, ValueError) as e:
-                raise OptionError(f"filter_params.{name}", f"{e} (filter {method!r})") from e
-            current: Any = base
-            for part in name.split("."):
-                current = getattr(current, part)
-            if not _same_kind(value, current):
-                raise OptionError(
-                    f"filter_params.{name}",
-                    f"Expected a finite {type(current).__name__} (filter {method!r}), "
-                    f"got {value!r}",
-                )
+        for declared in declared_fields(type(self)):
+            value = getattr(self, declared.name)
+            checked = check_field(declared, value)
+            if checked is not value:
+                object.__setattr__(self, declared.name, checked)
+        check_filter_params(
+            self.filter_method or "adaptive", self.filter_preset, self.filter_params
+        )
 
     def check_take_kind(self, kind: str, fps: float | None = None) -> None:
         """Refuse options that do not suit a take of ``kind`` ("motion" or "keypoints") at
@@ -272,29 +350,21 @@ class AnalysisOptions:
             raise OptionError("mapping", str(e)) from e
 
     def to_json(self) -> dict[str, Any]:
-        """The options as a JSON-ready dict."""
-        return {
-            "checks": list(self.checks),
-            "twist_method": self.twist_method,
-            "twist_apply": self.twist_apply,
-            "filter_method": self.filter_method,
-            "filter_preset": self.filter_preset,
-            "filter_params": dict(self.filter_params),
-            "max_points": self.max_points,
-            "mapping": dict(self.mapping),
-            "limits_model": self.limits_model,
-        }
+        """The options as a JSON-ready dict, every declared field in its order."""
+        return {f.name: json_value(getattr(self, f.name)) for f in declared_fields(type(self))}
 
     def request_json(self) -> dict[str, Any]:
         """The body of a run request for these options (``POST /takes/{id}/runs``): the JSON
         less ``limits_model``, which a run does not choose (its shoot's model, or the
         default, decides)."""
         body = self.to_json()
-        del body["limits_model"]
+        for declared in declared_fields(type(self)):
+            if not declared.spec.requested:
+                del body[declared.name]
         return body
 
     @classmethod
-    def from_json(cls, data: dict[str, Any] | None) -> AnalysisOptions:
+    def from_json(cls, data: dict[str, Any] | None) -> Self:
         """Options from a JSON dict; missing fields take their defaults.
 
         Raises
@@ -304,76 +374,12 @@ class AnalysisOptions:
         """
         if not data:
             return cls()
-        known = {"checks", "twist_method", "twist_apply", "filter_method", "filter_preset"}
-        known |= {"filter_params", "max_points", "mapping", "limits_model"}
-        extra = sorted(set(data) - known)
+        declared = declared_fields(cls)
+        known = sorted(f.name for f in declared)
+        extra = sorted(set(data) - set(known))
         if extra:
-            raise OptionError(extra[0], f"Expected option fields among {sorted(known)}")
-        params = data.get("filter_params") or {}
-        if not isinstance(params, dict) or not all(
-            isinstance(v, int | float | str) for v in params.values()
-        ):
-            raise OptionError("filter_params", f"Expected names mapped to values, got {params!r}")
-        checks = data.get("checks", list(CHECKS))
-        if not isinstance(checks, list | tuple) or not all(isinstance(c, str) for c in checks):
-            raise OptionError("checks", f"Expected a list of names, got {checks!r}")
-        max_points = data.get("max_points", 2000)
-        if not isinstance(max_points, int) or isinstance(max_points, bool):
-            raise OptionError("max_points", f"Expected an integer, got {max_points!r}")
-        strings = ("twist_method", "twist_apply", "filter_method", "filter_preset", "limits_model")
-        for name in strings:
-            value = data.get(name)
-            if value is not None and not isinstance(value, str):
-                raise OptionError(name, f"Expected a string, got {value!r}")
-        return cls(
-            checks=tuple(checks),
-            twist_method=data.get("twist_method") or "robust",
-            twist_apply=data.get("twist_apply") or "confident",
-            filter_method=data.get("filter_method"),
-            filter_preset=data.get("filter_preset"),
-            filter_params={str(k): v for k, v in params.items()},
-            max_points=max_points,
-            mapping=data.get("mapping") or {},
-            limits_model=data.get("limits_model"),
-        )
-
-
-def check_checks(checks: Sequence[str]) -> None:
-    """Refuse a ``checks`` option naming a check not in :data:`CHECKS` or one more than once
-    (so at most ``len(CHECKS)`` names). The one check of the option, used by
-    :class:`AnalysisOptions` and the API's request model.
-
-    Raises
-    ------
-    InputError
-        E.g. ``Expected each of ['twist', 'limits', 'filter'] at most once, got 'twist'
-        100000 times``.
-    """
-    unknown = sorted(set(checks) - set(CHECKS))
-    if unknown:
-        shown = [c[:40] for c in unknown[:3]] + (["…"] if len(unknown) > 3 else [])
-        raise InputError(f"Expected names among {list(CHECKS)}, got {shown}")
-    twice = next((c for c in CHECKS if checks.count(c) > 1), None)
-    if twice is not None:
-        raise InputError(
-            f"Expected each of {list(CHECKS)} at most once, got {twice!r} "
-            f"{checks.count(twice)} times"
-        )
-
-
-def check_mapping(mapping: object) -> dict[str, str]:
-    """The ``mapping`` option as role key → joint name, or an InputError naming the field.
-
-    The one check of the option, used by :class:`AnalysisOptions` and the API's request model.
-    """
-    if not isinstance(mapping, dict):
-        raise InputError(f"Expected mapping to be an object of role → joint name, got {mapping!r}")
-    if any(not isinstance(v, str) or not v for v in mapping.values()):
-        raise InputError("Expected mapping to name a joint (a non-empty string) for each role")
-    try:
-        return normalise_mapping(mapping)
-    except InputError as e:
-        raise InputError(f"mapping: {e}") from e
+            raise OptionError(extra[0], f"Expected option fields among {known}")
+        return cls(**{f.name: read_field(f, data) for f in declared})
 
 
 RUN_PRESETS: dict[str, AnalysisOptions] = {
@@ -390,102 +396,77 @@ RUN_PRESETS: dict[str, AnalysisOptions] = {
 editable). The filter's own presets are the filter registry's."""
 
 
-def describe_options() -> dict[str, Any]:
+FORM_GROUPS: tuple[FormGroup, ...] = (
+    FormGroup("twist", "Twist", "twist"),
+    FormGroup("limits", "Joint limits", "limits", note="the rig's joint-limit model; no settings"),
+    FormGroup(
+        "markers",
+        "Markers",
+        "markers",
+        note="swaps repaired, then confident gap fills applied; no settings",
+    ),
+    FormGroup("feet", "Feet and floor", "feet"),
+    FormGroup("filter", "Filter", "filter"),
+    FormGroup("advanced", "Advanced", None, advanced=True),
+)
+"""The groups of the re-run form, in its order: one per check (its box runs it), then the
+settings of no check. A declared option shows in the group its spec names."""
+
+DEFAULT_OPTIONS = AnalysisOptions()
+"""The options of a run that chooses none (the CLI's defaults read it)."""
+
+
+def option_fields(cls: type[AnalysisOptions] = AnalysisOptions) -> tuple[OptionField, ...]:
+    """The declared run options of ``cls`` (:class:`AnalysisOptions` or a subclass declaring
+    more), in their order."""
+    return declared_fields(cls)
+
+
+def _form_groups(fields: Sequence[OptionField]) -> list[dict[str, Any]]:
+    """:data:`FORM_GROUPS` as the form describes them, each with its declared fields."""
+    known = {group.name for group in FORM_GROUPS}
+    strays = [f.name for f in fields if f.spec.group is not None and f.spec.group not in known]
+    if strays:
+        raise ValueError(f"Expected the form group of {strays} among {sorted(known)}")
+    groups = []
+    for group in FORM_GROUPS:
+        described: dict[str, Any] = {"name": group.name, "label": group.label}
+        described["check"] = group.check
+        if group.advanced:
+            described["advanced"] = True
+        described["note"] = group.note
+        shown = [f for f in fields if f.spec.group == group.name]
+        described["fields"] = [describe_field(f, group) for f in shown]
+        groups.append(described)
+    return groups
+
+
+def _take_kinds() -> dict[str, list[str]]:
+    """The checks each kind of take can run (:func:`take_checks`): ``"motion"``, ``"markers"``
+    (a keypoint take read from one of :data:`MARKER_FORMATS`) and ``"keypoints"``."""
+    return {
+        "motion": list(take_checks("motion")),
+        "markers": list(take_checks("keypoints", MARKER_FORMATS[0])),
+        "keypoints": list(take_checks("keypoints")),
+    }
+
+
+def describe_options(cls: type[AnalysisOptions] = AnalysisOptions) -> dict[str, Any]:
     """The run options for a form: fields grouped by check, with types, units, choices, bounds,
-    defaults and the check each field belongs to, :data:`RUN_PRESETS` as JSON options, the
-    checks each kind of take can run (:func:`take_checks`) and the role keys a ``mapping`` may
-    name (:data:`mocapqa.core.rig.ROLE_KEYS`).
+    defaults, help and the check each field belongs to, :data:`RUN_PRESETS` as JSON options,
+    the checks each kind of take can run (:func:`take_checks`, a form offers those only) and
+    the role keys a ``mapping`` may name (:data:`mocapqa.core.rig.ROLE_KEYS`).
 
-    Derived from :class:`AnalysisOptions` and the constants above, so a form offers exactly
-    what ``from_json`` accepts. Filter parameters come from the filter registry
-    (``GET /filters``): they depend on the filter chosen.
+    Derived from the fields declared by ``cls`` (:class:`AnalysisOptions`, or a subclass
+    declaring more) and the constants above, so a form offers exactly what ``from_json``
+    accepts. Filter parameters come from the filter registry (``GET /filters``): they depend
+    on the filter chosen.
     """
-    default = AnalysisOptions()
-    low, high = MAX_POINTS_RANGE
-
-    def choice(name: str, label: str, choices: tuple[str, ...], check: str) -> dict[str, Any]:
-        value = getattr(default, name)
-        return {
-            "name": name,
-            "label": label,
-            "type": "choice",
-            "choices": list(choices),
-            "default": value,
-            "unit": "",
-            "check": check,
-        }
-
-    groups = [
-        {
-            "name": "twist",
-            "label": "Twist",
-            "check": "twist",
-            "fields": [
-                choice("twist_method", "detection method", TWIST_METHODS, "twist"),
-                choice(
-                    "twist_apply",
-                    "intervals removed in the corrected take",
-                    TWIST_APPLY_CHOICES,
-                    "twist",
-                ),
-            ],
-        },
-        {"name": "limits", "label": "Joint limits", "check": "limits", "fields": []},
-        {"name": "markers", "label": "Markers", "check": "markers", "fields": []},
-        {"name": "feet", "label": "Feet and floor", "check": "feet", "fields": []},
-        {
-            "name": "filter",
-            "label": "Filter",
-            "check": "filter",
-            "fields": [
-                {
-                    "name": "filter_method",
-                    "label": "filter",
-                    "type": "filter",
-                    "default": None,
-                    "unit": "",
-                    "check": "filter",
-                },
-                {
-                    "name": "filter_preset",
-                    "label": "filter preset",
-                    "type": "filter_preset",
-                    "default": None,
-                    "unit": "",
-                    "check": "filter",
-                },
-            ],
-        },
-        {
-            "name": "advanced",
-            "label": "Advanced",
-            "check": None,
-            "advanced": True,
-            "fields": [
-                {
-                    "name": "max_points",
-                    "label": "samples per plotted series",
-                    "type": "int",
-                    "default": default.max_points,
-                    "minimum": low,
-                    "maximum": high,
-                    "unit": "samples",
-                    "check": None,
-                },
-            ],
-        },
-    ]
     return {
         "checks": list(CHECKS),
-        # Which checks a take can run, by the take's kind ("markers": a keypoint take read from
-        # one of ``marker_formats``): the form offers those only.
-        "take_checks": {
-            "motion": list(take_checks("motion")),
-            "markers": list(take_checks("keypoints", MARKER_FORMATS[0])),
-            "keypoints": list(take_checks("keypoints")),
-        },
+        "take_checks": _take_kinds(),
         "marker_formats": list(MARKER_FORMATS),
-        "groups": groups,
+        "groups": _form_groups(option_fields(cls)),
         "presets": {name: options.request_json() for name, options in RUN_PRESETS.items()},
         # The rig roles a ``mapping`` may name (BVH takes), in the rig module's order.
         "role_keys": list(ROLE_KEYS),
