@@ -7,7 +7,11 @@ export default [
   {
     files: ["frontend/js/**/*.js"],
     languageOptions: { ecmaVersion: 2022, sourceType: "module", globals: { ...globals.browser } },
-    rules: { "no-unused-vars": ["error", { argsIgnorePattern: "^_" }], eqeqeq: ["error", "smart"], "prefer-const": "error" },
+    rules: {
+      "no-unused-vars": ["error", { argsIgnorePattern: "^_" }], eqeqeq: ["error", "smart"], "prefer-const": "error",
+      // A longer function is split into named steps.
+      "max-lines-per-function": ["error", { max: 80 }],
+    },
   },
   {
     files: ["tests/js/**/*.js"],

@@ -3,21 +3,13 @@
 // A's instant) with an optional offset in B's frames, one player and one scrubber.
 import * as api from "./api.js";
 import { h } from "./dom.js";
+import { flaggedAt } from "./findings.js";
+import { sampleOf } from "./frames.js";
 import { createPlayer } from "./player.js";
 
 /** B's frame at A's frame `f`: the same instant, moved by `offset` of B's frames, clamped. */
 export function syncedFrame(f, fpsA, fpsB, offset, nFramesB) {
   return Math.max(0, Math.min(nFramesB - 1, Math.round((f / fpsA) * fpsB) + offset));
-}
-
-/** The index of the sample of `source` (frames, step) nearest frame `f`. */
-export const sampleOf = (source, f) => Math.max(0, Math.min(source.frames.length - 1, Math.round((f - source.frames[0]) / source.step)));
-
-/** Joints inside a finding at frame `f`, as index → colour. */
-function flaggedAt(findings, jointIndex, f, color) {
-  const flagged = new Map();
-  for (const x of findings) if (jointIndex.has(x.joint) && f >= x.start_frame && f <= x.end_frame) flagged.set(jointIndex.get(x.joint), color);
-  return flagged;
 }
 
 /**
@@ -62,7 +54,7 @@ export async function compareViews(container, a, b, labels, onTeardown = () => {
     views.show({
       raw: framesA.corrected[ka], corrected: framesB.corrected[kb],
       rawRotations: oriented ? framesA.corrected_rotations[ka] : null, correctedRotations: oriented ? framesB.corrected_rotations[kb] : null,
-      rawFlagged: flaggedAt(a.result.findings, jointIndex, frame, "#1f77b4"), flagged: flaggedAt(b.result.findings, jointIndex, fb, "#ff7f0e"),
+      rawFlagged: flaggedAt(a.result.findings, jointIndex, frame, () => "#1f77b4"), flagged: flaggedAt(b.result.findings, jointIndex, fb, () => "#ff7f0e"),
     });
     titleA.textContent = `A: ${labels[0]} — frame ${frame}`;
     titleB.textContent = `B: ${labels[1]} — frame ${fb}`;

@@ -51,6 +51,75 @@ export async function decidedElsewhere(take, run, getDecisions = api.getDecision
   return null;
 }
 
+/** What Y / X act on: `{ id }` of the item to decide, or `{ message }` saying why there is none.
+ * `focused` is the focused findings row's `{ kind, interval }` (its data attributes) or null,
+ * `current` the last opened decidable item's id, `lastKind` the last opened finding's kind,
+ * `kind` the decidable kind and `ids` the decidable items' ids. */
+export function keyTarget(focused, current, lastKind, kind, ids) {
+  const reported = (k) => ({ message: `a ${k} finding is reported, not corrected: nothing to accept or reject` });
+  if (focused && !focused.interval) return reported(focused.kind);
+  const id = focused ? Number(focused.interval) : current;
+  if (id != null && ids.has(id)) return { id };
+  return lastKind && lastKind !== kind ? reported(lastKind) : { message: `open or focus a ${kind} finding first` };
+}
+
+/** The decision history's lines, newest last as the server lists them; `label(id)` names an item. */
+function historyItems(rows, label) {
+  return rows.map((r) => h("li", {}, `${new Date(r.created_at).toLocaleString()} · ${r.reviewer}: `, badge(LABELS[r.decision], BADGE[r.decision]),
+    ` ${label(r.interval_id)}`, r.note ? ` — ${r.note}` : ""));
+}
+
+/** Draw an item's decision cell: the run's choice, the decision, what the reviewed download
+ * does with it, and the Accept / Reject buttons (`onDecide(decision)`). */
+function fillCell(cell, f, decision, spec, onDecide) {
+  const buttons = ["accept", "reject"].map((d) => {
+    const button = h("button", { class: `small decide-${d}`, "data-decision": d, "aria-pressed": String(decision === d),
+      onclick: (e) => { e.stopPropagation(); onDecide(d); } }, d === "accept" ? "Accept" : "Reject");
+    // Enter or space on a button acts on the button, not on its row.
+    button.addEventListener("keydown", (e) => { if (e.key === "Enter" || e.key === " ") e.stopPropagation(); });
+    return button;
+  });
+  const corrected = decision ? decision === "accept" : f.applied;
+  // Redrawn under the keyboard's focus: the same button keeps it (screen readers and Tab
+  // carry on from there instead of the page's start).
+  const focused = cell.contains(document.activeElement) ? document.activeElement.dataset?.decision : null;
+  // The read-out wraps on the left; the buttons keep to the cell's right, side by side.
+  cell.replaceChildren(h("div", { class: "decision-cell" },
+    h("span", { class: "decision-state" },
+      h("span", { class: "applied muted", title: spec.applied }, f.applied ? "run: applied" : "run: not applied"), " · ",
+      decision ? badge(LABELS[decision], BADGE[decision]) : h("span", { class: "muted" }, "undecided"),
+      h("span", { class: "outcome muted", title: `what the reviewed download does with this ${spec.name}` }, corrected ? " → corrected" : " → left as recorded")),
+    h("span", { class: "decision-buttons" }, ...buttons)));
+  if (focused) buttons.find((b) => b.dataset.decision === focused)?.focus();
+}
+
+/** Below the findings table: the reviewed download, a note for the next decision, what the
+ * download is, and the history. */
+function decisionsFooter(run, result, spec, parts) {
+  // A marker take's reviewed download is C3D, for a take the run wrote a corrected C3D of.
+  const downloadable = spec.format !== "c3d" || (result.downloads || []).includes("c3d");
+  return h("div", { id: "decisions" },
+    parts.elsewhere,
+    h("div", { class: "controls" },
+      downloadable
+        ? h("a", { href: api.decidedUrl(run.id, spec.format), download: "", id: "download-decided", class: "download" }, "Download reviewed take")
+        : h("span", { class: "muted", id: "download-decided-none" }, "no reviewed download: it is written as C3D, for C3D takes"),
+      parts.note, parts.message),
+    h("p", { class: "muted" }, spec.explain),
+    parts.history);
+}
+
+/** The message line, the note on another run's decisions, the note field and the history list. */
+function decisionParts() {
+  return {
+    message: h("span", { id: "decision-message", class: "muted" }),
+    // Decisions belong to a run: a re-run starts undecided, and says where earlier ones are.
+    elsewhere: h("p", { id: "decisions-elsewhere", class: "notice", hidden: true }),
+    note: h("input", { id: "decision-note", placeholder: "note for the next decision", "aria-label": "decision note" }),
+    history: h("ul", { id: "decision-history" }),
+  };
+}
+
 /** Decision cells for the findings rows of `run` and the panel parts below the table. */
 export function intervalDecisions(run, result, take = null) {
   // Only a take with twist intervals or swaps has anything to accept or reject.
@@ -61,45 +130,17 @@ export function intervalDecisions(run, result, take = null) {
   const cells = new Map(); // item id -> the row's decision cell
   let current = null; // the last opened decidable item
   let lastKind = null; // the kind of the last opened finding
-  const message = h("span", { id: "decision-message", class: "muted" });
-  // Decisions belong to a run: a re-run starts undecided, and says where earlier ones are.
-  const elsewhere = h("p", { id: "decisions-elsewhere", class: "notice", hidden: true });
-  const note = h("input", { id: "decision-note", placeholder: "note for the next decision", "aria-label": "decision note" });
-  const history = h("ul", { id: "decision-history" });
+  const parts = decisionParts();
+  const { message, note, history } = parts;
   const byId = new Map((found ? found.items : []).map((i) => [i.id, i]));
+  const say = (text, cls) => { message.textContent = text; message.className = cls; };
 
-  const label = (id) => {
-    const i = byId.get(id);
-    return i ? itemLabel(kind, i) : `${spec ? spec.item : "item"} ${id}`;
-  };
-  const showHistory = (rows) => history.replaceChildren(...rows.map((r) =>
-    h("li", {}, `${new Date(r.created_at).toLocaleString()} · ${r.reviewer}: `, badge(LABELS[r.decision], BADGE[r.decision]),
-      ` ${label(r.interval_id)}`, r.note ? ` — ${r.note}` : "")));
-
+  const label = (id) => (byId.has(id) ? itemLabel(kind, byId.get(id)) : `${spec ? spec.item : "item"} ${id}`);
+  const showHistory = (rows) => history.replaceChildren(...historyItems(rows, label));
   const fill = (id) => {
     const cell = cells.get(id);
     const f = byId.get(id);
-    if (!cell || !f) return;
-    const decision = latest.get(id);
-    const buttons = ["accept", "reject"].map((d) => {
-      const button = h("button", { class: `small decide-${d}`, "data-decision": d, "aria-pressed": String(decision === d),
-        onclick: (e) => { e.stopPropagation(); decide(id, d); } }, d === "accept" ? "Accept" : "Reject");
-      // Enter or space on a button acts on the button, not on its row.
-      button.addEventListener("keydown", (e) => { if (e.key === "Enter" || e.key === " ") e.stopPropagation(); });
-      return button;
-    });
-    const corrected = decision ? decision === "accept" : f.applied;
-    // Redrawn under the keyboard's focus: the same button keeps it (screen readers and Tab
-    // carry on from there instead of the page's start).
-    const focused = cell.contains(document.activeElement) ? document.activeElement.dataset?.decision : null;
-    // The read-out wraps on the left; the buttons keep to the cell's right, side by side.
-    cell.replaceChildren(h("div", { class: "decision-cell" },
-      h("span", { class: "decision-state" },
-        h("span", { class: "applied muted", title: spec.applied }, f.applied ? "run: applied" : "run: not applied"), " · ",
-        decision ? badge(LABELS[decision], BADGE[decision]) : h("span", { class: "muted" }, "undecided"),
-        h("span", { class: "outcome muted", title: `what the reviewed download does with this ${spec.name}` }, corrected ? " → corrected" : " → left as recorded")),
-      h("span", { class: "decision-buttons" }, ...buttons)));
-    if (focused) buttons.find((b) => b.dataset.decision === focused)?.focus();
+    if (cell && f) fillCell(cell, f, latest.get(id), spec, (d) => decide(id, d));
   };
 
   async function decide(id, decision) {
@@ -111,31 +152,25 @@ export function intervalDecisions(run, result, take = null) {
       // The server records the signed-in user as the reviewer.
       await api.addDecision(run.id, id, { decision, note: note.value }, spec.item);
       note.value = "";
-      message.textContent = `${label(id)} ${LABELS[decision]}`; message.className = "muted";
+      say(`${label(id)} ${LABELS[decision]}`, "muted");
       toast(message.textContent);
       showHistory((await api.getDecisions(run.id)).history);
     } catch (e) {
       if (before) latest.set(id, before); else latest.delete(id);
       fill(id);
-      message.textContent = e.message; message.className = "error";
+      say(e.message, "error");
       toast(e.message);
     }
   }
 
+  // The saved decisions fill the cells drawn meanwhile.
   const loaded = found ? api.getDecisions(run.id).then(async (body) => {
     for (const i of kind === "swap" ? body.swaps : body.intervals) if (i.decision) latest.set(i.id, i.decision);
     for (const id of cells.keys()) fill(id);
     showHistory(body.history);
-    if (body.history.length || !take) return;
-    const other = await decidedElsewhere(take, run);
-    if (!other) return;
-    elsewhere.replaceChildren(`Run ${other.number} holds ${other.count} decision${other.count === 1 ? "" : "s"} on its ${spec.name}s; this run has none yet (decisions belong to the run they were made on). `,
-      h("a", { href: api.takeLink(take.id, other.run.id), id: "decisions-elsewhere-link" }, `open run ${other.number}`));
-    elsewhere.hidden = false;
-  }).catch((e) => { message.textContent = e.message; message.className = "error"; }) : Promise.resolve();
+    if (!body.history.length && take) await showElsewhere(take, run, spec, parts.elsewhere);
+  }).catch((e) => say(e.message, "error")) : Promise.resolve();
 
-  // A marker take's reviewed download is C3D, for a take the run wrote a corrected C3D of.
-  const downloadable = !spec || spec.format !== "c3d" || (result.downloads || []).includes("c3d");
   return {
     enabled: Boolean(found),
     /** The finding kind whose rows are decided ("twist" or "swap"), null for none. */
@@ -155,37 +190,21 @@ export function intervalDecisions(run, result, take = null) {
       const decision = DECISION_KEYS[e.key.toLowerCase()];
       if (!decision) return false;
       if (!found) { toast("this run has no twist intervals or swaps to accept or reject"); return true; }
-      const focused = document.activeElement && document.activeElement.closest && document.activeElement.closest("tr.finding");
-      if (focused && !focused.dataset.interval) {
-        message.textContent = `a ${focused.dataset.kind} finding is reported, not corrected: nothing to accept or reject`;
-        message.className = "muted";
-        toast(message.textContent);
-        return true;
-      }
-      const id = focused ? Number(focused.dataset.interval) : current;
-      if (id == null || !byId.has(id)) {
-        message.textContent = lastKind && lastKind !== kind
-          ? `a ${lastKind} finding is reported, not corrected: nothing to accept or reject`
-          : `open or focus a ${kind} finding first`;
-        message.className = "muted";
-        toast(message.textContent);
-        return true;
-      }
-      decide(id, decision);
+      const row = document.activeElement && document.activeElement.closest && document.activeElement.closest("tr.finding");
+      const target = keyTarget(row ? { kind: row.dataset.kind, interval: row.dataset.interval } : null, current, lastKind, kind, byId);
+      if (target.message) { say(target.message, "muted"); toast(message.textContent); } else decide(target.id, decision);
       return true;
     },
     /** Below the table: the download, a note for the next decision and the history. */
-    footer() {
-      if (!found) return null;
-      return h("div", { id: "decisions" },
-        elsewhere,
-        h("div", { class: "controls" },
-          downloadable
-            ? h("a", { href: api.decidedUrl(run.id, spec.format), download: "", id: "download-decided", class: "download" }, "Download reviewed take")
-            : h("span", { class: "muted", id: "download-decided-none" }, "no reviewed download: it is written as C3D, for C3D takes"),
-          note, message),
-        h("p", { class: "muted" }, spec.explain),
-        history);
-    },
+    footer() { return found ? decisionsFooter(run, result, spec, parts) : null; },
   };
+}
+
+/** Say, in `elsewhere`, which other run of `take` holds decisions when this one has none. */
+async function showElsewhere(take, run, spec, elsewhere) {
+  const other = await decidedElsewhere(take, run);
+  if (!other) return;
+  elsewhere.replaceChildren(`Run ${other.number} holds ${other.count} decision${other.count === 1 ? "" : "s"} on its ${spec.name}s; this run has none yet (decisions belong to the run they were made on). `,
+    h("a", { href: api.takeLink(take.id, other.run.id), id: "decisions-elsewhere-link" }, `open run ${other.number}`));
+  elsewhere.hidden = false;
 }

@@ -55,6 +55,15 @@ export const listOrder = (groups) => groups.flatMap((g) => g.rows);
 /** The finding whose frames hold `frame` (the first in `findings` order), else null. */
 export const findingAt = (findings, frame) => findings.find((f) => f.start_frame <= frame && frame <= f.end_frame) || null;
 
+/** Joints inside a finding at frame `f`, as joint index → colour (`colorOf(finding)`); a later
+ * finding on the same joint wins. Findings on joints not in `jointIndex` (name → index) are
+ * left out. */
+export function flaggedAt(findings, jointIndex, f, colorOf) {
+  const flagged = new Map();
+  for (const x of findings) if (jointIndex.has(x.joint) && f >= x.start_frame && f <= x.end_frame) flagged.set(jointIndex.get(x.joint), colorOf(x));
+  return flagged;
+}
+
 /** Frames that loop a finding: its frames with `margin` frames either side, inside the take. */
 export function loopOfFinding(f, margin, nFrames) {
   return [Math.max(0, f.start_frame - margin), Math.min(nFrames - 1, f.end_frame + margin)];

@@ -29,3 +29,6 @@ export function unpackFrames(buffer) {
   }
   return window;
 }
+
+/** The index of the sample of a window (`frames`, `step`) nearest frame `f`, clamped to it. */
+export const sampleOf = (source, f) => Math.max(0, Math.min(source.frames.length - 1, Math.round((f - source.frames[0]) / source.step)));

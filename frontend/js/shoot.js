@@ -3,18 +3,17 @@
 // The table is sorted, filtered and paged on the server; its state lives in the URL.
 import * as api from "./api.js";
 import { me } from "./account-api.js";
-import { activatable, badge, h, REVIEW } from "./dom.js";
-import { loadPlotly, untabbableModebar } from "./plotly.js";
+import { activatable, h, REVIEW } from "./dom.js";
 import { fmt } from "./format.js";
 import { limitsModelPanel } from "./shoot-limits.js";
 import {
-  decisionForKey, deleteConfirmed, exportQuery, formatCell, HEATMAP_COLORSCALE, HEATMAP_SIZES, HEATMAP_TICK_ANGLE, heatmapChanged, heatmapFigure,
-  heatmapKeyGradient, heatmapPage, heatmapPager, heatmapQuery, importLines, isFiltered, nextSort, pageInfo, progressSummary, scoreColor,
-  scoreRangeProblem, shootControls, TAKE_COLUMNS, tableState, takesQuery, viewQuery,
+  decisionForKey, deleteConfirmed, exportQuery, formatCell, heatmapChanged, importLines, isFiltered, progressSummary, scoreColor,
+  shootControls, TAKE_COLUMNS, tableState, viewQuery,
 } from "./shoot-format.js";
+import { createHeatmap } from "./shoot-heatmap.js";
+import { allColumnsToggle, createTakeTable, filterBar } from "./shoot-table.js";
 
 const POLL_MS = 1000;
-const ALL_COLUMNS_KEY = "mocapqa-shoot-all-columns"; // the take table's "all columns" choice, kept in the browser
 
 export async function shootsView(main) {
   const shoots = await api.listShoots();
@@ -157,271 +156,94 @@ function manageControls(shoot, who, onRenamed) {
   return out;
 }
 
-/** The take table's filters. Every field has a visible label (a typed number says nothing by
- * itself); a score range that can match no take is said at once beside the fields. The
- * "all columns" toggle shows the columns a narrow window hides (the table then scrolls in
- * its box). */
-function filterBar(state, apply, allColumns) {
-  const select = (key, label, options) => h("label", {}, `${label} `, h("select", { id: `shoot-${key}`, onchange: (e) => apply({ [key]: e.target.value }) },
-    options.map(([v, text]) => h("option", { value: v, selected: String(state[key]) === v }, text))));
-  const fields = {};
-  const input = (key, attrs, onInput = () => {}) => {
-    const el = h("input", { id: `shoot-${key}`, value: state[key], ...attrs });
-    let timer = null;
-    el.addEventListener("input", () => { onInput(); clearTimeout(timer); timer = setTimeout(() => apply({ [key]: el.value }), 350); });
-    fields[key] = el;
-    return el;
-  };
-  const scoreMessage = h("span", { id: "shoot-score-message", role: "alert" });
-  const checkScores = () => {
-    const problem = scoreRangeProblem({ min_score: fields.min_score.value, max_score: fields.max_score.value });
-    for (const key of ["min_score", "max_score"]) fields[key].setAttribute("aria-invalid", String(!!problem && problem.fields.includes(key)));
-    scoreMessage.textContent = problem ? problem.text : "";
-    scoreMessage.className = problem ? "error" : "";
-  };
-  const labelled = (label, el) => h("label", { for: el.id }, `${label} `, el);
-  const bar = h("div", { class: "controls shoot-filters" },
-    input("search", { type: "search", "aria-label": "search name", placeholder: "search name" }),
-    select("status", "run", [["", "any"], ["queued", "queued"], ["running", "running"], ["done", "done"], ["failed", "failed"]]),
-    select("review_status", "review", [["", "any"], ...Object.entries(REVIEW)]),
-    select("has_findings", "findings", [["", "any"], ["true", "some"], ["false", "none"]]),
-    labelled("rig", input("rig", { class: "short" })),
-    labelled("min score", input("min_score", { type: "number", min: 0, max: 100, step: "any", placeholder: "0", class: "short" }, () => checkScores())),
-    labelled("max score", input("max_score", { type: "number", min: 0, max: 100, step: "any", placeholder: "100", class: "short" }, () => checkScores())),
-    scoreMessage, allColumns);
-  checkScores();
-  return bar;
-}
-
-/** The "all columns" toggle (shown only where the window hides columns): a pressed button that
- * marks the table area, the choice kept in the browser. */
-function allColumnsToggle(area) {
-  const button = h("button", { type: "button", id: "shoot-all-columns", class: "columns-toggle", "aria-pressed": "false",
-    title: "show the duration, rig, spins, worst joint, filter, missing and reviewer columns too (the table scrolls sideways in its box)" }, "all columns");
-  const set = (on) => {
-    button.setAttribute("aria-pressed", String(on));
-    area.classList.toggle("all-columns", on);
-  };
-  let stored = null;
-  try { stored = localStorage.getItem(ALL_COLUMNS_KEY); } catch { /* storage refused: not kept */ }
-  set(stored === "1");
-  button.addEventListener("click", () => {
-    const on = button.getAttribute("aria-pressed") !== "true";
-    set(on);
-    try { localStorage.setItem(ALL_COLUMNS_KEY, on ? "1" : "0"); } catch { /* storage refused: not kept */ }
-  });
-  return button;
-}
-
-/** A selector finding again, after a redraw of `box`, the element of it that has the focus:
- * by a header's column, a row's take or the element's id (null when the focus is elsewhere). */
-function focusedIn(box) {
-  const el = document.activeElement;
-  if (!el || el === box || !box.contains(el)) return null;
-  if (el.dataset.sort) return `th[data-sort="${CSS.escape(el.dataset.sort)}"]`;
-  if (el.dataset.take) return `tr[data-take="${CSS.escape(el.dataset.take)}"]`;
-  return el.id ? `#${CSS.escape(el.id)}` : null;
-}
-
-function takeTable(page, state, apply) {
-  const header = TAKE_COLUMNS.map((c) => {
-    const sorted = state.sort === c.key;
-    const th = h("th", { class: `sortable${c.narrow ? " narrow-hide" : ""}`, "data-sort": c.key, "aria-sort": sorted ? (state.order === "asc" ? "ascending" : "descending") : "none", title: c.title || null },
-      c.label, sorted ? (state.order === "asc" ? " ▲" : " ▼") : "");
-    // From the state when clicked, not when drawn: two clicks before the answer toggle twice.
-    return activatable(th, () => apply((now) => nextSort(now, c.key)));
-  });
-  const rows = page.items.map((t) => activatable(h("tr", { class: "clickable", "data-take": t.take_id, "aria-label": `open ${t.name}` },
-    h("td", { class: "thumb-cell" }, t.status === "done" ? h("img", { class: "thumb", src: api.thumbnailUrl(t.take_id, t.run_id), alt: "" }) : null),
-    TAKE_COLUMNS.map((c) => {
-      const text = formatCell(c.key, t);
-      const cell = c.key === "status" ? badge(text) : c.key === "review_status" ? badge(text, t.review_status)
-        : c.key === "score" ? h("span", { class: "score", style: null, "data-score": t.score ?? "" }, text) : text;
-      const td = h("td", { class: `${c.key === "name" ? "name" : ""}${c.narrow ? " narrow-hide" : ""}` || null }, cell);
-      if (c.key === "score") td.firstChild.style.color = scoreColor(t.score);
-      return td;
-    })), () => { location.hash = api.takeLink(t.take_id, t.run_id); }));
-  // The order in words too: a narrow window hides some sorted columns' headers.
-  const by = TAKE_COLUMNS.find((c) => c.key === state.sort);
-  const caption = h("caption", { id: "shoot-sort", class: "muted" }, by ? `sorted by ${by.label} ${state.order === "asc" ? "▲" : "▼"}` : "");
-  return h("div", { class: "table-scroll" }, h("table", { id: "shoot-takes" }, caption,
-    h("thead", {}, h("tr", {}, h("th", {}, ""), header)), h("tbody", {}, rows)));
-}
-
 export async function shootView(main, shootId, params, onTeardown) {
   let state = tableState(params);
   const [shoot, who] = await Promise.all([api.getShoot(shootId), me().catch(() => null)]);
   // Runs queued from the model panel show their progress and redraw the table as they finish.
-  const modelPanel = await limitsModelPanel(shoot, who, () => restartPolling());
+  const modelPanel = await limitsModelPanel(shoot, who, () => progress.restart());
   const title = h("span", { id: "shoot-title" }, shoot.name);
-  const progressBar = h("progress", { id: "shoot-progress", max: 1, value: 0 });
-  const progressText = h("span", { id: "shoot-progress-text" });
   const tableBox = h("div", { id: "take-table-box" });
   const tableArea = h("div", { id: "shoot-table-area" });
-  const heatmap = h("div", { id: "shoot-heatmap", class: "panel" });
-  let timer = null;
-  let alive = true;
-  onTeardown(() => { alive = false; clearTimeout(timer); });
-
-  let drawn = 0; // the latest table request: an older answer arriving late is dropped
-  const drawTable = async () => {
-    const request = ++drawn;
-    const problem = scoreRangeProblem(state);
-    if (problem) { // no take can match: no request, and no silent "0–0 of 0" (the filter bar says why)
-      tableBox.replaceChildren(h("p", { class: "muted", id: "shoot-table-empty" }, "No takes listed: the score range above matches none."));
-      tableArea.dataset.query = takesQuery(state);
-      return;
-    }
-    const page = await api.shootTakes(shootId, takesQuery(state));
-    if (!alive || request !== drawn) return;
-    const info = pageInfo(state.offset, state.limit, page.total);
-    const move = (offset) => h("button", { disabled: offset == null, onclick: () => apply({ offset }) });
-    const previous = move(info.previous); previous.append("‹ previous"); previous.id = "page-previous";
-    const next = move(info.next); next.append("next ›"); next.id = "page-next";
-    // The filter bar stays (a poll must not take the focus from the search field); the table
-    // and pager are redrawn, and what had the focus in them keeps it: the same header, the
-    // same take's row (polled every second while takes are analysed), the same pager button.
-    const focused = focusedIn(tableBox);
-    tableBox.replaceChildren(takeTable(page, state, apply),
-      h("div", { class: "controls" }, previous, h("span", { id: "page-info" }, info.text), next));
-    if (focused) {
-      const again = tableBox.querySelector(focused);
-      if (again && !again.disabled) again.focus({ preventScroll: true });
-    }
-    tableArea.dataset.query = takesQuery(state);
-  };
-  // The downloads hold what the table lists (its filters and order), and say so when filtered.
-  const exportLinks = {
-    csv: h("a", { class: "download", id: "export-csv", download: "" }),
-    json: h("a", { class: "download", id: "export-json", download: "" }),
-  };
-  const labelExports = () => {
-    for (const [kind, link] of Object.entries(exportLinks)) {
-      link.href = api.summaryUrl(shootId, kind, exportQuery(state));
-      link.textContent = `${isFiltered(state) ? "filtered " : ""}summary ${kind.toUpperCase()}`;
-      link.title = isFiltered(state) ? "the takes that pass the table's filters, in its order" : "every take, in the table's order";
-    }
-  };
-  labelExports();
+  const life = { alive: true, timer: null };
+  onTeardown(() => { life.alive = false; clearTimeout(life.timer); });
+  const isAlive = () => life.alive;
+  const table = createTakeTable(shootId, tableArea, tableBox, () => state, apply, isAlive);
+  const heatmap = createHeatmap(shootId, () => state, isAlive);
+  const showError = (e) => tableArea.prepend(h("p", { class: "error" }, e.message));
+  const exports = exportLinks(shootId);
+  exports.label(state);
   function apply(change) {
     const patch = typeof change === "function" ? change(state) : change;
     const resetsPage = !("offset" in patch);
     const before = state;
     state = { ...state, ...patch, ...(resetsPage ? { offset: 0 } : {}) };
     history.replaceState(null, "", api.shootLink(shootId, viewQuery(state)));
-    labelExports();
-    drawTable().catch(showError);
-    if (heatmapChanged(before, state)) { // the heat map shows the table's takes, from its first page
-      heat = heatmapPage(0, heat.limit);
-      drawHeatmap().catch(showHeatmapError);
-    }
+    exports.label(state);
+    table.draw().catch(showError);
+    if (heatmapChanged(before, state)) heatmap.firstPage(); // the heat map shows the table's takes, from its first page
   }
-  const showError = (e) => tableArea.prepend(h("p", { class: "error" }, e.message));
-
-  // The heat map shows the take table's takes (its filters, sort and order) `heat.limit` at a
-  // time; the chart scrolls inside its box, and the pager keeps its place across polls. A
-  // redraw started later wins over one still waiting for its answer (typing in the search).
-  let heat = heatmapPage(0, 200);
-  let heatDrawn = 0;
-  const drawHeatmap = async () => {
-    const ticket = ++heatDrawn;
-    const shown = state;
-    const problem = scoreRangeProblem(shown);
-    if (problem) { // as the table: no request, the reason in words
-      heatmap.replaceChildren(h("h2", {}, "Joint limits"), h("p", { class: "muted", id: "heatmap-empty" }, `No take matches the table's filters: ${problem.text}.`));
-      return;
-    }
-    const [Plotly, first] = await Promise.all([loadPlotly(), api.shootHeatmap(shootId, heatmapQuery(heat, shown))]);
-    let data = first;
-    const safe = heatmapPage(heat.offset, heat.limit, data.total);
-    if (safe.offset !== heat.offset) { // the shoot shrank under the page: show its last page
-      heat = safe;
-      data = await api.shootHeatmap(shootId, heatmapQuery(heat, shown));
-    }
-    if (!alive || ticket !== heatDrawn) return;
-    heatmap.dataset.query = heatmapQuery(heat, shown);
-    const title = h("h2", {}, "Share of frames outside the joint limits (joint × take, in the table's order and filters)");
-    if (!data.total) {
-      const why = isFiltered(shown) ? "No take matches the table's filters." : "No joint-limit results yet.";
-      heatmap.replaceChildren(h("h2", {}, "Joint limits"), h("p", { class: "muted", id: "heatmap-empty" }, why));
-      return;
-    }
-    const pager = heatmapPager(heat, data.total);
-    const go = (offset) => { heat = heatmapPage(offset, heat.limit, data.total); drawHeatmap().catch(showHeatmapError); };
-    const previous = h("button", { type: "button", id: "heatmap-previous", disabled: pager.previous == null, onclick: () => go(pager.previous) }, "‹ previous");
-    const next = h("button", { type: "button", id: "heatmap-next", disabled: pager.next == null, onclick: () => go(pager.next) }, "next ›");
-    const size = h("select", { id: "heatmap-size", "aria-label": "takes per heat map page", onchange: (e) => {
-      heat = heatmapPage(heat.offset, e.target.value, data.total); drawHeatmap().catch(showHeatmapError);
-    } }, HEATMAP_SIZES.map((n) => h("option", { value: n, selected: n === heat.limit }, `${n} takes a page`)));
-    const controls = h("div", { class: "controls", id: "heatmap-pager" }, previous, h("span", { id: "heatmap-page", "aria-live": "polite" }, pager.text), next, size);
-    if (!data.joints.length) {
-      heatmap.replaceChildren(title, controls, h("p", { class: "muted", id: "heatmap-empty" }, "No joint outside its limits in these takes."));
-      return;
-    }
-    const figure = heatmapFigure(data, heat.offset);
-    const chart = h("div", { id: "heatmap-chart", "data-offset": heat.offset });
-    chart.style.minWidth = `${figure.minWidth}px`; // every joint column keeps its room: the box scrolls sideways instead
-    // The colour key stays in view at the top of the scrolling box (the chart's own colour bar
-    // would scroll away with a tall page); the joints are labelled above and below the cells.
-    const bar = h("span", { class: "heatmap-key-bar" });
-    bar.style.background = heatmapKeyGradient();
-    const key = h("div", { class: "heatmap-key", id: "heatmap-key" }, "share of frames outside the limits: ",
-      h("span", {}, "0 %"), bar, h("span", { id: "heatmap-key-max" }, `${fmt(figure.zmax, 1)} %`));
-    heatmap.replaceChildren(title, controls, h("div", { class: "heatmap-scroll", id: "heatmap-scroll", tabindex: "0", "aria-label": "heat map, scrolls" }, key, chart));
-    const joints = { ...figure.xaxis, tickangle: HEATMAP_TICK_ANGLE, automargin: true };
-    await Plotly.newPlot(chart, [{
-      type: "heatmap", x: figure.x, y: figure.y, z: figure.z, text: figure.text,
-      colorscale: HEATMAP_COLORSCALE, zmin: 0, zmax: figure.zmax, hoverongaps: false, showscale: false,
-      hovertemplate: "%{text}<br>%{x}: %{z:.1f} % of frames outside<extra></extra>",
-    }, { // no data to draw: it only gives the joints' axis above the cells its categories
-      type: "scatter", mode: "markers", x: figure.x, y: figure.x.map(() => figure.y[0]), xaxis: "x2",
-      marker: { opacity: 0 }, hoverinfo: "skip", showlegend: false,
-    }], {
-      height: figure.height, margin: figure.margin,
-      yaxis: { ...figure.yaxis, automargin: true },
-      xaxis: { ...joints, side: "bottom" },
-      xaxis2: { ...joints, side: "top", overlaying: "x", matches: "x" },
-    }, { responsive: true, displaylogo: false });
-    untabbableModebar(chart);
-  };
-  const showHeatmapError = (e) => heatmap.replaceChildren(h("p", { class: "error" }, e.message));
-
-  // Poll while anything is queued or running; when it all finishes, redraw table and heat map.
-  let wasRunning = false;
-  const poll = async () => {
-    const progress = await api.shootProgress(shootId);
-    if (!alive) return;
-    const summary = progressSummary(progress);
-    progressBar.value = summary.share;
-    progressText.textContent = summary.text;
-    progressPanel.dataset.finished = progress.finished ? "1" : "0";
-    if (!progress.finished) {
-      wasRunning = true;
-      await drawTable();
-      timer = setTimeout(() => poll().catch(showError), POLL_MS);
-    } else if (wasRunning) {
-      wasRunning = false;
-      await Promise.all([drawTable(), drawHeatmap()]);
-    }
-  };
-  const restartPolling = () => { clearTimeout(timer); wasRunning = true; poll().catch(showError); };
-  const progressPanel = h("div", { class: "panel", id: "progress-panel" }, "analysis ", progressBar, " ", progressText);
+  const progress = shootProgress(shootId, life, table.draw, heatmap.draw, showError);
 
   main.replaceChildren(
     h("h1", {}, h("a", { href: "#/shoots" }, "Shoots"), " / ", title),
     h("div", { class: "controls", id: "shoot-actions" },
       h("a", { class: "button primary", id: "review-queue", href: `#/shoot/${shootId}/review` }, "review queue"),
-      exportLinks.csv, exportLinks.json,
+      exports.csv, exports.json,
       manageControls(shoot, who, (renamed) => { title.textContent = renamed.name; })),
     modelPanel,
-    importPanel(shootId, restartPolling),
-    progressPanel,
-    tableArea, heatmap);
+    importPanel(shootId, progress.restart),
+    progress.panel,
+    tableArea, heatmap.el);
   tableArea.replaceChildren(filterBar(state, apply, allColumnsToggle(tableArea)), tableBox);
-  await drawTable();
-  await poll();
+  await table.draw();
+  await progress.poll();
   main.dataset.ready = "1";
-  drawHeatmap().catch(showHeatmapError);
+  heatmap.show();
+}
+
+/** The summary downloads: they hold what the table lists (its filters and order), and say so
+ * when filtered; `label(state)` writes their links and names for the table's state. */
+function exportLinks(shootId) {
+  const links = {
+    csv: h("a", { class: "download", id: "export-csv", download: "" }),
+    json: h("a", { class: "download", id: "export-json", download: "" }),
+  };
+  const label = (state) => {
+    for (const [kind, link] of Object.entries(links)) {
+      link.href = api.summaryUrl(shootId, kind, exportQuery(state));
+      link.textContent = `${isFiltered(state) ? "filtered " : ""}summary ${kind.toUpperCase()}`;
+      link.title = isFiltered(state) ? "the takes that pass the table's filters, in its order" : "every take, in the table's order";
+    }
+  };
+  return { ...links, label };
+}
+
+/** The analysis progress bar. It polls while anything is queued or running (redrawing the
+ * table), and when it all finishes redraws table and heat map; `life` holds the view's
+ * liveness and the poll's timer. */
+function shootProgress(shootId, life, drawTable, drawHeatmap, showError) {
+  const bar = h("progress", { id: "shoot-progress", max: 1, value: 0 });
+  const text = h("span", { id: "shoot-progress-text" });
+  const panel = h("div", { class: "panel", id: "progress-panel" }, "analysis ", bar, " ", text);
+  let wasRunning = false;
+  const poll = async () => {
+    const progress = await api.shootProgress(shootId);
+    if (!life.alive) return;
+    const summary = progressSummary(progress);
+    bar.value = summary.share;
+    text.textContent = summary.text;
+    panel.dataset.finished = progress.finished ? "1" : "0";
+    if (!progress.finished) {
+      wasRunning = true;
+      await drawTable();
+      life.timer = setTimeout(() => poll().catch(showError), POLL_MS);
+    } else if (wasRunning) {
+      wasRunning = false;
+      await Promise.all([drawTable(), drawHeatmap()]);
+    }
+  };
+  const restart = () => { clearTimeout(life.timer); wasRunning = true; poll().catch(showError); };
+  return { panel, poll, restart };
 }
 
 export async function reviewQueueView(main, shootId, onTeardown) {

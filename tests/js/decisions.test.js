@@ -1,6 +1,6 @@
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { decidable, decidedElsewhere, itemLabel } from "../../frontend/js/decisions.js";
+import { decidable, decidedElsewhere, itemLabel, keyTarget } from "../../frontend/js/decisions.js";
 
 const take = { runs: [{ id: "r1", status: "done" }, { id: "r2", status: "failed" }, { id: "r3", status: "done" }, { id: "r4", status: "done" }] };
 const histories = { r1: 2, r2: 5, r3: 0, r4: 0 };
@@ -32,4 +32,18 @@ test("a motion run decides its twist intervals, a marker run its swaps, others n
   assert.equal(decidable({ kind: "keypoints", series: {}, findings: [{ kind: "gap" }] }), null);
   assert.equal(itemLabel("swap", swap), "LFHD ↔ LBHD frames 400–429");
   assert.equal(itemLabel("twist", intervals[0]), "LeftLeg frames 3–9");
+});
+
+test("Y / X act on the focused decidable row, else on the last opened item, else say why not", () => {
+  const ids = new Map([[0, {}], [3, {}]]);
+  assert.deepEqual(keyTarget({ kind: "twist", interval: "3" }, 0, "twist", "twist", ids), { id: 3 });
+  // Item 0 is an item like any other (not "none").
+  assert.deepEqual(keyTarget({ kind: "twist", interval: "0" }, 3, "twist", "twist", ids), { id: 0 });
+  assert.deepEqual(keyTarget(null, 0, "twist", "twist", ids), { id: 0 });
+  // A focused row of a reported kind (no interval) says so, whatever was opened before.
+  assert.match(keyTarget({ kind: "limits", interval: undefined }, 3, "twist", "twist", ids).message, /a limits finding is reported/);
+  // Nothing opened, or an unknown id: a hint; another kind opened last: that kind is reported.
+  assert.equal(keyTarget(null, null, null, "swap", ids).message, "open or focus a swap finding first");
+  assert.equal(keyTarget({ kind: "twist", interval: "9" }, null, "twist", "twist", ids).message, "open or focus a twist finding first");
+  assert.match(keyTarget(null, null, "spin", "twist", ids).message, /a spin finding is reported, not corrected/);
 });

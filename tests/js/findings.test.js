@@ -90,13 +90,26 @@ test("the camera's focus: body centre over the floor, the root, the selected joi
 });
 
 test("compare: B's frame is the one at A's instant, moved by the offset, inside B", async () => {
-  const { sampleOf, syncedFrame } = await import("../../frontend/js/compare3d.js");
+  const { syncedFrame } = await import("../../frontend/js/compare3d.js");
+  const { sampleOf } = await import("../../frontend/js/frames.js");
   assert.equal(syncedFrame(60, 60, 120, 0, 1000), 120);
   assert.equal(syncedFrame(60, 60, 30, 5, 1000), 35);
   assert.equal(syncedFrame(60, 60, 30, -100, 1000), 0);
   assert.equal(syncedFrame(900, 60, 60, 0, 500), 499);
   assert.equal(sampleOf({ frames: [0, 4, 8, 12], step: 4 }, 9), 2);
   assert.equal(sampleOf({ frames: [0, 4, 8, 12], step: 4 }, 99), 3);
+});
+
+test("the joints inside a finding at a frame take its colour, the later finding winning", () => {
+  const jointIndex = new Map([["R_Calf", 0], ["L_Calf", 1]]);
+  const colorOf = (x) => (x.kind === "twist" ? "red" : "orange");
+  assert.deepEqual([...findings.flaggedAt(rows, jointIndex, 55, colorOf)], [[0, "orange"]]);
+  assert.deepEqual([...findings.flaggedAt(rows, jointIndex, 15, colorOf)], [[0, "red"]]);
+  // Spine is no joint of the index: left out; no finding at frame 40.
+  assert.deepEqual([...findings.flaggedAt(rows, jointIndex, 6, colorOf)], []);
+  assert.deepEqual([...findings.flaggedAt(rows, jointIndex, 40, colorOf)], []);
+  const overlapping = [f("limits", "L_Calf", 0, 9, 1), f("twist", "L_Calf", 5, 6, 1)];
+  assert.deepEqual([...findings.flaggedAt(overlapping, jointIndex, 5, colorOf)], [[1, "red"]]);
 });
 
 test("the re-run form checks values against their fields and builds the options", async () => {

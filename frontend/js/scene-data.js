@@ -1,0 +1,90 @@
+// Pure data of the 3D views (scene3d.js): which joints are drawn and which root is followed,
+// the vertex buffers a frame's points and axes are written into, the orbit's moves and a
+// joint's hover label. No three.js, no DOM: unit-tested with node --test.
+import { bonesOf, present } from "./geometry.js";
+
+/** Orbit limits: the elevation range (radians) and the zoom range (shares of the body's size). */
+export const ELEVATION = [-0.2, 1.55];
+export const ZOOM = [0.3, 8];
+
+/**
+ * The bones drawn, the joints left out and the root the camera follows.
+ *
+ * @param skeleton {names, parents, bones?, oriented}: keypoint takes of a known layout come with
+ *   their bones; others are joined by parents
+ * @returns {{bones: number[][], loose: Set<number>, drawnRoot: number}} A BVH joint the server
+ *   joined by no bone (a static root left at the origin while its child carries the travel, as
+ *   Bandai's joint_Root) is loose: not drawn, and the root followed is its child.
+ */
+export function drawnSkeleton(skeleton) {
+  const { names, parents, oriented } = skeleton;
+  const given = Boolean(skeleton.bones && skeleton.bones.length);
+  const bones = given ? skeleton.bones : bonesOf(parents);
+  const inBone = new Set(bones.flat());
+  const loose = new Set(oriented && given ? names.map((_, j) => j).filter((j) => !inBone.has(j)) : []);
+  const firstRoot = parents.indexOf(-1);
+  const drawnRoot = loose.has(firstRoot) ? parents.findIndex((p, j) => p === firstRoot && !loose.has(j)) : firstRoot;
+  return { bones, loose, drawnRoot };
+}
+
+/**
+ * Write each point `j` kept by `keep(j, point)` into `out` (x, y, z at 3j), NaN where not kept
+ * (a NaN vertex is not drawn).
+ *
+ * @returns the number of points kept
+ */
+export function writePoints(out, points, keep) {
+  let kept = 0;
+  points.forEach((p, j) => {
+    const on = Boolean(keep(j, p));
+    kept += on;
+    out[3 * j] = on ? p[0] : NaN; out[3 * j + 1] = on ? p[1] : NaN; out[3 * j + 2] = on ? p[2] : NaN;
+  });
+  return kept;
+}
+
+/** Write line segments between the point pairs `pairs` into `out` (two vertices each); a pair
+ * with a missing end is written at the origin, collapsed (not drawn). */
+export function writeSegments(out, points, pairs) {
+  let o = 0;
+  for (const [p, c] of pairs) {
+    const ok = present(points[p]) && present(points[c]);
+    for (const q of [points[p], points[c]]) {
+      out[o++] = ok ? q[0] : 0; out[o++] = ok ? q[1] : 0; out[o++] = ok ? q[2] : 0;
+    }
+  }
+}
+
+/**
+ * Write joint axes (geometry.triads: x, y, z with a null after each segment) as line segments:
+ * positions into `positions`, each segment's two vertices coloured by its axis (`axes`: three
+ * {r, g, b}, x, y and z in turn) into `colors`.
+ */
+export function writeTriads(t, positions, colors, axes) {
+  let o = 0, n = 0;
+  for (let k = 0; k < t.x.length; k++) {
+    if (t.x[k] === null && k % 3 === 2) continue;
+    positions[o++] = t.x[k] ?? 0; positions[o++] = t.y[k] ?? 0; positions[o++] = t.z[k] ?? 0;
+    const c = axes[Math.floor(n / 2) % 3]; n += 1;
+    colors[3 * (n - 1)] = c.r; colors[3 * (n - 1) + 1] = c.g; colors[3 * (n - 1) + 2] = c.b;
+  }
+}
+
+/** The orbit after a drag of (dx, dy) pixels: turned, its elevation kept in ELEVATION. */
+export function dragged(orbit, dx, dy) {
+  return { azimuth: orbit.azimuth - dx * 0.01, elevation: Math.max(ELEVATION[0], Math.min(ELEVATION[1], orbit.elevation + dy * 0.01)) };
+}
+
+/** The camera's distance after a wheel turn of `deltaY`, kept in ZOOM shares of `size`. */
+export function zoomed(distance, deltaY, size) {
+  return Math.max(size * ZOOM[0], Math.min(size * ZOOM[1], distance * Math.exp(deltaY * 0.001)));
+}
+
+/** A joint's hover label: its name, and with detection confidences the confidence, and (in the
+ * corrected view) whether the filter bridged it or a gap fill wrote it. */
+export function hoverLabel(name, frame, j, corrected) {
+  if (!frame.confidence) return name;
+  const bridged = frame.bridged && frame.bridged[j] && corrected ? " · bridged" : "";
+  const filled = frame.filled && frame.filled[j] > 0 && corrected ? " · filled" : "";
+  return `${name} · confidence ${frame.confidence[j].toFixed(2)}${bridged}${filled}`;
+}
