@@ -55,6 +55,7 @@ lint: install-dev js-deps
 	$(BIN)/ruff check backend tests scripts setup.py
 	$(BIN)/ruff format --check backend tests scripts setup.py
 	$(BIN)/lint-imports
+	$(BIN)/python scripts/function_length.py backend
 	$(BIN)/check-jsonschema --builtin-schema vendor.compose-spec docker-compose.yml
 	$(BIN)/hadolint Dockerfile
 

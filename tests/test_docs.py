@@ -71,16 +71,39 @@ def documented_assignments(module: ModuleType) -> set[str]:
     return found
 
 
+def imported_from(module: ModuleType) -> dict[str, str]:
+    """Names a module takes from another module of the package (``from mocapqa.x import n``):
+    name → that module. A re-exported constant is documented where it is defined."""
+    path = module.__file__
+    if path is None:
+        return {}
+    tree = ast.parse(Path(path).read_text(encoding="utf-8"))
+    return {
+        alias.asname or alias.name: node.module
+        for node in tree.body
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("mocapqa")
+        for alias in node.names
+    }
+
+
+def constant_documented(module: ModuleType, name: str) -> bool:
+    """Whether a module-level constant or alias is documented in ``module`` or, for a name it
+    imports from another module of the package, in that module."""
+    if name in documented_assignments(module):
+        return True
+    source = imported_from(module).get(name)
+    return source is not None and constant_documented(importlib.import_module(source), name)
+
+
 def undocumented(module: ModuleType) -> list[str]:
     missing = []
-    commented = documented_assignments(module)
     for name in getattr(module, "__all__", ()):
-        obj = getattr(module, name)
+        obj = inspect.unwrap(getattr(module, name))  # a functools.cache'd function is its own
         if inspect.isclass(obj) or inspect.isfunction(obj) or inspect.ismethod(obj):
             doc = own_docstring(obj)
             if not (doc and doc.strip()):
                 missing.append(name)
-        elif name not in commented:
+        elif not constant_documented(module, name):
             missing.append(name)
     return missing
 

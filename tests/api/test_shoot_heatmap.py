@@ -14,8 +14,10 @@ from mocapqa.config import Settings
 from mocapqa.jobs.demo import demo_paths
 from mocapqa.jobs.take_task import analyse_path
 from mocapqa.pipeline.options import AnalysisOptions
-from mocapqa.store.repository import Repository, new_id
-from mocapqa.store.shoots import DoneTake, ShootStore
+from mocapqa.store.repository import Repository
+from mocapqa.store.shoots import ShootStore
+from mocapqa.store.stamps import new_id
+from mocapqa.store.take_writer import DoneTake
 
 API = "/api/v1"
 SOURCES = (

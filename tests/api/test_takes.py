@@ -103,28 +103,58 @@ def test_keypoint_take_is_filtered_and_downloads_read_back(
 
 
 @pytest.mark.parametrize(
-    ("name", "content", "status", "pattern"),
+    ("name", "content", "status", "error", "pattern"),
     [
-        ("broken.bvh", b"HIERARCHY\nROOT Hips\n{\n", 422, "line"),
-        ("empty.bvh", b"", 422, "non-empty"),
-        ("picture.png", b"\x89PNG\r\n\x1a\n0000", 415, "Expected one of"),
-        # The error names the file as the user sent it, not the server's temporary copy.
-        ("notes.txt", b"hello", 415, "unrecognised file 'notes.txt'"),
+        # Each message names the file as the user sent it, not the server's temporary copy,
+        # then the line when there is one, then what was expected and what came.
+        (
+            "broken.bvh",
+            b"HIERARCHY\nROOT Hips\n{\n",
+            422,
+            "ParseError",
+            "broken.bvh, line 3: Expected 'OFFSET', 'CHANNELS', 'JOINT', 'End' or '}', got end",
+        ),
+        (
+            "empty.bvh",
+            b"",
+            422,
+            "ParseError",
+            "empty.bvh: Expected a non-empty file, got 0 bytes",
+        ),
+        (
+            "picture.png",
+            b"\x89PNG\r\n\x1a\n0000",
+            415,
+            "UnsupportedFormatError",
+            "got an unrecognised file 'picture.png'",
+        ),
+        ("notes.txt", b"hello", 415, "UnsupportedFormatError", "unrecognised file 'notes.txt'"),
         # A TRC cut short after its header keys: the file and line, and what a TRC needs.
         (
             "numbers.trc",
             b"PathFileType\t4\t(X/Y/Z)\tx.trc\nnonsense\n",
             422,
+            "ParseError",
             "numbers.trc, line 2: Expected a TRC header of 3 lines and a marker row",
         ),
     ],
 )
 def test_bad_uploads_are_refused_and_store_nothing(
-    client: TestClient, settings: Settings, name: str, content: bytes, status: int, pattern: str
+    client: TestClient,
+    settings: Settings,
+    name: str,
+    content: bytes,
+    status: int,
+    error: str,
+    pattern: str,
 ) -> None:
     response = client.post("/api/v1/takes", files={"file": (name, content)})
     assert response.status_code == status, response.text
-    assert pattern in response.json()["detail"]
+    body = response.json()
+    assert body["error"] == error, body
+    assert pattern in body["detail"], body
+    if status == 415:  # the formats a take may be in, named
+        assert body["detail"].startswith("Expected one of bvh, trc, "), body
     stored_nothing(client, settings)
 
 
@@ -167,7 +197,9 @@ def test_take_detail_delete_and_unknown_ids(
     detail = client.get(f"/api/v1/takes/{created['id']}").json()
     assert [r["id"] for r in detail["runs"]] == [created["run_id"]]
     thumbnail = client.get(f"/api/v1/takes/{created['id']}/thumbnail")
+    assert thumbnail.status_code == 200
     assert thumbnail.headers["content-type"] == "image/png"
+    assert thumbnail.content.startswith(b"\x89PNG\r\n\x1a\n")
     assert client.delete(f"/api/v1/takes/{created['id']}").status_code == 204
     assert client.get(f"/api/v1/takes/{created['id']}").status_code == 404
     assert client.get(f"/api/v1/runs/{created['run_id']}").status_code == 404

@@ -23,9 +23,11 @@ from mocapqa.jobs.demo import demo_paths
 from mocapqa.jobs.take_task import analyse_path
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.accounts import Accounts
-from mocapqa.store.repository import Repository, new_id
+from mocapqa.store.repository import Repository
 from mocapqa.store.roles import Role
-from mocapqa.store.shoots import DoneTake, ShootStore
+from mocapqa.store.shoots import ShootStore
+from mocapqa.store.stamps import new_id
+from mocapqa.store.take_writer import DoneTake
 
 pytestmark = pytest.mark.browser
 

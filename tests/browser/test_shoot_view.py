@@ -197,6 +197,7 @@ def test_import_progress_sort_review_export(
     p.click("h1")
     assert "A approve" in p.inner_text("#keys-help")
     p.keyboard.press("?")
+    assert p.locator("#keys-help").count() == 1
     assert p.locator("#keys-help").is_hidden()
     p.keyboard.press("?")
     assert p.locator("#keys-help").is_visible()
@@ -259,10 +260,13 @@ def test_import_progress_sort_review_export(
     # The heat map (Plotly, loaded by this view only): one row per take, lowest score first;
     # the keypoint take, which has no joint limits, is an empty row.
     p.wait_for_selector("#heatmap-chart .main-svg", timeout=60_000)
-    rows = p.evaluate(
+    joints, rows = p.evaluate(
         "() => { const d = document.getElementById('heatmap-chart').data[0];"
-        " return d.y.map((label, k) => [label, d.z[k]]); }"
+        " return [d.x, d.y.map((label, k) => [label, d.z[k]])]; }"
     )
+    # One cell per joint in every row, the empty row too.
+    assert joints
+    assert [len(z) for _, z in rows] == [len(joints)] * 4
     assert [label.split(". ", 1)[0] for label, _ in rows] == ["1", "2", "3", "4"]  # ranks
     rows = [[label.split(". ", 1)[1], z] for label, z in rows]
     assert rows[0][0] == "cmu_12_01_walk_twist_errors.bvh"

@@ -10,7 +10,7 @@ from tests.feet.walker import LEG_CM, reaxed, stand, walk
 
 from mocapqa.errors import ShapeError
 from mocapqa.feet.check import check_feet
-from mocapqa.feet.ground import column_percentile, stance_levels
+from mocapqa.feet.floor import column_percentile, stance_levels
 from mocapqa.feet.points import FootPoints
 
 

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from tests.markers.conftest import CLEAN_TAKES, Take, load_take
 
+from mocapqa.core.arrays import column_runs
 from mocapqa.markers.check import check_markers
 from mocapqa.markers.inject import inject_swaps
 from mocapqa.markers.segments import pair_stats
 from mocapqa.markers.swaps import repair_swaps
-from mocapqa.markers.take import column_runs
 
 
 @pytest.mark.parametrize("name", CLEAN_TAKES)

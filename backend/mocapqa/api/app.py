@@ -2,16 +2,12 @@
 
 Routes live under ``/api/v1`` (OpenAPI at ``/docs``). The frontend is served from the
 repository's ``frontend/`` folder when running from a checkout, else from the package's
-``mocapqa/static/frontend`` copy; Plotly is Plotly's cartesian bundle copied from its npm
-package into ``frontend/vendor/plotly`` (the charts use scatter, bar and heat map only), else the
-installed plotly wheel's full bundle (``package_data/plotly.min.js``), under a name that changes
-with its content, so the UI works offline.
+``mocapqa/static/frontend`` copy; the Plotly bundle is served under a name that changes with
+its content (:mod:`mocapqa.api.routes.plotly_bundle`), so the UI works offline.
 """
 
 from __future__ import annotations
 
-import gzip
-import hashlib
 import logging
 import re
 from collections.abc import AsyncIterator, Callable, Sequence
@@ -20,14 +16,13 @@ from pathlib import Path
 from typing import Any
 
 import anyio.to_thread
-import plotly
-from fastapi import APIRouter, Depends, FastAPI, Request, Response
+from fastapi import APIRouter, Depends, FastAPI
 from fastapi.middleware.gzip import GZipMiddleware
-from fastapi.responses import FileResponse, HTMLResponse, RedirectResponse
+from fastapi.responses import HTMLResponse, RedirectResponse
 
 from mocapqa import __version__
 from mocapqa.api.auth import quota_key_before_body, require
-from mocapqa.api.deps import Services
+from mocapqa.api.deps import Services, check_queue
 from mocapqa.api.errors import install_error_handlers
 from mocapqa.api.form_parts import check_form_parts
 from mocapqa.api.http_guards import install_http_guards
@@ -46,6 +41,7 @@ from mocapqa.api.routes import (
     takes,
     users,
 )
+from mocapqa.api.routes.plotly_bundle import add_plotly_route
 from mocapqa.api.static_files import CompressedStaticFiles
 from mocapqa.config import Settings
 from mocapqa.jobs.demo import load_demo
@@ -64,7 +60,6 @@ __all__ = [
     "create_app",
     "frontend_dir",
     "missing_vendored_scripts",
-    "plotly_js_path",
 ]
 
 API_PREFIX = "/api/v1"
@@ -109,19 +104,6 @@ back to the copy inside its own wheel); ``scripts/vendor_js.py`` copies them."""
 def missing_vendored_scripts(frontend: Path) -> list[str]:
     """The :data:`VENDORED_SCRIPTS` missing under ``frontend / "vendor"``."""
     return [name for name in VENDORED_SCRIPTS if not (frontend / "vendor" / name).is_file()]
-
-
-def plotly_js_path() -> Path:
-    """The Plotly bundle the dashboard loads: the cartesian bundle in ``frontend/vendor/plotly``
-    (``make js-deps``) when present, else ``plotly.min.js`` shipped inside the plotly wheel.
-
-    The cartesian bundle (1.5 MB) holds every trace type the dashboard draws; evaluating the
-    full one (4.8 MB) held the take view's main thread for 3 s on a loaded 2-core machine.
-    """
-    cartesian = frontend_dir() / "vendor" / "plotly" / "plotly-cartesian.min.js"
-    if cartesian.is_file():
-        return cartesian
-    return Path(plotly.__file__).resolve().parent / "package_data" / "plotly.min.js"
 
 
 def _services(settings: Settings, renderer: RenderService | None) -> Services:
@@ -182,30 +164,6 @@ def _lifespan(
     return lifespan
 
 
-def _add_plotly_route(app: FastAPI) -> str:
-    """Serve the Plotly bundle under a name holding its digest (cached for a year, gzipped
-    once); returns that path."""
-    plotly_path = plotly_js_path()
-    digest = hashlib.sha256(plotly_path.read_bytes()).hexdigest()[:12]
-    path = f"/vendor/{plotly_path.stem.removesuffix('.min')}-{digest}.min.js"
-    compressed: list[bytes] = []
-
-    @app.get(path, include_in_schema=False)
-    def plotly_js(request: Request) -> Response:
-        headers = {
-            "Cache-Control": "public, max-age=31536000, immutable",
-            "Vary": "Accept-Encoding",
-        }
-        if "gzip" not in request.headers.get("accept-encoding", ""):
-            return FileResponse(plotly_path, media_type="text/javascript", headers=headers)
-        if not compressed:  # compressed once, not on every request
-            compressed.append(gzip.compress(plotly_path.read_bytes(), compresslevel=6))
-        headers["Content-Encoding"] = "gzip"
-        return Response(compressed[0], media_type="text/javascript", headers=headers)
-
-    return path
-
-
 def _add_pages(app: FastAPI, plotly_url: str) -> None:
     """The dashboard's page, the take links it answers and its static files."""
     static = frontend_dir()
@@ -263,7 +221,7 @@ def create_app(
         app,
         settings,
         f"{API_PREFIX}/takes",
-        services.runner.pending,
+        lambda key: check_queue(services, key),
         lambda connection: quota_key_before_body(connection, accounts),
         re.compile(rf"{API_PREFIX}/shoots/([^/]+)/takes"),
         ShootStore(services.repository.engine).require,
@@ -271,5 +229,5 @@ def create_app(
     install_error_handlers(app)
     for router, dependencies in ROUTERS:
         app.include_router(router, prefix=API_PREFIX, dependencies=list(dependencies))
-    _add_pages(app, _add_plotly_route(app))
+    _add_pages(app, add_plotly_route(app, frontend_dir()))
     return app

@@ -10,8 +10,8 @@ from typing import Annotated, Any
 from fastapi import Depends, Request
 
 from mocapqa.api.auth import PrincipalDep, client_address, quota_key
-from mocapqa.api.http_guards import queue_full
 from mocapqa.config import Settings
+from mocapqa.errors import RateLimitError
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.render.service import RenderService
 from mocapqa.store.files import FileStore
@@ -22,6 +22,7 @@ __all__ = [
     "Services",
     "ServicesDep",
     "TakeDep",
+    "check_queue",
     "get_client",
     "get_services",
     "get_take",
@@ -75,7 +76,9 @@ ClientDep = Annotated[str, Depends(get_client)]
 def run_places(services: Services, client: str, wanted: int = 1) -> Iterator[int]:
     """Hold up to ``wanted`` of the client's free places in the run queue while the block
     records and submits its runs (:meth:`JobRunner.places`); yields how many it got, at least
-    one: none free is refused (429) for a user with ``max_queued_runs_per_user`` waiting.
+    one: none free is refused (429) for a user with ``max_queued_runs_per_user`` waiting. The
+    one check of the queued-run limit: the routes that start runs and the request guard
+    (:func:`check_queue`) both refuse here.
 
     Raises
     ------
@@ -84,5 +87,21 @@ def run_places(services: Services, client: str, wanted: int = 1) -> Iterator[int
     limit = services.settings.max_queued_runs_per_user
     with services.runner.places(client, wanted, limit) as granted:
         if granted == 0:
-            raise queue_full(limit)
+            raise RateLimitError(
+                f"Expected at most {limit} queued runs per user (setting "
+                "max_queued_runs_per_user), got that many waiting",
+                retry_after_s=10,
+            )
         yield granted
+
+
+def check_queue(services: Services, client: str) -> None:
+    """Refuse (429) a client whose run queue is full, as :func:`run_places` does, holding no
+    place: the request guard's check before an upload's body is read.
+
+    Raises
+    ------
+    RateLimitError
+    """
+    with run_places(services, client):
+        pass

@@ -74,7 +74,6 @@ __all__ = [
     "RequestGuard",
     "install_http_guards",
     "origin_allowed",
-    "queue_full",
     "unstorable_location",
 ]
 
@@ -196,7 +195,7 @@ class RequestGuard:
         app: ASGIApp,
         settings: Settings,
         upload_path: str,
-        pending_runs: Callable[[str], int],
+        check_queue: Callable[[str], None],
         quota_key: Callable[[HTTPConnection], str | None],
         import_paths: re.Pattern[str] | None = None,
         import_target: Callable[[str], None] | None = None,
@@ -208,7 +207,7 @@ class RequestGuard:
         self.upload_path = upload_path
         self.import_paths = import_paths
         self.import_bytes = int(settings.archive_max_unpacked_mb * 1_000_000)
-        self.pending_runs = pending_runs
+        self.check_queue = check_queue
         self.uploads = RateWindow(settings.uploads_per_minute_per_user)
         self.upload_bytes = int(settings.max_upload_mb * 1_000_000) + MULTIPART_SLACK_BYTES
         self.request_bytes = int(settings.max_request_kb * 1000)
@@ -299,9 +298,9 @@ class RequestGuard:
         return self.staging.admit(key, min(announced, limit), is_import)
 
     def _upload_refusal(self, key: str) -> tuple[dict[str, object], int] | None:
-        limit = self.settings.max_queued_runs_per_user
-        if self.pending_runs(key) >= limit:
-            full = queue_full(limit)
+        try:
+            self.check_queue(key)
+        except RateLimitError as full:
             return error_body("RateLimitError", str(full)), full.retry_after_s
         wait = self.uploads.admit(key)
         if wait > 0:
@@ -349,30 +348,22 @@ class RequestGuard:
         return secured
 
 
-def queue_full(limit: int) -> RateLimitError:
-    """The refusal of a run (or an upload, which starts one) from a user with ``limit`` runs
-    waiting: one message for the guard before the body and the routes' place in the queue."""
-    return RateLimitError(
-        f"Expected at most {limit} queued runs per user (setting max_queued_runs_per_user), "
-        "got that many waiting",
-        retry_after_s=10,
-    )
-
-
 def install_http_guards(
     app: FastAPI,
     settings: Settings,
     upload_path: str,
-    pending_runs: Callable[[str], int],
+    check_queue: Callable[[str], None],
     quota_key: Callable[[HTTPConnection], str | None],
     import_paths: re.Pattern[str] | None = None,
     import_target: Callable[[str], None] | None = None,
 ) -> None:
     """Add the request guard, CORS (when ``cors_origins`` is set), the Host check and, for
     ``trusted_proxies``, uvicorn's forwarded-header middleware, in the order that makes the
-    forwarded headers apply first, then the Host check. ``pending_runs`` counts a quota key's queued
-    runs, ``quota_key`` names a request's key from its headers, None for a request to refuse
-    with 401 (a blocking call: it runs on a worker thread); ``import_paths`` matches the
+    forwarded headers apply first, then the Host check. ``check_queue`` refuses a quota key
+    whose run queue is full (raising :class:`~mocapqa.errors.RateLimitError`, answered 429
+    before the upload's body is read), ``quota_key`` names a request's key from its headers,
+    None for a request to refuse with 401 (a blocking call: it runs on a worker thread);
+    ``import_paths`` matches the
     routes that take many files in one request (uploads with the import body limit), its
     first group the target's id, which ``import_target`` (blocking) checks, raising
     :class:`~mocapqa.errors.NotFoundError` (answered 404) when it does not exist.
@@ -382,7 +373,7 @@ def install_http_guards(
         RequestGuard,
         settings=settings,
         upload_path=upload_path,
-        pending_runs=pending_runs,
+        check_queue=check_queue,
         quota_key=quota_key,
         import_paths=import_paths,
         import_target=import_target,

@@ -19,8 +19,9 @@ from __future__ import annotations
 
 import dataclasses
 import json
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import typer
 
@@ -28,6 +29,16 @@ from mocapqa.cli.app import app
 from mocapqa.cli.reading import read_input
 from mocapqa.cli.roles import FpsOption, MappingOption, RootTranslationOption, load_mapping
 from mocapqa.errors import InputError
+
+if TYPE_CHECKING:
+    from mocapqa.core.keypoints import KeypointSequence
+    from mocapqa.core.motion import Motion
+    from mocapqa.feet.check import FeetReport
+    from mocapqa.feet.contacts import Contact
+    from mocapqa.feet.findings import Finding
+    from mocapqa.feet.lock import Lock
+    from mocapqa.feet.params import FeetParams
+    from mocapqa.feet.points import FootPoints
 
 __all__ = ["feet_app", "feet_check", "feet_fix"]
 
@@ -149,29 +160,17 @@ def feet_check(
     root_translation: RootTranslationOption = "auto",
 ) -> None:
     """Find the up axis, the floor, foot contacts, skate, penetration, floating and jitter."""
+    from mocapqa.feet.fix_choice import add_ids
     from mocapqa.pipeline.feet import check_take_feet, feet_report_json
 
     read, roles = _read_take(take, fps, length_unit, mapping, root_translation)
     points, report, skipped = check_take_feet(read, roles)
     result = {"path": str(take), **feet_report_json(points, report, skipped)}
-    _add_ids(result, report, skipped)
+    add_ids(result, report.contacts, report.findings, skipped)
     if json_output:
         typer.echo(json.dumps(result, indent=2))
     else:
         _print_report(take, result)
-
-
-def _add_ids(result: dict[str, Any], report: Any, skipped: int) -> None:
-    """Give each contact and finding of the check's JSON its id (``feet fix --apply IDS``),
-    and each skate finding the confidence of its contact (``--apply confident``)."""
-    from mocapqa.feet.fix_choice import contact_id, finding_confidence, finding_id
-
-    for item, contact in zip(result["contacts"], report.contacts, strict=True):
-        item["id"] = contact_id(contact, skipped)
-    for item, finding in zip(result["findings"], report.findings, strict=True):
-        item["id"] = finding_id(finding, skipped)
-        if finding.kind == "skate":
-            item["confidence"] = finding_confidence(finding, report.contacts)
 
 
 def _print_fix(path: Path, out: Path, result: dict[str, Any]) -> None:
@@ -243,15 +242,10 @@ def feet_fix(
 ) -> None:
     """Lock planted feet (BVH: two-bone leg IK; keypoints: pinned), blended, and write the take."""
     from mocapqa.core.motion import Motion
-    from mocapqa.feet.fix import foot_rig, lock_feet
     from mocapqa.feet.fix_choice import choose_locks
     from mocapqa.feet.fix_report import fix_report_json
-    from mocapqa.feet.lock import Lock
     from mocapqa.feet.params import FeetParams
-    from mocapqa.feet.pin import foot_keypoints, pin_feet
     from mocapqa.io.atomic import write_text
-    from mocapqa.io.bvh_write import write_bvh
-    from mocapqa.io.formats import write_keypoints
     from mocapqa.pipeline.feet import check_take_feet
 
     if not apply.strip() or (apply.strip().startswith(",") or apply.strip().endswith(",")):
@@ -265,39 +259,17 @@ def feet_fix(
     params = FeetParams()
     points, report, skipped = check_take_feet(read, roles, params)
     chosen = choose_locks(apply.strip(), report.contacts, report.findings, skipped)
-
-    def shifted(contacts: Any) -> list[Lock]:
-        return [Lock(c.foot, c.start + skipped, c.end + skipped) for c in contacts]
-
-    plant = params.plant_speed * points.leg_length
-    n_contacts = len(report.contacts)
-    if isinstance(read, Motion):
-        locked = lock_feet(
-            read, foot_rig(read, roles), report.up, shifted(chosen), plant, points.leg_length,
-            first=skipped, measure=shifted(report.contacts),
-        )  # fmt: skip
-        _, after, _ = check_take_feet(locked.motion, roles, params)
-        write_bvh(output, locked.motion)
-        before, after_slide = locked.before, locked.after
-        clamped, miss = locked.clamped.tolist(), locked.miss.tolist()
-    else:
-        feet, members = foot_keypoints(read.names, points.names, points.sides)
-        pinned = pin_feet(
-            read.positions, feet, members, report.up, shifted(chosen), read.fps, plant,
-            measure=shifted(report.contacts),
-        )  # fmt: skip
-        moved = dataclasses.replace(read, positions=pinned.positions)
-        _, after, _ = check_take_feet(moved, None, params)
-        write_keypoints(output, moved)
-        before, after_slide = pinned.before, pinned.after
-        clamped, miss = [0] * n_contacts, [0.0] * n_contacts
+    plan = _Plan(points, report, chosen, skipped, params, output)
+    done = (
+        _fix_motion(read, roles, plan) if isinstance(read, Motion) else _fix_keypoints(read, plan)
+    )
     fixed = {
         "path": str(take),
         "output": str(output),
         "apply": apply.strip(),
         **fix_report_json(
-            points, report.contacts, report.findings, chosen, before.tolist(),
-            after_slide.tolist(), clamped, miss, after.findings, skipped,
+            points, report.contacts, report.findings, chosen, done.before, done.after,
+            done.clamped, done.miss, done.findings_after, skipped,
         ),
     }  # fmt: skip
     text = json.dumps(fixed, indent=2)
@@ -307,3 +279,74 @@ def feet_fix(
         typer.echo(text)
     else:
         _print_fix(take, output, fixed)
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class _Fixed:
+    """Per contact of the check: the slide before and after, clamped frames, reach missed;
+    and the findings of the check of the written take."""
+
+    before: list[float]
+    after: list[float]
+    clamped: list[int]
+    miss: list[float]
+    findings_after: Sequence[Finding]
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class _Plan:
+    """The feet check of the take as read, the contacts chosen to lock, and the output."""
+
+    points: FootPoints
+    report: FeetReport
+    chosen: Sequence[Contact]
+    skipped: int
+    params: FeetParams
+    output: Path
+
+    def locks(self, contacts: Sequence[Contact]) -> list[Lock]:
+        """Locks of contacts, in frames of the take as read."""
+        from mocapqa.feet.lock import Lock
+
+        skipped = self.skipped
+        return [Lock(c.foot, c.start + skipped, c.end + skipped) for c in contacts]
+
+    @property
+    def plant_speed(self) -> float:
+        """The planted-foot speed, take units per second."""
+        return self.params.plant_speed * self.points.leg_length
+
+
+def _fix_motion(read: Motion, roles: dict[str, str] | None, plan: _Plan) -> _Fixed:
+    """Lock the chosen contacts of a BVH take by two-bone leg IK, check and write it."""
+    from mocapqa.feet.fix import foot_rig, lock_feet
+    from mocapqa.io.bvh_write import write_bvh
+    from mocapqa.pipeline.feet import check_take_feet
+
+    locked = lock_feet(
+        read, foot_rig(read, roles), plan.report.up, plan.locks(plan.chosen), plan.plant_speed,
+        plan.points.leg_length, first=plan.skipped, measure=plan.locks(plan.report.contacts),
+    )  # fmt: skip
+    _, after, _ = check_take_feet(locked.motion, roles, plan.params)
+    write_bvh(plan.output, locked.motion)
+    return _Fixed(locked.before.tolist(), locked.after.tolist(), locked.clamped.tolist(),
+                  locked.miss.tolist(), after.findings)  # fmt: skip
+
+
+def _fix_keypoints(read: KeypointSequence, plan: _Plan) -> _Fixed:
+    """Pin the chosen contacts of a keypoint take, check and write it."""
+    from mocapqa.feet.pin import foot_keypoints, pin_feet
+    from mocapqa.io.formats import write_keypoints
+    from mocapqa.pipeline.feet import check_take_feet
+
+    feet, members = foot_keypoints(read.names, plan.points.names, plan.points.sides)
+    pinned = pin_feet(
+        read.positions, feet, members, plan.report.up, plan.locks(plan.chosen), read.fps,
+        plan.plant_speed, measure=plan.locks(plan.report.contacts),
+    )  # fmt: skip
+    moved = dataclasses.replace(read, positions=pinned.positions)
+    _, after, _ = check_take_feet(moved, None, plan.params)
+    write_keypoints(plan.output, moved)
+    n_contacts = len(plan.report.contacts)
+    return _Fixed(pinned.before.tolist(), pinned.after.tolist(), [0] * n_contacts,
+                  [0.0] * n_contacts, after.findings)  # fmt: skip

@@ -253,6 +253,20 @@ def info_command(
         _print_table(file, summary)
 
 
+def _check_keypoint_output(mapped: bool, output: Path, source: str) -> None:
+    """Refuse ``--mapping`` for a keypoint or marker ``source``, and an output that is not a
+    keypoint format."""
+    from mocapqa.io.formats import KEYPOINT_WRITE_FORMATS
+
+    if mapped:
+        raise InputError(f"Expected --mapping only for BVH input, got {source}")
+    if output.suffix.lower().lstrip(".") not in KEYPOINT_WRITE_FORMATS:
+        raise UnsupportedFormatError(
+            f"Expected a keypoint output among {', '.join(KEYPOINT_WRITE_FORMATS)}, "
+            f"got {output.name!r}"
+        )
+
+
 @app.command("convert")
 def convert_command(
     source: Annotated[Path, typer.Argument(help="Input take (BVH or keypoints).")],
@@ -269,7 +283,6 @@ def convert_command(
     from mocapqa.io.bvh_write import write_bvh
     from mocapqa.io.c3d import write_c3d
     from mocapqa.io.formats import (
-        KEYPOINT_WRITE_FORMATS,
         check_fps,
         detect_format,
         require_frames,
@@ -284,13 +297,7 @@ def convert_command(
     check_outputs({"-o": output}, [take_input(source), mapping], sidecars=True)
     roles = load_mapping(mapping)
     if detect_format(source) == "c3d":
-        if roles is not None:
-            raise InputError("Expected --mapping only for BVH input, got a c3d file")
-        if suffix not in KEYPOINT_WRITE_FORMATS:
-            raise UnsupportedFormatError(
-                f"Expected a keypoint output among {', '.join(KEYPOINT_WRITE_FORMATS)}, "
-                f"got {output.name!r}"
-            )
+        _check_keypoint_output(roles is not None, output, "a c3d file")
         markers = _read_marker_take(source)
         if suffix == "c3d":
             # Through the source (analogs, force plates, events kept) when ezc3d reads it.
@@ -309,12 +316,6 @@ def convert_command(
             )
         write_bvh(output, take, precision=precision)
     else:
-        if roles is not None:
-            raise InputError("Expected --mapping only for BVH input, got a keypoint take")
-        if suffix not in KEYPOINT_WRITE_FORMATS:
-            raise UnsupportedFormatError(
-                f"Expected a keypoint output among {', '.join(KEYPOINT_WRITE_FORMATS)}, "
-                f"got {output.name!r}"
-            )
+        _check_keypoint_output(roles is not None, output, "a keypoint take")
         write_keypoints(output, take)
     typer.echo(f"wrote {output} ({suffix}, {take.n_frames} frames)")

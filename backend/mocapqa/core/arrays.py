@@ -15,7 +15,15 @@ from numpy.typing import NDArray
 
 from mocapqa.errors import ShapeError
 
-__all__ = ["BoolArray", "FloatArray", "IntArray", "as_float_array", "check_shape", "true_runs"]
+__all__ = [
+    "BoolArray",
+    "FloatArray",
+    "IntArray",
+    "as_float_array",
+    "check_shape",
+    "column_runs",
+    "true_runs",
+]
 
 FloatArray = NDArray[np.float64]
 """float64 array of any shape (positions, quaternions, angles)."""
@@ -103,3 +111,32 @@ def true_runs(flags: BoolArray) -> IntArray:
     edges = np.diff(np.concatenate(([0], flags.astype(np.int8), [0])))
     starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
     return np.stack([starts, stops - 1], axis=1).astype(np.intp)
+
+
+def column_runs(mask: BoolArray) -> tuple[IntArray, IntArray, IntArray]:
+    """The runs of true frames in each column of a mask.
+
+    Parameters
+    ----------
+    mask : ndarray of bool, shape (F, N)
+
+    Returns
+    -------
+    columns, starts, ends : ndarray of int, shape (R,)
+        Column, first and last frame (both inside the run) of each run, by column then start.
+
+    Raises
+    ------
+    ShapeError
+        If ``mask`` is not two-dimensional.
+    """
+    mask = np.asarray(mask, dtype=bool)
+    if mask.ndim != 2:
+        raise ShapeError(f"Expected `mask` to have shape (F, N), got {mask.shape}")
+    n_frames, n_columns = mask.shape
+    padded = np.zeros((n_columns, n_frames + 2), dtype=np.int8)
+    padded[:, 1:-1] = mask.T
+    edges = np.diff(padded, axis=1)
+    columns, starts = np.nonzero(edges == 1)
+    _, stops = np.nonzero(edges == -1)
+    return columns.astype(np.intp), starts.astype(np.intp), (stops - 1).astype(np.intp)

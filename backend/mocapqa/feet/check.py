@@ -4,7 +4,7 @@
 
 1. speeds of every point (moving average over ``speed_window_s``, central differences);
 2. the up axis (:func:`mocapqa.feet.ground.detect_up_axis`), unless the caller names it;
-3. the floor and each point's stance level (:func:`mocapqa.feet.ground.fit_floor`); a tilted
+3. the floor and each point's stance level (:func:`mocapqa.feet.floor.fit_floor`); a tilted
    floor is reported, and heights are then measured from its plane (fitted again on the
    levelled heights for the stance levels and the drift);
 4. point and foot contacts (:mod:`mocapqa.feet.contacts`);
@@ -36,7 +36,8 @@ from mocapqa.feet.findings import (
     find_penetration,
     find_skate,
 )
-from mocapqa.feet.ground import Floor, UpAxis, detect_up_axis, fit_floor
+from mocapqa.feet.floor import Floor, fit_floor
+from mocapqa.feet.ground import UpAxis, detect_up_axis
 from mocapqa.feet.params import FeetParams
 from mocapqa.feet.points import FootPoints
 from mocapqa.feet.tracks import (

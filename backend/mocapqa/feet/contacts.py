@@ -3,7 +3,7 @@
 Conventions
 -----------
 * ``elevations`` ``(F, P)`` are each point's heights above its own stance level (the floor
-  plus the point's offset, :class:`mocapqa.feet.ground.Floor`), ``speeds`` ``(F, P)`` its 3D
+  plus the point's offset, :class:`mocapqa.feet.floor.Floor`), ``speeds`` ``(F, P)`` its 3D
   speeds; both in take units and take units per second. Thresholds are leg lengths
   (:class:`mocapqa.feet.params.FeetParams`).
 * A point enters a contact where it is below ``contact_height`` and slower than
@@ -26,12 +26,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mocapqa.core.arrays import BoolArray, FloatArray
+from mocapqa.core.arrays import BoolArray, FloatArray, column_runs
 from mocapqa.feet.params import FeetParams
 from mocapqa.feet.points import SIDES, per_foot
 from mocapqa.feet.runs import (
     close_short_gaps,
-    column_runs,
     drop_short_runs,
     frames_in,
     hysteresis,
@@ -85,10 +84,9 @@ def point_contact_mask(
         Heights above each point's stance level, take units (NaN: not in contact).
     speeds : ndarray, shape (F, P)
         Take units per second.
-    fps : float
-    leg_length : float
-        Take units.
-    params : FeetParams, optional
+    fps, leg_length, params
+        Frames per second, the leg length (take units) and the thresholds (None: the
+        defaults).
 
     Returns
     -------

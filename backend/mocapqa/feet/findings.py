@@ -31,13 +31,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.core.arrays import BoolArray, FloatArray, IntArray, column_runs
 from mocapqa.feet.params import FeetParams
 from mocapqa.feet.points import SIDES, per_foot
 from mocapqa.feet.runs import (
     Runs,
     close_short_gaps,
-    column_runs,
     drop_short_runs,
     frames_in,
     run_mean,
@@ -183,10 +182,9 @@ def find_skate(
     sides : tuple of str
     horizontal : tuple of int
         The two horizontal axes.
-    fps : float
-    leg_length : float
-        Take units.
-    params : FeetParams, optional
+    fps, leg_length, params
+        Frames per second, the leg length (take units) and the thresholds (None: the
+        defaults).
 
     Returns
     -------
@@ -200,35 +198,11 @@ def find_skate(
     frame, column, run_index = _run_frames(runs)
     lengths = runs[2] - runs[1] + 1
     firsts = np.cumsum(lengths) - lengths  # each run's first row in the concatenated order
-    flat = velocities[..., list(horizontal)]  # (F, P, 2)
-    # A point can carry the foot at a frame while in contact and within plant_height of its
-    # lowest height in this contact (the local floor, so a drifting floor does not count):
-    # a heel or toe rising at push-off rolls over, it does not slide.
-    lift = elevations[frame]  # (N, P)
-    lowest = np.minimum.reduceat(np.where(np.isfinite(lift), lift, np.inf), firsts, axis=0)
-    with np.errstate(invalid="ignore"):
-        low = (
-            side_members(sides)[column]
-            & point_mask[frame]
-            & (lift - lowest[run_index] < p.plant_height * leg_length)
-        )
-    # The foot's velocity is that of its least-moving low point: on the line from the rear
-    # point (heel or ankle) to the toe when both are low (velocities of a rigid foot vary
-    # linearly along it, so a foot rolling over its toe, or turning about its ball or its
-    # midfoot, has a point there that stays), else the one low point.
-    rear, toe = foot_pair(sides)
-    rows = np.arange(frame.size)
-    rear_velocity = flat[frame, rear[column]]
-    toe_velocity = flat[frame, toe[column]]
-    rear_low = low[rows, rear[column]]
-    toe_low = low[rows, toe[column]]
-    span = toe_velocity - rear_velocity
-    with np.errstate(invalid="ignore", divide="ignore"):
-        share = -np.einsum("nk,nk->n", rear_velocity, span) / np.einsum("nk,nk->n", span, span)
-    share = np.where(rear_low & toe_low, np.clip(np.nan_to_num(share), 0.0, 1.0),
-                     np.where(toe_low, 1.0, 0.0))  # fmt: skip
-    foot_velocity = rear_velocity + share[:, None] * span
-    pivot_speed = np.where(rear_low | toe_low, norms(foot_velocity), np.inf)
+    low = _low_points(elevations[frame], point_mask[frame], sides, column, run_index, firsts,
+                      p.plant_height * leg_length)  # fmt: skip
+    foot_velocity, pivot_speed = _pivot_velocity(
+        velocities[..., list(horizontal)], low, sides, frame, column
+    )
     # Planted: the pivot is slower than plant_speed, or than 1.5 times the contact's median
     # pivot speed, so a steady slide counts in full while the quick landing and push-off of
     # a clean contact do not.
@@ -258,6 +232,57 @@ def find_skate(
     )
 
 
+def _low_points(
+    lift: FloatArray,
+    in_contact: BoolArray,
+    sides: tuple[str, ...],
+    column: IntArray,
+    run_index: IntArray,
+    firsts: IntArray,
+    plant_height: float,
+) -> BoolArray:
+    """Which points can carry the foot at each frame of each contact, ``(N, P)``.
+
+    A point can carry the foot while in contact and within ``plant_height`` (take units) of
+    its lowest height in this contact (the local floor, so a drifting floor does not count):
+    a heel or toe rising at push-off rolls over, it does not slide. ``lift`` and
+    ``in_contact`` are the elevations and point contacts at the contacts' frames, ``(N, P)``.
+    """
+    lowest = np.minimum.reduceat(np.where(np.isfinite(lift), lift, np.inf), firsts, axis=0)
+    with np.errstate(invalid="ignore"):
+        low: BoolArray = (
+            side_members(sides)[column] & in_contact & (lift - lowest[run_index] < plant_height)
+        )
+    return low
+
+
+def _pivot_velocity(
+    flat: FloatArray, low: BoolArray, sides: tuple[str, ...], frame: IntArray, column: IntArray
+) -> tuple[FloatArray, FloatArray]:
+    """The foot's horizontal velocity ``(N, 2)`` and the pivot's speed ``(N,)`` (inf where no
+    point is low).
+
+    The foot's velocity is that of its least-moving low point: on the line from the rear
+    point (heel or ankle) to the toe when both are low (velocities of a rigid foot vary
+    linearly along it, so a foot rolling over its toe, or turning about its ball or its
+    midfoot, has a point there that stays), else the one low point.
+    """
+    rear, toe = foot_pair(sides)
+    rows = np.arange(frame.size)
+    rear_velocity = flat[frame, rear[column]]
+    toe_velocity = flat[frame, toe[column]]
+    rear_low = low[rows, rear[column]]
+    toe_low = low[rows, toe[column]]
+    span = toe_velocity - rear_velocity
+    with np.errstate(invalid="ignore", divide="ignore"):
+        share = -np.einsum("nk,nk->n", rear_velocity, span) / np.einsum("nk,nk->n", span, span)
+    share = np.where(rear_low & toe_low, np.clip(np.nan_to_num(share), 0.0, 1.0),
+                     np.where(toe_low, 1.0, 0.0))  # fmt: skip
+    foot_velocity: FloatArray = rear_velocity + share[:, None] * span
+    pivot_speed: FloatArray = np.where(rear_low | toe_low, norms(foot_velocity), np.inf)
+    return foot_velocity, pivot_speed
+
+
 def find_penetration(
     elevations: FloatArray,
     spreads: FloatArray,
@@ -270,17 +295,13 @@ def find_penetration(
 
     Parameters
     ----------
-    elevations : ndarray, shape (F, P)
-        Heights above each point's stance level, take units.
+    elevations, sides, fps, leg_length, params
+        As in :func:`find_skate`.
     spreads : ndarray, shape (P,)
         How much each point's height varies at rest (:attr:`Floor.point_spreads`), take units:
         a point is below the floor when deeper than ``penetration_depth`` plus its spread (an
         ankle joint sinks and rises by a centimetre on a planted foot by itself; a toe or a
         heel marker barely moves).
-    sides : tuple of str
-    fps : float
-    leg_length : float
-    params : FeetParams, optional
 
     Returns
     -------
@@ -313,16 +334,8 @@ def find_floating(
 
     Parameters
     ----------
-    elevations : ndarray, shape (F, P)
-        Heights above each point's stance level, take units.
-    speeds : ndarray, shape (F, P)
-        Take units per second.
-    foot_mask : ndarray of bool, shape (F, 2)
-        Foot contacts.
-    sides : tuple of str
-    fps : float
-    leg_length : float
-    params : FeetParams, optional
+    elevations, speeds, foot_mask, sides, fps, leg_length, params
+        As in :func:`find_skate`.
 
     Returns
     -------

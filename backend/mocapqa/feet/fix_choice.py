@@ -4,12 +4,20 @@ confidence of a skate finding, and the choice itself."""
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 from mocapqa.errors import InputError
 from mocapqa.feet.contacts import Contact
 from mocapqa.feet.findings import Finding
 
-__all__ = ["CONFIDENT", "choose_locks", "contact_id", "finding_confidence", "finding_id"]
+__all__ = [
+    "CONFIDENT",
+    "add_ids",
+    "choose_locks",
+    "contact_id",
+    "finding_confidence",
+    "finding_id",
+]
 
 CONFIDENT = 0.5
 """Contact confidence (:mod:`mocapqa.feet.contacts`) at and above which ``--apply confident``
@@ -117,3 +125,20 @@ def choose_locks(
                 )
     unique = {(c.foot, c.start): c for c in chosen}
     return [unique[k] for k in sorted(unique, key=lambda k: (k[1], k[0]))]
+
+
+def add_ids(
+    check: dict[str, Any],
+    contacts: Sequence[Contact],
+    findings: Sequence[Finding],
+    skipped: int = 0,
+) -> None:
+    """Give each contact and finding of a feet check's JSON (``check["contacts"]``,
+    ``check["findings"]``, in the order of ``contacts`` and ``findings``) its id, and each
+    skate finding the confidence of its contact, in place."""
+    for item, contact in zip(check["contacts"], contacts, strict=True):
+        item["id"] = contact_id(contact, skipped)
+    for item, finding in zip(check["findings"], findings, strict=True):
+        item["id"] = finding_id(finding, skipped)
+        if finding.kind == "skate":
+            item["confidence"] = finding_confidence(finding, contacts)

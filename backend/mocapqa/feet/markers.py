@@ -129,6 +129,90 @@ def _cluster_ends(
     return (a, b) if near_a <= near_b else (b, a)
 
 
+def _chosen_points(
+    positions: FloatArray,
+    names: tuple[str, ...],
+    roles: dict[tuple[str, str], int],
+    clusters: dict[str, list[int]],
+    pelvis: FloatArray | None,
+) -> dict[str, list[tuple[int, str]]]:
+    """Per foot, (marker, part) of its rear point (heel or ankle) then its toe, by name or
+    from a foot cluster.
+
+    Raises
+    ------
+    InputError
+        If a foot has none.
+    """
+    chosen: dict[str, list[tuple[int, str]]] = {}
+    for side in SIDES:
+        rear = next(((roles[(side, r)], r) for r in ("heel", "ankle") if (side, r) in roles), None)
+        toe = roles.get((side, "toe"))
+        if rear is None and toe is None and len(clusters.get(f"{side} foot", [])) >= 2:
+            heel, tip = _cluster_ends(
+                positions, clusters[f"{side} foot"], clusters.get(f"{side} shank", []), pelvis
+            )
+            rear, toe = (heel, "heel"), tip
+        chosen[side] = ([rear] if rear is not None else []) + (
+            [(toe, "toe")] if toe is not None else []
+        )
+    missing = [side for side in SIDES if not chosen[side]]
+    if missing:
+        shown = ", ".join(marker_label(n) for n in names[:12]) + (
+            ", ..." if len(names) > 12 else ""
+        )
+        raise InputError(
+            f"Expected heel, toe or ankle markers on both feet (Plug-in Gait and CMU LHEE, "
+            f"LTOE, LANK; Vicon LHEL; LCAL, LMT1, LHAL; a foot cluster LFT1, LFT2, ...), got "
+            f"none for the {' and '.join(missing)} foot among the take's {len(names)} markers"
+            f"{': ' + shown if names else ''}"
+        )
+    return chosen
+
+
+def _leg_length(
+    positions: FloatArray,
+    roles: dict[tuple[str, str], int],
+    chosen: dict[str, list[tuple[int, str]]],
+    pelvis: FloatArray | None,
+) -> float:
+    """Median pelvis-front → knee → ankle over frames and sides, else the 90th percentile of
+    the pelvis-to-rear-point distance, file units.
+
+    Raises
+    ------
+    InputError
+        If neither gives a length > 0.
+    """
+    legs = [
+        np.linalg.norm(
+            positions[:, roles[(s, "pelvis_front")]] - positions[:, roles[(s, "knee")]], axis=-1
+        )
+        + np.linalg.norm(
+            positions[:, roles[(s, "knee")]] - positions[:, roles[(s, "ankle")]], axis=-1
+        )
+        for s in SIDES
+        if all((s, r) in roles for r in ("pelvis_front", "knee", "ankle"))
+    ]
+    if legs:
+        leg_length = _nanmedian(np.concatenate(legs))
+    elif pelvis is not None:
+        reach = np.concatenate(
+            [np.linalg.norm(positions[:, chosen[s][0][0]] - pelvis, axis=-1) for s in SIDES]
+        )
+        finite = reach[np.isfinite(reach)]
+        leg_length = float(np.percentile(finite, 90)) if finite.size else float("nan")
+    else:
+        leg_length = float("nan")
+    if not leg_length > 0:
+        raise InputError(
+            "Expected pelvis markers (LASI/RASI, LPSI/RPSI, LFWT/LBWT, a PV cluster) that give "
+            "a leg length > 0, got "
+            + ("none" if pelvis is None else f"a leg length of {leg_length} (markers not moving?)")
+        )
+    return leg_length
+
+
 def marker_foot_points(sequence: KeypointSequence) -> FootPoints:
     """The foot points of a marker take.
 
@@ -158,55 +242,8 @@ def marker_foot_points(sequence: KeypointSequence) -> FootPoints:
         + clusters.get("pelvis", [])
     )
     pelvis = _nanmean_points(positions, pelvis_markers) if pelvis_markers else None
-    chosen: dict[str, list[tuple[int, str]]] = {}
-    for side in SIDES:
-        rear = next(((roles[(side, r)], r) for r in ("heel", "ankle") if (side, r) in roles), None)
-        toe = roles.get((side, "toe"))
-        if rear is None and toe is None and len(clusters.get(f"{side} foot", [])) >= 2:
-            heel, tip = _cluster_ends(
-                positions, clusters[f"{side} foot"], clusters.get(f"{side} shank", []), pelvis
-            )
-            rear, toe = (heel, "heel"), tip
-        chosen[side] = ([rear] if rear is not None else []) + (
-            [(toe, "toe")] if toe is not None else []
-        )
-    missing = [side for side in SIDES if not chosen[side]]
-    if missing:
-        shown = ", ".join(marker_label(n) for n in names[:12]) + (
-            ", ..." if len(names) > 12 else ""
-        )
-        raise InputError(
-            f"Expected heel, toe or ankle markers on both feet (Plug-in Gait and CMU LHEE, "
-            f"LTOE, LANK; Vicon LHEL; LCAL, LMT1, LHAL; a foot cluster LFT1, LFT2, ...), got "
-            f"none for the {' and '.join(missing)} foot among the take's {len(names)} markers"
-            f"{': ' + shown if names else ''}"
-        )
-    legs = [
-        np.linalg.norm(
-            positions[:, roles[(s, "pelvis_front")]] - positions[:, roles[(s, "knee")]], axis=-1
-        )
-        + np.linalg.norm(
-            positions[:, roles[(s, "knee")]] - positions[:, roles[(s, "ankle")]], axis=-1
-        )
-        for s in SIDES
-        if all((s, r) in roles for r in ("pelvis_front", "knee", "ankle"))
-    ]
-    if legs:
-        leg_length = _nanmedian(np.concatenate(legs))
-    elif pelvis is not None:
-        reach = np.concatenate(
-            [np.linalg.norm(positions[:, chosen[s][0][0]] - pelvis, axis=-1) for s in SIDES]
-        )
-        finite = reach[np.isfinite(reach)]
-        leg_length = float(np.percentile(finite, 90)) if finite.size else float("nan")
-    else:
-        leg_length = float("nan")
-    if not leg_length > 0:
-        raise InputError(
-            "Expected pelvis markers (LASI/RASI, LPSI/RPSI, LFWT/LBWT, a PV cluster) that give "
-            "a leg length > 0, got "
-            + ("none" if pelvis is None else f"a leg length of {leg_length} (markers not moving?)")
-        )
+    chosen = _chosen_points(positions, names, roles, clusters, pelvis)
+    leg_length = _leg_length(positions, roles, chosen, pelvis)
     indices = [i for s in SIDES for i, _ in chosen[s]]
     return FootPoints(
         positions=positions[:, indices],

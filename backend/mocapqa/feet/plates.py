@@ -34,11 +34,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mocapqa.core.arrays import BoolArray, FloatArray
+from mocapqa.core.arrays import BoolArray, FloatArray, column_runs
 from mocapqa.errors import ShapeError
 from mocapqa.feet.contacts import Contact
 from mocapqa.feet.points import SIDES, per_foot
-from mocapqa.feet.runs import close_short_gaps, column_runs, drop_short_runs, frames_in
+from mocapqa.feet.runs import close_short_gaps, drop_short_runs, frames_in
 
 __all__ = [
     "MAX_BREAK_S",

@@ -14,13 +14,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.core.arrays import BoolArray, FloatArray, IntArray, column_runs
 from mocapqa.errors import ShapeError
 
 __all__ = [
     "Runs",
     "close_short_gaps",
-    "column_runs",
     "drop_short_runs",
     "frames_in",
     "hysteresis",
@@ -63,28 +62,6 @@ def hysteresis(enter: BoolArray, stay: BoolArray) -> BoolArray:
     last_break = np.maximum.accumulate(np.where(stay, -1, frames), axis=0)
     result: BoolArray = last_enter > last_break
     return result
-
-
-def column_runs(mask: BoolArray) -> Runs:
-    """The runs of true frames in each column.
-
-    Parameters
-    ----------
-    mask : ndarray of bool, shape (F, N)
-
-    Returns
-    -------
-    columns, starts, ends : ndarray of int, shape (R,)
-        Column, first and last frame of each run, by column then start.
-    """
-    mask = _as_2d(mask, "mask")
-    n_frames, n_columns = mask.shape
-    padded = np.zeros((n_columns, n_frames + 2), dtype=np.int8)
-    padded[:, 1:-1] = mask.T
-    edges = np.diff(padded, axis=1)
-    columns, starts = np.nonzero(edges == 1)
-    _, stops = np.nonzero(edges == -1)
-    return columns.astype(np.intp), starts.astype(np.intp), (stops - 1).astype(np.intp)
 
 
 def paint_runs(runs: Runs, shape: tuple[int, int]) -> BoolArray:

@@ -46,6 +46,13 @@ def _adaptive_frame(
 ) -> None:
     """One frame of the innovation-weighted blend over ``N = 3K`` channels, in place.
 
+    Kept whole because it is the compiled body of both the streaming step and the batch loop:
+    the body drift, the Kalman, One Euro and EMA updates and the blend share passes over the
+    channels with the ~25 unpacked settings held in local variables, and splitting it into
+    separately compiled functions would pass those through every call on the per-frame path
+    and risk reordering floating-point operations whose results the streaming and batch
+    outputs, and the reference filters the tests compare them with, must match bit for bit.
+
     Parameters
     ----------
     z : ndarray, shape (N,)

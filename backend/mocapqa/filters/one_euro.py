@@ -28,7 +28,13 @@ from mocapqa.errors import InputError
 from mocapqa.filters.ranges import BELOW_ONE, FREQUENCY, NON_NEGATIVE, bounded, check_ranges
 from mocapqa.filters.streaming import channel_count, run_streaming
 
-__all__ = ["OneEuroFilter", "OneEuroParams", "one_euro_filter", "smoothing_factor"]
+__all__ = [
+    "OneEuroFilter",
+    "OneEuroParams",
+    "check_cutoffs",
+    "one_euro_filter",
+    "smoothing_factor",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -54,11 +60,22 @@ class OneEuroParams:
 
     def __post_init__(self) -> None:
         check_ranges(self)
-        if not (self.min_cutoff_hz > 0 and self.d_cutoff_hz > 0 and self.beta >= 0):
-            raise InputError(
-                "Expected `min_cutoff_hz` > 0, `d_cutoff_hz` > 0 and `beta` >= 0, got "
-                f"{self.min_cutoff_hz}, {self.d_cutoff_hz} and {self.beta}"
-            )
+        check_cutoffs(self.min_cutoff_hz, self.d_cutoff_hz, self.beta)
+
+
+def check_cutoffs(min_cutoff_hz: float, d_cutoff_hz: float, beta: float) -> None:
+    """Refuse One Euro settings (positional or quaternion) whose cutoffs (Hz) are not
+    positive or whose slope is negative.
+
+    Raises
+    ------
+    InputError
+    """
+    if not (min_cutoff_hz > 0 and d_cutoff_hz > 0 and beta >= 0):
+        raise InputError(
+            "Expected `min_cutoff_hz` > 0, `d_cutoff_hz` > 0 and `beta` >= 0, got "
+            f"{min_cutoff_hz}, {d_cutoff_hz} and {beta}"
+        )
 
 
 def smoothing_factor(cutoff_hz: FloatArray | float, fps: float) -> FloatArray:

@@ -23,6 +23,7 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray, check_shape
 from mocapqa.errors import InputError
+from mocapqa.filters.one_euro import check_cutoffs
 from mocapqa.filters.ranges import FREQUENCY, NON_NEGATIVE, bounded, check_ranges
 from mocapqa.kinematics.quaternion import exp_map, log_map, multiply, unwrap
 
@@ -49,11 +50,7 @@ class QuatOneEuroParams:
 
     def __post_init__(self) -> None:
         check_ranges(self)
-        if not (self.min_cutoff_hz > 0 and self.d_cutoff_hz > 0 and self.beta >= 0):
-            raise InputError(
-                "Expected `min_cutoff_hz` > 0, `d_cutoff_hz` > 0 and `beta` >= 0, got "
-                f"{self.min_cutoff_hz}, {self.d_cutoff_hz} and {self.beta}"
-            )
+        check_cutoffs(self.min_cutoff_hz, self.d_cutoff_hz, self.beta)
 
 
 class QuatOneEuroFilter:

@@ -161,16 +161,23 @@ class PendingFile:
         """
         if not self._open:
             return
-        try:
+        with self.discarding():
             output_target(self.path)
             os.replace(self.temporary, self.target)
+        self._open = False
+
+    @contextmanager
+    def discarding(self) -> Iterator[None]:
+        """Discard the temporary file when the block fails, and re-raise: an ``OSError``
+        with the output's path as its ``filename``, anything else as it is."""
+        try:
+            yield
         except OSError as e:
             self.discard()
             raise with_output_path(e, self.path) from e
         except BaseException:
             self.discard()
             raise
-        self._open = False
 
     def discard(self) -> None:
         """Remove the temporary file; the target is left as it was."""
@@ -206,14 +213,8 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         the temporary file is removed and an existing output is left unchanged.
     """
     pending = PendingFile(path)
-    try:
+    with pending.discarding():
         yield pending.temporary
-    except OSError as e:
-        pending.discard()
-        raise with_output_path(e, pending.path) from e
-    except BaseException:
-        pending.discard()
-        raise
     pending.commit()
 
 

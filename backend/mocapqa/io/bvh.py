@@ -26,8 +26,9 @@ import codecs
 import math
 import re
 import sys
+from collections.abc import Callable
 from pathlib import Path
-from typing import Literal
+from typing import Literal, TypeVar
 
 import numpy as np
 
@@ -185,6 +186,23 @@ def parse_bvh(
         text = text.replace("\r", "\n")  # classic Mac line endings
     # Lines are counted by LF everywhere (CR is whitespace), so error line numbers agree with
     # editors for LF, CRLF and mixed files.
+    hierarchy, cursor = _sections(text, path)
+    n_frames, frame_time = _motion_header(cursor, path)
+    n_channels = sum(len(c) for c in hierarchy.channels)
+    block = text[cursor.position :]
+    if number_reader == "auto":
+        big = len(block) >= AUTO_ARROW_BYTES
+        number_reader = "arrow" if big or "pyarrow.csv" in sys.modules else "python"
+    values = None
+    if number_reader == "arrow":
+        values = frames_by_arrow(block, n_frames, n_channels)
+    if values is None:
+        values = frames_by_line(text.split("\n"), cursor.number + 1, n_frames, n_channels, path)
+    return _motion_from_channels(hierarchy, values, 1.0 / frame_time, root_translation, length_unit)
+
+
+def _sections(text: str, path: str) -> tuple[Hierarchy, _LineCursor]:
+    """The hierarchy, and a cursor on the MOTION line."""
     match = _MOTION.search(text)
     if match is None:
         # The hierarchy read to the end names a truncation, or stray text where MOTION belongs.
@@ -201,41 +219,50 @@ def parse_bvh(
     hierarchy = parse_hierarchy(
         text[: match.start()].split("\n"), path, "end of hierarchy (truncated file?)"
     )
-    cursor = _LineCursor(text, match.end(), motion_line)
+    return hierarchy, _LineCursor(text, match.end(), motion_line)
+
+
+_Number = TypeVar("_Number", int, float)
+
+
+def _header_number(
+    cursor: _LineCursor,
+    pattern: re.Pattern[str],
+    key: str,
+    number: Callable[[str], _Number],
+    expected: str,
+    path: str,
+) -> tuple[_Number, str]:
+    """The number on the next non-blank line, ``key`` followed by it, and its text.
+
+    Raises
+    ------
+    ParseError
+        At the end of the file, on another line, or when ``number`` refuses the value
+        ("Expected ``expected``, got ...").
+    """
     line = cursor.next_nonblank()
     if line is None:
-        raise ParseError("Expected 'Frames:', got end of file", path, cursor.number + 1)
-    frames_text = _header_value(line, _FRAMES, "Frames:", path, cursor.number + 1)
+        raise ParseError(f"Expected {key!r}, got end of file", path, cursor.number + 1)
+    text = _header_value(line, pattern, key, path, cursor.number + 1)
     try:
-        n_frames = int(frames_text)
+        return number(text), text
     except ValueError:
         raise ParseError(
-            f"Expected a frame count, got {quoted(frames_text)}", path, cursor.number + 1
+            f"Expected {expected}, got {quoted(text)}", path, cursor.number + 1
         ) from None
+
+
+def _motion_header(cursor: _LineCursor, path: str) -> tuple[int, float]:
+    """The ``Frames:`` count and the ``Frame Time:`` (seconds) below MOTION."""
+    n_frames, _ = _header_number(cursor, _FRAMES, "Frames:", int, "a frame count", path)
     if n_frames < 0:
         raise ParseError(f"Expected a frame count >= 0, got {n_frames}", path, cursor.number + 1)
-    line = cursor.next_nonblank()
-    if line is None:
-        raise ParseError("Expected 'Frame Time:', got end of file", path, cursor.number + 1)
-    time_text = _header_value(line, _FRAME_TIME, "Frame Time:", path, cursor.number + 1)
-    try:
-        frame_time = float(time_text)
-    except ValueError:
-        raise ParseError(
-            f"Expected a frame time in seconds, got {quoted(time_text)}", path, cursor.number + 1
-        ) from None
+    frame_time, time_text = _header_number(
+        cursor, _FRAME_TIME, "Frame Time:", float, "a frame time in seconds", path
+    )
     _check_frame_time(frame_time, time_text, path, cursor.number + 1)
-    n_channels = sum(len(c) for c in hierarchy.channels)
-    block = text[cursor.position :]
-    if number_reader == "auto":
-        big = len(block) >= AUTO_ARROW_BYTES
-        number_reader = "arrow" if big or "pyarrow.csv" in sys.modules else "python"
-    values = None
-    if number_reader == "arrow":
-        values = frames_by_arrow(block, n_frames, n_channels)
-    if values is None:
-        values = frames_by_line(text.split("\n"), cursor.number + 1, n_frames, n_channels, path)
-    return _motion_from_channels(hierarchy, values, 1.0 / frame_time, root_translation, length_unit)
+    return n_frames, frame_time
 
 
 def _motion_from_channels(

@@ -328,7 +328,7 @@ def inspect_c3d(path: str | Path) -> C3DLayout:
     Parameters
     ----------
     path : str or Path
-        The file.
+        The C3D file to check.
 
     Returns
     -------
@@ -718,67 +718,14 @@ def write_c3d(path: str | Path, take: MarkerTake, source: str | Path | None = No
     ShapeError
         When the residuals or camera masks do not match the points.
     """
-    import ezc3d
-
     _check_take(take)
     seq = take.points
-    n_frames, n_points = seq.n_frames, seq.n_keypoints
     if source is not None:
-        source = Path(source)
-        layout = inspect_c3d(source)
-        if layout.header.processor == 86:
-            raise UnsupportedFormatError(
-                f"Expected a source C3D that ezc3d reads, got a MIPS file: {source.name}"
-            )
-        check_for_ezc3d(layout, source)
-        try:
-            c3d = ezc3d.c3d(str(source))
-        except Exception as e:  # as in read_c3d
-            raise UnsupportedFormatError(
-                f"Expected a source C3D that ezc3d reads, got {source.name} ({_reason(e)})"
-            ) from e
-        held = c3d["data"]["points"].shape
-        if held[1:] != (n_points, n_frames):
-            raise InputError(
-                f"Expected the take to have the source's {held[1]} points and {held[2]} frames, "
-                f"got {n_points} points and {n_frames} frames ({source.name})"
-            )
-        _trim_analog_labels(c3d["parameters"], c3d["data"]["analogs"].shape[1])
+        c3d = _source_c3d(Path(source), seq.n_keypoints, seq.n_frames)
     else:
-        c3d = ezc3d.c3d()
-        for event in take.events:
-            minutes = math.floor(event.time_s / 60.0)
-            c3d.add_event(
-                [float(minutes), event.time_s - 60.0 * minutes],
-                context=event.context,
-                label=event.label,
-            )
-    point = c3d["parameters"]["POINT"]
-    _set_in_255s(c3d, "LABELS", list(seq.names))
-    if n_points <= 255:  # ezc3d 1.7.2 writes no POINT:DESCRIPTIONS for more points
-        descriptions = list(take.descriptions[:n_points])
-        point["DESCRIPTIONS"]["value"] = descriptions + [""] * (n_points - len(descriptions))
-    if seq.length_unit != "unknown" or source is None:
-        point["UNITS"]["value"] = [seq.length_unit]
-    point["RATE"]["value"] = np.array([seq.fps])
-    c3d["header"]["points"]["first_frame"] = take.first_frame - 1
-
-    missing = np.asarray(np.isnan(seq.positions).any(axis=2), dtype=bool)  # (F, M)
-    residuals = np.asarray(take.residuals, dtype=np.float64)
-    step = _residual_step(c3d, np.where(missing, 0.0, residuals))
-    # Whole steps of |POINT:SCALE|: a measured residual stays > 0, a filled one 0, missing −1.
-    steps = np.clip(np.round(residuals / step), 1, _MAX_RESIDUAL_STEPS)
-    written = np.where(residuals > 0, steps * step, 0.0)
-    written = np.where(missing, -1.0, written)
-    block = np.ones((4, n_points, n_frames))
-    block[:3] = np.where(missing[..., None], 0.0, seq.positions).transpose(2, 1, 0)
-    data = c3d["data"]
-    data["points"] = block
-    data["meta_points"]["residuals"] = written.T[None]
-    bits = np.left_shift(1, np.arange(7, dtype=np.intp))
-    masks = (np.asarray(take.camera_masks, dtype=np.intp).T[None] & bits[:, None, None]) != 0
-    data["meta_points"]["camera_masks"] = masks & ~missing.T[None]
-
+        c3d = _new_c3d(take.events)
+    _set_point_parameters(c3d, take, keep_unit=source is not None)
+    _set_point_data(c3d, take)
     with atomic_path(path) as temporary:
         # ezc3d adds ".c3d" to a name without it, so it writes beside the temporary file.
         named = temporary.with_name(temporary.name + ".c3d")
@@ -790,3 +737,80 @@ def write_c3d(path: str | Path, take: MarkerTake, source: str | Path | None = No
             os.replace(named, temporary)
         finally:
             named.unlink(missing_ok=True)
+
+
+def _source_c3d(source: Path, n_points: int, n_frames: int) -> Any:
+    """The ezc3d object of the C3D a take was read from, checked against the take."""
+    import ezc3d
+
+    layout = inspect_c3d(source)
+    if layout.header.processor == 86:
+        raise UnsupportedFormatError(
+            f"Expected a source C3D that ezc3d reads, got a MIPS file: {source.name}"
+        )
+    check_for_ezc3d(layout, source)
+    try:
+        c3d = ezc3d.c3d(str(source))
+    except Exception as e:  # as in read_c3d
+        raise UnsupportedFormatError(
+            f"Expected a source C3D that ezc3d reads, got {source.name} ({_reason(e)})"
+        ) from e
+    held = c3d["data"]["points"].shape
+    if held[1:] != (n_points, n_frames):
+        raise InputError(
+            f"Expected the take to have the source's {held[1]} points and {held[2]} frames, "
+            f"got {n_points} points and {n_frames} frames ({source.name})"
+        )
+    _trim_analog_labels(c3d["parameters"], c3d["data"]["analogs"].shape[1])
+    return c3d
+
+
+def _new_c3d(events: Sequence[C3DEvent]) -> Any:
+    """A new ezc3d object holding ``events``."""
+    import ezc3d
+
+    c3d = ezc3d.c3d()
+    for event in events:
+        minutes = math.floor(event.time_s / 60.0)
+        c3d.add_event(
+            [float(minutes), event.time_s - 60.0 * minutes],
+            context=event.context,
+            label=event.label,
+        )
+    return c3d
+
+
+def _set_point_parameters(c3d: Any, take: MarkerTake, *, keep_unit: bool) -> None:
+    """``POINT`` labels, descriptions, unit (kept from a source when the take's is unknown),
+    rate, and the header's first frame."""
+    seq = take.points
+    n_points = seq.n_keypoints
+    point = c3d["parameters"]["POINT"]
+    _set_in_255s(c3d, "LABELS", list(seq.names))
+    if n_points <= 255:  # ezc3d 1.7.2 writes no POINT:DESCRIPTIONS for more points
+        descriptions = list(take.descriptions[:n_points])
+        point["DESCRIPTIONS"]["value"] = descriptions + [""] * (n_points - len(descriptions))
+    if seq.length_unit != "unknown" or not keep_unit:
+        point["UNITS"]["value"] = [seq.length_unit]
+    point["RATE"]["value"] = np.array([seq.fps])
+    c3d["header"]["points"]["first_frame"] = take.first_frame - 1
+
+
+def _set_point_data(c3d: Any, take: MarkerTake) -> None:
+    """Positions, residuals (and ``POINT:SCALE``) and camera masks of the points."""
+    seq = take.points
+    missing = np.asarray(np.isnan(seq.positions).any(axis=2), dtype=bool)  # (F, M)
+    residuals = np.asarray(take.residuals, dtype=np.float64)
+    step = _residual_step(c3d, np.where(missing, 0.0, residuals))
+    # Whole steps of |POINT:SCALE|: a measured residual stays > 0, a filled one 0, missing −1.
+    steps = np.clip(np.round(residuals / step), 1, _MAX_RESIDUAL_STEPS)
+    written = np.where(residuals > 0, steps * step, 0.0)
+    written = np.where(missing, -1.0, written)
+    block = np.ones((4, seq.n_keypoints, seq.n_frames))
+    block[:3] = np.where(missing[..., None], 0.0, seq.positions).transpose(2, 1, 0)
+    data = c3d["data"]
+    data["points"] = block
+    data["meta_points"]["residuals"] = written.T[None]
+    bits = np.left_shift(1, np.arange(7, dtype=np.intp))
+    masks = (np.asarray(take.camera_masks, dtype=np.intp).T[None] & bits[:, None, None]) != 0
+    data["meta_points"]["camera_masks"] = masks & ~missing.T[None]

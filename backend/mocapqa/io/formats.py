@@ -373,10 +373,8 @@ def write_keypoints(path: str | Path, seq: KeypointSequence, format: str | None 
 
     Parameters
     ----------
-    path : str or Path
-        Destination file.
-    seq : KeypointSequence
-        The data.
+    path, seq : str or Path, KeypointSequence
+        The destination file, and the data.
     format : str, optional
         One of :data:`KEYPOINT_WRITE_FORMATS`; default from the extension.
 

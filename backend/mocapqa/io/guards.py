@@ -483,7 +483,7 @@ def read_c3d_header(path: str | Path) -> C3DHeader:
     Parameters
     ----------
     path : str or Path
-        The file.
+        The C3D file.
 
     Returns
     -------

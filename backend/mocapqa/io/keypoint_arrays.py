@@ -127,10 +127,8 @@ def parse_keypoint_npy(
 
     Parameters
     ----------
-    data : bytes
-        The file's content.
-    path : str or Path
-        The file name used in messages.
+    data, path : bytes, str or Path
+        The file's content, and its name in messages.
     fps : float
         Frames per second (required: the file does not store it).
     length_unit : str, optional
@@ -180,10 +178,8 @@ def parse_keypoint_npz(
 
     Parameters
     ----------
-    data : bytes
-        The file's content.
-    path : str or Path
-        The file name used in messages.
+    data, path : bytes, str or Path
+        The file's content, and its name in messages.
     fps : float, optional
         Frames per second; else the archive's ``fps``; else an error.
     length_unit : str, optional
@@ -264,10 +260,8 @@ def write_keypoint_npy(path: str | Path, seq: KeypointSequence) -> None:
 
     Parameters
     ----------
-    path : str or Path
-        Destination file.
-    seq : KeypointSequence
-        The data.
+    path, seq : str or Path, KeypointSequence
+        The destination file, and the data.
     """
     stacked = np.concatenate([seq.positions, seq.confidence[..., None]], axis=-1)
     with atomic_path(path) as temporary, temporary.open("wb") as handle:
@@ -279,10 +273,8 @@ def write_keypoint_npz(path: str | Path, seq: KeypointSequence) -> None:
 
     Parameters
     ----------
-    path : str or Path
-        Destination file.
-    seq : KeypointSequence
-        The data.
+    path, seq : str or Path, KeypointSequence
+        The destination file, and the data.
     """
     with atomic_path(path) as temporary, temporary.open("wb") as handle:
         np.savez(

@@ -29,6 +29,7 @@ import csv
 import io
 import json
 import math
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -37,7 +38,7 @@ import numpy as np
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import ParseError
 from mocapqa.io.atomic import atomic_path
-from mocapqa.io.guards import ReadLimits, check_take_size
+from mocapqa.io.guards import ReadLimits
 from mocapqa.io.keypoint_input import (
     build_keypoint_sequence,
     decode_text,
@@ -47,6 +48,7 @@ from mocapqa.io.keypoint_input import (
     resolve_length_unit,
     snap_fps,
 )
+from mocapqa.io.keypoint_rows import KeypointRow, dense_keypoints
 
 __all__ = [
     "KEYPOINT_CSV_COLUMNS",
@@ -62,7 +64,6 @@ __all__ = [
 # Columns of the long CSV format; time, z and confidence are optional on read.
 KEYPOINT_CSV_COLUMNS = ("frame", "time", "keypoint", "x", "y", "z", "confidence")
 _REQUIRED = ("frame", "keypoint", "x", "y")
-_MAX_FRAME_GAP_FACTOR = 4
 
 
 def _metadata(lines: list[str], path: str) -> tuple[dict[str, str], int]:
@@ -135,6 +136,90 @@ def _fps_from_time_column(times: dict[int, float], path: str, notes: list[str]) 
     return None if estimate is None else snap_fps(estimate, "the time column", notes)
 
 
+def _table(lines: list[str], start: int, path: str) -> tuple[list[list[str]], dict[str, int]]:
+    """The CSV cells below the metadata lines, and the header's column of each known name."""
+    try:
+        table = list(csv.reader(io.StringIO("\n".join(lines[start:]), newline="")))
+    except csv.Error as e:
+        raise ParseError(f"Expected CSV, got {e}", path) from e
+    if not table:
+        raise ParseError("Expected a header line, got an empty file", path, start + 1)
+    header = [c.strip().lower() for c in table[0]]
+    missing = [name for name in _REQUIRED if name not in header]
+    if missing or len(set(header)) != len(header):
+        raise ParseError(
+            f"Expected unique columns including {','.join(_REQUIRED)}, got {header[:8]}",
+            path,
+            start + 1,
+        )
+    return table, {name: header.index(name) for name in KEYPOINT_CSV_COLUMNS if name in header}
+
+
+@dataclass(slots=True)
+class _Rows:
+    """The data rows of a long keypoint CSV as read: names in order, times, row tuples."""
+
+    names: dict[str, int] = field(default_factory=dict)
+    times: dict[int, float] = field(default_factory=dict)
+    rows: list[KeypointRow] = field(default_factory=list)
+
+
+def _read_row(
+    cells: list[str], col: dict[str, int], axes: list[str], path: str, line: int, read: _Rows
+) -> None:
+    """Check one data row and add it to ``read``."""
+    frame = _frame_number(cells[col["frame"]], path, line)
+    name = cells[col["keypoint"]].strip()
+    if not name:
+        raise ParseError("Expected a keypoint name, got an empty cell", path, line, "keypoint")
+    xyz = [float_from_text(cells[col[a]], path, line, a) for a in axes]
+    if len(axes) == 2:
+        xyz.append(0.0 if not any(map(math.isnan, xyz)) else math.nan)
+    conf = 1.0
+    if "confidence" in col and cells[col["confidence"]].strip():
+        conf = float_from_text(cells[col["confidence"]], path, line, "confidence")
+        if not 0.0 <= conf <= 1.0:
+            raise ParseError(f"Expected confidence in [0, 1], got {conf}", path, line)
+    if "time" in col:
+        times = read.times
+        t = float_from_text(cells[col["time"]], path, line, "time")
+        if times.setdefault(frame, t) != t and not (math.isnan(t) and math.isnan(times[frame])):
+            raise ParseError(f"Expected one time per frame {frame}", path, line, "time")
+    read.rows.append((frame, read.names.setdefault(name, len(read.names)), xyz, conf, line))
+
+
+def _data_rows(
+    table: list[list[str]], col: dict[str, int], axes: list[str], path: str, start: int
+) -> _Rows:
+    """Every non-blank data row below the header (file line ``start + 1``)."""
+    read = _Rows()
+    width = len(table[0])
+    for line, cells in enumerate(table[1:], start=start + 2):
+        if not cells or not "".join(cells).strip():
+            continue
+        if len(cells) != width:
+            raise ParseError(f"Expected {width} cells, got {len(cells)}", path, line)
+        _read_row(cells, col, axes, path, line, read)
+    return read
+
+
+def _frame_rate(
+    fps: float | None,
+    meta: dict[str, str],
+    side: dict[str, Any],
+    times: dict[int, float],
+    path: str,
+    notes: list[str],
+) -> float:
+    """The caller's ``fps``, else the sidecar's, else the ``# fps`` line, else the times'."""
+    file_fps = float_from_text(meta["fps"], path, None, "fps") if "fps" in meta else None
+    if side.get("fps") is not None:
+        file_fps = float(side["fps"])
+    if fps is None and file_fps is None:
+        file_fps = _fps_from_time_column(times, path, notes)
+    return resolve_fps(fps, file_fps, None, path, "CSV", notes)
+
+
 def parse_keypoint_csv(
     data: bytes | str,
     path: str | Path = "<keypoints.csv>",
@@ -147,10 +232,8 @@ def parse_keypoint_csv(
 
     Parameters
     ----------
-    data : bytes or str
-        The file's content.
-    path : str or Path
-        The file name used in messages.
+    data, path : bytes or str, str or Path
+        The file's content, and its name in messages.
     fps : float, optional
         Frames per second; required when the file has neither ``time`` nor ``# fps``.
     length_unit : str, optional
@@ -179,80 +262,28 @@ def parse_keypoint_csv(
     path = str(path)
     lines = decode_text(data, path).splitlines()
     meta, start = _metadata(lines, path)
-    try:
-        table = list(csv.reader(io.StringIO("\n".join(lines[start:]), newline="")))
-    except csv.Error as e:
-        raise ParseError(f"Expected CSV, got {e}", path) from e
-    if not table:
-        raise ParseError("Expected a header line, got an empty file", path, start + 1)
-    header = [c.strip().lower() for c in table[0]]
-    missing = [name for name in _REQUIRED if name not in header]
-    if missing or len(set(header)) != len(header):
-        raise ParseError(
-            f"Expected unique columns including {','.join(_REQUIRED)}, got {header[:8]}",
-            path,
-            start + 1,
-        )
-    col = {name: header.index(name) for name in KEYPOINT_CSV_COLUMNS if name in header}
+    table, col = _table(lines, start, path)
     axes = [a for a in "xyz" if a in col]
-    names: dict[str, int] = {}
-    times: dict[int, float] = {}
-    rows: list[tuple[int, int, list[float], float, int]] = []
-    for offset, cells in enumerate(table[1:], start=start + 2):
-        if not cells or not "".join(cells).strip():
-            continue
-        if len(cells) != len(header):
-            raise ParseError(f"Expected {len(header)} cells, got {len(cells)}", path, offset)
-        frame = _frame_number(cells[col["frame"]], path, offset)
-        name = cells[col["keypoint"]].strip()
-        if not name:
-            raise ParseError(
-                "Expected a keypoint name, got an empty cell", path, offset, "keypoint"
-            )
-        xyz = [float_from_text(cells[col[a]], path, offset, a) for a in axes]
-        if len(axes) == 2:
-            xyz.append(0.0 if not any(map(math.isnan, xyz)) else math.nan)
-        conf = 1.0
-        if "confidence" in col and cells[col["confidence"]].strip():
-            conf = float_from_text(cells[col["confidence"]], path, offset, "confidence")
-            if not 0.0 <= conf <= 1.0:
-                raise ParseError(f"Expected confidence in [0, 1], got {conf}", path, offset)
-        if "time" in col:
-            t = float_from_text(cells[col["time"]], path, offset, "time")
-            if times.setdefault(frame, t) != t and not (math.isnan(t) and math.isnan(times[frame])):
-                raise ParseError(f"Expected one time per frame {frame}", path, offset, "time")
-        rows.append((frame, names.setdefault(name, len(names)), xyz, conf, offset))
-    if not rows:
+    read = _data_rows(table, col, axes, path, start)
+    if not read.rows:
         raise ParseError("Expected at least one data row, got none", path, len(lines))
-    first = min(r[0] for r in rows)
-    n_frames = max(r[0] for r in rows) - first + 1
-    if n_frames > _MAX_FRAME_GAP_FACTOR * len(rows):
-        raise ParseError(f"Expected contiguous frame numbers, got a span of {n_frames}", path)
-    if limits is not None:
-        check_take_size(n_frames, len(names), Path(path).name, limits)
-    positions = np.full((n_frames, len(names), 3), np.nan)
-    confidence = np.zeros((n_frames, len(names)))
-    seen = np.zeros((n_frames, len(names)), dtype=bool)
-    for frame, index, xyz, conf, line in rows:
-        if seen[frame - first, index]:
-            raise ParseError("Expected one row per frame and keypoint, got a repeat", path, line)
-        seen[frame - first, index] = True
-        positions[frame - first, index] = xyz
-        confidence[frame - first, index] = conf
+    dense = dense_keypoints(
+        read.rows,
+        len(read.names),
+        path,
+        limits,
+        lambda frame, point: "Expected one row per frame and keypoint, got a repeat",
+    )
     notes: list[str] = []
     side = sidecar or {}
-    file_fps = float_from_text(meta["fps"], path, None, "fps") if "fps" in meta else None
-    if side.get("fps") is not None:
-        file_fps = float(side["fps"])
-    if fps is None and file_fps is None:
-        file_fps = _fps_from_time_column(times, path, notes)
-    rate = resolve_fps(fps, file_fps, None, path, "CSV", notes)
+    rate = _frame_rate(fps, meta, side, read.times, path, notes)
     file_unit = side.get("length_unit") or meta.get("unit")
     unit = resolve_length_unit(length_unit or file_unit, "unknown", path, notes)
-    numbers = first + np.arange(n_frames)
+    numbers = dense.first + np.arange(dense.n_frames)
+    times = read.times
     column = np.array([times.get(int(f), math.nan) for f in numbers]) if times else None
     return build_keypoint_sequence(
-        path, tuple(names), positions, confidence, rate,
+        path, tuple(read.names), dense.positions, dense.confidence, rate,
         length_unit=unit, n_dims=len(axes), source_format="csv", assumptions=notes,
         frame_numbers=numbers, times=column,
     )  # fmt: skip
@@ -327,10 +358,8 @@ def write_keypoint_csv(path: str | Path, seq: KeypointSequence) -> None:
 
     Parameters
     ----------
-    path : str or Path
-        Destination file.
-    seq : KeypointSequence
-        The data.
+    path, seq : str or Path, KeypointSequence
+        The destination file, and the data.
     """
     path = Path(path)
     sidecar = csv_sidecar_path(path)

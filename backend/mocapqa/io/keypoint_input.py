@@ -118,10 +118,8 @@ def parse_json(data: bytes | str, path: str | Path) -> Any:
 
     Parameters
     ----------
-    data : bytes or str
-        The file's content.
-    path : str or Path
-        The file name used in messages.
+    data, path : bytes or str, str or Path
+        The file's content, and its name in messages.
 
     Returns
     -------
@@ -413,7 +411,7 @@ def build_keypoint_sequence(
     Returns
     -------
     KeypointSequence
-        The sequence.
+        The sequence, its coordinates checked.
 
     Raises
     ------

@@ -91,10 +91,8 @@ def parse_keypoint_json(
 
     Parameters
     ----------
-    data : bytes or str
-        The file's content.
-    path : str or Path
-        The file name used in messages.
+    data, path : bytes or str, str or Path
+        The file's content, and its name in messages.
     fps : float, optional
         Frames per second; else the file's ``fps``; else an error.
     length_unit : str, optional
@@ -200,9 +198,7 @@ def write_keypoint_json(path: str | Path, seq: KeypointSequence) -> None:
 
     Parameters
     ----------
-    path : str or Path
-        Destination file.
-    seq : KeypointSequence
-        The data.
+    path, seq : str or Path, KeypointSequence
+        The destination file, and the data.
     """
     write_text(path, format_keypoint_json(seq))

@@ -29,7 +29,7 @@ import numpy as np
 
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import ParseError
-from mocapqa.io.guards import ReadLimits, check_take_size
+from mocapqa.io.guards import ReadLimits
 from mocapqa.io.keypoint_input import (
     build_keypoint_sequence,
     decode_text,
@@ -40,6 +40,7 @@ from mocapqa.io.keypoint_input import (
     resolve_length_unit,
 )
 from mocapqa.io.keypoint_layouts import MEDIAPIPE_33_NAMES
+from mocapqa.io.keypoint_rows import KeypointRow, dense_keypoints
 
 __all__ = [
     "MEDIAPIPE_DEFAULT_FPS",
@@ -55,7 +56,6 @@ __all__ = [
 MEDIAPIPE_DEFAULT_FPS = 30.0
 _N = len(MEDIAPIPE_33_NAMES)
 _INDEX = {name: i for i, name in enumerate(MEDIAPIPE_33_NAMES)}
-_MAX_FRAME_GAP_FACTOR = 4
 
 
 def _landmark_index(text: str, path: str, line: int) -> int:
@@ -76,6 +76,35 @@ def _frame_number(text: str, path: str, line: int) -> int:
     return int(value)
 
 
+def _landmark_rows(lines: list[str], path: str) -> list[KeypointRow]:
+    """The landmark rows of a long MediaPipe CSV below its header line.
+
+    A row's line, named when its (frame, landmark) repeats, is its place among the rows + 1.
+    """
+    header = [c.strip().lower() for c in lines[0].split(",")] if lines else []
+    required = ["frame_number", "landmark", "x", "y", "z"]
+    if any(name not in header for name in required):
+        raise ParseError(f"Expected header with {','.join(required)}, got {header[:8]}", path, 1)
+    cols = [header.index(name) for name in required]
+    vis_col = header.index("visibility") if "visibility" in header else None
+    rows: list[KeypointRow] = []
+    for number, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        cells = line.split(",")
+        if len(cells) != len(header):
+            raise ParseError(f"Expected {len(header)} cells, got {len(cells)}", path, number)
+        frame = _frame_number(cells[cols[0]], path, number)
+        landmark = _landmark_index(cells[cols[1]], path, number)
+        xyz = [
+            float_from_text(cells[c], path, number, n)
+            for c, n in zip(cols[2:], "xyz", strict=False)
+        ]
+        vis = 1.0 if vis_col is None else float_from_text(cells[vis_col], path, number)
+        rows.append((frame, landmark, xyz, 0.0 if math.isnan(vis) else vis, len(rows) + 2))
+    return rows
+
+
 def parse_mediapipe_csv(
     data: bytes | str,
     path: str | Path = "<mediapipe.csv>",
@@ -87,10 +116,8 @@ def parse_mediapipe_csv(
 
     Parameters
     ----------
-    data : bytes or str
-        The file's content.
-    path : str or Path
-        The file name used in messages.
+    data, path : bytes or str, str or Path
+        The file's content, and its name in messages.
     fps : float, optional
         Frames per second (not stored in the file); default 30, recorded.
     length_unit : str, optional
@@ -113,54 +140,24 @@ def parse_mediapipe_csv(
     """
     path = str(path)
     lines = decode_text(data, path).splitlines()
-    header = [c.strip().lower() for c in lines[0].split(",")] if lines else []
-    required = ["frame_number", "landmark", "x", "y", "z"]
-    if any(name not in header for name in required):
-        raise ParseError(f"Expected header with {','.join(required)}, got {header[:8]}", path, 1)
-    cols = [header.index(name) for name in required]
-    vis_col = header.index("visibility") if "visibility" in header else None
-    rows: list[tuple[int, int, list[float], float]] = []
-    for number, line in enumerate(lines[1:], start=2):
-        if not line.strip():
-            continue
-        cells = line.split(",")
-        if len(cells) != len(header):
-            raise ParseError(f"Expected {len(header)} cells, got {len(cells)}", path, number)
-        frame = _frame_number(cells[cols[0]], path, number)
-        landmark = _landmark_index(cells[cols[1]], path, number)
-        xyz = [
-            float_from_text(cells[c], path, number, n)
-            for c, n in zip(cols[2:], "xyz", strict=False)
-        ]
-        vis = 1.0 if vis_col is None else float_from_text(cells[vis_col], path, number)
-        rows.append((frame, landmark, xyz, vis))
+    rows = _landmark_rows(lines, path)
     if not rows:
         raise ParseError("Expected at least one landmark row, got none", path, len(lines))
-    first = min(r[0] for r in rows)
-    n_frames = max(r[0] for r in rows) - first + 1
-    if n_frames > _MAX_FRAME_GAP_FACTOR * len(rows):
-        raise ParseError(f"Expected contiguous frame numbers, got a span of {n_frames}", path)
-    if limits is not None:
-        check_take_size(n_frames, _N, Path(path).name, limits)
-    positions = np.full((n_frames, _N, 3), np.nan)
-    confidence = np.zeros((n_frames, _N))
-    seen = np.zeros((n_frames, _N), dtype=bool)
-    for number, (frame, landmark, xyz, vis) in enumerate(rows, start=2):
-        if seen[frame - first, landmark]:
-            raise ParseError(
-                f"Expected one row per frame and landmark, got a repeated "
-                f"{MEDIAPIPE_33_NAMES[landmark]} in frame {frame}",
-                path,
-                number,
-            )
-        seen[frame - first, landmark] = True
-        positions[frame - first, landmark] = xyz
-        confidence[frame - first, landmark] = 0.0 if math.isnan(vis) else vis
+    dense = dense_keypoints(
+        rows,
+        _N,
+        path,
+        limits,
+        lambda frame, landmark: (
+            f"Expected one row per frame and landmark, got a repeated "
+            f"{MEDIAPIPE_33_NAMES[landmark]} in frame {frame}"
+        ),
+    )
     notes: list[str] = []
     unit = resolve_length_unit(length_unit, "m", path, notes)
     rate = resolve_fps(fps, None, MEDIAPIPE_DEFAULT_FPS, path, "MediaPipe CSV", notes)
     return build_keypoint_sequence(
-        path, MEDIAPIPE_33_NAMES, positions, confidence, rate,
+        path, MEDIAPIPE_33_NAMES, dense.positions, dense.confidence, rate,
         length_unit=unit, n_dims=3, source_format="mediapipe-csv", assumptions=notes,
     )  # fmt: skip
 
@@ -216,10 +213,8 @@ def parse_mediapipe_json(
 
     Parameters
     ----------
-    data : bytes or str
-        The file's content.
-    path : str or Path
-        The file name used in messages.
+    data, path : bytes or str, str or Path
+        The file's content, and its name in messages.
     fps : float, optional
         Frames per second; else the file's ``fps``; else 30, recorded.
     length_unit : str, optional
@@ -334,10 +329,8 @@ def parse_mediapipe_pbtxt(
 
     Parameters
     ----------
-    data : bytes or str
-        The file's content.
-    path : str or Path
-        The file name used in messages.
+    data, path : bytes or str, str or Path
+        The file's content, and its name in messages.
     fps : float, optional
         Frames per second for the one frame; default 30, recorded.
 

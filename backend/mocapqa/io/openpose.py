@@ -125,10 +125,8 @@ def parse_openpose_frame(
 
     Parameters
     ----------
-    data : bytes or str
-        The file's content.
-    path : str or Path
-        The file name used in messages.
+    data, path : bytes or str, str or Path
+        The file's content, and its name in messages.
     person_index : int
         Which entry of ``people`` to return.
 

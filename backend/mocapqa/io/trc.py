@@ -119,10 +119,8 @@ def parse_trc(data: bytes | str, path: str | Path = "<trc>") -> KeypointSequence
 
     Parameters
     ----------
-    data : bytes or str
-        The file's content.
-    path : str or Path
-        The file name used in messages.
+    data, path : bytes or str, str or Path
+        The file's content, and its name in messages.
 
     Returns
     -------

@@ -196,13 +196,7 @@ def charted(
     """
     check_rig(model, motion.skeleton, mapping)
     if model.frame != "canonical":
-        index = [motion.skeleton.index(j.name) for j in model.joints]
-        axes = np.stack([j.axis for j in model.joints])
-        references = np.stack([j.reference for j in model.joints])
-        params = limit_params_from_quats(motion.quats[:, index], axes, references)
-        modelled = {j.name for j in model.joints}
-        rest = tuple(n for n in motion.skeleton.names if n not in modelled)
-        return params, list(range(len(model.joints))), rest, tuple(j.name for j in model.joints)
+        return _charted_by_name(motion, model)
     try:
         if mapping:
             frames = take_frames(motion, rig=find_roles(motion.skeleton, mapping), ignore=ignore)
@@ -213,16 +207,7 @@ def charted(
     column = {role: k for k, role in enumerate(frames.roles)}
     columns = [k for k, j in enumerate(model.joints) if j.role in column]
     picked = [column[model.joints[k].role] for k in columns]
-    references = np.stack([model.joints[k].reference for k in columns])
-    by_role = {j.role: j for j in model.joints}
-    for c, k in enumerate(columns):
-        # A missing parent role (an upper arm's clavicle) stands at the model's mean pose of
-        # that role relative to the body: conj(A_body ⊗ ref_parent) ⊗ A_child.
-        role = model.joints[k].role
-        side, _, own = role.partition("_")
-        stand_in = by_role.get(f"{side}_{STAND_IN_PARENTS.get(own, '')}")
-        if role in frames.stand_ins and stand_in is not None:
-            references[c] = multiply(stand_in.reference, references[c])
+    references = _references(model, columns, frames.stand_ins)
     # conj(reference) ⊗ conj(A_parent) ⊗ A_child = conj(A_parent ⊗ reference) ⊗ A_child: the
     # reference joins the parent's constant frame, saving one product per frame.
     charted_frames = replace(
@@ -239,6 +224,35 @@ def charted(
     missing = [j.role for j in model.joints if j.role not in column]
     names = tuple(motion.skeleton.names[int(frames.joints[c])] for c in picked)
     return params, columns, tuple(unused + missing), names
+
+
+def _charted_by_name(
+    motion: Motion, model: LimitsModel
+) -> tuple[FloatArray, list[int], tuple[str, ...], tuple[str, ...]]:
+    """:func:`charted` with a per-rig model, whose joints are matched by name."""
+    index = [motion.skeleton.index(j.name) for j in model.joints]
+    axes = np.stack([j.axis for j in model.joints])
+    references = np.stack([j.reference for j in model.joints])
+    params = limit_params_from_quats(motion.quats[:, index], axes, references)
+    modelled = {j.name for j in model.joints}
+    rest = tuple(n for n in motion.skeleton.names if n not in modelled)
+    return params, list(range(len(model.joints))), rest, tuple(j.name for j in model.joints)
+
+
+def _references(model: LimitsModel, columns: list[int], stand_ins: tuple[str, ...]) -> FloatArray:
+    """The reference rotation of each of the model's joints ``columns``, shape (K, 4): a role
+    in ``stand_ins``, whose parent role (an upper arm's clavicle) is missing, has it stand at
+    the model's mean pose of that role relative to the body: conj(A_body ⊗ ref_parent) ⊗
+    A_child."""
+    references = np.stack([model.joints[k].reference for k in columns])
+    by_role = {j.role: j for j in model.joints}
+    for c, k in enumerate(columns):
+        role = model.joints[k].role
+        side, _, own = role.partition("_")
+        stand_in = by_role.get(f"{side}_{STAND_IN_PARENTS.get(own, '')}")
+        if role in stand_ins and stand_in is not None:
+            references[c] = multiply(stand_in.reference, references[c])
+    return references
 
 
 def _known_frames(motion: Motion, model: LimitsModel) -> CanonicalFrames | None:

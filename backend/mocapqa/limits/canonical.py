@@ -46,15 +46,14 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.motion import Motion, Skeleton
 from mocapqa.core.rig import SIDES, RigMap, Side, find_roles, mapped_roles, role_key
 from mocapqa.errors import InputError
 from mocapqa.kinematics.forward import forward_kinematics
-from mocapqa.kinematics.quaternion import conjugate, rotate
 from mocapqa.limits.rig import MODELLED_ROLES, axis_label
+from mocapqa.limits.segment_frames import PARENT_ROLE, SegmentFraming, body_axes
 
 __all__ = [
     "CANONICAL_AXIS",
@@ -73,15 +72,7 @@ __all__ = [
 
 # The long axis of every canonical frame.
 CANONICAL_AXIS = np.array([0.0, 1.0, 0.0])
-_FLEXION_AXIS = np.array([1.0, 0.0, 0.0])
 
-_PARENT_ROLE = {
-    "upper_arm": "clavicle",
-    "forearm": "upper_arm",
-    "hand": "forearm",
-    "lower_leg": "upper_leg",
-    "foot": "lower_leg",
-}
 # Roles whose limb plane gives a proximal segment's flexion axis.
 _PLANE_ROLE = {"upper_arm": "forearm", "upper_leg": "lower_leg"}
 
@@ -111,23 +102,13 @@ def frame_needs(role: str) -> tuple[str, ...]:
     :data:`STAND_IN_PARENTS`) and, for an upper arm or upper leg, the next segment that gives
     its flexion axis. Without them the role is not checked (a hand read against the body, not
     the forearm, reads as 100° out)."""
-    parent = _PARENT_ROLE.get(role)
+    parent = PARENT_ROLE.get(role)
     if STAND_IN_PARENTS.get(role) == parent:
         parent = None
     return tuple(r for r in (parent, _PLANE_ROLE.get(role)) if r is not None)
 
 
-_DISTAL_ROLE = {
-    "clavicle": "upper_arm",
-    "upper_arm": "forearm",
-    "forearm": "hand",
-    "upper_leg": "lower_leg",
-    "lower_leg": "foot",
-    "foot": "toe",
-}
-_MIN_BEND_SIN2 = float(np.sin(np.deg2rad(10.0)) ** 2)
 _MEDIAN_FRAMES = 4000
-_ARM_ROLES = ("clavicle", "upper_arm", "forearm", "hand")
 
 
 def pose_sample(n_frames: int) -> np.ndarray | None:
@@ -140,7 +121,7 @@ def pose_sample(n_frames: int) -> np.ndarray | None:
 
 def role_parent(role: str) -> str | None:
     """The role whose anatomical frame a role's rotation is taken relative to (None: body)."""
-    return _PARENT_ROLE.get(role)
+    return PARENT_ROLE.get(role)
 
 
 @dataclass(frozen=True, slots=True)
@@ -178,103 +159,26 @@ class CanonicalFrames:
     stand_ins: tuple[str, ...] = ()
 
 
-def _unit(v: FloatArray) -> FloatArray:
-    n = np.linalg.norm(v, axis=-1, keepdims=True)
-    return np.asarray(v / np.where(n > 1e-12, n, 1.0), dtype=np.float64)
+def _framed_roles(skeleton: Skeleton, rig: RigMap) -> dict[tuple[Side, str], int]:
+    """Each modelled role joint by (side, role) whose frame can be measured (the roles
+    :func:`frame_needs` are present), the index kept with the key.
 
-
-def _local(world_quats: FloatArray, vectors: FloatArray) -> FloatArray:
-    """World vectors ``(F, 3)`` in a joint's frame (``R^T v``), shape (F, 3)."""
-    return rotate(conjugate(world_quats), vectors)
-
-
-def _parallel(x: FloatArray, y: FloatArray) -> bool:
-    """Whether two directions are (nearly) parallel, or one has no length: no frame has them
-    as its ``x`` and ``y``."""
-    return bool(np.linalg.norm(np.cross(_unit(x), _unit(y))) < 1e-6)
-
-
-def _frame_quat(x: FloatArray, y: FloatArray) -> FloatArray:
-    """Quaternion of the frame with columns ``(x⊥, y, x⊥ × y)``, ``y`` taken exactly."""
-    y = _unit(y)
-    x = _unit(x - np.dot(x, y) * y)
-    matrix = np.stack((x, y, np.cross(x, y)), axis=1)
-    return np.asarray(Rotation.from_matrix(matrix).as_quat(), dtype=np.float64)
-
-
-def _median_direction(
-    vectors: FloatArray, axis: FloatArray, sign_ref: FloatArray, ignore: BoolArray | None = None
-) -> tuple[FloatArray, float]:
-    """Robust direction of ``vectors`` ``(F, 3)`` around ``axis``, and their mean squared norm.
-
-    The weighted circular median (weights = squared norms, so straight limbs weigh nothing)
-    of the vectors' azimuths about ``axis``, on a 1° grid: up to half the frames may point
-    anywhere (a burst of twist errors) without moving it. Frames flagged in ``ignore`` (F,)
-    weigh nothing, unless that leaves no weight at all. Signed like ``sign_ref``.
+    Raises
+    ------
+    InputError
+        If there is none.
     """
-    e1 = _unit(sign_ref - np.dot(sign_ref, axis) * axis)
-    if np.linalg.norm(e1) < 0.5:
-        e1 = _unit(np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0]))
-    e2 = np.cross(axis, e1)
-    weights = np.sum(vectors * vectors, axis=-1)
-    if ignore is not None and (weights * ~ignore).sum() > 0:
-        weights = weights * ~ignore
-    azimuth = np.arctan2(vectors @ e2, vectors @ e1)
-    best = 0.0
-    # Coarse to fine: 10° steps round the circle, then 1° steps around the best.
-    for grid in (np.deg2rad(np.arange(-180.0, 180.0, 10.0)), np.deg2rad(np.arange(-10.0, 11.0))):
-        candidates = best + grid
-        cost = np.abs((azimuth[None, :] - candidates[:, None] + np.pi) % (2 * np.pi) - np.pi)
-        best = float(candidates[int(np.argmin(cost @ weights))])
-    direction = np.cos(best) * e1 + np.sin(best) * e2
-    if np.dot(direction, sign_ref) < 0:
-        direction = -direction
-    return np.asarray(direction, dtype=np.float64), float(np.mean(weights))
-
-
-def _end_axis(skeleton: Skeleton, joint: int) -> FloatArray | None:
-    """Long axis of a segment without a next role joint (a foot without a toe): toward the
-    mean of its children and End Sites; None when they all sit at zero offset.
-
-    A sum, not the longest child, so two children of equal length cannot swap places.
-    """
-    offsets = [skeleton.offsets[c] for c in skeleton.children(joint)]
-    offsets += [np.asarray(o, dtype=np.float64) for o in skeleton.end_site_offsets(joint)]
-    total = np.sum(offsets, axis=0) if offsets else np.zeros(3)
-    if np.linalg.norm(total) > 1e-4:
-        return _unit(np.asarray(total, dtype=np.float64))
-    return None
-
-
-def _body_axes(rig: RigMap, positions: FloatArray, arms: bool) -> tuple[FloatArray, FloatArray]:
-    """Per-frame body left and up axes ``(F, 3)`` from the hips and shoulders."""
-    pairs = (
-        [("upper_arm", "clavicle"), ("upper_leg",)]
-        if arms
-        else [("upper_leg",), ("upper_arm", "clavicle")]
-    )
-    left = None
-    for group in pairs:
-        for role in group:
-            jl, jr = rig.joint("left", role), rig.joint("right", role)
-            if jl is not None and jr is not None:
-                left = positions[:, jl] - positions[:, jr]
-                break
-        if left is not None:
-            break
-    mids = []
-    for group in (("upper_leg",), ("upper_arm", "clavicle")):
-        for role in group:
-            jl, jr = rig.joint("left", role), rig.joint("right", role)
-            if jl is not None and jr is not None:
-                mids.append(0.5 * (positions[:, jl] + positions[:, jr]))
-                break
-    if left is None or len(mids) != 2:
+    keys: dict[tuple[Side, str], int] = {}
+    for s in SIDES:
+        for r in MODELLED_ROLES:
+            j = rig.joint(s, r)
+            if j is not None and all(rig.joint(s, n) is not None for n in frame_needs(r)):
+                keys[(s, r)] = j
+    if not keys:
         raise InputError(
-            "Expected both hips and both shoulders (or clavicles) among the roles to find the "
-            f"body's axes, got roles {sorted(rig.roles)}"
+            f"Expected a skeleton with limb roles, got none among {skeleton.names[:8]}"
         )
-    return _unit(left), _unit(mids[1] - mids[0])
+    return keys
 
 
 def canonical_frames(
@@ -312,18 +216,7 @@ def canonical_frames(
     """
     skeleton = motion if isinstance(motion, Skeleton) else motion.skeleton
     rig = find_roles(skeleton) if rig is None else rig
-    # Each modelled role joint by (side, role), with the roles its frame needs: the index is
-    # kept with the key, so no later look-up can come back empty.
-    keys: dict[tuple[Side, str], int] = {}
-    for s in SIDES:
-        for r in MODELLED_ROLES:
-            j = rig.joint(s, r)
-            if j is not None and all(rig.joint(s, n) is not None for n in frame_needs(r)):
-                keys[(s, r)] = j
-    if not keys:
-        raise InputError(
-            f"Expected a skeleton with limb roles, got none among {skeleton.names[:8]}"
-        )
+    keys = _framed_roles(skeleton, rig)
     if world is None:
         if isinstance(motion, Skeleton):
             raise InputError("Expected a take's world poses with a skeleton alone, got none")
@@ -333,120 +226,20 @@ def canonical_frames(
     if keep is not None:
         quats, positions = quats[keep], positions[keep]
         ignore = None if ignore is None else ignore[keep]
-    body = {arms: _body_axes(rig, positions, arms) for arms in (True, False)}
+    body = {arms: body_axes(rig, positions, arms) for arms in (True, False)}
+    framing = SegmentFraming(skeleton, rig, quats, positions, ignore, body)
     roles, joints, parents, frames, parent_frames = [], [], [], [], []
-    cache: dict[int, FloatArray] = {}
-    long_axes: dict[int, FloatArray] = {}
-
-    def mean_direction(joint: int, vectors: FloatArray) -> FloatArray | None:
-        """The mean direction of world vectors ``(F, 3)`` seen from the joint's frame; None
-        when they are all (nearly) zero, a bone of no length."""
-        if np.median(np.linalg.norm(vectors, axis=-1)) < 1e-6:
-            return None
-        mean = np.mean(_unit(_local(quats[:, joint], vectors)), axis=0)
-        return _unit(mean) if np.linalg.norm(mean) > 1e-6 else None
-
-    def long_axis(side: str, role: str, joint: int) -> FloatArray:
-        distal = rig.joint(side, _DISTAL_ROLE[role]) if role in _DISTAL_ROLE else None  # type: ignore[arg-type]
-        if distal is not None:
-            axis = mean_direction(joint, positions[:, distal] - positions[:, joint])
-        elif role == "hand":
-            # A hand continues its forearm's bone (from the forearm joint, so that a helper
-            # bone of no length between them does not matter), seen from its own frame, on
-            # average over the frames: CMU and Bandai hands have no knuckle offsets, and
-            # pointing the others at theirs read the Character Creator wrist 10-14 degrees
-            # flexed against those rigs. The knuckles only stand in for a hand at its forearm.
-            forearm = rig.joint(side, "forearm")  # type: ignore[arg-type]
-            anchor = int(skeleton.parents[joint]) if forearm is None else forearm
-            axis = mean_direction(joint, positions[:, joint] - positions[:, anchor])
-            if axis is None:
-                axis = _end_axis(skeleton, joint)
-        else:
-            # A foot without a toe points to its End Site, or else continues its parent's bone.
-            axis = _end_axis(skeleton, joint)
-            if axis is None:
-                parent = int(skeleton.parents[joint])
-                axis = mean_direction(joint, positions[:, joint] - positions[:, parent])
-        if axis is None:
-            raise InputError(
-                f"Expected the {side} {role.replace('_', ' ')} ({skeleton.names[joint]!r}) to "
-                f"have a bone of non-zero length toward the next joint of its limb; its long "
-                f"axis cannot be found (check the role mapping)"
-            )
-        return axis
-
-    def world_long(side: str, role: str, joint: int) -> FloatArray:
-        if joint not in long_axes:
-            long_axes[joint] = long_axis(side, role, joint)
-        return rotate(quats[:, joint], np.broadcast_to(long_axes[joint], (quats.shape[0], 3)))
-
-    def frame_of(side: str, role: str, joint: int) -> FloatArray:
-        if joint in cache:
-            return cache[joint]
-        left_w, up_w = body[role in _ARM_ROLES]
-        along = world_long(side, role, joint)
-        if role == "clavicle":
-            partner = up_w
-            sign_w = np.cross(left_w, up_w)
-        elif role in ("upper_arm", "upper_leg"):
-            child = rig.joint(side, _DISTAL_ROLE[role])  # type: ignore[arg-type]
-            partner = world_long(side, _DISTAL_ROLE[role], child) if child is not None else left_w
-            sign_w = left_w
-        else:
-            parent_role = _PARENT_ROLE[role]
-            parent = rig.joint(side, parent_role)  # type: ignore[arg-type]
-            partner = world_long(side, parent_role, parent) if parent is not None else left_w
-            sign_w = left_w
-        forearm = rig.joint(side, "forearm") if role == "hand" else None  # type: ignore[arg-type]
-        skip = None if ignore is None else ignore[:, joint]
-        if skip is not None and forearm is not None:
-            skip = skip | ignore[:, forearm]  # type: ignore[index]
-        kept = slice(None) if skip is None or skip.all() else ~skip
-        sign_ref = np.mean(_local(quats[kept, joint], sign_w[kept]), axis=0)
-        if forearm is not None:
-            # The wrist hardly bends, so its bend plane is a weak, rig-dependent signal: the
-            # hand takes the forearm's flexion axis, as seen from its own frame.
-            forearm_x = rotate(frame_of(side, "forearm", forearm), _FLEXION_AXIS)
-            normals = _local(quats[:, joint], rotate(quats[:, forearm], forearm_x[None]))
-        else:
-            normals = _local(quats[:, joint], np.cross(along, partner))
-        flexion, bend = _median_direction(normals, long_axes[joint], sign_ref, skip)
-        if bend < _MIN_BEND_SIN2 or _parallel(flexion, long_axes[joint]):
-            flexion = sign_ref
-        if _parallel(flexion, long_axes[joint]):
-            # A segment along the body's left-right axis on average (a mapping that names an
-            # arm joint for a leg role): no flexion axis can be found for it.
-            raise InputError(
-                f"Expected the {side} {role.replace('_', ' ')} ({skeleton.names[joint]!r}) to "
-                "run across the body's left-right axis, got a segment along it; its flexion "
-                "axis cannot be found (check the role mapping)"
-            )
-        cache[joint] = _frame_quat(flexion, long_axes[joint])
-        return cache[joint]
-
     for (side, role), joint in keys.items():
-        frames.append(frame_of(side, role, joint))
-        parent_role = _PARENT_ROLE.get(role)
-        parent = rig.joint(side, parent_role) if parent_role else None  # type: ignore[arg-type]
+        frames.append(framing.frame_of(side, role, joint))
+        parent_role = PARENT_ROLE.get(role)
+        parent = rig.joint(side, parent_role) if parent_role else None
         if parent is not None and parent_role is not None:
-            parent_frames.append(frame_of(side, parent_role, parent))
+            parent_frames.append(framing.frame_of(side, parent_role, parent))
         else:
             parent = int(skeleton.parents[joint])
             if parent < 0:
                 raise InputError(f"Expected role joint {skeleton.names[joint]!r} to have a parent")
-            left_w, up_w = body[role in _ARM_ROLES]
-            left_l = np.mean(_local(quats[:, parent], left_w), axis=0)
-            up_l = np.mean(_local(quats[:, parent], up_w), axis=0)
-            if _parallel(left_l, up_l):
-                # Hips or shoulders stacked along the up axis (a mapping that names an arm
-                # joint for a leg role): no body frame.
-                raise InputError(
-                    "Expected the body's left-right axis (hips, shoulders) across its up axis "
-                    f"(hips to shoulders), got the two along each other, framing "
-                    f"{skeleton.names[joint]!r} (check the role mapping)"
-                )
-            # Legs hang: their body frame's long axis points down, so standing is near identity.
-            parent_frames.append(_frame_quat(left_l, up_l if role in _ARM_ROLES else -up_l))
+            parent_frames.append(framing.body_frame(role, joint, parent))
         roles.append(role_key(side, role))
         joints.append(joint)
         parents.append(parent)

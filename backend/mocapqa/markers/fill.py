@@ -20,11 +20,10 @@ from typing import Literal
 
 import numpy as np
 
-from mocapqa.core.arrays import BoolArray, FloatArray, check_shape
+from mocapqa.core.arrays import BoolArray, FloatArray, check_shape, column_runs
 from mocapqa.errors import OptionError, ShapeError
 from mocapqa.markers.fill_params import FillParams
 from mocapqa.markers.fill_plan import FillContext, GapPlan, plan_gap
-from mocapqa.markers.take import column_runs
 
 __all__ = [
     "FillContext",

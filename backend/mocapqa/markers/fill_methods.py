@@ -48,18 +48,12 @@ def spline_fill(
 
     Parameters
     ----------
-    positions : ndarray, shape (F, M, 3)
-        Marker positions in file units, NaN where missing.
-    visible : ndarray of bool, shape (F, M)
-        Where ``positions`` holds a sample.
-    m, a, b : int
-        Marker index and first and last missing frame (inclusive).
+    positions, visible, m, a, b, before, after
+        The take and the gap, as in the module's conventions.
     window : int
         Frames either side of the gap whose visible samples the spline passes through.
     max_length : int
         Longest gap (frames) the spline may fill.
-    before, after : bool
-        Whether samples before ``a`` / after ``b`` may be used.
 
     Returns
     -------
@@ -202,19 +196,13 @@ def rigid_fill(
 
     Parameters
     ----------
-    positions : ndarray, shape (F, M, 3)
-        Marker positions in file units, NaN where missing.
-    visible : ndarray of bool, shape (F, M)
-        Where ``positions`` holds a sample.
-    m, a, b : int
-        Marker index and first and last missing frame (inclusive).
+    positions, visible, m, a, b, before, after
+        The take and the gap, as in the module's conventions.
     donors : ndarray of int, shape (K,)
         Donor marker indices (K >= 3), visible over ``a - 1 .. b + 1`` where those frames are
         used.
     window : int
         Frames either side of the gap used to fit the target's local position.
-    before, after : bool
-        Whether samples before ``a`` / after ``b`` may be used.
 
     Returns
     -------

@@ -58,10 +58,8 @@ def pca_model(
 
     Parameters
     ----------
-    positions : ndarray, shape (F, M, 3)
-        Marker positions in file units, NaN where missing.
-    visible : ndarray of bool, shape (F, M)
-        Where ``positions`` holds a sample.
+    positions, visible
+        The take, as in :mod:`mocapqa.markers.fill_methods`.
     m : int
         Target marker.
     model : ndarray of int, shape (K,)
@@ -135,12 +133,8 @@ def pca_fill(
 
     Parameters
     ----------
-    positions : ndarray, shape (F, M, 3)
-        Marker positions in file units, NaN where missing.
-    visible : ndarray of bool, shape (F, M)
-        Where ``positions`` holds a sample.
-    m, a, b : int
-        Marker index and first and last missing frame (inclusive).
+    positions, visible, m, a, b, before, after
+        The take and the gap, as in :mod:`mocapqa.markers.fill_methods`.
     model : ndarray of int, shape (K,)
         The other markers of the model, visible over ``a..b``.
     weight_scale : float
@@ -158,8 +152,6 @@ def pca_fill(
     fitted : PcaModel, optional
         A training matrix of the same target and model built by :func:`pca_model` (its
         training frames inside ``a..b`` and ``hidden`` are taken out); built here when omitted.
-    before, after : bool
-        Whether samples before ``a`` / after ``b`` may be used.
 
     Returns
     -------
@@ -167,12 +159,8 @@ def pca_fill(
         None without model markers, with fewer training frames than coordinates, or when a
         model marker is missing in the gap.
     """
-    n = positions.shape[0]
-    times, _, _ = frames_around(n, a, b, window, before, after)
-    if model.size == 0:
-        return None
-    times = times[visible[times[:, None], model].all(axis=1)]
-    if np.count_nonzero((times >= a) & (times <= b)) < b - a + 1:
+    times = _usable_times(visible, a, b, model, window, before, after)
+    if times is None:
         return None
     if fitted is None:
         fitted = pca_model(
@@ -181,13 +169,57 @@ def pca_fill(
         )  # fmt: skip
         if fitted is None:
             return None
+    p = fitted.cols.size * 3
+    y = positions[times[:, None], fitted.cols[1:]].reshape(times.size, p - 3)
+    predicted = _conditional_target(fitted, _gram_without(fitted, {(a, b), hidden or (a, b)}),
+                                    y, variance)  # fmt: skip
+    recorded = recorded_around(positions, visible, m, times, a, b)
+    return anchor(predicted, times, recorded, a, b, smooth=smooth)
+
+
+def _usable_times(
+    visible: BoolArray,
+    a: int,
+    b: int,
+    model: IntArray,
+    window: int,
+    before: bool,
+    after: bool,
+) -> IntArray | None:
+    """The frames around and in the gap where every model marker is visible; None without
+    model markers or when one is missing in the gap."""
+    times, _, _ = frames_around(visible.shape[0], a, b, window, before, after)
+    if model.size == 0:
+        return None
+    times = times[visible[times[:, None], model].all(axis=1)]
+    if np.count_nonzero((times >= a) & (times <= b)) < b - a + 1:
+        return None
+    usable: IntArray = times
+    return usable
+
+
+def _gram_without(fitted: PcaModel, stretches: set[tuple[int, int]]) -> FloatArray:
+    """``fitted.gram`` less the training frames inside each (first, last) stretch."""
     gram = fitted.gram
-    for lo, hi in {(a, b), hidden or (a, b)}:
+    for lo, hi in stretches:
         rows = fitted.z[
             np.searchsorted(fitted.train, lo) : np.searchsorted(fitted.train, hi, "right")
         ]
         if rows.size:
             gram = gram - rows.T @ rows
+    return gram
+
+
+def _conditional_target(
+    fitted: PcaModel, gram: FloatArray, y: FloatArray, variance: float
+) -> FloatArray:
+    """The target's coordinates ``(T, 3)`` given the model markers' ``y`` ``(T, 3 K)``.
+
+    The conditional mean under the probabilistic PCA model (the components that explain
+    ``variance`` of ``gram``, plus isotropic noise at the discarded components' mean variance):
+    a least-squares fit of the scores that shrinks the weak components instead of trusting
+    them fully.
+    """
     p = fitted.cols.size * 3
     eigval, eigvec = np.linalg.eigh(gram)
     eigval, eigvec = np.maximum(eigval[::-1], 0.0), eigvec[:, ::-1]
@@ -195,15 +227,9 @@ def pca_fill(
     k = min(int(np.searchsorted(share, variance)) + 1, p - 3)
     v = eigvec[:, :k]
     mean, sd, weight = fitted.mean, fitted.sd, fitted.weight
-    y = positions[times[:, None], fitted.cols[1:]].reshape(times.size, p - 3)
     zo = (y - mean[3:]) / sd[3:] * weight[3:]
-    # Conditional mean of the target given the visible coordinates under the probabilistic PCA
-    # model (kept components plus isotropic noise at the discarded components' mean variance):
-    # a least-squares fit of the scores that shrinks the weak components instead of trusting
-    # them fully.
     noise = max(float(eigval[k:].mean()) if k < p else 0.0, 1e-9 * float(eigval[0]))
     cov = (v * eigval[:k]) @ v.T + noise * np.eye(p)
     zt = cov[:3, 3:] @ np.linalg.solve(cov[3:, 3:], zo.T)
-    predicted = zt.T / weight[:3] * sd[:3] + mean[:3]
-    recorded = recorded_around(positions, visible, m, times, a, b)
-    return anchor(predicted, times, recorded, a, b, smooth=smooth)
+    predicted: FloatArray = zt.T / weight[:3] * sd[:3] + mean[:3]
+    return predicted

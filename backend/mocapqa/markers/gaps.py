@@ -13,9 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mocapqa.core.arrays import BoolArray
+from mocapqa.core.arrays import BoolArray, column_runs
 from mocapqa.markers.params import MarkerParams
-from mocapqa.markers.take import column_runs
 
 __all__ = ["Gap", "MarkerGaps", "find_gaps", "gap_severity", "summarise_gaps"]
 

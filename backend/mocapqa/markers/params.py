@@ -3,7 +3,7 @@
 Lengths are millimetres and are converted to the take's unit (:func:`unit_scale`), so one set
 of values suits takes in metres, centimetres, millimetres and inches; a take in an unknown unit
 is read as millimetres. Times are seconds, so the values hold at any frame rate.
-``swap_misfit`` and ``swap_gain`` are the grid point :func:`mocapqa.bench.markers.choose`
+``swap_misfit`` and ``swap_gain`` are the grid point :func:`mocapqa_bench.markers.choose`
 picks on the bench files; the others were set by hand on them (docs/markers.md, "Thresholds
 and figures").
 """

@@ -29,9 +29,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mocapqa.core.arrays import FloatArray
+from mocapqa.core.arrays import FloatArray, column_runs
 from mocapqa.markers.params import MarkerParams, unit_scale
-from mocapqa.markers.take import close_breaks, column_runs
+from mocapqa.markers.take import close_breaks
 
 __all__ = ["Spike", "departures", "find_spikes"]
 

@@ -43,11 +43,11 @@ from typing import Literal
 
 import numpy as np
 
-from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.core.arrays import BoolArray, FloatArray, IntArray, column_runs
 from mocapqa.errors import InputError, OptionError
 from mocapqa.markers.params import MarkerParams, unit_scale
 from mocapqa.markers.segments import PairStats, mates, nearest
-from mocapqa.markers.take import column_runs, visible
+from mocapqa.markers.take import visible
 
 __all__ = [
     "APPLY_RULES",

@@ -14,10 +14,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.core.arrays import BoolArray, FloatArray, IntArray, column_runs
 from mocapqa.errors import InputError, ShapeError
 
-__all__ = ["Runs", "check_take", "close_breaks", "column_runs", "visible"]
+__all__ = ["Runs", "check_take", "close_breaks", "visible"]
 
 Runs = tuple[IntArray, IntArray, IntArray]
 """``(markers, starts, ends)`` of the runs of a mask, ends inclusive."""
@@ -47,23 +47,6 @@ def visible(positions: FloatArray) -> BoolArray:
     """``(F, M)`` mask: the samples whose three coordinates are finite."""
     mask: BoolArray = np.asarray(np.isfinite(positions).all(axis=-1))
     return mask
-
-
-def column_runs(mask: BoolArray) -> Runs:
-    """The runs of true frames in each column of a ``(F, M)`` mask.
-
-    Returns
-    -------
-    markers, starts, ends : ndarray of int, shape (R,)
-        Column, first and last frame of each run, by column then start.
-    """
-    n_frames, n_columns = mask.shape
-    padded = np.zeros((n_columns, n_frames + 2), dtype=np.int8)
-    padded[:, 1:-1] = mask.T
-    edges = np.diff(padded, axis=1)
-    columns, starts = np.nonzero(edges == 1)
-    _, stops = np.nonzero(edges == -1)
-    return columns.astype(np.intp), starts.astype(np.intp), (stops - 1).astype(np.intp)
 
 
 def close_breaks(mask: BoolArray, max_break: int) -> BoolArray:

@@ -17,7 +17,6 @@ without a limits model, a keypoint take for twist) reports why, and the take pas
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -29,7 +28,7 @@ from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.decimate import peak_frames
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
-from mocapqa.core.rig import find_roles
+from mocapqa.core.rig import RigMap, find_roles
 from mocapqa.errors import InputError
 from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
@@ -39,6 +38,7 @@ from mocapqa.pipeline.frames import motion_pose, rigid_bones
 from mocapqa.pipeline.loading import Take
 from mocapqa.pipeline.marker_step import run_markers
 from mocapqa.pipeline.options import AnalysisOptions, take_checks
+from mocapqa.pipeline.step_log import StepLog, requested
 from mocapqa.pipeline.steps import (
     StepOutcome,
     run_filter_keypoints,
@@ -133,110 +133,133 @@ def series_json(
     return series
 
 
+def _feet_step(
+    take: Motion | KeypointSequence,
+    options: AnalysisOptions,
+    progress: ProgressCallback,
+    percent: int,
+    steps: StepLog,
+) -> None:
+    """The feet check of the take as read (plotted only when it ran to the end)."""
+    if not requested("feet", options, steps):
+        return
+    progress(percent, "feet and floor check")
+    mapping = options.mapping if isinstance(take, Motion) else None
+    with steps.timed("feet_s"):
+        outcome = run_feet(take, mapping)
+    steps.record("feet", outcome, plot=outcome.state == "done")
+
+
+def _motion_checks(
+    motion: Motion,
+    options: AnalysisOptions,
+    progress: ProgressCallback,
+    catalog: ModelCatalog | None,
+    steps: StepLog,
+) -> Motion:
+    """The twist, limits and feet checks of a motion take; returns it twist-refined."""
+    corrected = motion
+    if requested("twist", options, steps):
+        progress(25, "twist analysis")
+        with steps.timed("twist_s"):
+            outcome = run_twist(motion, options.twist_method, options.mapping, options.twist_apply)
+        steps.record("twist", outcome)
+        if outcome.motion is not None:
+            corrected = outcome.motion
+
+    if requested("limits", options, steps):
+        progress(55, "joint-limit check")
+        with steps.timed("limits_s"):
+            twist_outcome = steps.outcomes.get("twist")
+            outcome = run_limits(
+                motion,
+                options.mapping,
+                options.limits_model or DEFAULT_MODEL,
+                catalog,
+                twist_findings=twist_outcome.findings if twist_outcome else None,
+            )
+        steps.record("limits", outcome)
+
+    _feet_step(motion, options, progress, 65, steps)
+    return corrected
+
+
+def _motion_filter(
+    corrected: Motion, options: AnalysisOptions, progress: ProgressCallback, steps: StepLog
+) -> Motion:
+    """The chosen filter over the corrected motion (neither plotted nor a source of
+    findings); returns the filtered motion."""
+    if "filter" not in options.checks or not options.filter_method:
+        steps.skip("filter", "no filter chosen for motion takes")
+        return corrected
+    progress(75, "filtering the corrected motion")
+    with steps.timed("filter_s"):
+        outcome = run_filter_motion(corrected, options.filter_method, options.filter_params)
+    steps.record("filter", outcome, plot=False, findings=False)
+    return outcome.motion if outcome.motion is not None else corrected
+
+
+def _summary(
+    take: Motion | KeypointSequence, facts: dict[str, Any], findings: list[dict[str, Any]]
+) -> dict[str, Any]:
+    """The ``summary`` of a report: frames, rate and length, the take kind's ``facts``, then
+    the findings counted."""
+    return {
+        "n_frames": take.n_frames,
+        "fps": take.fps,
+        "duration_s": take.n_frames / take.fps,
+        **facts,
+        "n_findings": len(findings),
+        "findings_by_kind": _count_by_kind(findings),
+    }
+
+
+def _motion_facts(motion: Motion, rig: RigMap) -> dict[str, Any]:
+    """What the summary of a motion take says of its skeleton and rig."""
+    skeleton = motion.skeleton
+    return {
+        "n_joints": skeleton.n_joints,
+        "length_unit": skeleton.length_unit,
+        "root_translation": skeleton.root_translation,
+        "bind_pose_frames": leading_bind_pose(motion.quats),
+        "roles": {key: skeleton.names[j] for key, j in sorted(rig.roles.items())},
+        "missing_roles": list(rig.unmapped),
+    }
+
+
 def _analyze_motion(
     motion: Motion,
     options: AnalysisOptions,
     progress: ProgressCallback,
     catalog: ModelCatalog | None,
 ) -> AnalysisResult:
-    outcomes: dict[str, StepOutcome] = {}
-    plotted: dict[str, StepOutcome] = {}
-    findings: list[dict[str, Any]] = []
-    timings: dict[str, float] = {}
-
+    steps = StepLog()
     rig = find_roles(motion.skeleton, options.mapping)  # a bad mapping fails the run here
     progress(10, "forward kinematics (raw)")
-    clock = time.perf_counter()
-    names, parents, raw_points, raw_rotations = motion_pose(motion)
-    timings["fk_raw_s"] = time.perf_counter() - clock
-
-    corrected = motion
-    if "twist" in options.checks:
-        progress(25, "twist analysis")
-        clock = time.perf_counter()
-        outcome = run_twist(motion, options.twist_method, options.mapping, options.twist_apply)
-        timings["twist_s"] = time.perf_counter() - clock
-        outcomes["twist"] = plotted["twist"] = outcome
-        if outcome.motion is not None:
-            corrected = outcome.motion
-        findings += outcome.findings
-    else:
-        outcomes["twist"] = StepOutcome("skipped", "not requested")
-
-    if "limits" in options.checks:
-        progress(55, "joint-limit check")
-        clock = time.perf_counter()
-        twist_outcome = outcomes.get("twist")
-        outcome = run_limits(
-            motion,
-            options.mapping,
-            options.limits_model or DEFAULT_MODEL,
-            catalog,
-            twist_findings=twist_outcome.findings if twist_outcome else None,
-        )
-        timings["limits_s"] = time.perf_counter() - clock
-        outcomes["limits"] = plotted["limits"] = outcome
-        findings += outcome.findings
-    else:
-        outcomes["limits"] = StepOutcome("skipped", "not requested")
-
-    if "feet" in options.checks:
-        progress(65, "feet and floor check")
-        clock = time.perf_counter()
-        outcome = run_feet(motion, options.mapping)
-        timings["feet_s"] = time.perf_counter() - clock
-        outcomes["feet"] = outcome
-        if outcome.state == "done":
-            plotted["feet"] = outcome
-        findings += outcome.findings
-    else:
-        outcomes["feet"] = StepOutcome("skipped", "not requested")
-
-    if "filter" in options.checks and options.filter_method:
-        progress(75, "filtering the corrected motion")
-        clock = time.perf_counter()
-        outcome = run_filter_motion(corrected, options.filter_method, options.filter_params)
-        timings["filter_s"] = time.perf_counter() - clock
-        outcomes["filter"] = outcome
-        if outcome.motion is not None:
-            corrected = outcome.motion
-    else:
-        outcomes["filter"] = StepOutcome("skipped", "no filter chosen for motion takes")
-    outcomes["markers"] = StepOutcome("skipped", "BVH takes have joints, not markers")
+    with steps.timed("fk_raw_s"):
+        names, parents, raw_points, raw_rotations = motion_pose(motion)
+    corrected = _motion_checks(motion, options, progress, catalog, steps)
+    corrected = _motion_filter(corrected, options, progress, steps)
+    steps.skip("markers", "BVH takes have joints, not markers")
 
     progress(85, "forward kinematics (corrected)")
-    clock = time.perf_counter()
-    _, _, corrected_points, corrected_rotations = motion_pose(corrected)
-    timings["fk_corrected_s"] = time.perf_counter() - clock
-    clock = time.perf_counter()
-    series = series_json(plotted, motion.n_frames, motion.fps, options.max_points)
-    timings["series_s"] = time.perf_counter() - clock
-    skeleton = motion.skeleton
+    with steps.timed("fk_corrected_s"):
+        _, _, corrected_points, corrected_rotations = motion_pose(corrected)
+    with steps.timed("series_s"):
+        series = series_json(steps.plotted, motion.n_frames, motion.fps, options.max_points)
     report = {
         "kind": "motion",
         "version": __version__,
-        "summary": {
-            "n_frames": motion.n_frames,
-            "fps": motion.fps,
-            "duration_s": motion.n_frames / motion.fps,
-            "n_joints": skeleton.n_joints,
-            "length_unit": skeleton.length_unit,
-            "root_translation": skeleton.root_translation,
-            "bind_pose_frames": leading_bind_pose(motion.quats),
-            "roles": {key: skeleton.names[j] for key, j in sorted(rig.roles.items())},
-            "missing_roles": list(rig.unmapped),
-            "n_findings": len(findings),
-            "findings_by_kind": _count_by_kind(findings),
-        },
+        "summary": _summary(motion, _motion_facts(motion, rig), steps.findings),
         "options": options.to_json(),
-        "steps": _steps_json(outcomes),
-        "timings_s": {k: round(v, 4) for k, v in timings.items()},
-        "findings": findings,
+        "steps": _steps_json(steps.outcomes),
+        "timings_s": {k: round(v, 4) for k, v in steps.timings.items()},
+        "findings": steps.findings,
         "points": {
             "names": names,
             "parents": parents,
             "bones": rigid_bones(motion),
-            "n_joints": skeleton.n_joints,
+            "n_joints": motion.skeleton.n_joints,
         },
         "series": series,
     }
@@ -251,98 +274,96 @@ def _analyze_motion(
     )
 
 
+def _keypoint_markers(
+    sequence: KeypointSequence,
+    options: AnalysisOptions,
+    progress: ProgressCallback,
+    steps: StepLog,
+) -> KeypointSequence:
+    """The marker check of a marker take (swaps repaired, gaps filled); returns the repaired
+    take, or the take as read when the check did not run or changed nothing."""
+    if "markers" not in take_checks("keypoints", sequence.source_format):
+        reason = "video keypoints are detections, not markers (C3D and TRC takes only)"
+        steps.skip("markers", reason)
+        return sequence
+    if not requested("markers", options, steps):
+        return sequence
+    progress(15, "checking markers, repairing swaps, filling gaps")
+    outcome = steps.record("markers", run_markers(sequence))
+    return outcome.keypoints if outcome.keypoints is not None else sequence
+
+
+def _keypoint_filter(
+    corrected: KeypointSequence,
+    options: AnalysisOptions,
+    progress: ProgressCallback,
+    steps: StepLog,
+) -> KeypointSequence:
+    """The keypoint filter (adaptive unless one is chosen); returns the filtered take."""
+    if not requested("filter", options, steps):
+        return corrected
+    progress(30, "filtering keypoints")
+    outcome = run_filter_keypoints(
+        corrected,
+        options.filter_method or "adaptive",
+        options.filter_preset,
+        options.filter_params,
+    )
+    steps.record("filter", outcome)
+    return outcome.keypoints if outcome.keypoints is not None else corrected
+
+
+def _keypoint_facts(sequence: KeypointSequence) -> dict[str, Any]:
+    """What the summary of a keypoint take says of its points."""
+    return {
+        "n_keypoints": sequence.n_keypoints,
+        "length_unit": sequence.length_unit,
+        "missing_fraction": sequence.missing_fraction,
+        "assumptions": list(sequence.assumptions),
+    }
+
+
 def _analyze_keypoints(
     sequence: KeypointSequence, options: AnalysisOptions, progress: ProgressCallback
 ) -> AnalysisResult:
     if options.mapping:
         raise InputError("Expected the mapping option only for BVH takes, got a keypoint take")
-    outcomes: dict[str, StepOutcome] = {
-        "twist": StepOutcome("skipped", "keypoint takes have no joint rotations"),
-        "limits": StepOutcome("skipped", "keypoint takes have no joint rotations"),
-    }
-    plotted: dict[str, StepOutcome] = {}
-    findings: list[dict[str, Any]] = []
-    correction: MarkerRepair | None = None
-    corrected = sequence
-    if "markers" not in take_checks("keypoints", sequence.source_format):
-        reason = "video keypoints are detections, not markers (C3D and TRC takes only)"
-        outcomes["markers"] = StepOutcome("skipped", reason)
-    elif "markers" in options.checks:
-        progress(15, "checking markers, repairing swaps, filling gaps")
-        outcome = run_markers(sequence)
-        outcomes["markers"] = plotted["markers"] = outcome
-        correction = outcome.markers
-        if outcome.keypoints is not None:
-            corrected = outcome.keypoints
-        findings += outcome.findings
-    else:
-        outcomes["markers"] = StepOutcome("skipped", "not requested")
-    if "feet" in options.checks:  # the feet of the take as read
-        progress(25, "feet and floor check")
-        outcome = run_feet(sequence)
-        outcomes["feet"] = outcome
-        if outcome.state == "done":
-            plotted["feet"] = outcome
-        findings += outcome.findings
-    else:
-        outcomes["feet"] = StepOutcome("skipped", "not requested")
-    filtered = corrected
-    if "filter" in options.checks:
-        progress(30, "filtering keypoints")
-        outcome = run_filter_keypoints(
-            corrected,
-            options.filter_method or "adaptive",
-            options.filter_preset,
-            options.filter_params,
-        )
-        outcomes["filter"] = plotted["filter"] = outcome
-        if outcome.keypoints is not None:
-            filtered = outcome.keypoints
-        findings += outcome.findings
-    else:
-        outcomes["filter"] = StepOutcome("skipped", "not requested")
+    steps = StepLog()
+    steps.skip("twist", "keypoint takes have no joint rotations")
+    steps.skip("limits", "keypoint takes have no joint rotations")
+    corrected = _keypoint_markers(sequence, options, progress, steps)
+    _feet_step(sequence, options, progress, 25, steps)  # the feet of the take as read
+    filtered = _keypoint_filter(corrected, options, progress, steps)
     progress(85, "collecting results")
     # Missing keypoints stay NaN: drawing them at the origin would show points never seen.
-    raw_points = sequence.positions
-    corrected_points = filtered.positions
     points: dict[str, Any] = {
         "names": list(sequence.names),
         "parents": [-1] * sequence.n_keypoints,
         "n_joints": sequence.n_keypoints,
     }
-    series = series_json(plotted, sequence.n_frames, sequence.fps, options.max_points)
+    series = series_json(steps.plotted, sequence.n_frames, sequence.fps, options.max_points)
     if series.get("markers"):  # the inferred segments, drawn as sticks
         points["bones"] = series["markers"]["sticks"]
     report = {
         "kind": "keypoints",
         "version": __version__,
-        "summary": {
-            "n_frames": sequence.n_frames,
-            "fps": sequence.fps,
-            "duration_s": sequence.n_frames / sequence.fps,
-            "n_keypoints": sequence.n_keypoints,
-            "length_unit": sequence.length_unit,
-            "missing_fraction": sequence.missing_fraction,
-            "assumptions": list(sequence.assumptions),
-            "n_findings": len(findings),
-            "findings_by_kind": _count_by_kind(findings),
-        },
+        "summary": _summary(sequence, _keypoint_facts(sequence), steps.findings),
         "options": options.to_json(),
-        "steps": _steps_json(outcomes),
-        "findings": findings,
+        "steps": _steps_json(steps.outcomes),
+        "findings": steps.findings,
         "points": points,
         "series": series,
     }
-    bridged = outcomes["filter"].bridged
+    markers = steps.outcomes["markers"].markers
     return AnalysisResult(
         report,
         None,
         filtered,
-        raw_points,
-        corrected_points,
+        sequence.positions,
+        filtered.positions,
         confidence=sequence.confidence,
-        bridged=bridged,
-        markers=correction,
+        bridged=steps.outcomes["filter"].bridged,
+        markers=markers,
     )
 
 

@@ -41,6 +41,7 @@ from mocapqa.core.rig import find_roles
 from mocapqa.core.rig_names import split_side, token_of
 from mocapqa.errors import InputError
 from mocapqa.feet.check import FeetReport, check_feet
+from mocapqa.feet.findings import Finding
 from mocapqa.feet.markers import MARKER_PARAMS, marker_foot_points
 from mocapqa.feet.params import FeetParams
 from mocapqa.feet.points import LEG_HEIGHT_RATIO, SIDES, FootPoints, cm_per_unit
@@ -268,6 +269,123 @@ def _round(value: float | None, digits: int = 4) -> float | None:
     return round(float(value), digits)
 
 
+def _finding_json(
+    finding: Finding, skipped: int, height: float, to_cm: float | None
+) -> dict[str, Any]:
+    """One finding of :func:`feet_report_json`."""
+    item: dict[str, Any] = {
+        "kind": finding.kind,
+        "foot": finding.foot,
+        "start": finding.start + skipped,
+        "end": finding.end + skipped,
+        "peak": finding.peak + skipped,
+        "size": _round(finding.size, 5),
+        "size_cm": _cm(finding.size, to_cm),
+        "size_rel_height": _round(finding.size / height, 5),
+    }
+    if finding.speed is not None:
+        item["speed_cm_s"] = _cm(finding.speed, to_cm)
+        item["speed_rel_height_s"] = _round(finding.speed / height, 5)
+    return item
+
+
+def _cm(value: float | None, to_cm: float | None) -> float | None:
+    """A size in take units in centimetres, rounded; None where the unit does not convert."""
+    return None if value is None or to_cm is None else _round(value * to_cm, 3)
+
+
+def _sizes_json(points: FootPoints, to_cm: float | None) -> dict[str, Any]:
+    """The units, leg length and body height of :func:`feet_report_json`."""
+    return {
+        "length_unit": points.length_unit,
+        "cm_per_unit": to_cm,
+        "sizes": "cm"
+        if to_cm is not None
+        else (
+            f"unit {points.length_unit!r} does not convert to cm: size_cm is null; read "
+            "size_rel_height (size over the body height estimated from the leg length)"
+        ),
+        "leg_length": _round(points.leg_length, 5),
+        "leg_length_cm": _cm(points.leg_length, to_cm),
+        "body_height_estimate": _round(points.body_height, 5),
+        "body_height_note": f"leg length / {LEG_HEIGHT_RATIO} (hip-knee-ankle over stature)",
+    }
+
+
+def _floor_json(report: FeetReport, skipped: int, to_cm: float | None) -> dict[str, Any]:
+    """The up axis, floor level and ``floor_check`` of :func:`feet_report_json`."""
+    up, floor = report.up, report.floor
+    return {
+        "up_axis": up.label,
+        "up_axis_detail": {
+            "method": up.method,
+            "feet_spreads_leg": [_round(s, 5) for s in up.feet_spreads],
+            "body_axis": None if up.body_axis is None else "XYZ"[up.body_axis],
+        },
+        "floor": _round(up.sign * floor.level, 5),
+        "floor_check": {
+            "tilt_deg": _round(floor.tilt_deg, 3),
+            "rise": _round(floor.rise, 5),
+            "rise_cm": _cm(floor.rise, to_cm),
+            "drift": _round(floor.drift, 5),
+            "drift_cm": _cm(floor.drift, to_cm),
+            "tilted": floor.tilted,
+            "moving": floor.moving,
+            "plane_gradient": None
+            if floor.gradient is None
+            else [_round(g, 6) for g in floor.gradient],
+            "plane_origin": [_round(o, 5) for o in floor.origin],
+            "heights_from": "the tilted plane through `floor` at `plane_origin`"
+            if floor.tilted
+            else "the level floor",
+            "segments": [
+                {"start": s + skipped, "end": e + skipped, "floor": _round(up.sign * level, 5)}
+                for s, e, level in floor.segments
+            ],
+            "stance_samples": floor.n_samples,
+        },
+    }
+
+
+def _contacts_json(report: FeetReport, skipped: int) -> dict[str, Any]:
+    """The ``contacts`` and ``point_contacts`` of :func:`feet_report_json`."""
+    return {
+        "contacts": [
+            {
+                "foot": c.foot,
+                "start": c.start + skipped,
+                "end": c.end + skipped,
+                "confidence": c.confidence,
+            }
+            for c in report.contacts
+        ],
+        "point_contacts": [
+            {
+                "foot": c.foot,
+                "part": c.part,
+                "start": c.start + skipped,
+                "end": c.end + skipped,
+                "confidence": c.confidence,
+            }
+            for c in report.point_contacts
+        ],
+    }
+
+
+def _summary_json(report: FeetReport, minutes: float) -> dict[str, Any]:
+    """The ``summary`` of :func:`feet_report_json`: counts by foot and kind, skate rate."""
+    return {
+        "contacts": {s: sum(c.foot == s for c in report.contacts) for s in SIDES},
+        "findings": {
+            k: sum(f.kind == k for f in report.findings)
+            for k in ("skate", "penetration", "floating", "jitter")
+        },
+        "skate_per_minute": _round(sum(f.kind == "skate" for f in report.findings) / minutes, 3)
+        if minutes > 0
+        else None,
+    }
+
+
 def feet_report_json(points: FootPoints, report: FeetReport, skipped: int = 0) -> dict[str, Any]:
     """The feet check as a JSON-ready dict (the ``mocapqa feet check --json`` object).
 
@@ -289,74 +407,13 @@ def feet_report_json(points: FootPoints, report: FeetReport, skipped: int = 0) -
         ends inclusive, counted in the take as read.
     """
     to_cm = cm_per_unit(points.length_unit)
-    height = points.body_height
-    up, floor = report.up, report.floor
-
-    def cm(value: float | None) -> float | None:
-        return None if value is None or to_cm is None else _round(value * to_cm, 3)
-
-    findings = []
-    for f in report.findings:
-        item: dict[str, Any] = {
-            "kind": f.kind,
-            "foot": f.foot,
-            "start": f.start + skipped,
-            "end": f.end + skipped,
-            "peak": f.peak + skipped,
-            "size": _round(f.size, 5),
-            "size_cm": cm(f.size),
-            "size_rel_height": _round(f.size / height, 5),
-        }
-        if f.speed is not None:
-            item["speed_cm_s"] = cm(f.speed)
-            item["speed_rel_height_s"] = _round(f.speed / height, 5)
-        findings.append(item)
     frames = report.contact_mask.shape[0]
-    minutes = frames / points.fps / 60.0
     return {
         "frames": frames + skipped,
         "checked_frames": [skipped, frames + skipped - 1],
         "fps": points.fps,
-        "length_unit": points.length_unit,
-        "cm_per_unit": to_cm,
-        "sizes": "cm"
-        if to_cm is not None
-        else (
-            f"unit {points.length_unit!r} does not convert to cm: size_cm is null; read "
-            "size_rel_height (size over the body height estimated from the leg length)"
-        ),
-        "leg_length": _round(points.leg_length, 5),
-        "leg_length_cm": cm(points.leg_length),
-        "body_height_estimate": _round(height, 5),
-        "body_height_note": f"leg length / {LEG_HEIGHT_RATIO} (hip-knee-ankle over stature)",
-        "up_axis": up.label,
-        "up_axis_detail": {
-            "method": up.method,
-            "feet_spreads_leg": [_round(s, 5) for s in up.feet_spreads],
-            "body_axis": None if up.body_axis is None else "XYZ"[up.body_axis],
-        },
-        "floor": _round(up.sign * floor.level, 5),
-        "floor_check": {
-            "tilt_deg": _round(floor.tilt_deg, 3),
-            "rise": _round(floor.rise, 5),
-            "rise_cm": cm(floor.rise),
-            "drift": _round(floor.drift, 5),
-            "drift_cm": cm(floor.drift),
-            "tilted": floor.tilted,
-            "moving": floor.moving,
-            "plane_gradient": None
-            if floor.gradient is None
-            else [_round(g, 6) for g in floor.gradient],
-            "plane_origin": [_round(o, 5) for o in floor.origin],
-            "heights_from": "the tilted plane through `floor` at `plane_origin`"
-            if floor.tilted
-            else "the level floor",
-            "segments": [
-                {"start": s + skipped, "end": e + skipped, "floor": _round(up.sign * level, 5)}
-                for s, e, level in floor.segments
-            ],
-            "stance_samples": floor.n_samples,
-        },
+        **_sizes_json(points, to_cm),
+        **_floor_json(report, skipped, to_cm),
         "points": [
             {
                 "name": name,
@@ -365,38 +422,11 @@ def feet_report_json(points: FootPoints, report: FeetReport, skipped: int = 0) -
                 "stance_above_floor": _round(float(offset), 5),
             }
             for name, side, part, offset in zip(
-                points.names, points.sides, points.parts, floor.point_offsets, strict=True
+                points.names, points.sides, points.parts, report.floor.point_offsets, strict=True
             )
         ],
         "bind_pose_frames": skipped,
-        "contacts": [
-            {
-                "foot": c.foot,
-                "start": c.start + skipped,
-                "end": c.end + skipped,
-                "confidence": c.confidence,
-            }
-            for c in report.contacts
-        ],
-        "point_contacts": [
-            {
-                "foot": c.foot,
-                "part": c.part,
-                "start": c.start + skipped,
-                "end": c.end + skipped,
-                "confidence": c.confidence,
-            }
-            for c in report.point_contacts
-        ],
-        "findings": findings,
-        "summary": {
-            "contacts": {s: sum(c.foot == s for c in report.contacts) for s in SIDES},
-            "findings": {
-                k: sum(f.kind == k for f in report.findings)
-                for k in ("skate", "penetration", "floating", "jitter")
-            },
-            "skate_per_minute": _round(sum(f.kind == "skate" for f in report.findings) / minutes, 3)
-            if minutes > 0
-            else None,
-        },
+        **_contacts_json(report, skipped),
+        "findings": [_finding_json(f, skipped, points.body_height, to_cm) for f in report.findings],
+        "summary": _summary_json(report, frames / points.fps / 60.0),
     }

@@ -32,7 +32,7 @@ from mocapqa.core.arrays import IntArray
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
-from mocapqa.feet.fix_choice import contact_id, finding_confidence, finding_id
+from mocapqa.feet.fix_choice import add_ids
 from mocapqa.feet.points import SIDES
 from mocapqa.pipeline.feet import check_take_feet, feet_report_json
 from mocapqa.pipeline.steps import Plot, StepOutcome
@@ -97,10 +97,8 @@ def run_feet(
 
     Parameters
     ----------
-    take : Motion or KeypointSequence
-        A BVH motion, or keypoints (a C3D take's markers when ``source_format`` is "c3d").
-    mapping : mapping, optional
-        Role key → joint name (BVH only).
+    take, mapping
+        As in :func:`mocapqa.pipeline.feet.check_take_feet`.
 
     Returns
     -------
@@ -117,12 +115,7 @@ def run_feet(
     except InputError as e:
         return StepOutcome("skipped", f"no feet to check: {e}")
     check = feet_report_json(points, report, skipped)
-    for item, contact in zip(check["contacts"], report.contacts, strict=True):
-        item["id"] = contact_id(contact, skipped)
-    for item, finding in zip(check["findings"], report.findings, strict=True):
-        item["id"] = finding_id(finding, skipped)
-        if finding.kind == "skate":
-            item["confidence"] = finding_confidence(finding, report.contacts)
+    add_ids(check, report.contacts, report.findings, skipped)
     rear: dict[str, str] = {}
     for name, side in zip(points.names, points.sides, strict=True):
         rear.setdefault(side, name)  # each side's rear point (ankle or heel) comes first

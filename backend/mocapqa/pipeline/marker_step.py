@@ -35,6 +35,7 @@ import numpy as np
 from mocapqa.core.arrays import IntArray
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.markers.check import MarkerReport, check_markers
+from mocapqa.markers.fill import GapFill
 from mocapqa.markers.gaps import gap_severity
 from mocapqa.markers.params import MM_PER_UNIT, MarkerParams
 from mocapqa.markers.repair import MarkerRepair, repair_markers
@@ -88,38 +89,8 @@ def marker_findings(
     params : MarkerParams
         The check's thresholds (gap severity of a gap the repair moved).
     """
-    names, unit, fps = report.names, report.length_unit, report.fps
-    last = report.frames - 1
     severity = {(g.marker, g.start, g.end): g.severity for g in report.gaps}
-    findings: list[dict[str, Any]] = []
-    for gap in repair.fills.gaps:
-        name = names[gap.marker]
-        error, error_unit = _length(gap.expected_error, unit)
-        seconds = (gap.end - gap.start + 1) / fps
-        expected = "no method could fill it" if error is None else (
-            f"expected error {error:g} {error_unit}"
-        )  # fmt: skip
-        if gap.applied:
-            readout = f"filled ({gap.method}), {expected}"
-        elif gap.method is not None:
-            readout = f"not filled: {expected} ({gap.method}), not confident"
-        else:
-            readout = f"not filled: {expected}"
-        findings.append({
-            "kind": "gap" if gap.applied else "gap not filled",
-            "joint": name,
-            "start_frame": gap.start,
-            "end_frame": gap.end,
-            "value": error,
-            "unit": error_unit,
-            "confidence": None,
-            "method": gap.method,
-            "confident": gap.confident,
-            "applied": gap.applied,
-            "seconds": round(seconds, 6),
-            "severity": severity.get((name, gap.start, gap.end), gap_severity(seconds, params)),
-            "readout": readout,
-        })  # fmt: skip
+    findings = [_gap_finding(gap, report, severity, params) for gap in repair.fills.gaps]
     repaired = {(s.markers, s.start, s.end) for s in repair.repaired}
     for number, swap in enumerate(report.swaps):
         findings.append({
@@ -137,6 +108,50 @@ def marker_findings(
             "readout": f"{' ↔ '.join(swap.markers)}, "
             f"{'' if (swap.markers, swap.start, swap.end) in repaired else 'not '}repaired",
         })  # fmt: skip
+    return findings + _take_findings(report)
+
+
+def _gap_finding(
+    gap: GapFill,
+    report: MarkerReport,
+    severity: dict[tuple[str, int, int], str],
+    params: MarkerParams,
+) -> dict[str, Any]:
+    """The ``gap`` or ``gap not filled`` finding of one gap of the repaired take."""
+    name = report.names[gap.marker]
+    error, error_unit = _length(gap.expected_error, report.length_unit)
+    seconds = (gap.end - gap.start + 1) / report.fps
+    expected = "no method could fill it" if error is None else (
+        f"expected error {error:g} {error_unit}"
+    )  # fmt: skip
+    if gap.applied:
+        readout = f"filled ({gap.method}), {expected}"
+    elif gap.method is not None:
+        readout = f"not filled: {expected} ({gap.method}), not confident"
+    else:
+        readout = f"not filled: {expected}"
+    return {
+        "kind": "gap" if gap.applied else "gap not filled",
+        "joint": name,
+        "start_frame": gap.start,
+        "end_frame": gap.end,
+        "value": error,
+        "unit": error_unit,
+        "confidence": None,
+        "method": gap.method,
+        "confident": gap.confident,
+        "applied": gap.applied,
+        "seconds": round(seconds, 6),
+        "severity": severity.get((name, gap.start, gap.end), gap_severity(seconds, params)),
+        "readout": readout,
+    }
+
+
+def _take_findings(report: MarkerReport) -> list[dict[str, Any]]:
+    """The ``spike``, ``static marker``, ``absent marker``, ``unlabelled marker`` and
+    ``duplicate label`` findings of the take as read."""
+    unit, last = report.length_unit, report.frames - 1
+    findings: list[dict[str, Any]] = []
     for spike in report.spikes:
         offset, offset_unit = _length(spike.offset, unit)
         findings.append({

@@ -184,6 +184,50 @@ def _residual_mm(result: AnalysisResult, unit: str) -> float | None:
     return round(float(np.sqrt(np.mean(distance**2))) * scale, 4)
 
 
+def _limits_fields(
+    findings: list[dict[str, Any]], n_frames: int
+) -> tuple[float, str | None, dict[str, float]]:
+    """The limits fields of the summary from the findings of a limits check that ran.
+
+    Returns
+    -------
+    violation_share : float
+        Share of frames where at least one joint is outside its limits.
+    worst_joint : str or None
+        The joint outside its limits in the most frames (None when none is).
+    joint_violations : dict of str to float
+        Per joint, share of frames outside the limits (joints with any).
+    """
+    limit_findings = [f for f in findings if f["kind"] == "limits"]
+    violation_share = round(_union_frames(limit_findings, n_frames) / max(n_frames, 1), 6)
+    per_joint: dict[str, int] = {}
+    for finding in limit_findings:
+        length = int(finding["end_frame"]) - int(finding["start_frame"]) + 1
+        per_joint[finding["joint"]] = per_joint.get(finding["joint"], 0) + length
+    joint_violations = {j: round(n / max(n_frames, 1), 6) for j, n in per_joint.items()}
+    worst_joint = max(per_joint, key=lambda j: (per_joint[j], j)) if per_joint else None
+    return violation_share, worst_joint, joint_violations
+
+
+def _score_terms(
+    summary: dict[str, Any],
+    twist_count: int | None,
+    corrected_share: float | None,
+    markers: dict[str, Any] | None,
+    feet: dict[str, int] | None,
+) -> dict[str, float | None]:
+    """The measures :func:`qa_score` weighs, from the summary's fields (None: not checked)."""
+    return {
+        "twist_intervals": None if twist_count is None else float(twist_count),
+        "corrected_share": corrected_share,
+        "violation_share": summary["violation_share"],
+        "missing_share": summary["missing_share"],
+        "filter_residual_mm": summary["filter_residual_mm"],
+        **{k: float(markers[k]) for k in MARKER_FIELDS if k in SCORE_TERMS and markers},
+        **{k: float(feet[k]) for k in FEET_FIELDS if k in SCORE_TERMS and feet},
+    }
+
+
 def qa_summary(result: AnalysisResult) -> dict[str, Any]:
     """The QA summary of an analysis (fields in the module docstring).
 
@@ -213,24 +257,12 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
     spins = [f for f in findings if f["kind"] == "spin"]
     corrected = sum(int(f["end_frame"]) - int(f["start_frame"]) + 1 for f in twist)
     n_joints = int(info.get("n_joints") or info.get("n_keypoints") or 1)
-
     rig = "keypoints"
-    joint_violations: dict[str, float] = {}
-    violation_share: float | None = None
-    worst_joint: str | None = None
     if result.corrected_motion is not None:
         rig = rig_family(result.corrected_motion.skeleton)
-    if limits_ran:
-        limit_findings = [f for f in findings if f["kind"] == "limits"]
-        violation_share = round(_union_frames(limit_findings, n_frames) / max(n_frames, 1), 6)
-        per_joint: dict[str, int] = {}
-        for finding in limit_findings:
-            length = int(finding["end_frame"]) - int(finding["start_frame"]) + 1
-            per_joint[finding["joint"]] = per_joint.get(finding["joint"], 0) + length
-        joint_violations = {j: round(n / max(n_frames, 1), 6) for j, n in per_joint.items()}
-        if per_joint:
-            worst_joint = max(per_joint, key=lambda j: (per_joint[j], j))
-
+    violation_share, worst_joint, joint_violations = (
+        _limits_fields(findings, n_frames) if limits_ran else (None, None, {})
+    )
     residual = _residual_mm(result, str(info.get("length_unit"))) if filter_ran else None
     missing = 0.0 if motion else round(float(info.get("missing_fraction") or 0.0), 6)
     markers = _marker_counts(findings, n_frames * n_joints) if markers_ran else None
@@ -259,19 +291,7 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
     # were not found, a run of the filter only) has no score: 100 would read as "checked and
     # clean".
     checked = twist_ran or limits_ran or feet_ran or not motion
-    summary["score"] = (
-        qa_score(
-            {
-                "twist_intervals": float(len(twist)) if twist_ran else None,
-                "corrected_share": corrected / max(n_frames * n_joints, 1) if twist_ran else None,
-                "violation_share": violation_share,
-                "missing_share": missing,
-                "filter_residual_mm": residual,
-                **{k: float(markers[k]) for k in MARKER_FIELDS if k in SCORE_TERMS and markers},
-                **{k: float(feet[k]) for k in FEET_FIELDS if k in SCORE_TERMS and feet},
-            }
-        )
-        if checked
-        else None
-    )
+    corrected_share = corrected / max(n_frames * n_joints, 1) if twist_ran else None
+    terms = _score_terms(summary, len(twist) if twist_ran else None, corrected_share, markers, feet)
+    summary["score"] = qa_score(terms) if checked else None
     return summary

@@ -19,7 +19,7 @@ import numpy as np
 
 from mocapqa.core.arrays import BoolArray
 from mocapqa.errors import ShapeError
-from mocapqa.render.engine import FIXED_COLOR, FLAG_COLOR, CanvasPool, ImageArray
+from mocapqa.render.engine import FIXED_COLOR, FLAG_COLOR, CanvasPool, ImageArray, pool_or_own
 from mocapqa.render.scene import SkeletonTrack, check_same_shape, frame_camera
 from mocapqa.render.still import flags_at
 
@@ -76,10 +76,9 @@ def render_clip_frames(
     width, height = _multiple_of_16(width_px), _multiple_of_16(height_px)
     views = 1 if corrected is None else 2
     camera = frame_camera(raw, (start_frame, end_frame + 1), aspect=width / height)
-    pool = canvases or CanvasPool()
     frames = []
     total = end_frame - start_frame + 1
-    try:
+    with pool_or_own(canvases) as pool:
         for k, frame in enumerate(range(start_frame, end_frame + 1), start=1):
             row = flags_at(flagged, frame, len(raw.names))
             canvas = pool.get(views * width, height, views)
@@ -93,9 +92,6 @@ def render_clip_frames(
             frames.append(canvas.image())
             if progress is not None:
                 progress(k, total)
-    finally:
-        if canvases is None:
-            pool.close()
     return frames
 
 

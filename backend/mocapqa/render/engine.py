@@ -14,12 +14,14 @@ Conventions
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from mocapqa.core.arrays import BoolArray
+from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.errors import RenderUnavailableError
 from mocapqa.render.scene import CameraView, SkeletonTrack
 
@@ -34,6 +36,7 @@ __all__ = [
     "ImageArray",
     "load_pyvista",
     "png_bytes",
+    "pool_or_own",
 ]
 
 # An RGB image, shape (H, W, 3), row 0 at the top.
@@ -82,6 +85,18 @@ def _nice_spacing(length: float) -> float:
         if step * 10**exponent >= length:
             return float(step * 10**exponent)
     return float(10 ** (exponent + 1))
+
+
+def _segment_cells(n_segments: int) -> NDArray[np.int64]:
+    """VTK line cells of ``n_segments`` two-point segments over points ``2k`` and ``2k + 1``:
+    ``[2, 0, 1, 2, 2, 3, …]``, shape (3 · n_segments,)."""
+    return np.column_stack(
+        [
+            np.full(n_segments, 2),
+            np.arange(0, 2 * n_segments, 2),
+            np.arange(1, 2 * n_segments, 2),
+        ]
+    ).ravel()
 
 
 class Canvas:
@@ -174,14 +189,7 @@ class Canvas:
             points[2 * k, [a, b]] = pa, pb
             points[2 * k + 1, [a, b]] = qa, qb
         points[:, up_index] = camera.floor_height
-        lines = np.column_stack(
-            [
-                np.full(len(segments), 2),
-                np.arange(0, 2 * len(segments), 2),
-                np.arange(1, 2 * len(segments), 2),
-            ]
-        ).ravel()
-        return self.pv.PolyData(points, lines=lines)
+        return self.pv.PolyData(points, lines=_segment_cells(len(segments)))
 
     def draw(
         self,
@@ -215,9 +223,7 @@ class Canvas:
         legend : bool
             Whether to add a legend naming the flagged joints.
         """
-        pv = self.pv
-        plotter = self.plotter
-        plotter.subplot(0, column)
+        self.plotter.subplot(0, column)
         points = track.positions[frame]
         valid = np.all(np.isfinite(points), axis=1)
         marks = (
@@ -225,8 +231,26 @@ class Canvas:
             if flagged is None
             else np.asarray(flagged, dtype=bool)
         )
-        height = track.height
         self._add_actor(self._floor(track, camera), FLOOR_COLOR, smooth=False)
+        self._bones(track, points, valid, marks, flag_color)
+        self._joints(track.height, points, valid, marks, flag_color)
+        if title:
+            self._title(title)
+        flagged_names = [track.names[j] for j in np.flatnonzero(marks)]
+        if legend and flagged_names:
+            self._legend(flagged_names, flag_color)
+        self._aim(camera)
+
+    def _bones(
+        self,
+        track: SkeletonTrack,
+        points: FloatArray,
+        valid: BoolArray,
+        marks: BoolArray,
+        flag_color: str,
+    ) -> None:
+        """Tubes along the bones whose two ends are known, those ending at a flagged joint in
+        ``flag_color``."""
         bones = (
             track.bones[valid[track.bones[:, 0]] & valid[track.bones[:, 1]]]
             if len(track.bones)
@@ -240,41 +264,48 @@ class Canvas:
             if len(chosen) == 0:
                 continue
             ends = points[chosen].reshape(-1, 3)
-            lines = np.column_stack(
-                [
-                    np.full(len(chosen), 2),
-                    np.arange(0, 2 * len(chosen), 2),
-                    np.arange(1, 2 * len(chosen), 2),
-                ]
-            ).ravel()
-            tubes = pv.PolyData(ends, lines=lines).tube(radius=0.008 * height, n_sides=10)
+            lines = _segment_cells(len(chosen))
+            tubes = self.pv.PolyData(ends, lines=lines).tube(
+                radius=0.008 * track.height, n_sides=10
+            )
             self._add_actor(tubes, color)
+
+    def _joints(
+        self,
+        height: float,
+        points: FloatArray,
+        valid: BoolArray,
+        marks: BoolArray,
+        flag_color: str,
+    ) -> None:
+        """A sphere on each known joint, flagged ones twice as large in ``flag_color``."""
         for selection, color, scale in ((~marks, JOINT_COLOR, 0.015), (marks, flag_color, 0.03)):
             chosen_points = points[selection & valid]
             if len(chosen_points) == 0:
                 continue
-            glyphs = pv.PolyData(chosen_points).glyph(
+            glyphs = self.pv.PolyData(chosen_points).glyph(
                 geom=self._sphere(round(scale * height, 9)), scale=False, orient=False
             )
             self._add_actor(glyphs, color)
-        if title:
-            self._title(title)
-        flagged_names = [track.names[j] for j in np.flatnonzero(marks)]
-        if legend and flagged_names:
-            shown = (
-                "flagged: "
-                + ", ".join(flagged_names[:3])
-                + (" …" if len(flagged_names) > 3 else "")
-            )
-            plotter.add_legend(
-                labels=[[shown, flag_color], ["bones", BONE_COLOR]],
-                bcolor="white",
-                border=True,
-                loc="lower left",
-                size=(min(0.95, 0.1 + 0.022 * len(shown)), 0.1),
-                face="circle",
-            )
+
+    def _legend(self, flagged_names: list[str], flag_color: str) -> None:
+        """A legend naming the first three flagged joints, and the bones' colour."""
+        shown = (
+            "flagged: " + ", ".join(flagged_names[:3]) + (" …" if len(flagged_names) > 3 else "")
+        )
+        self.plotter.add_legend(
+            labels=[[shown, flag_color], ["bones", BONE_COLOR]],
+            bcolor="white",
+            border=True,
+            loc="lower left",
+            size=(min(0.95, 0.1 + 0.022 * len(shown)), 0.1),
+            face="circle",
+        )
+
+    def _aim(self, camera: CameraView) -> None:
+        """Point the current viewport's camera as ``camera`` says (30° view angle)."""
         # Setting the camera object's fields directly avoids pyvista's extra render per change.
+        plotter = self.plotter
         vtk_camera = plotter.renderer.GetActiveCamera()
         vtk_camera.SetPosition(camera.position)
         vtk_camera.SetFocalPoint(camera.focal_point)
@@ -339,3 +370,20 @@ class CanvasPool:
         for canvas in self._canvases.values():
             canvas.close()
         self._canvases.clear()
+
+
+@contextmanager
+def pool_or_own(canvases: CanvasPool | None) -> Iterator[CanvasPool]:
+    """The caller's pool of canvases, or a pool of this block's own, closed when it ends.
+
+    Parameters
+    ----------
+    canvases : CanvasPool, optional
+        Reused windows; left open.
+    """
+    pool = canvases or CanvasPool()
+    try:
+        yield pool
+    finally:
+        if canvases is None:
+            pool.close()

@@ -23,7 +23,14 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray
 from mocapqa.errors import ShapeError
-from mocapqa.render.engine import FIXED_COLOR, FLAG_COLOR, CanvasPool, ImageArray
+from mocapqa.render.engine import (
+    FIXED_COLOR,
+    FLAG_COLOR,
+    Canvas,
+    CanvasPool,
+    ImageArray,
+    pool_or_own,
+)
 from mocapqa.render.scene import SkeletonTrack, check_same_shape, frame_camera
 
 __all__ = [
@@ -207,46 +214,47 @@ def render_contact_sheet(
     if corrected is not None:
         check_same_shape(raw, corrected)
     views = 1 if corrected is None else 2
-    pool = canvases or CanvasPool()
     images = []
-    try:
+    with pool_or_own(canvases) as pool:
         for done, tile in enumerate(tiles, start=1):
             if not 0 <= tile.frame < raw.n_frames:
                 raise ShapeError(
                     f"Expected tile frames in [0, {raw.n_frames - 1}], got {tile.frame}"
                 )
-            flagged = np.zeros(len(raw.names), dtype=bool)
-            flagged[list(tile.joints)] = True
-            camera = frame_camera(
-                raw, (tile.frame, tile.frame + 1), aspect=tile_width_px / tile_height_px
-            )
             canvas = pool.get(views * tile_width_px, tile_height_px, views)
-            caption = f"raw · {tile.label}"
-            if corrected is None and tile.not_applied is not None:
-                caption += f" · {tile.not_applied}"
-            canvas.draw(
-                0, raw, tile.frame, camera, flagged, _two_lines(caption), FLAG_COLOR, legend=False
-            )
-            if corrected is not None and tile.not_applied is not None:
-                # No corrected pose for an interval the corrected take does not fix.
-                canvas.caption(1, f"{tile.not_applied}:\nraw pose only, nothing corrected")
-            elif corrected is not None:
-                canvas.draw(
-                    1,
-                    corrected,
-                    tile.frame,
-                    camera,
-                    flagged,
-                    "corrected",
-                    FIXED_COLOR,
-                    legend=False,
-                )
+            _draw_tile(canvas, raw, tile, corrected, tile_width_px / tile_height_px)
             images.append(canvas.image())
             if progress is not None:
                 progress(done, len(tiles))
-    finally:
-        if canvases is None:
-            pool.close()
+    return _lay_out(images, columns)
+
+
+def _draw_tile(
+    canvas: Canvas,
+    raw: SkeletonTrack,
+    tile: SheetTile,
+    corrected: SkeletonTrack | None,
+    aspect: float,
+) -> None:
+    """Draw one tile: the raw pose, then the corrected pose or why there is none."""
+    flagged = np.zeros(len(raw.names), dtype=bool)
+    flagged[list(tile.joints)] = True
+    camera = frame_camera(raw, (tile.frame, tile.frame + 1), aspect=aspect)
+    caption = f"raw · {tile.label}"
+    if corrected is None and tile.not_applied is not None:
+        caption += f" · {tile.not_applied}"
+    canvas.draw(0, raw, tile.frame, camera, flagged, _two_lines(caption), FLAG_COLOR, legend=False)
+    if corrected is not None and tile.not_applied is not None:
+        # No corrected pose for an interval the corrected take does not fix.
+        canvas.caption(1, f"{tile.not_applied}:\nraw pose only, nothing corrected")
+    elif corrected is not None:
+        canvas.draw(
+            1, corrected, tile.frame, camera, flagged, "corrected", FIXED_COLOR, legend=False
+        )
+
+
+def _lay_out(images: Sequence[ImageArray], columns: int) -> ImageArray:
+    """The images row by row on a white sheet, :data:`_GAP_PX` apart and from its edges."""
     columns = max(1, min(columns, len(images)))
     rows = -(-len(images) // columns)
     tile_h, tile_w = images[0].shape[:2]

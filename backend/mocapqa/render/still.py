@@ -16,7 +16,7 @@ import numpy as np
 
 from mocapqa.core.arrays import BoolArray
 from mocapqa.errors import ShapeError
-from mocapqa.render.engine import FIXED_COLOR, FLAG_COLOR, CanvasPool, ImageArray
+from mocapqa.render.engine import FIXED_COLOR, FLAG_COLOR, CanvasPool, ImageArray, pool_or_own
 from mocapqa.render.scene import CameraView, SkeletonTrack, check_same_shape, frame_camera
 
 __all__ = [
@@ -130,8 +130,7 @@ def render_still(
         options.elevation_deg,
         options.width_px / options.height_px,
     )
-    pool = canvases or CanvasPool()
-    try:
+    with pool_or_own(canvases) as pool:
         canvas = pool.get(options.width_px, options.height_px, 1)
         canvas.draw(
             0,
@@ -143,9 +142,6 @@ def render_still(
             legend=legend,
         )
         return canvas.image()
-    finally:
-        if canvases is None:
-            pool.close()
 
 
 def render_side_by_side(
@@ -188,16 +184,12 @@ def render_side_by_side(
         raw, None, options.azimuth_deg, options.elevation_deg, options.width_px / options.height_px
     )
     row = flags_at(flagged, frame, len(raw.names))
-    pool = canvases or CanvasPool()
-    try:
+    with pool_or_own(canvases) as pool:
         canvas = pool.get(2 * options.width_px, options.height_px, 2)
         captions = [f"{t} · frame {frame}" if t else f"frame {frame}" for t in titles]
         canvas.draw(0, raw, frame, camera, row, captions[0], FLAG_COLOR)
         canvas.draw(1, corrected, frame, camera, row, captions[1], FIXED_COLOR)
         return canvas.image()
-    finally:
-        if canvases is None:
-            pool.close()
 
 
 def render_thumbnail(

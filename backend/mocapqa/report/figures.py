@@ -43,6 +43,37 @@ def _bands(findings: Sequence[Mapping[str, Any]], color: str) -> list[dict[str, 
     ]
 
 
+def _lines_figure(
+    lines: Sequence[tuple[str, Sequence[Any], Sequence[Any]]],
+    hover: str,
+    title: str,
+    y_title: str,
+    shapes: list[dict[str, Any]],
+) -> Any:
+    """A Plotly figure of one line per ``(name, frames, values)``, hovered as ``frame … <br>
+    hover``, with the title, the y axis' title and the shaded bands."""
+    import plotly.graph_objects as go
+
+    fig = go.Figure()
+    for name, frames, values in lines:
+        fig.add_trace(
+            go.Scatter(
+                x=frames,
+                y=values,
+                mode="lines",
+                name=name,
+                hovertemplate=f"frame %{{x}}<br>{hover}<extra>%{{fullData.name}}</extra>",
+            )
+        )
+    fig.update_layout(
+        **_LAYOUT,
+        title={"text": title},
+        yaxis={"title": {"text": y_title}},
+        shapes=shapes,
+    )
+    return fig
+
+
 def twist_timeline_figure(
     twist: Mapping[str, Any], findings: Sequence[Mapping[str, Any]] = ()
 ) -> Any:
@@ -55,30 +86,19 @@ def twist_timeline_figure(
     findings : sequence of mapping
         Twist findings to shade.
     """
-    import plotly.graph_objects as go
 
     frames = twist.get("frames", [])
     chains = twist.get("chains", [])
     if not frames or not chains:
         return None
-    fig = go.Figure()
-    for chain in chains:
-        fig.add_trace(
-            go.Scatter(
-                x=frames,
-                y=chain.get("offset_deg", []),
-                mode="lines",
-                name=str(chain.get("joint")),
-                hovertemplate="frame %{x}<br>offset %{y:.1f}°<extra>%{fullData.name}</extra>",
-            )
-        )
-    fig.update_layout(
-        **_LAYOUT,
-        title={"text": "Twist offset removed per chain"},
-        yaxis={"title": {"text": "offset (deg)"}},
-        shapes=_bands(findings, "#d62728"),
+    lines = [(str(chain.get("joint")), frames, chain.get("offset_deg", [])) for chain in chains]
+    return _lines_figure(
+        lines,
+        "offset %{y:.1f}°",
+        "Twist offset removed per chain",
+        "offset (deg)",
+        _bands(findings, "#d62728"),
     )
-    return fig
 
 
 def limits_timeline_figure(
@@ -96,7 +116,6 @@ def limits_timeline_figure(
     max_joints : int
         Most joints drawn, by largest score.
     """
-    import plotly.graph_objects as go
 
     series: list[tuple[str, list[Any], list[float]]] = []
     joints = limits.get("joints", [])
@@ -114,24 +133,13 @@ def limits_timeline_figure(
     series.sort(key=lambda s: -max(s[2]))
     if not series:
         return None
-    fig = go.Figure()
-    for name, frames, scores in series[:max_joints]:
-        fig.add_trace(
-            go.Scatter(
-                x=frames,
-                y=scores,
-                mode="lines",
-                name=name,
-                hovertemplate="frame %{x}<br>outside by %{y:.1f}°<extra>%{fullData.name}</extra>",
-            )
-        )
-    fig.update_layout(
-        **_LAYOUT,
-        title={"text": "Distance outside joint limits"},
-        yaxis={"title": {"text": "score (deg)"}},
-        shapes=_bands(findings, "#ff7f0e"),
+    return _lines_figure(
+        series[:max_joints],
+        "outside by %{y:.1f}°",
+        "Distance outside joint limits",
+        "score (deg)",
+        _bands(findings, "#ff7f0e"),
     )
-    return fig
 
 
 def filter_weights_figure(filters: Mapping[str, Any], frames: Sequence[int] = ()) -> Any:

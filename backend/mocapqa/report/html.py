@@ -188,18 +188,45 @@ def build_report(
     reasons = dict(unavailable or {})
     fps = take.get("fps")
     fps_value = float(fps) if isinstance(fps, (int, float)) and fps > 0 else None
-    if findings is None:
-        twists = twist_findings(twist)
-        spins: list[dict[str, Any]] = []
-        limit_runs = limit_findings(limits)
-    else:
-        given = normalise_findings([dict(f) for f in findings])
-        twists = [f for f in given if f["kind"] == "twist"]
-        spins = [f for f in given if f["kind"] == "spin"]
-        limit_runs = [f for f in given if f["kind"] not in ("twist", "spin")]
+    twists, spins, limit_runs = _split_findings(findings, twist, limits)
     name = title or str(take.get("name", "take"))
+    parts = _head(name)
+    parts.append('<h2 id="summary">Take summary</h2>')
+    parts.append(_key_value_table(take))
+    parts += _findings_section(twist, limits, reasons, [*twists, *spins, *limit_runs], fps_value)
+    parts += _timeline_sections(
+        {"twist": twist, "limits": limits, "filters": filters},
+        reasons,
+        twists,
+        limit_runs,
+        filter_frames,
+    )
+    parts += _images_section(contact_sheet_png, images, reasons)
+    parts += _settings_section(settings, software)
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def _split_findings(
+    findings: Sequence[Mapping[str, Any]] | None,
+    twist: Mapping[str, Any] | None,
+    limits: Mapping[str, Any] | None,
+) -> tuple[list[dict[str, Any]], list[dict[str, Any]], list[dict[str, Any]]]:
+    """The twist intervals, limb spins and other findings (limits, markers, feet) of a report:
+    the pipeline's ``findings`` when given, else those of ``twist`` and ``limits``."""
+    if findings is None:
+        return twist_findings(twist), [], limit_findings(limits)
+    given = normalise_findings([dict(f) for f in findings])
+    twists = [f for f in given if f["kind"] == "twist"]
+    spins = [f for f in given if f["kind"] == "spin"]
+    others = [f for f in given if f["kind"] not in ("twist", "spin")]
+    return twists, spins, others
+
+
+def _head(name: str) -> list[str]:
+    """The document's head (styles, policy, Plotly) and its title lines."""
     created = datetime.now(UTC).strftime("%Y-%m-%d %H:%M:%S UTC")
-    parts = [
+    return [
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
         f'<meta http-equiv="Content-Security-Policy" content="{_CSP}">',
@@ -209,24 +236,47 @@ def build_report(
         "</head><body>",
         f"<h1>QA report · {_esc(name)}</h1>",
         f'<p class="muted">Generated {created} by mocapqa {_esc(__version__)}.</p>',
-        '<h2 id="summary">Take summary</h2>',
-        _key_value_table(take),
     ]
 
-    parts.append('<h2 id="findings">Findings</h2>')
+
+def _findings_section(
+    twist: Mapping[str, Any] | None,
+    limits: Mapping[str, Any] | None,
+    reasons: Mapping[str, str],
+    findings: list[dict[str, Any]],
+    fps: float | None,
+) -> list[str]:
+    """The findings table, in frame order, after why the twist or limits check is missing."""
+    parts = ['<h2 id="findings">Findings</h2>']
     missing = [s for s in ("twist", "limits") if (twist if s == "twist" else limits) is None]
     if missing:
         parts.append(_unavailable("; ".join(f"{s}: {reasons.get(s, 'not run')}" for s in missing)))
     # In frame order, as the take view lists them ungrouped.
-    listed = sorted([*twists, *spins, *limit_runs], key=lambda f: (f["start_frame"], f["kind"]))
-    parts.append(_findings_table(listed, fps_value))
+    listed = sorted(findings, key=lambda f: (f["start_frame"], f["kind"]))
+    parts.append(_findings_table(listed, fps))
+    return parts
 
-    sections: list[tuple[str, str, str, Mapping[str, Any] | None]] = [
-        ("twist", "twist-timeline", "Twist timeline", twist),
-        ("limits", "limits-timeline", "Limits timeline", limits),
-        ("filters", "filter-weights", "Filter weights", filters),
-    ]
-    for key, div_id, heading, data in sections:
+
+_TIMELINES = (
+    ("twist", "twist-timeline", "Twist timeline"),
+    ("limits", "limits-timeline", "Limits timeline"),
+    ("filters", "filter-weights", "Filter weights"),
+)
+"""The plotted sections: key of their series, the figure's div id, heading."""
+
+
+def _timeline_sections(
+    series: Mapping[str, Mapping[str, Any] | None],
+    reasons: Mapping[str, str],
+    twists: list[dict[str, Any]],
+    limit_runs: list[dict[str, Any]],
+    filter_frames: Sequence[int],
+) -> list[str]:
+    """The twist timeline, limits timeline and filter weights sections (each its figure, or
+    why it is missing)."""
+    parts = []
+    for key, div_id, heading in _TIMELINES:
+        data = series[key]
         parts.append(f'<h2 id="{div_id}-section">{heading}</h2>')
         if data is None:
             parts.append(_unavailable(reasons.get(key, f"The {key} analysis was not run.")))
@@ -241,8 +291,14 @@ def build_report(
             parts.append('<p class="muted">Nothing to plot: the analysis returned no series.</p>')
         else:
             parts.append(_figure_html(fig, div_id))
+    return parts
 
-    parts.append('<h2 id="contact-sheet">Contact sheet</h2>')
+
+def _images_section(
+    contact_sheet_png: bytes | None, images: Sequence[tuple[str, bytes]], reasons: Mapping[str, str]
+) -> list[str]:
+    """The contact sheet (or why there is none), then the further images with captions."""
+    parts = ['<h2 id="contact-sheet">Contact sheet</h2>']
     if contact_sheet_png is not None:
         parts.append(_png_tag(contact_sheet_png, "contact sheet of the flagged intervals"))
     else:
@@ -253,16 +309,20 @@ def build_report(
         parts.append(
             f"<figure>{_png_tag(png, caption)}<figcaption>{_esc(caption)}</figcaption></figure>"
         )
+    return parts
 
-    parts.append('<h2 id="settings">Settings and software</h2>')
-    parts.append(
+
+def _settings_section(
+    settings: Mapping[str, Any] | None, software: Mapping[str, str] | None
+) -> list[str]:
+    """The options the analyses ran with and the software versions."""
+    return [
+        '<h2 id="settings">Settings and software</h2>',
         "<pre>"
         + _esc(json.dumps(dict(settings or {}), indent=2, sort_keys=True, default=str))
-        + "</pre>"
-    )
-    parts.append(_key_value_table(dict(software or software_versions())))
-    parts.append("</body></html>")
-    return "\n".join(parts)
+        + "</pre>",
+        _key_value_table(dict(software or software_versions())),
+    ]
 
 
 def report_from_analysis(

@@ -446,31 +446,35 @@ def analyze_twist(
         found, detected, geometries, skeleton.names, choice, method == "robust", anatomy,
         natural_deg,
     )  # fmt: skip
-    refined_quats = refine_quats(motion.quats, geometries, offsets)
-    changed = np.any(refined_quats != motion.quats, axis=-1)
-    if changed.any():
-        refined = replace(
-            motion,
-            quats=refined_quats,
-            euler_hint_deg=refined_hint(motion, refined_quats, changed),
-        )
-    else:
-        refined = motion
-    if geometries:
-        axes = np.stack([g.axis for g in geometries])
-        theta = parent_twist_angles(motion.quats[:, [g.chain.parent for g in geometries]], axes)
-    else:
-        theta = np.zeros((n_frames, 0))
     return TwistAnalysis(
         method=method,
-        refined=refined,
+        refined=_refined(motion, refine_quats(motion.quats, geometries, offsets)),
         intervals=tuple(intervals),
         chains=geometries,
         joint_names=skeleton.names,
         fps=motion.fps,
-        parent_twist_rad=theta,
+        parent_twist_rad=_parent_twist(motion, geometries),
         offsets_rad=offsets,
         detected_offsets_rad=detected,
         apply="ids" if isinstance(choice, frozenset) else choice,
         found=tuple(found),
     )
+
+
+def _refined(motion: Motion, refined_quats: FloatArray) -> Motion:
+    """The take with the refined rotations ``(F, J, 4)`` and an Euler hint for the rows they
+    change; the take itself when they change nothing."""
+    changed = np.any(refined_quats != motion.quats, axis=-1)
+    if not changed.any():
+        return motion
+    return replace(
+        motion, quats=refined_quats, euler_hint_deg=refined_hint(motion, refined_quats, changed)
+    )
+
+
+def _parent_twist(motion: Motion, geometries: tuple[ChainGeometry, ...]) -> FloatArray:
+    """Twist angle of each chain's parent about its axis per frame, radians, shape (F, C)."""
+    if not geometries:
+        return np.zeros((motion.n_frames, 0))
+    axes = np.stack([g.axis for g in geometries])
+    return parent_twist_angles(motion.quats[:, [g.chain.parent for g in geometries]], axes)

@@ -34,15 +34,16 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from mocapqa.core.arrays import BoolArray, FloatArray
+from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError, LimitsFileError
 from mocapqa.twist.angles import ChainGeometry
+from mocapqa.twist.chain_events import DetectedInterval
 from mocapqa.twist.refine import refine_quats
 
-if TYPE_CHECKING:  # detect imports the confidence module, which reads this one
+if TYPE_CHECKING:
     from mocapqa.limits.model import LimitsModel
-    from mocapqa.twist.detect import DetectedInterval
+    from mocapqa.limits.occupancy import OccupancyMap
 
 __all__ = ["AnatomyEvidence", "anatomy_evidence"]
 
@@ -121,9 +122,7 @@ def anatomy_evidence(
     # The limits stack (scipy among it) is imported when there is an interval to read, so a
     # module that only names the twist options does not pay for it.
     from mocapqa.limits.analysis import charted
-    from mocapqa.limits.canonical import pose_sample, rig_key
-    from mocapqa.limits.intervals import wrap
-    from mocapqa.limits.occupancy import evaluate, twist_bounds
+    from mocapqa.limits.canonical import rig_key
 
     n = len(found)
     if n == 0:
@@ -131,80 +130,137 @@ def anatomy_evidence(
     model = _model_for(motion, mapping) if model is None else model
     if model is None:
         return AnatomyEvidence.empty(n)
-    lengths = np.array([i.end_frame - i.start_frame + 1 for i in found], dtype=np.intp)
-    starts = np.concatenate(([0], np.cumsum(lengths)[:-1]))
-    block = np.repeat(np.arange(n), lengths)
-    first = np.array([i.start_frame for i in found], dtype=np.intp)
-    rows = first[block] + np.arange(len(block)) - starts[block]
+    rows, block, starts = _interval_rows(found)
     chain_of = np.array([i.chain for i in found], dtype=np.intp)
     # Each interval's block of rows, with its own levels only, on its own chain.
     offsets = np.zeros((len(rows), len(geometries)))
     offsets[np.arange(len(rows)), chain_of[block]] = detected[rows, chain_of[block]]
     raw = motion.quats[rows]
     stacked = np.concatenate((raw, refine_quats(raw, geometries, offsets)))
-    translations = np.concatenate((motion.translations[rows],) * 2)
     known = model.frame != "canonical" or (not mapping and rig_key(motion) in model.rig_frames)
-    if known:
-        rows_motion = Motion(motion.skeleton, stacked, translations, motion.fps)
-        ignore = None
-        head = 0
-    else:
-        # Frames of a rig the model has not seen come from the take's own frames (at most
-        # 4,000 evenly spaced, as the limits check samples them) without the frames inside
-        # intervals; the rows to read follow them and are left out of that estimate too.
-        inside = np.zeros(motion.n_frames, dtype=bool)
-        inside[rows] = True
-        sample = pose_sample(motion.n_frames)
-        sample = np.arange(motion.n_frames) if sample is None else sample
-        rows_motion = Motion(
-            motion.skeleton,
-            np.concatenate((motion.quats[sample], stacked)),
-            np.concatenate((motion.translations[sample], translations)),
-            motion.fps,
-        )
-        ignore = np.ones(rows_motion.quats.shape[:2], dtype=bool)
-        ignore[: len(sample)] = inside[sample, None]
-        head = len(sample)
+    rows_motion, ignore, head = _rows_motion(motion, rows, stacked, known)
     try:
         params, columns, _, names = charted(rows_motion, model, mapping, ignore)
     except (LimitsFileError, InputError):
         return AnatomyEvidence.empty(n)
-    params = params[head:]
+    readings = _Readings.of_rows(len(rows), n)
     column = {name: k for k, name in enumerate(names)}
     skeleton = motion.skeleton
-    m = len(rows)
-    depth_raw = np.full(m, -np.inf)
-    depth_fixed = np.full(m, -np.inf)
-    child_raw = np.zeros(m)
-    child_fixed = np.zeros(m)
-    checked = np.zeros(n, dtype=bool)
     for c, geometry in enumerate(geometries):
         mine = chain_of[block] == c
         if not mine.any():
             continue
-        parent = column.get(skeleton.names[geometry.chain.parent])
-        child = column.get(skeleton.names[geometry.chain.child])
+        parent, child = (
+            _grid(model, columns, column.get(skeleton.names[j]))
+            for j in (geometry.chain.parent, geometry.chain.child)
+        )
+        readings.read_chain(params[head:], mine, chain_of == c, parent, child)
+    reduce = np.maximum.reduceat
+    inward = readings.checked[block]
+    return AnatomyEvidence(
+        raw_deg=reduce(np.maximum(readings.depth_raw, 0.0), starts),
+        fixed_deg=reduce(np.maximum(readings.depth_fixed, 0.0), starts),
+        outward_deg=reduce(
+            np.where(inward, readings.depth_fixed - readings.depth_raw, 0.0), starts
+        ),
+        child_raw_deg=reduce(readings.child_raw, starts),
+        child_fixed_deg=reduce(readings.child_fixed, starts),
+        checked=readings.checked,
+    )
+
+
+def _interval_rows(found: Sequence[DetectedInterval]) -> tuple[IntArray, IntArray, IntArray]:
+    """The frames of every interval one after the other (shape (R,)), the interval of each
+    (shape (R,)) and where each interval's block starts (shape (N,))."""
+    lengths = np.array([i.end_frame - i.start_frame + 1 for i in found], dtype=np.intp)
+    starts = np.concatenate(([0], np.cumsum(lengths)[:-1]))
+    block = np.repeat(np.arange(len(found)), lengths)
+    first = np.array([i.start_frame for i in found], dtype=np.intp)
+    rows = first[block] + np.arange(len(block)) - starts[block]
+    return rows, block, starts
+
+
+def _grid(model: LimitsModel, columns: list[int], k: int | None) -> tuple[int, OccupancyMap] | None:
+    """Column ``k`` of a charted take and its joint's occupancy grid; None for None."""
+    return None if k is None else (k, model.joints[columns[k]].occupancy)
+
+
+def _rows_motion(
+    motion: Motion, rows: IntArray, stacked: FloatArray, known: bool
+) -> tuple[Motion, BoolArray | None, int]:
+    """The take's ``rows`` as read and as corrected (``stacked``, ``(2R, J, 4)``) as a motion to
+    chart, the frames that must not set its canonical frames, and how many leading frames to
+    drop from its reading.
+
+    Frames of a rig the model has not seen (``known`` False) come from the take's own frames
+    (at most 4,000 evenly spaced, as the limits check samples them) without the frames inside
+    intervals; the rows to read follow them and are left out of that estimate too.
+    """
+    from mocapqa.limits.canonical import pose_sample
+
+    translations = np.concatenate((motion.translations[rows],) * 2)
+    if known:
+        return Motion(motion.skeleton, stacked, translations, motion.fps), None, 0
+    inside = np.zeros(motion.n_frames, dtype=bool)
+    inside[rows] = True
+    sample = pose_sample(motion.n_frames)
+    sample = np.arange(motion.n_frames) if sample is None else sample
+    rows_motion = Motion(
+        motion.skeleton,
+        np.concatenate((motion.quats[sample], stacked)),
+        np.concatenate((motion.translations[sample], translations)),
+        motion.fps,
+    )
+    ignore = np.ones(rows_motion.quats.shape[:2], dtype=bool)
+    ignore[: len(sample)] = inside[sample, None]
+    return rows_motion, ignore, len(sample)
+
+
+@dataclass(frozen=True, slots=True)
+class _Readings:
+    """Per row of the intervals (shape (R,)): the parent's twist depth beyond its range raw and
+    corrected (degrees, negative inside, -inf unread) and the child's distance outside its
+    range raw and corrected (degrees); per interval (shape (N,)): whether its parent was read.
+    """
+
+    depth_raw: FloatArray
+    depth_fixed: FloatArray
+    child_raw: FloatArray
+    child_fixed: FloatArray
+    checked: BoolArray
+
+    @classmethod
+    def of_rows(cls, m: int, n: int) -> _Readings:
+        """Nothing read yet, for ``m`` rows of ``n`` intervals."""
+        return cls(
+            np.full(m, -np.inf), np.full(m, -np.inf), np.zeros(m), np.zeros(m),
+            np.zeros(n, dtype=bool),
+        )  # fmt: skip
+
+    def read_chain(
+        self,
+        params: FloatArray,
+        mine: BoolArray,
+        intervals: BoolArray,
+        parent: tuple[int, OccupancyMap] | None,
+        child: tuple[int, OccupancyMap] | None,
+    ) -> None:
+        """Read one chain's rows ``mine`` (R,) from ``params`` ``(2R, K, 3)`` (raw rows then
+        corrected ones): its parent's and its child's column and occupancy grid (None: not in
+        the model); mark its ``intervals`` (N,) checked when its parent is read."""
+        from mocapqa.limits.intervals import wrap
+        from mocapqa.limits.occupancy import evaluate, twist_bounds
+
         both = np.concatenate((mine, mine))
+        count = mine.sum()
         if parent is not None:
             # Signed distance of the twist to the edge of its range (negative inside), degrees.
-            read = params[both, parent]
-            centre, half = twist_bounds(model.joints[columns[parent]].occupancy, read)
+            read = params[both, parent[0]]
+            centre, half = twist_bounds(parent[1], read)
             depth = np.rad2deg(np.abs(wrap(read[:, 2] - centre)) - half)
-            depth_raw[mine], depth_fixed[mine] = depth[: mine.sum()], depth[mine.sum() :]
-            checked[chain_of == c] = True
+            self.depth_raw[mine], self.depth_fixed[mine] = depth[:count], depth[count:]
+            self.checked[intervals] = True
         if child is not None:
-            _, swing, twist, _ = evaluate(
-                model.joints[columns[child]].occupancy, params[both, child]
-            )
+            _, swing, twist, _ = evaluate(child[1], params[both, child[0]])
             distance = np.hypot(swing, twist)
-            child_raw[mine], child_fixed[mine] = distance[: mine.sum()], distance[mine.sum() :]
-    reduce = np.maximum.reduceat
-    inward = checked[block]
-    return AnatomyEvidence(
-        raw_deg=reduce(np.maximum(depth_raw, 0.0), starts),
-        fixed_deg=reduce(np.maximum(depth_fixed, 0.0), starts),
-        outward_deg=reduce(np.where(inward, depth_fixed - depth_raw, 0.0), starts),
-        child_raw_deg=reduce(child_raw, starts),
-        child_fixed_deg=reduce(child_fixed, starts),
-        checked=checked,
-    )
+            self.child_raw[mine], self.child_fixed[mine] = distance[:count], distance[count:]

@@ -193,15 +193,7 @@ def choose_intervals(
     InputError
         For an interval id the take does not have.
     """
-    if isinstance(choice, frozenset) and choice and max(choice) >= len(found):
-        if not found:
-            raise InputError(
-                f"Expected no interval ids in apply on a take with no twist interval, got "
-                f"{sorted(choice)}"
-            )
-        raise InputError(
-            f"Expected interval ids 0 to {len(found) - 1} in apply, got {sorted(choice)}"
-        )
+    _check_ids(choice, len(found))
     offsets = np.zeros_like(detected)
     intervals = []
     probability = np.array([i.confidence for i in found], dtype=np.float64)
@@ -212,42 +204,15 @@ def choose_intervals(
         natural_deg=natural_deg,
     )  # fmt: skip
     for k, i in enumerate(found):
-        if isinstance(choice, frozenset):
-            applied = k in choice
-        elif choice == "confident":
-            applied = bool(confident[k])
-        else:
-            applied = choice != "none"
+        applied = _is_applied(choice, k, bool(confident[k]))
         evidence: tuple[tuple[str, float | str], ...] = ()
         if features[k]:
-            evidence = (("calibrated", float(i.confidence)),)
-            if anatomy is not None and anatomy.checked[k]:
-                evidence += (
-                    ("anatomy_deg", float(anatomy.raw_deg[k] - anatomy.fixed_deg[k])),
-                    ("child_anatomy_deg",
-                     float(anatomy.child_raw_deg[k] - anatomy.child_fixed_deg[k])),
-                )  # fmt: skip
             natural = 0.0 if natural_deg is None else float(natural_deg[k])
-            if natural > 0.0:
-                evidence += (("natural_roll_deg", natural),)
-            evidence += (("rule", rules[k]), ("default", "applied" if confident[k] else "listed"))
-            if rules[k] == "natural_roll":
-                segment = geometries[i.chain].chain.segment.replace("_", " ")
-                evidence += (
-                    ("reason",
-                     f"smaller than this rig's natural {segment} roll (p99 {natural:.1f}°)"),
-                )  # fmt: skip
+            segment = geometries[i.chain].chain.segment
+            evidence = _evidence(i, k, anatomy, natural, rules[k], bool(confident[k]), segment)
         rows = slice(i.start_frame, i.end_frame + 1)
         if applied:
             offsets[rows, i.chain] = detected[rows, i.chain]
-        values = detected[rows, i.chain]
-        cuts = np.flatnonzero(np.diff(values) != 0.0) + 1
-        levels = tuple(
-            (i.start_frame + int(part[0]), i.start_frame + int(part[-1]),
-             float(np.rad2deg(values[part[0]])))
-            for part in np.split(np.arange(len(values)), cuts)
-            if values[part[0]] != 0.0
-        )  # fmt: skip
         geometry = geometries[i.chain]
         intervals.append(
             TwistInterval(
@@ -260,11 +225,79 @@ def choose_intervals(
                 confidence=float(i.confidence),
                 id=k,
                 applied=applied,
-                levels=levels,
+                levels=_levels(detected[rows, i.chain], i.start_frame),
                 evidence=evidence,
             )
         )
     return offsets, intervals
+
+
+def _is_applied(choice: str | frozenset[int], k: int, confident: bool) -> bool:
+    """Whether ``choice`` (from :func:`parse_apply`) applies interval ``k``, whose default is
+    ``confident``."""
+    if isinstance(choice, frozenset):
+        return k in choice
+    if choice == "confident":
+        return confident
+    return choice != "none"
+
+
+def _check_ids(choice: str | frozenset[int], n_found: int) -> None:
+    """Refuse interval ids in ``choice`` beyond the ``n_found`` intervals of the take.
+
+    Raises
+    ------
+    InputError
+        For an interval id the take does not have.
+    """
+    if isinstance(choice, frozenset) and choice and max(choice) >= n_found:
+        if not n_found:
+            raise InputError(
+                f"Expected no interval ids in apply on a take with no twist interval, got "
+                f"{sorted(choice)}"
+            )
+        raise InputError(f"Expected interval ids 0 to {n_found - 1} in apply, got {sorted(choice)}")
+
+
+def _evidence(
+    interval: DetectedInterval,
+    k: int,
+    anatomy: AnatomyEvidence | None,
+    natural: float,
+    rule: str,
+    confident: bool,
+    segment: str,
+) -> tuple[tuple[str, float | str], ...]:
+    """What decided the default for interval ``k``: its calibrated probability, its anatomy
+    readings (degrees), its segment's natural roll level (degrees, 0: none), the deciding
+    ``rule`` and whether the default applies it."""
+    evidence: tuple[tuple[str, float | str], ...] = (("calibrated", float(interval.confidence)),)
+    if anatomy is not None and anatomy.checked[k]:
+        evidence += (
+            ("anatomy_deg", float(anatomy.raw_deg[k] - anatomy.fixed_deg[k])),
+            ("child_anatomy_deg", float(anatomy.child_raw_deg[k] - anatomy.child_fixed_deg[k])),
+        )
+    if natural > 0.0:
+        evidence += (("natural_roll_deg", natural),)
+    evidence += (("rule", rule), ("default", "applied" if confident else "listed"))
+    if rule == "natural_roll":
+        name = segment.replace("_", " ")
+        evidence += (
+            ("reason", f"smaller than this rig's natural {name} roll (p99 {natural:.1f}°)"),
+        )
+    return evidence
+
+
+def _levels(values: FloatArray, start_frame: int) -> tuple[tuple[int, int, float], ...]:
+    """Each run of one non-zero level in an interval's offsets ``values`` (radians, from frame
+    ``start_frame``): first and last frame and the level in degrees."""
+    cuts = np.flatnonzero(np.diff(values) != 0.0) + 1
+    return tuple(
+        (start_frame + int(part[0]), start_frame + int(part[-1]),
+         float(np.rad2deg(values[part[0]])))
+        for part in np.split(np.arange(len(values)), cuts)
+        if values[part[0]] != 0.0
+    )  # fmt: skip
 
 
 _READOUTS = {

@@ -37,17 +37,18 @@ from __future__ import annotations
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from importlib import resources
+from functools import cache
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from mocapqa.core.arrays import FloatArray
+from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.errors import InputError
 from mocapqa.twist.anatomy import AnatomyEvidence
 from mocapqa.twist.intervals import FEATURES
 from mocapqa.twist.repetition import family_counts
+from mocapqa.twist.shipped import shipped_json
 
 __all__ = [
     "ANATOMY_MAX_MISMATCH",
@@ -116,7 +117,25 @@ RULES = (
     "end_evidence",
     "uncalibrated",
 )
-"""Which evidence decided an interval under ``apply="confident"`` (:func:`decide`)."""
+"""Which evidence decided an interval under ``apply="confident"`` (:func:`decide`).
+
+In order: no calibrated features (the paper's method) applies (``"uncalibrated"``); failing
+:func:`has_evidence` does not (``"min_evidence"``); an interval whose largest level is under
+the natural roll level of its rig's segment (``natural_deg``,
+:mod:`mocapqa.twist.natural_roll`) does not, whatever else speaks for it (``"natural_roll"``):
+it cannot be told from natural roll by its size; a one-sided interval (``sides``: "head" or
+"tail") whose level is under :data:`END_MIN_LEVEL_DEG` and whose event's mismatch ratio is over
+:data:`END_MAX_MISMATCH` does not (``"end_evidence"``); a correction that moves the parent's
+twist or the child's rotation from inside its range to ``min_deg`` or more beyond it does not
+(``"anatomy_against"``); a raw twist ``min_deg`` or more beyond the range that the correction
+brings inside, moving no frame's twist ``min_deg`` or more toward the range's edge, with the
+child not pushed ``min_deg`` further out, a mismatch ratio of at most ``max_mismatch`` and a
+duration of at most ``max_s``, applies (``"anatomy"``); with ``min_family`` > 0, an interval as
+short and as well counter-rotated with at least ``min_family`` other strong intervals on its
+chain (probability ≥ ``strong_p`` or the anatomy rule,
+:func:`mocapqa.twist.repetition.family_counts`) applies (``"repetition"``); otherwise the
+calibrated probability decides against :data:`APPLY_THRESHOLD` (``"calibrated"``).
+"""
 CALIBRATION_FILE = "calibration.json"
 """Name of the stored calibration in the package's ``data/twist`` folder."""
 
@@ -235,22 +254,8 @@ def decide(
 ) -> tuple[np.ndarray, tuple[str, ...]]:
     """Whether ``apply="confident"`` applies each interval, and which evidence decided.
 
-    In order: no calibrated features (the paper's method) applies (``"uncalibrated"``); failing
-    :func:`has_evidence` does not (``"min_evidence"``); an interval whose largest level is under
-    the natural roll level of its rig's segment (``natural_deg``,
-    :mod:`mocapqa.twist.natural_roll`) does not, whatever else speaks for it (``"natural_roll"``):
-    it cannot be told from natural roll by its size; a one-sided interval (``sides``: "head" or
-    "tail") whose level is under :data:`END_MIN_LEVEL_DEG` and whose event's mismatch ratio is over
-    :data:`END_MAX_MISMATCH` does not (``"end_evidence"``); a correction that moves the parent's
-    twist or the child's rotation from inside its range to ``min_deg`` or more beyond it does not
-    (``"anatomy_against"``); a raw twist ``min_deg`` or more beyond the range that the correction
-    brings inside, moving no frame's twist ``min_deg`` or more toward the range's edge, with the
-    child not pushed ``min_deg`` further out, a mismatch ratio of at most ``max_mismatch`` and a
-    duration of at most ``max_s``, applies (``"anatomy"``); with ``min_family`` > 0, an interval as
-    short and as well counter-rotated with at least ``min_family`` other strong intervals on its
-    chain (probability ≥ ``strong_p`` or the anatomy rule,
-    :func:`mocapqa.twist.repetition.family_counts`) applies (``"repetition"``); otherwise the
-    calibrated probability decides against :data:`APPLY_THRESHOLD` (``"calibrated"``).
+    The rules, in the order they are tried (the first that holds decides), are described at
+    :data:`RULES`.
 
     Parameters
     ----------
@@ -287,10 +292,75 @@ def decide(
         anatomy = AnatomyEvidence.empty(n)
     calibrated = np.array([len(f) > 0 for f in features], dtype=bool)
     evidence = np.array([has_evidence(f) for f in features], dtype=bool)
+    weak_end = _weak_ends(features, sides)
+    natural = np.zeros(n) if natural_deg is None else np.asarray(natural_deg, dtype=np.float64)
+    level, mismatch, short = _feature_arrays(features, max_s)
+    rolled = calibrated & evidence & (level < natural.reshape(n))
+    against, brought = _anatomy_rules(anatomy, min_deg)
+    support = anatomy.checked & brought & short & (mismatch <= max_mismatch) & ~against
+    family = (
+        _family(chains, min_family, calibrated & evidence & ~against, support, p >= strong_p)
+        & short & (mismatch <= max_mismatch) & (p < APPLY_THRESHOLD)
+    )  # fmt: skip
+    applied = np.where(
+        ~calibrated,
+        True,
+        evidence & ~rolled & ~weak_end & ~against & (support | family | (p >= APPLY_THRESHOLD)),
+    )
+    rules = np.select(
+        [~calibrated, ~evidence, rolled, weak_end, against, support, family],
+        ["uncalibrated", "min_evidence", "natural_roll", "end_evidence", "anatomy_against",
+         "anatomy", "repetition"],
+        "calibrated",
+    )  # fmt: skip
+    return applied.astype(bool), tuple(str(r) for r in rules)
+
+
+def _family(
+    chains: Sequence[int] | None,
+    min_family: int,
+    eligible: BoolArray,
+    support: BoolArray,
+    strong_p: BoolArray,
+) -> BoolArray:
+    """Whether each ``eligible`` interval not applied by the anatomy rule has at least
+    ``min_family`` other strong intervals (``support`` or ``strong_p``, eligible) on its chain,
+    shape (N,); none without ``chains`` or with ``min_family`` 0."""
+    if chains is None or min_family <= 0:
+        return np.zeros(len(eligible), dtype=bool)
+    strong = eligible & (support | strong_p)
+    others = family_counts(np.asarray(chains, dtype=np.intp), strong)
+    family: BoolArray = (others >= min_family) & eligible & ~support
+    return family
+
+
+def _feature_arrays(
+    features: Sequence[Sequence[float]], max_s: float
+) -> tuple[FloatArray, FloatArray, BoolArray]:
+    """Each interval's largest level (degrees) and mismatch ratio (inf without features), and
+    whether it lasts at most ``max_s`` seconds, each shape (N,)."""
+    level = np.array(
+        [np.exp(f[FEATURES.index("log_level_deg")]) if f else np.inf for f in features],
+        dtype=np.float64,
+    )
+    mismatch = np.array(
+        [f[FEATURES.index("mismatch")] if f else np.inf for f in features], dtype=np.float64
+    )
+    short = np.array(
+        [bool(f) and f[FEATURES.index("log_length_s")] <= np.log(max_s) for f in features],
+        dtype=bool,
+    )
+    return level, mismatch, short
+
+
+def _weak_ends(features: Sequence[Sequence[float]], sides: Sequence[str] | None) -> BoolArray:
+    """Whether each interval is one-sided with a level under :data:`END_MIN_LEVEL_DEG` and a
+    mismatch ratio over :data:`END_MAX_MISMATCH`, shape (N,) of bool."""
+    n = len(features)
     one_sided = np.array(
         [False] * n if sides is None else [bool(side) for side in sides], dtype=bool
     )
-    weak_end = one_sided & np.array(
+    weak: BoolArray = one_sided & np.array(
         [
             bool(f)
             and f[FEATURES.index("log_level_deg")] < np.log(END_MIN_LEVEL_DEG)
@@ -299,69 +369,32 @@ def decide(
         ],
         dtype=bool,
     )
-    natural = np.zeros(n) if natural_deg is None else np.asarray(natural_deg, dtype=np.float64)
-    level = np.array(
-        [np.exp(f[FEATURES.index("log_level_deg")]) if f else np.inf for f in features],
-        dtype=np.float64,
-    )
-    rolled = calibrated & evidence & (level < natural.reshape(n))
-    mismatch = np.array(
-        [f[FEATURES.index("mismatch")] if f else np.inf for f in features], dtype=np.float64
-    )
-    short = np.array(
-        [bool(f) and f[FEATURES.index("log_length_s")] <= np.log(max_s) for f in features],
-        dtype=bool,
-    )
+    return weak
+
+
+def _anatomy_rules(anatomy: AnatomyEvidence, min_deg: float) -> tuple[BoolArray, BoolArray]:
+    """Per interval, shape (N,) of bool each: whether the correction pushes the parent's twist
+    or the child's rotation from inside its range to ``min_deg`` or more beyond it (checked
+    intervals only), and whether it brings a raw twist ``min_deg`` or more beyond the range
+    inside, moving no frame ``min_deg`` toward the edge and the child not ``min_deg`` further
+    out."""
     raw, fixed = anatomy.raw_deg, anatomy.fixed_deg
     child_raw, child_fixed = anatomy.child_raw_deg, anatomy.child_fixed_deg
     pushed = ((raw <= 0.0) & (fixed >= min_deg)) | ((child_raw <= 0.0) & (child_fixed >= min_deg))
-    against = anatomy.checked & pushed
     brought = (
         (raw >= min_deg)
         & (fixed <= 0.0)
         & (anatomy.outward_deg < min_deg)
         & (child_fixed - child_raw < min_deg)
     )
-    support = anatomy.checked & brought & short & (mismatch <= max_mismatch) & ~against
-    family = np.zeros(n, dtype=bool)
-    if chains is not None and min_family > 0:
-        strong = calibrated & evidence & ~against & (support | (p >= strong_p))
-        others = family_counts(np.asarray(chains, dtype=np.intp), strong)
-        family = (
-            (others >= min_family) & calibrated & evidence & ~against & ~support
-            & short & (mismatch <= max_mismatch) & (p < APPLY_THRESHOLD)
-        )  # fmt: skip
-    applied = np.where(
-        ~calibrated,
-        True,
-        evidence & ~rolled & ~weak_end & ~against & (support | family | (p >= APPLY_THRESHOLD)),
-    )
-    rules = np.select(
-        [~calibrated, ~evidence, rolled, weak_end, against, support, family],
-        [
-            "uncalibrated",
-            "min_evidence",
-            "natural_roll",
-            "end_evidence",
-            "anatomy_against",
-            "anatomy",
-            "repetition",
-        ],
-        "calibrated",
-    )
-    return applied.astype(bool), tuple(str(r) for r in rules)
+    against: BoolArray = anatomy.checked & pushed
+    return against, brought
 
 
-_LOADED: dict[str, Calibration] = {}
-
-
+@cache
 def default_calibration() -> Calibration:
     """The shipped calibration (``mocapqa/data/twist/calibration.json``), read once."""
-    if CALIBRATION_FILE not in _LOADED:
-        resource = resources.files("mocapqa") / "data" / "twist" / CALIBRATION_FILE
-        data = json.loads(resource.read_text(encoding="utf-8"))
-        _LOADED[CALIBRATION_FILE] = Calibration.from_json(data, str(resource))
-    return _LOADED[CALIBRATION_FILE]
+    return Calibration.from_json(*shipped_json(CALIBRATION_FILE))
 
 
 def fit_calibration(

@@ -16,7 +16,7 @@ Conventions
   accumulated level back to zero within ``max_interval_s``; events left unpaired are ignored,
   so a single spurious event cannot shift the rest of a take — except the first and last
   events near the take's ends, which form an interval to that end when the level holds there
-  and the jump stands out (:func:`mocapqa.twist.intervals.one_sided`).
+  and the jump stands out (:func:`mocapqa.twist.one_sided.one_sided`).
 * Bind-pose first frames (:func:`leading_pose_frames`) are left out of the detection.
 """
 
@@ -30,7 +30,9 @@ from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
 from mocapqa.errors import InputError
 from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.twist.angles import wrap_angle
-from mocapqa.twist.intervals import IntervalEstimate, chain_intervals
+from mocapqa.twist.chain_events import DetectedInterval
+from mocapqa.twist.confidence import default_calibration
+from mocapqa.twist.intervals import ChainSettings, IntervalEstimate, chain_intervals
 
 __all__ = [
     "MAX_HELD_POSE_FRAMES",
@@ -145,7 +147,7 @@ class RobustParams:
     ends : bool
         Also report intervals that run to an end of the take: an unmatched onset within
         ``max_interval_s`` of the last frame, or release within it of the first, whose level
-        holds to that end (:func:`mocapqa.twist.intervals.one_sided`).
+        holds to that end (:func:`mocapqa.twist.one_sided.one_sided`).
     end_contrast : float
         Such an event's jump must be at least this many times every raw roll step of the
         parent within ``burst_gap_s`` of it (one event is weaker evidence than an onset and a
@@ -155,7 +157,7 @@ class RobustParams:
         (within ``max_interval_s``) on either side, the parent's roll steps back by its jump
         and the child's by the mirror, each within this fraction of the jump, over windows of
         up to ``burst_gap_s`` (the other end of an interior interval that made no event;
-        :func:`mocapqa.twist.intervals.one_sided`). 0: off.
+        :func:`mocapqa.twist.one_sided.one_sided`). 0: off.
     """
 
     min_threshold_deg: float = 2.0
@@ -221,36 +223,14 @@ class RobustParams:
         """Frames between the 3 samples taken on each side at ``fps`` (``neighbour_s`` / 3)."""
         return max(1, round(self.neighbour_s * fps / 3))
 
-
-@dataclass(frozen=True, slots=True)
-class DetectedInterval:
-    """One error interval on one chain.
-
-    Parameters
-    ----------
-    chain : int
-        Index of the chain.
-    start_frame, end_frame : int
-        First and last corrupted frame (inclusive).
-    offset_rad : float
-        Circular mean of the offset over the interval, radians (−π, π].
-    confidence : float
-        Calibrated probability that applying the interval is right, [0, 1].
-    features : tuple of float
-        The confidence features (:data:`mocapqa.twist.intervals.FEATURES`; empty for the
-        paper's method).
-    side : {"", "head", "tail"}
-        "head" for an interval from the take's first frame to a release with no onset,
-        "tail" for one from an onset with no release to its last frame, else "".
-    """
-
-    chain: int
-    start_frame: int
-    end_frame: int
-    offset_rad: float
-    confidence: float
-    features: tuple[float, ...] = ()
-    side: str = ""
+    def chain_settings(self, threshold: float, scale: float, fps: float) -> ChainSettings:
+        """How :func:`mocapqa.twist.intervals.chain_intervals` reads the events of a chain
+        with jump ``threshold`` and natural roll ``scale`` per frame (radians) at ``fps``."""
+        return ChainSettings(
+            threshold, scale, fps, self.closure_fraction, self.agreement, self.burst_gap_s,
+            self.max_interval_s, self.tail_s, self.precision, self.mirror, self.ends,
+            self.end_contrast, self.end_return,
+        )  # fmt: skip
 
 
 @dataclass(frozen=True, slots=True)
@@ -443,16 +423,76 @@ def detect_robust(
         ``offsets`` holds every interval found; their ``confidence`` is the calibrated
         probability of :func:`mocapqa.twist.confidence.default_calibration`.
     """
-    # Imported here: the calibration's evidence modules use this module's types.
-    from mocapqa.twist.confidence import default_calibration
-
     dp, dc = parent_increments, child_increments
     n_frames, n_chains = dp.shape
     stride = params.neighbour_stride(fps)
-    reach = 3 * stride
-    if n_frames <= 2 * reach + 1 or fps < params.min_fps:
+    if n_frames <= 2 * 3 * stride + 1 or fps < params.min_fps:
         zeros = np.zeros_like(dp)
         return Detection(dp, dc, zeros.astype(bool), zeros, (), zeros)
+    res = _robust_residuals(dp, dc, stride, params)
+    jumps = _event_jumps(res, params)
+    # Counter-rotated steps below the threshold: where a burst's decay tail shows.
+    small = np.zeros_like(dp)
+    weak = (res.smaller > params.tail_factor * res.threshold) & res.consistent & ~res.events
+    rows_w, cols_w = np.nonzero(weak)
+    small[rows_w, cols_w] = np.angle(np.exp(1j * res.rp[weak]) + np.exp(-1j * res.rc[weak]))
+    rows, cols = np.nonzero(res.events)
+    ratio = np.zeros_like(dp)
+    ratio[rows, cols] = res.mismatch[rows, cols] / np.maximum(res.smaller[rows, cols], 1e-12)
+    # Each jump is read twice (parent step, child counter-step): half their gap is its error.
+    uncertainty = 0.5 * params.closure_noise * res.mismatch
+    # The chain's natural roll per frame: noise or typical velocity, whichever is larger.
+    roll_scale = np.maximum(
+        np.maximum(res.scale, np.median(np.abs(res.natural_p), axis=0)), np.deg2rad(0.01)
+    )
+    offsets = np.zeros_like(dp)
+    found: list[tuple[int, IntervalEstimate]] = []
+    for c in range(n_chains):
+        frames = np.flatnonzero(res.events[:, c])
+        if len(frames) == 0:
+            continue
+        if params.pair_events:
+            settings = params.chain_settings(float(res.threshold[c]), float(roll_scale[c]), fps)
+            offsets[:, c], estimates = chain_intervals(
+                frames, jumps[frames, c], ratio[frames, c], dp[:, c], res.natural_p[:, c],
+                settings, small[:, c], uncertainty[frames, c], (dc[:, c], res.natural_c[:, c]),
+            )  # fmt: skip
+        else:
+            offsets[:, c], estimates = _unpaired_intervals(frames, jumps[frames, c], n_frames)
+        found += [(c, e) for e in estimates]
+    return Detection(dp, dc, res.events, offsets, _scored(found), jumps)
+
+
+@dataclass(frozen=True, slots=True)
+class _Residuals:
+    """The rolls' steps against their natural velocities, and the events they make, each
+    shape (F, C) unless noted: the state :func:`detect_robust` reads after its passes.
+
+    ``rp``, ``rc`` are the parent's and the child's residual steps (radians), ``smaller`` the
+    smaller of their sizes, ``mismatch`` the size of their sum, ``consistent`` whether that
+    mismatch is within the allowed counter-rotation, ``scale`` and ``threshold`` shape (C,)
+    the noise scale and jump threshold per chain, ``natural_p``, ``natural_c`` the natural
+    velocities.
+    """
+
+    rp: FloatArray
+    rc: FloatArray
+    smaller: FloatArray
+    mismatch: FloatArray
+    consistent: BoolArray
+    scale: FloatArray
+    threshold: FloatArray
+    events: BoolArray
+    natural_p: FloatArray
+    natural_c: FloatArray
+
+
+def _robust_residuals(
+    dp: FloatArray, dc: FloatArray, stride: int, params: RobustParams
+) -> _Residuals:
+    """The events of ``params.passes`` passes, each re-estimating the natural velocities with
+    the previous pass's large steps left out."""
+    reach = 3 * stride
     floor = np.deg2rad(params.min_threshold_deg)
     natural_p = _neighbour_median(dp, stride)
     natural_c = _neighbour_median(dc, stride)
@@ -489,8 +529,17 @@ def detect_robust(
         natural_c = natural_c.copy()
         natural_p[near] = _clean_median(dp, outliers, stride, near, natural_p[near])
         natural_c[near] = _clean_median(dc, outliers, stride, near, natural_c[near])
-    rows, cols = np.nonzero(events)
-    jumps = np.zeros_like(dp)
+    return _Residuals(
+        rp, rc, smaller, mismatch, mismatch <= allowed, scale, threshold, events, natural_p,
+        natural_c,
+    )  # fmt: skip
+
+
+def _event_jumps(res: _Residuals, params: RobustParams) -> FloatArray:
+    """The jump of each event (0 elsewhere), radians, shape (F, C)."""
+    rp, rc = res.rp, res.rc
+    rows, cols = np.nonzero(res.events)
+    jumps = np.zeros_like(rp)
     if params.weighted_jumps:
         # Two measurements of one jump: the parent's step and the child's counter-step, each
         # weighted by the inverse variance of its chain's residuals (a jittery parent roll
@@ -503,44 +552,27 @@ def detect_robust(
     else:
         # The circular mean of the parent's step and the child's counter-step.
         jumps[rows, cols] = np.angle(np.exp(1j * rp[rows, cols]) + np.exp(-1j * rc[rows, cols]))
-    # Counter-rotated steps below the threshold: where a burst's decay tail shows.
-    small = np.zeros_like(dp)
-    weak = (smaller > params.tail_factor * threshold) & (mismatch <= allowed) & ~events
-    rows_w, cols_w = np.nonzero(weak)
-    small[rows_w, cols_w] = np.angle(np.exp(1j * rp[weak]) + np.exp(-1j * rc[weak]))
-    ratio = np.zeros_like(dp)
-    ratio[rows, cols] = mismatch[rows, cols] / np.maximum(smaller[rows, cols], 1e-12)
-    # Each jump is read twice (parent step, child counter-step): half their gap is its error.
-    uncertainty = 0.5 * params.closure_noise * mismatch
-    # The chain's natural roll per frame: noise or typical velocity, whichever is larger.
-    roll_scale = np.maximum(
-        np.maximum(scale, np.median(np.abs(natural_p), axis=0)), np.deg2rad(0.01)
-    )
-    offsets = np.zeros_like(dp)
-    found: list[tuple[int, IntervalEstimate]] = []
-    for c in range(n_chains):
-        frames = np.flatnonzero(events[:, c])
-        if len(frames) == 0:
-            continue
-        if params.pair_events:
-            offsets[:, c], estimates = chain_intervals(
-                frames, jumps[frames, c], ratio[frames, c], dp[:, c], natural_p[:, c],
-                float(threshold[c]), float(roll_scale[c]), fps, params.closure_fraction,
-                params.agreement, params.burst_gap_s, params.max_interval_s, small[:, c],
-                params.tail_s, uncertainty[frames, c], params.precision,
-                (dc[:, c], natural_c[:, c]), params.mirror, params.ends, params.end_contrast,
-                params.end_return,
-            )  # fmt: skip
-        else:
-            steps = np.zeros(n_frames)
-            steps[frames] = jumps[frames, c]
-            offsets[:, c] = wrap_angle(np.cumsum(steps))
-            offsets[np.abs(offsets[:, c]) < 1e-12, c] = 0.0
-            estimates = [
-                IntervalEstimate(s, e, _circular_mean(offsets[s : e + 1, c]), ())
-                for s, e in runs(offsets[:, c] != 0.0)
-            ]
-        found += [(c, e) for e in estimates]
+    return jumps
+
+
+def _unpaired_intervals(
+    frames: IntArray, jumps: FloatArray, n_frames: int
+) -> tuple[FloatArray, list[IntervalEstimate]]:
+    """Offsets (shape (F,)) and intervals of one chain when events are not paired: the jumps
+    accumulated, each run of non-zero level one interval (no features)."""
+    steps = np.zeros(n_frames)
+    steps[frames] = jumps
+    offsets = wrap_angle(np.cumsum(steps))
+    offsets[np.abs(offsets) < 1e-12] = 0.0
+    estimates = [
+        IntervalEstimate(s, e, _circular_mean(offsets[s : e + 1]), ())
+        for s, e in runs(offsets != 0.0)
+    ]
+    return offsets, estimates
+
+
+def _scored(found: list[tuple[int, IntervalEstimate]]) -> tuple[DetectedInterval, ...]:
+    """The chains' intervals with their calibrated probability (0.5 without features)."""
     with_features = [(c, e) for c, e in found if e.features]
     scores: list[float] = (
         default_calibration().probability(np.array([e.features for _, e in with_features])).tolist()
@@ -548,9 +580,8 @@ def detect_robust(
         else []
     )
     probabilities = iter(scores)
-    intervals = tuple(
+    return tuple(
         DetectedInterval(c, e.start_frame, e.end_frame, e.offset_rad,
                          float(next(probabilities)) if e.features else 0.5, e.features, e.side)
         for c, e in found
     )  # fmt: skip
-    return Detection(dp, dc, events, offsets, intervals, jumps)

@@ -52,6 +52,7 @@ __all__ = [
     "KINDS",
     "InjectedInterval",
     "InjectionTruth",
+    "add_mismatch",
     "choose_targets",
     "inject_twist_errors",
 ]
@@ -127,14 +128,21 @@ class InjectionTruth:
         clean_quats: FloatArray,
         geometries: list[ChainGeometry],
         intervals: list[InjectedInterval],
-        error_mask: BoolArray,
-        offsets_rad: FloatArray,
+        chain_offsets: FloatArray,
+        chain_mask: BoolArray,
     ) -> InjectionTruth:
-        """The truth of an injection into the target chains ``geometries`` (their parent
-        joints are the targets); the other arguments as the fields."""
+        """The truth of an injection into the target chains ``geometries`` (on different
+        limbs; their parent joints are the targets): ``chain_offsets`` (F, C), radians, and
+        ``chain_mask`` (F, C), the corrupted frames, are each chain's parent's
+        ``offsets_rad`` and ``error_mask``; the other arguments as the fields."""
+        parents = [g.chain.parent for g in geometries]
+        error_mask = np.zeros(clean_quats.shape[:2], dtype=bool)
+        error_mask[:, parents] = chain_mask
+        offsets_rad = np.zeros(clean_quats.shape[:2])
+        offsets_rad[:, parents] = chain_offsets
         return cls(
             clean_quats=clean_quats,
-            targets=tuple(g.chain.parent for g in geometries),
+            targets=tuple(parents),
             children=tuple(g.chain.child for g in geometries),
             sides=tuple(g.chain.side for g in geometries),
             segments=tuple(g.chain.segment for g in geometries),
@@ -298,6 +306,94 @@ def inject_twist_errors(
     InputError
         If the parameters are inconsistent or the rig has too few separate limbs.
     """
+    _check_injection(kind, ends, (min_offset_deg, max_offset_deg),
+                     (min_intervals, max_intervals, max_interval_frames))  # fmt: skip
+    names = motion.skeleton.names
+    geometries = choose_targets(motion, rng, n_targets, mapping)
+    n_frames = motion.n_frames
+    first = leading_pose_frames(motion.quats) if ends == "head" else 0
+    chain_offsets = np.zeros((n_frames, len(geometries)))
+    intervals: list[InjectedInterval] = []
+    mismatch = np.zeros((n_frames, len(geometries)))
+    shape = _Shape(kind, motion.fps, (min_offset_deg, max_offset_deg), max_interval_frames)
+    for c, geometry in enumerate(geometries):
+        count = int(rng.integers(min_intervals, max_intervals + 1))
+        parent = geometry.chain.parent
+        for start, end in _place_with_end(rng, n_frames, count, shape.longest, ends, first):
+            for a, b, value in shape.parts(rng, start, end, mismatch[:, c]):
+                chain_offsets[a : b + 1, c] = np.deg2rad(value)
+                intervals.append(
+                    InjectedInterval(names[parent], geometry.chain.side,
+                                     geometry.chain.segment, a, b, value)
+                )  # fmt: skip
+    # Injecting +δ is refining by −δ.
+    corrupted_quats = refine_quats(motion.quats, geometries, -chain_offsets)
+    add_mismatch(corrupted_quats, geometries, mismatch, chain_offsets)
+    # No part is injected at 0°: the corrupted frames are those with an offset.
+    truth = InjectionTruth.of_chains(
+        motion.quats.copy(), geometries, intervals, chain_offsets, chain_offsets != 0.0
+    )
+    return replace(motion, quats=corrupted_quats), truth
+
+
+@dataclass(frozen=True, slots=True)
+class _Shape:
+    """The error shape of an injection: its ``kind``, the take's frame rate, the range of a
+    level shift's magnitude (degrees) and its longest length (frames)."""
+
+    kind: str
+    fps: float
+    offsets_deg: tuple[float, float]
+    max_interval_frames: int
+
+    @property
+    def hold(self) -> int:
+        """Longest hold of a burst, frames."""
+        return max(1, round(0.05 * self.fps))
+
+    @property
+    def tail_max(self) -> int:
+        """Longest decaying tail of a burst, frames."""
+        return round(0.1 * self.fps)
+
+    @property
+    def longest(self) -> int:
+        """Longest interval, frames."""
+        return {"level": self.max_interval_frames, "burst": 4 * self.hold + self.tail_max,
+                "cluster": max(3, round(0.6 * self.fps))}[self.kind]  # fmt: skip
+
+    def parts(
+        self, rng: np.random.Generator, start: int, end: int, mismatch: FloatArray
+    ) -> list[tuple[int, int, float]]:
+        """The parts of the interval ``[start, end]`` (first and last frame, offset in
+        degrees), the child's mismatch ratio of bursts and clusters written into the chain's
+        ``mismatch`` column (F,)."""
+        if self.kind == "burst":
+            parts = _burst_parts(rng, start, end, self.hold, self.tail_max)
+            mismatch[start : end + 1] = rng.uniform(-0.2, 0.2)
+            return parts
+        if self.kind == "cluster":
+            parts = _cluster_parts(rng, start, end, self.fps)
+            for a, b, _ in parts:
+                mismatch[a : b + 1] = rng.uniform(-0.2, 0.2)
+            return parts
+        magnitude = rng.uniform(*self.offsets_deg)
+        return [(start, end, float(magnitude * rng.choice((-1.0, 1.0))))]
+
+
+def _check_injection(
+    kind: str, ends: str, offsets_deg: tuple[float, float], counts: tuple[int, int, int]
+) -> None:
+    """Refuse inconsistent parameters of :func:`inject_twist_errors`: the kind, the ends, the
+    offset range (degrees) and the interval counts and longest interval (frames).
+
+    Raises
+    ------
+    InputError
+        If they are inconsistent.
+    """
+    min_offset_deg, max_offset_deg = offsets_deg
+    min_intervals, max_intervals, max_interval_frames = counts
     if kind not in KINDS:
         raise InputError(f"Expected kind 'level', 'burst' or 'cluster', got {kind!r}")
     if ends not in ENDS or (ends and kind != "level"):
@@ -312,55 +408,22 @@ def inject_twist_errors(
             "Expected 1 ≤ min_intervals ≤ max_intervals and max_interval_frames ≥ 1, got "
             f"{min_intervals}, {max_intervals}, {max_interval_frames}"
         )
-    skeleton = motion.skeleton
-    geometries = choose_targets(motion, rng, n_targets, mapping)
-    n_frames, n_joints = motion.quats.shape[:2]
-    first = leading_pose_frames(motion.quats) if ends == "head" else 0
-    chain_offsets = np.zeros((n_frames, len(geometries)))
-    error_mask = np.zeros((n_frames, n_joints), dtype=bool)
-    offsets_rad = np.zeros((n_frames, n_joints))
-    intervals: list[InjectedInterval] = []
-    mismatch = np.zeros((n_frames, len(geometries)))
+
+
+def add_mismatch(
+    quats: FloatArray,
+    geometries: list[ChainGeometry],
+    mismatch: FloatArray,
+    chain_offsets: FloatArray,
+) -> None:
+    """Make each chain's first child counter-rotate by (1 + ε) δ where ``mismatch`` (F, C) holds ε
+    and ``chain_offsets`` (F, C) δ, radians, as a real retarget rarely does it exactly (its
+    world orientation moves by ε δ); ``quats`` (F, J, 4) is changed in place."""
     for c, geometry in enumerate(geometries):
-        count = int(rng.integers(min_intervals, max_intervals + 1))
-        hold = max(1, round(0.05 * motion.fps))
-        tail_max = round(0.1 * motion.fps)
-        longest = {"level": max_interval_frames, "burst": 4 * hold + tail_max,
-                   "cluster": max(3, round(0.6 * motion.fps))}[kind]  # fmt: skip
-        parent = geometry.chain.parent
-        for start, end in _place_with_end(rng, n_frames, count, longest, ends, first):
-            parts = [(start, end, 0.0)]
-            if kind == "burst":
-                parts = _burst_parts(rng, start, end, hold, tail_max)
-                mismatch[start : end + 1, c] = rng.uniform(-0.2, 0.2)
-            elif kind == "cluster":
-                parts = _cluster_parts(rng, start, end, motion.fps)
-                for a, b, _ in parts:
-                    mismatch[a : b + 1, c] = rng.uniform(-0.2, 0.2)
-            for a, b, value in parts:
-                if kind == "level":
-                    magnitude = rng.uniform(min_offset_deg, max_offset_deg)
-                    value = float(magnitude * rng.choice((-1.0, 1.0)))
-                chain_offsets[a : b + 1, c] = np.deg2rad(value)
-                error_mask[a : b + 1, parent] = True
-                offsets_rad[a : b + 1, parent] = np.deg2rad(value)
-                intervals.append(
-                    InjectedInterval(skeleton.names[parent], geometry.chain.side,
-                                     geometry.chain.segment, a, b, value)
-                )  # fmt: skip
-    # Injecting +δ is refining by −δ.
-    corrupted_quats = refine_quats(motion.quats, geometries, -chain_offsets)
-    for c, geometry in enumerate(geometries):
-        # Bursts: the child counter-rotates by (1 + ε) δ, as a real retarget rarely does it
-        # exactly (its world orientation moves by ε δ).
         rows = np.flatnonzero(mismatch[:, c] != 0.0)
         if len(rows):
             first = geometry.intermediates[0] if geometry.intermediates else geometry.chain.child
             extra = quats_from_axis_angle(
                 geometry.axis, -mismatch[rows, c] * chain_offsets[rows, c]
             )
-            corrupted_quats[rows, first] = multiply(extra, corrupted_quats[rows, first])
-    truth = InjectionTruth.of_chains(
-        motion.quats.copy(), geometries, intervals, error_mask, offsets_rad
-    )
-    return replace(motion, quats=corrupted_quats), truth
+            quats[rows, first] = multiply(extra, quats[rows, first])

@@ -38,11 +38,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from mocapqa.core.arrays import FloatArray, IntArray
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
 from mocapqa.kinematics.quaternion import multiply, quats_from_axis_angle
 from mocapqa.twist.angles import ChainGeometry
-from mocapqa.twist.inject import InjectedInterval, InjectionTruth, choose_targets
+from mocapqa.twist.inject import InjectedInterval, InjectionTruth, add_mismatch, choose_targets
 from mocapqa.twist.refine import refine_quats
 
 __all__ = ["UnpairedShape", "inject_unpaired_bursts"]
@@ -147,7 +148,7 @@ def inject_unpaired_bursts(
     fps = motion.fps
     jitter = max(1, round(shape.jitter_s * fps))
     longest = jitter + round(shape.gap_s[1] * fps) + shape.max_burst_frames + 2
-    n_frames, n_joints = motion.quats.shape[:2]
+    n_frames = motion.n_frames
     if n_frames < longest + 4:
         raise InputError(f"Expected a take of at least {longest + 4} frames, got {n_frames}")
     geometries = choose_targets(motion, rng, n_targets, mapping)
@@ -155,34 +156,17 @@ def inject_unpaired_bursts(
     child_roll = np.zeros((n_frames, len(geometries)))
     offsets = np.zeros((n_frames, len(geometries)))
     mismatch = np.zeros((n_frames, len(geometries)))
-    error_mask = np.zeros((n_frames, n_joints), dtype=bool)
-    offsets_rad = np.zeros((n_frames, n_joints))
+    error_mask = np.zeros((n_frames, len(geometries)), dtype=bool)
     intervals: list[InjectedInterval] = []
     for c, geometry in enumerate(geometries):
-        gap = round(rng.uniform(*shape.gap_s) * fps)
-        length = int(rng.integers(1, shape.max_burst_frames + 1))
-        t0 = int(rng.integers(jitter + 1, n_frames - gap - length - 2))
-        burst = np.arange(t0 + gap, t0 + gap + length)
-        back = int(burst[-1]) + 1
-        step = np.deg2rad(rng.uniform(*shape.step_deg) * rng.choice((-1.0, 1.0)))
-        follow = rng.uniform(*shape.child_follow)
-        after = step * rng.uniform(*shape.return_fraction) * rng.choice((-1.0, 1.0))
-        window = np.arange(t0 - jitter, t0 + 2)
-        amplitude = np.deg2rad(rng.uniform(*shape.jitter_deg, size=2))
-        parent_roll[window, c] = rng.uniform(-1.0, 1.0, size=len(window)) * amplitude[0]
-        child_roll[window, c] = rng.uniform(-1.0, 1.0, size=len(window)) * amplitude[1]
-        parent_roll[t0:back, c] += step
-        parent_roll[back:, c] += after
-        child_roll[t0, c] -= step
-        child_roll[t0 + 1 :, c] -= follow * step
+        burst = _natural_step(rng, shape, fps, jitter, parent_roll[:, c], child_roll[:, c])
         sign = float(rng.choice((-1.0, 1.0)))
         parent = geometry.chain.parent
         for frame in burst:
             sign = -sign
             value = float(sign * rng.uniform(*shape.flip_deg))
             offsets[frame, c] = np.deg2rad(value)
-            error_mask[frame, parent] = True
-            offsets_rad[frame, parent] = np.deg2rad(value)
+            error_mask[frame, c] = True
             intervals.append(
                 InjectedInterval(motion.skeleton.names[parent], geometry.chain.side,
                                  geometry.chain.segment, int(frame), int(frame), value)
@@ -199,10 +183,37 @@ def inject_unpaired_bursts(
         clean[rows, first] = multiply(turn, clean[rows, first])
     # Injecting +δ is refining by −δ; then the child's counter-rotation is off by ε δ.
     corrupted = refine_quats(clean, geometries, -offsets)
-    for c, geometry in enumerate(geometries):
-        rows = np.flatnonzero(mismatch[:, c] != 0.0)
-        extra = quats_from_axis_angle(geometry.axis, -mismatch[rows, c] * offsets[rows, c])
-        first = _first_child(geometry)
-        corrupted[rows, first] = multiply(extra, corrupted[rows, first])
-    truth = InjectionTruth.of_chains(clean, geometries, intervals, error_mask, offsets_rad)
+    add_mismatch(corrupted, geometries, mismatch, offsets)
+    truth = InjectionTruth.of_chains(clean, geometries, intervals, offsets, error_mask)
     return replace(motion, quats=corrupted), truth
+
+
+def _natural_step(
+    rng: np.random.Generator,
+    shape: UnpairedShape,
+    fps: float,
+    jitter: int,
+    parent_roll: FloatArray,
+    child_roll: FloatArray,
+) -> IntArray:
+    """Draw one chain's natural roll step, with its jitter before it and its partial return
+    after the burst, into its ``parent_roll`` and ``child_roll`` columns (F,), radians, and
+    return the burst's frames after it."""
+    n_frames = len(parent_roll)
+    gap = round(rng.uniform(*shape.gap_s) * fps)
+    length = int(rng.integers(1, shape.max_burst_frames + 1))
+    t0 = int(rng.integers(jitter + 1, n_frames - gap - length - 2))
+    burst = np.arange(t0 + gap, t0 + gap + length)
+    back = int(burst[-1]) + 1
+    step = np.deg2rad(rng.uniform(*shape.step_deg) * rng.choice((-1.0, 1.0)))
+    follow = rng.uniform(*shape.child_follow)
+    after = step * rng.uniform(*shape.return_fraction) * rng.choice((-1.0, 1.0))
+    window = np.arange(t0 - jitter, t0 + 2)
+    amplitude = np.deg2rad(rng.uniform(*shape.jitter_deg, size=2))
+    parent_roll[window] = rng.uniform(-1.0, 1.0, size=len(window)) * amplitude[0]
+    child_roll[window] = rng.uniform(-1.0, 1.0, size=len(window)) * amplitude[1]
+    parent_roll[t0:back] += step
+    parent_roll[back:] += after
+    child_roll[t0] -= step
+    child_roll[t0 + 1 :] -= follow * step
+    return burst

@@ -21,7 +21,7 @@ from __future__ import annotations
 import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from importlib import resources
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +31,7 @@ from mocapqa.core.arrays import FloatArray
 from mocapqa.errors import InputError
 from mocapqa.twist.angles import ChainGeometry
 from mocapqa.twist.detect import Detection
+from mocapqa.twist.shipped import shipped_json
 
 __all__ = [
     "NATURAL_ROLL_FILE",
@@ -166,13 +167,7 @@ def fit_natural_roll(
     return natural
 
 
-_LOADED: dict[str, NaturalRoll] = {}
-
-
+@cache
 def default_natural_roll() -> NaturalRoll:
     """The shipped levels (``mocapqa/data/twist/natural_roll.json``), read once."""
-    if NATURAL_ROLL_FILE not in _LOADED:
-        resource = resources.files("mocapqa") / "data" / "twist" / NATURAL_ROLL_FILE
-        data = json.loads(resource.read_text(encoding="utf-8"))
-        _LOADED[NATURAL_ROLL_FILE] = NaturalRoll.from_json(data, str(resource))
-    return _LOADED[NATURAL_ROLL_FILE]
+    return NaturalRoll.from_json(*shipped_json(NATURAL_ROLL_FILE))

@@ -3,18 +3,21 @@ take."""
 
 from __future__ import annotations
 
-from typing import Annotated, Any
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Annotated, Any, Literal
 
 from fastapi import APIRouter, Depends, Path, Request
 from fastapi.responses import Response
 
 from mocapqa.api.auth import Principal, audit, client_address, require
 from mocapqa.api.decision_schemas import DecisionIn, DecisionOut, DecisionsOut
-from mocapqa.api.deps import ServicesDep
+from mocapqa.api.deps import Services, ServicesDep
 from mocapqa.api.disposition import attachment, download_stem
 from mocapqa.api.errors import responses
 from mocapqa.core.text import display_name
 from mocapqa.errors import NotFoundError
+from mocapqa.io.guards import ReadLimits
 from mocapqa.jobs.accepted import (
     decided_bvh,
     decided_c3d,
@@ -27,6 +30,7 @@ from mocapqa.jobs.accepted import (
 from mocapqa.pipeline.marker_step import MARKER_APPLY
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.decisions import DecidedItem, IntervalDecisions
+from mocapqa.store.files import FileStore
 from mocapqa.store.roles import Action
 
 __all__ = ["router"]
@@ -55,30 +59,59 @@ def _out(row: dict[str, Any], item: DecidedItem) -> DecisionOut:
     return DecisionOut.model_validate({**row, "item": item, "reviewer": reviewer})
 
 
-def _record(
+@dataclass(frozen=True, slots=True)
+class _Review:
+    """Who decides on which run, and the stores a decision is checked against and kept in."""
+
+    request: Request
+    principal: Principal
+    run: dict[str, Any]
+    services: Services
+    decisions: IntervalDecisions
+
+
+def _review(
     request: Request,
-    principal: Principal,
-    decisions: IntervalDecisions,
-    run_id: str,
-    item: DecidedItem,
-    item_id: int,
-    body: DecisionIn,
-) -> DecisionOut:
-    """Append a decision by who is signed in (a body's ``reviewer`` is ignored), from the
-    request's address (not the run-quota key, ``user:N`` for a signed-in user), and audit it."""
-    address = client_address(request)
-    row = decisions.add(run_id, item_id, body.decision, body.note, principal.name, address)
-    audit(request, principal, "decision", run_id, f"{item} {item_id}: {body.decision}")
-    return _out(row, item)
+    principal: Annotated[Principal, Depends(require(Action.REVIEW))],
+    run: DoneRunDep,
+    services: ServicesDep,
+    decisions: DecisionsDep,
+) -> _Review:
+    return _Review(request, principal, run, services, decisions)
 
 
-def _require_id(run_id: str, item: DecidedItem, item_id: int, items: list[dict[str, Any]]) -> None:
-    known = {int(i["id"]) for i in items}
+ReviewDep = Annotated[_Review, Depends(_review)]
+
+
+def _decide(review: _Review, item: DecidedItem, item_id: int, body: DecisionIn) -> DecisionOut:
+    """Append a decision on a twist interval or swap of the run, by who is signed in (a body's
+    ``reviewer`` is ignored), from the request's address (not the run-quota key, ``user:N``
+    for a signed-in user), and audit it.
+
+    Raises
+    ------
+    NotFoundError
+        If the run has no such interval or swap.
+    """
+    run_id = str(review.run["id"])
+    listed = run_intervals if item == "interval" else run_swaps
+    known = {int(i["id"]) for i in listed(review.services.files, run_id)}
     if item_id not in known:
         name = "twist interval" if item == "interval" else "swap"
         raise NotFoundError(
             f"Expected a {name} id of run {run_id} ({len(known)} {name}(s)), got {item_id}"
         )
+    request, principal = review.request, review.principal
+    address = client_address(request)
+    row = review.decisions.add(run_id, item_id, body.decision, body.note, principal.name, address)
+    audit(request, principal, "decision", run_id, f"{item} {item_id}: {body.decision}")
+    return _out(row, item)
+
+
+_DECISION_POST: dict[str, Any] = {
+    "status_code": 201,
+    "responses": responses(401, 403, 404, 409, 413),
+}
 
 
 @router.get("/decisions", responses=responses(401, 404, 409))
@@ -101,46 +134,26 @@ def list_decisions(run: DoneRunDep, services: ServicesDep, decisions: DecisionsD
     )
 
 
-@router.post(
-    "/intervals/{interval_id}/decisions",
-    status_code=201,
-    responses=responses(401, 403, 404, 409, 413),
-)
+@router.post("/intervals/{interval_id}/decisions", **_DECISION_POST)
 def add_decision(
-    request: Request,
-    principal: Annotated[Principal, Depends(require(Action.REVIEW))],
-    run: DoneRunDep,
+    review: ReviewDep,
     interval_id: Annotated[int, Path(ge=0, le=2**31 - 1)],
     body: DecisionIn,
-    services: ServicesDep,
-    decisions: DecisionsDep,
 ) -> DecisionOut:
     """Accept or reject one twist interval; the newest decision per interval counts, every
     one is kept, with the reviewer and the client's address (as the audit log has it)."""
-    run_id = str(run["id"])
-    _require_id(run_id, "interval", interval_id, run_intervals(services.files, run_id))
-    return _record(request, principal, decisions, run_id, "interval", interval_id, body)
+    return _decide(review, "interval", interval_id, body)
 
 
-@router.post(
-    "/swaps/{swap_id}/decisions",
-    status_code=201,
-    responses=responses(401, 403, 404, 409, 413),
-)
+@router.post("/swaps/{swap_id}/decisions", **_DECISION_POST)
 def add_swap_decision(
-    request: Request,
-    principal: Annotated[Principal, Depends(require(Action.REVIEW))],
-    run: DoneRunDep,
+    review: ReviewDep,
     swap_id: Annotated[int, Path(ge=0, le=2**31 - 1)],
     body: DecisionIn,
-    services: ServicesDep,
-    decisions: DecisionsDep,
 ) -> DecisionOut:
     """Accept or reject one swap of a marker run (its ``id`` in the run's findings), kept as
     the interval decisions are."""
-    run_id = str(run["id"])
-    _require_id(run_id, "swap", swap_id, run_swaps(services.files, run_id))
-    return _record(request, principal, decisions, run_id, "swap", swap_id, body)
+    return _decide(review, "swap", swap_id, body)
 
 
 @router.get(
@@ -152,19 +165,17 @@ def download_decided(run: DoneRunDep, services: ServicesDep, decisions: Decision
     """The raw take with exactly the accepted corrections, as BVH: the levels of accepted
     intervals removed; an undecided interval follows the run's ``twist_apply`` choice. No
     motion filter is applied."""
-    take = services.repository.get_take(str(run["take_id"]))
-    motion = decided_motion(
-        services.files,
-        run,
-        take,
-        decisions.latest(str(run["id"])),
-        services.settings.read_limits,
-    )
-    return Response(
-        decided_bvh(motion),
-        media_type="text/plain",
-        headers=attachment(f"{download_stem(take)}.decided.bvh"),
-    )
+    return _decided_download(run, services, decisions, _decided_bvh, "bvh")
+
+
+def _decided_bvh(
+    files: FileStore,
+    run: dict[str, Any],
+    take: dict[str, Any],
+    latest: dict[int, str],
+    limits: ReadLimits | None,
+) -> bytes:
+    return decided_bvh(decided_motion(files, run, take, latest, limits))
 
 
 @router.get(
@@ -178,8 +189,25 @@ def download_decided_c3d(
     """The C3D of a marker take with exactly the accepted swaps repaired (an undecided swap
     follows the run's ``applied``), then its gaps filled by the run's rule (the confident
     fills), as the run's ``corrected.c3d`` is written. No filter."""
+    return _decided_download(run, services, decisions, decided_c3d, "c3d")
+
+
+_MEDIA_TYPES = {"bvh": "text/plain", "c3d": "application/octet-stream"}
+
+
+def _decided_download(
+    run: dict[str, Any],
+    services: Services,
+    decisions: IntervalDecisions,
+    content: Callable[
+        [FileStore, dict[str, Any], dict[str, Any], dict[int, str], ReadLimits | None], bytes
+    ],
+    suffix: Literal["bvh", "c3d"],
+) -> Response:
+    """The decided take of a run as an attachment ``<take>.decided.<suffix>``: ``content``
+    of the run's files, the run, its take, the newest decisions and the reading limits."""
     take = services.repository.get_take(str(run["take_id"]))
-    content = decided_c3d(
+    data = content(
         services.files,
         run,
         take,
@@ -187,7 +215,7 @@ def download_decided_c3d(
         services.settings.read_limits,
     )
     return Response(
-        content,
-        media_type="application/octet-stream",
-        headers=attachment(f"{download_stem(take)}.decided.c3d"),
+        data,
+        media_type=_MEDIA_TYPES[suffix],
+        headers=attachment(f"{download_stem(take)}.decided.{suffix}"),
     )

@@ -32,7 +32,8 @@ from mocapqa.jobs.batch_output import COLUMNS
 from mocapqa.jobs.shoot_import import ImportLimits, import_uploads
 from mocapqa.store.repository import ReviewStatus, RunStatus
 from mocapqa.store.roles import Action
-from mocapqa.store.shoots import SORT_COLUMNS, ShootStore, TakeFilter
+from mocapqa.store.shoot_pages import SORT_COLUMNS, TakeFilter
+from mocapqa.store.shoots import ShootStore
 
 __all__ = ["EXPORT_COLUMNS", "HEATMAP_MAX_TAKES", "MAX_OFFSET", "router", "take_filter"]
 
