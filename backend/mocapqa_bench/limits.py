@@ -25,8 +25,7 @@ import numpy as np
 from mocapqa.core.arrays import FloatArray
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
-from mocapqa.io.bvh import read_bvh
-from mocapqa.jobs.limits_takes import canonical_takes, rig_takes, split_takes
+from mocapqa.jobs.limits_takes import canonical_takes, corpus_takes, rig_takes, split_takes
 from mocapqa.limits.analysis import check_limits, limit_params
 from mocapqa.limits.build import DEFAULT_BUILD, BuildParams, build_model
 from mocapqa.limits.model import LimitsModel
@@ -161,14 +160,9 @@ def role_takes(corpus_dir: Path) -> list[tuple[str, Motion]]:
     Raises
     ------
     InputError
-        If a file cannot be read (naming it).
+        As :func:`mocapqa.jobs.limits_takes.corpus_takes`.
     """
-    takes = []
-    for path in corpus_files(corpus_dir):
-        motion = read_bvh(path)
-        if rig_fingerprint(motion.skeleton):
-            takes.append((path.name, motion))
-    return takes
+    return [(name, m) for name, m in corpus_takes(corpus_dir) if rig_fingerprint(m.skeleton)]
 
 
 def tiled_take(motion: Motion, min_frames: int = 50_000) -> Motion:

@@ -24,6 +24,7 @@ from typing import Annotated
 from fastapi import Depends, Request
 from starlette.requests import HTTPConnection
 
+from mocapqa.api.app_state import app_state
 from mocapqa.errors import AuthenticationError, ForbiddenError
 from mocapqa.store.accounts import Accounts, User
 from mocapqa.store.roles import Action, Role, allows
@@ -76,10 +77,7 @@ class Principal:
 
 def get_accounts(connection: HTTPConnection) -> Accounts:
     """The app's account store."""
-    accounts = connection.app.state.accounts
-    if not isinstance(accounts, Accounts):  # pragma: no cover - set by create_app
-        raise RuntimeError("app.state.accounts is not set")
-    return accounts
+    return app_state(connection, "accounts", Accounts)
 
 
 AccountsDep = Annotated[Accounts, Depends(get_accounts)]

@@ -9,6 +9,7 @@ from typing import Annotated, Any
 
 from fastapi import Depends, Request
 
+from mocapqa.api.app_state import app_state
 from mocapqa.api.auth import PrincipalDep, client_address, quota_key
 from mocapqa.config import Settings
 from mocapqa.errors import RateLimitError
@@ -43,10 +44,7 @@ class Services:
 
 def get_services(request: Request) -> Services:
     """The app's services."""
-    services = request.app.state.services
-    if not isinstance(services, Services):  # pragma: no cover - set by create_app
-        raise RuntimeError("app.state.services is not set")
-    return services
+    return app_state(request, "services", Services)
 
 
 ServicesDep = Annotated[Services, Depends(get_services)]

@@ -54,6 +54,23 @@ def _check_method(method: str) -> None:
         raise InputError(f"Expected --method in {METHODS}, got {method!r}")
 
 
+def _analysed(
+    input_path: Path, mapping: Path | None, method: str, apply: str
+) -> tuple[TwistAnalysis, list[str], list[LimbSpin]]:
+    """Read the take and analyse its twist: the analysis, the roles neither found by name nor
+    in the mapping, and the limb spins."""
+    from mocapqa.io.formats import require_frames
+    from mocapqa.twist.analysis import analyze_twist
+    from mocapqa.twist.spin import find_limb_spins
+
+    roles = load_mapping(mapping)
+    motion = read_input_bvh(input_path)
+    require_frames(motion, input_path)
+    missing = missing_roles(motion.skeleton, roles)
+    analysis = analyze_twist(motion, method, roles, apply=apply)
+    return analysis, missing, find_limb_spins(motion, mapping=roles)
+
+
 @app.command()
 def refine(
     input_path: Annotated[Path, typer.Argument(metavar="IN.bvh", help="Take to refine.")],
@@ -72,19 +89,11 @@ def refine(
     """
     from mocapqa.io.atomic import write_text
     from mocapqa.io.bvh_write import write_bvh
-    from mocapqa.io.formats import require_frames
-    from mocapqa.twist.analysis import analyze_twist
-    from mocapqa.twist.spin import find_limb_spins
 
     _check_method(method)
     require_suffix("-o", output, (".bvh",), "a BVH take")
     check_outputs({"-o": output, "--report": report}, [input_path, mapping])
-    roles = load_mapping(mapping)
-    motion = read_input_bvh(input_path)
-    require_frames(motion, input_path)
-    missing = missing_roles(motion.skeleton, roles)
-    analysis = analyze_twist(motion, method, roles, apply=apply)
-    spins = find_limb_spins(motion, mapping=roles)
+    analysis, missing, spins = _analysed(input_path, mapping, method, apply)
     write_bvh(output, analysis.refined)
     if report is not None:
         write_text(report, json.dumps(_report(analysis, input_path, missing, spins), indent=2))
@@ -108,17 +117,8 @@ def detect(
     mapping: MappingOption = None,
 ) -> None:
     """Report axial twist error intervals (and which refine would apply) without writing."""
-    from mocapqa.io.formats import require_frames
-    from mocapqa.twist.analysis import analyze_twist
-    from mocapqa.twist.spin import find_limb_spins
-
     _check_method(method)
-    roles = load_mapping(mapping)
-    motion = read_input_bvh(input_path)
-    require_frames(motion, input_path)
-    missing = missing_roles(motion.skeleton, roles)
-    analysis = analyze_twist(motion, method, roles, apply=apply)
-    spins = find_limb_spins(motion, mapping=roles)
+    analysis, missing, spins = _analysed(input_path, mapping, method, apply)
     if as_json:
         typer.echo(json.dumps(_report(analysis, input_path, missing, spins), indent=2))
         return

@@ -37,6 +37,7 @@ import struct
 import tarfile
 import zipfile
 from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from typing import IO
@@ -219,6 +220,8 @@ _ZIP_DAMAGE = (zipfile.BadZipFile, OSError, EOFError, ValueError)
 """What reading a damaged zip member raises."""
 _TAR_DAMAGE = (tarfile.TarError, OSError, EOFError, ValueError)
 """What reading a damaged tar member raises."""
+_Entry = tuple[str, str | None, Callable[[], IO[bytes] | None]]
+"""A member to unpack: its name, why it is not unpacked (None: it is) and its stream's opener."""
 
 
 def _extract(
@@ -255,37 +258,34 @@ def _extract(
     return Member(name, target)
 
 
-def _zip_members(
-    path: Path,
-    dest: Path,
-    max_members: int,
-    max_bytes: int,
-    max_member_bytes: int,
-    before_extract: Callable[[int], None],
-) -> Iterator[Member]:
+def _zip_problem(info: zipfile.ZipInfo) -> str | None:
+    """Why a zip member is not unpacked (an unsafe name, a symbolic link), or None."""
+    problem = _unsafe_name(info.filename)
+    if problem is None and stat.S_ISLNK(info.external_attr >> 16):
+        problem = "symbolic link"
+    return problem
+
+
+@contextmanager
+def _zip_entries(
+    path: Path, max_members: int, max_bytes: int
+) -> Iterator[tuple[int, Iterator[_Entry]]]:
+    """The open zip's declared unpacked total and its members, folders left out, once both
+    are found within the limits (raising as :func:`unpack`)."""
     try:
         _check_zip_directory(path, max_members)
         archive = zipfile.ZipFile(path)
     except (zipfile.BadZipFile, OSError) as e:
         raise InputError(f"Expected a readable .zip archive, got {e}") from e
     with archive:
-        entries = archive.infolist()
-        infos = [i for i in entries if not i.is_dir()]
+        listed = archive.infolist()
+        infos = [i for i in listed if not i.is_dir()]
         declared = sum(i.file_size for i in infos)
-        _check_totals(len(entries), declared, max_members, max_bytes)
-        before_extract(declared)
-        budget, limits = [0], (max_bytes, max_member_bytes)
-        for index, info in enumerate(infos):
-            mode = info.external_attr >> 16
-            problem = _unsafe_name(info.filename)
-            if problem is None and stat.S_ISLNK(mode):
-                problem = "symbolic link"
-            if problem is not None:
-                yield Member(info.filename, None, problem)
-                continue
-            target = dest / f"{index:06d}"
-            opened = functools.partial(archive.open, info)
-            yield _extract(info.filename, target, opened, _ZIP_DAMAGE, budget, limits)
+        _check_totals(len(listed), declared, max_members, max_bytes)
+        yield (
+            declared,
+            ((i.filename, _zip_problem(i), functools.partial(archive.open, i)) for i in infos),
+        )
 
 
 def _decompressed(path: Path) -> io.BufferedIOBase:
@@ -361,14 +361,24 @@ def _scan_tar_headers(path: Path, max_members: int, max_bytes: int) -> None:
         raise InputError(f"Expected a readable .tar.gz archive, got {e}") from e
 
 
-def _tar_members(
-    path: Path,
-    dest: Path,
-    max_members: int,
-    max_bytes: int,
-    max_member_bytes: int,
-    before_extract: Callable[[int], None],
-) -> Iterator[Member]:
+def _tar_problem(info: tarfile.TarInfo) -> str | None:
+    """Why a tar member is not unpacked (an unsafe name, a link, not a regular file), or None."""
+    problem = _unsafe_name(info.name)
+    if problem is None and info.issym():
+        problem = "symbolic link"
+    elif problem is None and info.islnk():
+        problem = "hard link"
+    elif problem is None and not info.isfile():
+        problem = "not a regular file"
+    return problem
+
+
+@contextmanager
+def _tar_entries(
+    path: Path, max_members: int, max_bytes: int
+) -> Iterator[tuple[int, Iterator[_Entry]]]:
+    """The open tar's declared unpacked total and its members, folders left out, once its
+    headers and then both are found within the limits (raising as :func:`unpack`)."""
     _scan_tar_headers(path, max_members, max_bytes)
     try:
         archive = tarfile.open(path, mode="r:*")  # noqa: SIM115 - closed by the with below
@@ -387,22 +397,29 @@ def _tar_members(
                 _check_totals(entries, declared, max_members, max_bytes)
         except (tarfile.TarError, OSError, EOFError) as e:
             raise InputError(f"Expected a readable .tar.gz archive, got {e}") from e
-        before_extract(declared)
-        budget, limits = [0], (max_bytes, max_member_bytes)
-        for index, info in enumerate(infos):
-            problem = _unsafe_name(info.name)
-            if problem is None and info.issym():
-                problem = "symbolic link"
-            elif problem is None and info.islnk():
-                problem = "hard link"
-            elif problem is None and not info.isfile():
-                problem = "not a regular file"
-            if problem is not None:
-                yield Member(info.name, None, problem)
-                continue
-            target = dest / f"{index:06d}"
-            opened = functools.partial(archive.extractfile, info)
-            yield _extract(info.name, target, opened, _TAR_DAMAGE, budget, limits)
+        yield (
+            declared,
+            ((i.name, _tar_problem(i), functools.partial(archive.extractfile, i)) for i in infos),
+        )
+
+
+def _extract_all(
+    entries: Iterator[_Entry],
+    dest: Path,
+    damaged: tuple[type[Exception], ...],
+    limits: tuple[int, int],
+) -> list[Member]:
+    """Each member reported with its problem, or else streamed to a fresh numbered file in
+    ``dest`` (:func:`_extract`), all within one budget of unpacked bytes."""
+    budget = [0]
+    members = []
+    for index, (name, problem, opened) in enumerate(entries):
+        if problem is not None:
+            members.append(Member(name, None, problem))
+            continue
+        target = dest / f"{index:06d}"
+        members.append(_extract(name, target, opened, damaged, budget, limits))
+    return members
 
 
 def _nothing(declared: int) -> None:
@@ -453,6 +470,10 @@ def unpack(
         raise InputError(
             f"Expected an archive ending in {', '.join(ARCHIVE_SUFFIXES)}, got {name!r}"
         )
-    reader = _zip_members if kind == "zip" else _tar_members
+    entries_of, damaged = (
+        (_zip_entries, _ZIP_DAMAGE) if kind == "zip" else (_tar_entries, _TAR_DAMAGE)
+    )
     member = max_bytes if max_member_bytes is None else max_member_bytes
-    return list(reader(path, dest, max_members, max_bytes, member, before_extract))
+    with entries_of(path, max_members, max_bytes) as (declared, entries):
+        before_extract(declared)
+        return _extract_all(entries, dest, damaged, (max_bytes, member))

@@ -7,7 +7,7 @@ The Dask build picks the same takes from per-take summaries (:mod:`mocapqa.jobs.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 
 from mocapqa.core.motion import Motion
@@ -21,26 +21,38 @@ from mocapqa.limits.split import (
     split_group,
 )
 
-__all__ = ["canonical_takes", "rig_takes", "split_takes"]
+__all__ = ["canonical_takes", "corpus_takes", "rig_takes", "split_takes"]
 
 
-def split_takes(
-    corpus_dir: Path, families: tuple[str, ...] | None
-) -> list[tuple[str, tuple[object, ...], Motion]]:
-    """Name, split group and motion of every take of ``families`` (all families but
-    "other" when None), in :func:`mocapqa.limits.split.corpus_files` order.
+def corpus_takes(corpus_dir: Path) -> Iterator[tuple[str, Motion]]:
+    """File name and motion of every BVH take under ``corpus_dir``, read one at a time in
+    :func:`mocapqa.limits.split.corpus_files` order.
 
     Raises
     ------
     InputError
         If a file cannot be read (naming it).
     """
-    read = []
     for path in corpus_files(corpus_dir):
-        motion = read_bvh(path)
+        yield path.name, read_bvh(path)
+
+
+def split_takes(
+    corpus_dir: Path, families: tuple[str, ...] | None
+) -> list[tuple[str, tuple[object, ...], Motion]]:
+    """Name, split group and motion of every take of ``families`` (all families but
+    "other" when None), in :func:`corpus_takes` order.
+
+    Raises
+    ------
+    InputError
+        As :func:`corpus_takes`.
+    """
+    read = []
+    for name, motion in corpus_takes(corpus_dir):
         key = split_group(motion.skeleton)
         if key is not None and (families is None or key[0] in families):
-            read.append((path.name, key, motion))
+            read.append((name, key, motion))
     return read
 
 
@@ -75,7 +87,7 @@ def canonical_takes(
     ``exclude`` are left out. ``mapping`` gives roles to the takes whose skeleton has the
     joints it names (:func:`mocapqa.core.rig.mapped_roles`).
     """
-    read = [(path.name, read_bvh(path)) for path in corpus_files(corpus_dir)]
+    read = list(corpus_takes(corpus_dir))
     held = set() if all_takes else held_back_names([(n, split_group(m.skeleton)) for n, m in read])
     return tuple(
         (n, m) for n, m in read
