@@ -12,6 +12,8 @@ Layout under the data folder (the folders are :class:`~mocapqa.store.files.FileS
     runs/<run_id>/corrected.c3d       a C3D marker run's repaired take
     runs/<run_id>/thumbnail.png       the rendered thumbnail (:mod:`mocapqa.jobs.rendered`)
     runs/<run_id>/report.html         the HTML report, built on its first download
+    runs/<run_id>/prior.json          the reviewer prior a twist run used, when it had one
+                                      (:class:`~mocapqa.twist.reviewer_prior.ReviewerPrior`)
 
 Conventions
 -----------
@@ -41,6 +43,7 @@ from mocapqa.store.files import FileStore
 if TYPE_CHECKING:
     from mocapqa.markers.repair import MarkerRepair
     from mocapqa.pipeline.analyze import AnalysisResult
+    from mocapqa.twist.reviewer_prior import ReviewerPrior
 
 __all__ = [
     "CORRECTED_BVH",
@@ -50,6 +53,7 @@ __all__ = [
     "FILTERED_TRC",
     "POINTS_NPZ",
     "POINT_ARRAYS",
+    "PRIOR_JSON",
     "READING_FILE",
     "REPORT_HTML",
     "REPORT_JSON",
@@ -65,6 +69,7 @@ __all__ = [
     "reading_of",
     "relative_folder",
     "run_summary",
+    "twist_items_of",
     "write_corrected_c3d",
     "write_outputs",
     "write_reading",
@@ -90,6 +95,8 @@ THUMBNAIL_PNG = "thumbnail.png"
 """A run's rendered thumbnail."""
 REPORT_HTML = "report.html"
 """A run's HTML report."""
+PRIOR_JSON = "prior.json"
+"""The reviewer prior a twist run used (its ``to_json``), so the run can be made again."""
 DOWNLOAD_FILES = {
     "bvh": CORRECTED_BVH,
     "csv": FILTERED_CSV,
@@ -150,6 +157,11 @@ class RunFolder:
     def report_html(self) -> Path:
         """:data:`REPORT_HTML`."""
         return self.path / REPORT_HTML
+
+    @property
+    def prior(self) -> Path:
+        """:data:`PRIOR_JSON`."""
+        return self.path / PRIOR_JSON
 
     def download(self, kind: str) -> Path:
         """The file of a download kind (:data:`DOWNLOAD_FILES`)."""
@@ -277,6 +289,21 @@ def joint_parents_of(files: FileStore, take_id: str) -> list[int] | None:
     return [int(p) for p in parents]
 
 
+def twist_items_of(files: FileStore, run_id: str) -> dict[int, tuple[str, float]]:
+    """A finished run's twist intervals: id → (joint, calibrated probability as the run
+    scored it), from its report's findings (empty for a run without twist findings or whose
+    report cannot be read)."""
+    try:
+        findings = load_report(RunFolder.of(files, run_id).report).get("findings") or []
+    except (OSError, ValueError):
+        return {}
+    return {
+        int(f["id"]): (str(f["joint"]), float(f.get("confidence") or 0.0))
+        for f in findings
+        if isinstance(f, dict) and f.get("kind") == "twist" and "id" in f
+    }
+
+
 def run_summary(result: AnalysisResult) -> dict[str, Any]:
     """What a run stores as its summary: the report's summary, step states and QA summary."""
     from mocapqa.pipeline.summary import qa_summary
@@ -363,8 +390,12 @@ def _write_filtered(run: RunFolder, run_id: str, result: AnalysisResult) -> list
     return kinds
 
 
-def _report_json(result: AnalysisResult, kinds: list[str]) -> bytes:
-    """The report as stored: with its downloads and, for keypoints, the bones to draw."""
+def _report_json(
+    result: AnalysisResult, kinds: list[str], prior: ReviewerPrior | None = None
+) -> bytes:
+    """The report as stored: with its downloads, for keypoints the bones to draw and, for a
+    run with a reviewer prior, the prior's ``summary`` (hash and counts) as
+    ``reviewer_prior``."""
     from mocapqa.render.layouts import bones_for_keypoints
 
     points = result.report["points"]
@@ -375,14 +406,21 @@ def _report_json(result: AnalysisResult, kinds: list[str]) -> bytes:
         if layout or "bones" not in points:
             points = {**points, "bones": layout}
     report = {**result.report, "points": points, "downloads": kinds}
+    if prior is not None:
+        report["reviewer_prior"] = prior.summary()
     return json.dumps(report, allow_nan=False).encode()
 
 
 def write_outputs(
-    files: FileStore, run_id: str, result: AnalysisResult, source: Path | None = None
+    files: FileStore,
+    run_id: str,
+    result: AnalysisResult,
+    source: Path | None = None,
+    prior: ReviewerPrior | None = None,
 ) -> list[str]:
     """Write a run's files (report, points, corrected BVH or filtered keypoints; for a C3D
-    marker take, ``corrected.c3d``: :func:`write_corrected_c3d`), the report last.
+    marker take, ``corrected.c3d``: :func:`write_corrected_c3d`; the reviewer ``prior`` the
+    run used, :data:`PRIOR_JSON`), the report last.
 
     Parameters
     ----------
@@ -391,6 +429,8 @@ def write_outputs(
     result : AnalysisResult
     source : Path, optional
         The take's stored file (a C3D's is opened again for its residuals and other groups).
+    prior : ReviewerPrior, optional
+        The reviewer prior the analysis used (written whole, and summarised in the report).
 
     Returns
     -------
@@ -412,5 +452,7 @@ def write_outputs(
             kinds.append("c3d")
         except MocapQAError as e:
             log.info("no c3d output for run %s: %s", run_id, e)
-    files.write_bytes(run.report, _report_json(result, kinds))
+    if prior is not None:
+        files.write_bytes(run.prior, json.dumps(prior.to_json(), indent=2).encode())
+    files.write_bytes(run.report, _report_json(result, kinds, prior))
     return kinds

@@ -7,6 +7,11 @@ its attempts: a run that was started ``max_attempts`` times and never finished i
 the reason instead, so a take that crashes the server cannot do so forever). Deleting a take
 cancels its runs (:meth:`JobRunner.cancel`) and removes their folders. numpy and the
 file I/O release the GIL for most of the work, so the event loop stays responsive.
+
+A twist run of a take in a shoot uses the reviewer prior of the shoot's other takes'
+decisions (:func:`mocapqa.jobs.shoot_prior.shoot_prior`), built when the run starts and
+recorded in its folder and report; an approved take gets none. A prior only ever shapes the
+run being made: nothing here re-runs a take because its shoot's decisions changed.
 """
 
 from __future__ import annotations
@@ -34,13 +39,16 @@ from mocapqa.jobs.run_folder import (
     write_outputs,
 )
 from mocapqa.jobs.sent_files import SentFiles
+from mocapqa.jobs.shoot_prior import shoot_prior
 from mocapqa.limits.catalog import ModelCatalog
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.loading import ReadOptions, Take, read_take_file
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.render.service import RenderService
+from mocapqa.store.decisions import IntervalDecisions
 from mocapqa.store.files import FileStore
 from mocapqa.store.repository import Repository
+from mocapqa.twist.reviewer_prior import ReviewerPrior
 
 __all__ = ["JobRunner"]
 
@@ -230,13 +238,16 @@ class JobRunner:
             with self._lock:
                 preloaded = self._preloaded.pop(run_id, None)
             reading = read_options_of(path.parent)
+            prior = self._prior(take, options)
             if self.engine is not None:
-                summary = self._execute_on_dask(self.engine, run_id, run, take, path, reading)
+                summary = self._execute_on_dask(
+                    self.engine, run_id, run, take, path, reading, prior
+                )
             else:
                 read = preloaded or read_take_file(
                     path, str(take["format"]), str(take["name"]), reading, self.read_limits
                 )
-                summary = self._execute_here(run_id, read, options, path)
+                summary = self._execute_here(run_id, read, options, path, prior)
             self.repository.finish_run(run_id, summary, None, time.perf_counter() - started)
         except _RunCancelledError:
             log.info("run %s cancelled: its take was deleted", run_id)
@@ -245,6 +256,14 @@ class JobRunner:
         except Exception as e:  # a bug must not leave the run "running" forever
             log.exception("run %s failed", run_id)
             self._fail(run_id, f"internal error: {type(e).__name__}: {e}", started)
+
+    def _prior(self, take: dict[str, Any], options: AnalysisOptions) -> ReviewerPrior | None:
+        """The reviewer prior of a new robust twist run of ``take`` (None for other runs, a
+        take outside a shoot or approved, or a shoot without decisions on its other takes)."""
+        twist = "twist" in options.checks and options.twist_method == "robust"
+        if take.get("kind") != "motion" or not twist:
+            return None
+        return shoot_prior(IntervalDecisions(self.repository.engine), self.files, take)
 
     def _progress(self, run_id: str) -> Callable[[int, str], None]:
         """A run's progress report: recorded at most every 0.2 s (and from 95 %), and where
@@ -263,14 +282,20 @@ class JobRunner:
         return progress
 
     def _execute_here(
-        self, run_id: str, take: Take, options: AnalysisOptions, path: Path
+        self,
+        run_id: str,
+        take: Take,
+        options: AnalysisOptions,
+        path: Path,
+        prior: ReviewerPrior | None = None,
     ) -> dict[str, Any]:
-        """Analyse on this thread, write the run's files and thumbnail; returns the summary."""
+        """Analyse on this thread (with the reviewer ``prior``), write the run's files and
+        thumbnail; returns the summary."""
         progress = self._progress(run_id)
         catalog = ModelCatalog.of_data_folder(self.files.root)
-        result = analyze(take, options, progress, catalog)
+        result = analyze(take, options, progress, catalog, prior)
         progress(96, "writing the outputs")
-        write_outputs(self.files, run_id, result, path)
+        write_outputs(self.files, run_id, result, path, prior)
         if self.renderer is not None:
             progress(97, "rendering the thumbnail")
             render_thumbnail(self.files, run_id, result.report, result.raw_points, self.renderer)
@@ -284,9 +309,11 @@ class JobRunner:
         take: dict[str, Any],
         path: Path,
         reading: ReadOptions,
+        prior: ReviewerPrior | None = None,
     ) -> dict[str, Any]:
         """Analyse on the cluster (the take's path, or its bytes to workers that do not share
-        the data folder), with the read options read here; returns the summary."""
+        the data folder), with the read options and reviewer ``prior`` read here; returns the
+        summary."""
         from mocapqa.jobs.sent_files import pack
         from mocapqa.jobs.take_task import analyse_stored, analyse_stored_sent, sent_models
 
@@ -294,16 +321,17 @@ class JobRunner:
         if self._shares_disk is None:  # asked once: the cluster's workers keep their disks
             self._shares_disk = engine.shares_disk(path, self.files.root)
         format_name, name, read = str(take["format"]), str(take["name"]), reading.to_json()
+        recorded = None if prior is None else prior.to_json()
         if self._shares_disk:
             future = engine.client().submit(
                 analyse_stored, str(path), format_name, name, run["options"], run_id,
-                str(self.files.root), read, key=f"run-{run_id}", pure=False,
+                str(self.files.root), read, recorded, key=f"run-{run_id}", pure=False,
             )  # fmt: skip
         else:
             models = sent_models(self.files.root, run["options"].get("limits_model"))
             future = engine.client().submit(
                 analyse_stored_sent, pack(path.parent, [path]), path.name, format_name, name,
-                run["options"], run_id, models, read, key=f"run-{run_id}", pure=False,
+                run["options"], run_id, models, read, recorded, key=f"run-{run_id}", pure=False,
             )  # fmt: skip
         try:
             answer = future.result()

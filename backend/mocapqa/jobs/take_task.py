@@ -86,19 +86,26 @@ def _store_take(
 
 
 def _analyse(
-    take: Take, options: dict[str, Any], data_dir: str | None, run_id: str, source: Path | None
+    take: Take,
+    options: dict[str, Any],
+    data_dir: str | None,
+    run_id: str,
+    source: Path | None,
+    prior: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """Analyse a read take with the data folder's limits models, write the run's files there
-    (with ``data_dir``; ``source`` is the take's file, None for a frame folder) and return
-    the run summary."""
+    """Analyse a read take with the data folder's limits models (and the reviewer ``prior``
+    as JSON, when the server built one), write the run's files there (with ``data_dir``;
+    ``source`` is the take's file, None for a frame folder) and return the run summary."""
     from mocapqa.limits.catalog import ModelCatalog
     from mocapqa.pipeline.analyze import analyze
     from mocapqa.pipeline.options import AnalysisOptions
+    from mocapqa.twist.reviewer_prior import ReviewerPrior
 
     catalog = ModelCatalog.of_data_folder(data_dir)
-    result = analyze(take, AnalysisOptions.from_json(options), catalog=catalog)
+    used = None if prior is None else ReviewerPrior.from_json(prior)
+    result = analyze(take, AnalysisOptions.from_json(options), catalog=catalog, prior=used)
     if data_dir is not None:
-        write_outputs(FileStore(Path(data_dir)), run_id, result, source)
+        write_outputs(FileStore(Path(data_dir)), run_id, result, source, used)
     return run_summary(result)
 
 
@@ -163,11 +170,13 @@ def analyse_stored(
     run_id: str,
     data_dir: str,
     read: dict[str, Any] | None = None,
+    prior: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """A server run on a Dask worker: read a stored take, analyse it, write the run's files.
 
     ``read`` is the take's read options as JSON (the server read them from the take's
-    reading record, so the worker does not).
+    reading record, so the worker does not); ``prior`` the reviewer prior the server built
+    for the run, as JSON (:class:`mocapqa.twist.reviewer_prior.ReviewerPrior`), or None.
 
     Returns
     -------
@@ -179,7 +188,7 @@ def analyse_stored(
 
     stored = Path(path)
     take = read_take_file(stored, format_name, name, ReadOptions.from_json(read))
-    return _analyse(take, options, data_dir, run_id, stored)
+    return _analyse(take, options, data_dir, run_id, stored, prior)
 
 
 def sent_models(data_dir: Path | None, model: str | None) -> SentFiles:
@@ -242,6 +251,7 @@ def analyse_stored_sent(
     run_id: str,
     models: SentFiles,
     read: dict[str, Any] | None = None,
+    prior: dict[str, Any] | None = None,
 ) -> tuple[dict[str, Any], SentFiles]:
     """:func:`analyse_stored` on a worker that cannot read the server's data folder.
 
@@ -261,6 +271,8 @@ def analyse_stored_sent(
         Files of the data folder the run reads, relative to it.
     read : dict, optional
         The take's read options as JSON (from its reading record, read by the server).
+    prior : dict, optional
+        The reviewer prior of the run as JSON, when the server built one.
 
     Returns
     -------
@@ -272,7 +284,7 @@ def analyse_stored_sent(
         take.unpack(inbox)
         models.unpack(data)
         summary = analyse_stored(
-            str(inbox / file_name), format_name, name, options, run_id, str(data), read
+            str(inbox / file_name), format_name, name, options, run_id, str(data), read, prior
         )
         files = FileStore(data)
         return summary, pack_tree(data, [relative_folder(files, files.run_dir(run_id))])

@@ -46,6 +46,7 @@ from mocapqa.pipeline.steps import (
     run_limits,
     run_twist,
 )
+from mocapqa.twist.reviewer_prior import ReviewerPrior
 
 __all__ = ["AnalysisResult", "ProgressCallback", "analyze", "series_json"]
 
@@ -156,13 +157,17 @@ def _motion_checks(
     progress: ProgressCallback,
     catalog: ModelCatalog | None,
     steps: StepLog,
+    prior: ReviewerPrior | None = None,
 ) -> Motion:
-    """The twist, limits and feet checks of a motion take; returns it twist-refined."""
+    """The twist (with the reviewer ``prior``), limits and feet checks of a motion take;
+    returns it twist-refined."""
     corrected = motion
     if requested("twist", options, steps):
         progress(25, "twist analysis")
         with steps.timed("twist_s"):
-            outcome = run_twist(motion, options.twist_method, options.mapping, options.twist_apply)
+            outcome = run_twist(
+                motion, options.twist_method, options.mapping, options.twist_apply, prior
+            )
         steps.record("twist", outcome)
         if outcome.motion is not None:
             corrected = outcome.motion
@@ -232,13 +237,14 @@ def _analyze_motion(
     options: AnalysisOptions,
     progress: ProgressCallback,
     catalog: ModelCatalog | None,
+    prior: ReviewerPrior | None = None,
 ) -> AnalysisResult:
     steps = StepLog()
     rig = find_roles(motion.skeleton, options.mapping)  # a bad mapping fails the run here
     progress(10, "forward kinematics (raw)")
     with steps.timed("fk_raw_s"):
         names, parents, raw_points, raw_rotations = motion_pose(motion)
-    corrected = _motion_checks(motion, options, progress, catalog, steps)
+    corrected = _motion_checks(motion, options, progress, catalog, steps, prior)
     corrected = _motion_filter(corrected, options, progress, steps)
     steps.skip("markers", "BVH takes have joints, not markers")
 
@@ -380,6 +386,7 @@ def analyze(
     options: AnalysisOptions,
     progress: ProgressCallback | None = None,
     catalog: ModelCatalog | None = None,
+    prior: ReviewerPrior | None = None,
 ) -> AnalysisResult:
     """Analyse a take.
 
@@ -394,6 +401,9 @@ def analyze(
     catalog : ModelCatalog, optional
         Where ``options.limits_model`` is looked up (the server's and the batch's: the data
         folder's registered models too); None offers the shipped models only.
+    prior : ReviewerPrior, optional
+        The reviewer prior of the take's shoot for the twist step
+        (:mod:`mocapqa.twist.reviewer_prior`); None: none.
 
     Returns
     -------
@@ -401,7 +411,7 @@ def analyze(
     """
     report_progress = progress or _no_progress
     if isinstance(take, Motion):
-        result = _analyze_motion(take, options, report_progress, catalog)
+        result = _analyze_motion(take, options, report_progress, catalog, prior)
     else:
         result = _analyze_keypoints(take, options, report_progress)
     report_progress(95, "analysis finished")

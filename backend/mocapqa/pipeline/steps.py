@@ -39,6 +39,7 @@ from mocapqa.limits.model import LimitsModel
 from mocapqa.pipeline.options import ParamValue
 from mocapqa.twist.analysis import analyze_twist, interval_frames
 from mocapqa.twist.choice import decision_readout
+from mocapqa.twist.reviewer_prior import ReviewerPrior
 from mocapqa.twist.spin import LimbSpin, find_limb_spins
 
 if TYPE_CHECKING:
@@ -127,8 +128,10 @@ def run_twist(
     method: str,
     mapping: dict[str, str] | None = None,
     apply: str = "confident",
+    prior: ReviewerPrior | None = None,
 ) -> StepOutcome:
-    """Detect twist errors on every limb chain and remove those ``apply`` chooses.
+    """Detect twist errors on every limb chain and remove those ``apply`` chooses (``prior``:
+    a shoot's reviewer prior, :mod:`mocapqa.twist.reviewer_prior`).
 
     ``mapping`` (role key → joint name) overrides the roles found on the rig; the message names
     the roles that were not found, whose chains are not checked. Every interval is a finding,
@@ -136,7 +139,7 @@ def run_twist(
     removed. Limb spins and flips (:func:`mocapqa.twist.spin.find_limb_spins`) are findings of
     kind ``spin``, never applied.
     """
-    analysis = analyze_twist(motion, method=method, mapping=mapping, apply=apply)
+    analysis = analyze_twist(motion, method=method, mapping=mapping, apply=apply, prior=prior)
     rig = find_roles(motion.skeleton, mapping)
     missing = rig.unmapped
     if not analysis.chains:

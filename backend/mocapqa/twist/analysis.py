@@ -45,6 +45,7 @@ from mocapqa.twist.detect import (
 )
 from mocapqa.twist.natural_roll import NaturalRoll, default_natural_roll
 from mocapqa.twist.refine import refine_quats
+from mocapqa.twist.reviewer_prior import ReviewerPrior
 
 __all__ = [
     "METHODS",
@@ -389,6 +390,7 @@ def analyze_twist(
     params: RobustParams | PaperParams | None = None,
     apply: str | frozenset[int] = "confident",
     natural_roll: NaturalRoll | None = None,
+    prior: ReviewerPrior | None = None,
 ) -> TwistAnalysis:
     """Detect axial twist errors in a take and remove those chosen by ``apply``.
 
@@ -412,6 +414,8 @@ def analyze_twist(
         Natural roll levels per rig family and segment (:mod:`mocapqa.twist.natural_roll`);
         ``confident`` applies no interval smaller than its rig segment's level. Default: the
         shipped levels; ``NaturalRoll()`` for none.
+    prior : ReviewerPrior, optional
+        A shoot's reviewer decisions (:mod:`mocapqa.twist.reviewer_prior`); None: none.
 
     Returns
     -------
@@ -444,7 +448,7 @@ def analyze_twist(
     natural_deg = [natural.level_deg(family, geometries[i.chain].chain.segment) for i in found]
     offsets, intervals = choose_intervals(
         found, detected, geometries, skeleton.names, choice, method == "robust", anatomy,
-        natural_deg,
+        natural_deg, prior, family,
     )  # fmt: skip
     return TwistAnalysis(
         method=method,

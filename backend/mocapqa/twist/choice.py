@@ -8,6 +8,10 @@ never those it contradicts (:func:`mocapqa.twist.confidence.decide`; methods wit
 calibrated confidence apply all); an interval smaller than its rig segment's natural roll
 (:mod:`mocapqa.twist.natural_roll`) is never applied by ``confident``. Each interval's
 ``evidence`` records which evidence decided, and why when it is the natural roll.
+A shoot's reviewers' decisions (:class:`mocapqa.twist.reviewer_prior.ReviewerPrior`) move the
+calibrated probability the ``calibrated`` rule compares; an interval whose probability they
+moved records it (``reviewer_probability``, ``reviewer_accepted``, ``reviewer_rejected``) and
+its readout says by how many decisions.
 Each :class:`TwistInterval` lists its ``levels``: the stretches of constant offset, so the
 refined take is exactly the raw one with the applied levels removed.
 """
@@ -21,12 +25,14 @@ from typing import Any
 
 import numpy as np
 
-from mocapqa.core.arrays import FloatArray
+from mocapqa.core.arrays import FloatArray, IntArray
 from mocapqa.errors import InputError
 from mocapqa.twist.anatomy import AnatomyEvidence
 from mocapqa.twist.angles import ChainGeometry
 from mocapqa.twist.confidence import decide
 from mocapqa.twist.detect import DetectedInterval
+from mocapqa.twist.readouts import decision_readout
+from mocapqa.twist.reviewer_prior import ReviewerPrior
 
 __all__ = [
     "APPLY_CHOICES",
@@ -115,7 +121,10 @@ class TwistInterval:
         ``child_anatomy_deg`` (the same for the child's rotation), ``natural_roll_deg`` (the
         natural roll level of the rig's segment, when one is stored), ``rule`` (one of
         :data:`mocapqa.twist.confidence.RULES`) and, for the rule ``natural_roll``, ``reason``
-        (readable). Empty for the paper's method.
+        (readable); with a reviewer prior that has labels on the interval's joint,
+        ``reviewer_probability`` (the probability after the prior, which the ``calibrated``
+        rule compares), ``reviewer_accepted`` and ``reviewer_rejected`` (the decisions that
+        moved it). Empty for the paper's method.
     """
 
     joint: str
@@ -160,6 +169,8 @@ def choose_intervals(
     calibrated: bool,
     anatomy: AnatomyEvidence | None = None,
     natural_deg: Sequence[float] | None = None,
+    prior: ReviewerPrior | None = None,
+    rig: str = "",
 ) -> tuple[FloatArray, list[TwistInterval]]:
     """The offsets to remove and the report entry of every interval.
 
@@ -181,6 +192,10 @@ def choose_intervals(
     natural_deg : sequence of float, optional
         Natural roll level of each interval's rig segment, degrees (0: none stored;
         :mod:`mocapqa.twist.natural_roll`); None: no natural roll rule.
+    prior : ReviewerPrior, optional
+        A shoot's reviewers' decisions, moving the calibrated probability on their joints.
+    rig : str
+        The take's rig family (:func:`mocapqa.limits.rig.rig_family`), the prior's key.
 
     Returns
     -------
@@ -194,42 +209,75 @@ def choose_intervals(
         For an interval id the take does not have.
     """
     _check_ids(choice, len(found))
-    offsets = np.zeros_like(detected)
-    intervals = []
+    offsets, intervals = np.zeros_like(detected), list[TwistInterval]()
     probability = np.array([i.confidence for i in found], dtype=np.float64)
     features = [i.features if calibrated else () for i in found]
-    chains = [i.chain for i in found]
+    joints = [names[geometries[i.chain].chain.parent] for i in found]
+    reviewed = _reviewed(probability, features, prior, rig, joints)
     confident, rules = decide(
-        probability, features, anatomy, chains=chains, sides=[i.side for i in found],
-        natural_deg=natural_deg,
+        reviewed[0], features, anatomy, chains=[i.chain for i in found],
+        sides=[i.side for i in found], natural_deg=natural_deg,
     )  # fmt: skip
     for k, i in enumerate(found):
         applied = _is_applied(choice, k, bool(confident[k]))
+        chain = geometries[i.chain].chain
         evidence: tuple[tuple[str, float | str], ...] = ()
         if features[k]:
             natural = 0.0 if natural_deg is None else float(natural_deg[k])
-            segment = geometries[i.chain].chain.segment
-            evidence = _evidence(i, k, anatomy, natural, rules[k], bool(confident[k]), segment)
+            evidence = _evidence(
+                i, k, anatomy, natural, rules[k], bool(confident[k]), chain.segment
+            )
+            evidence = _with_reviewers(evidence, reviewed, k)
         rows = slice(i.start_frame, i.end_frame + 1)
         if applied:
             offsets[rows, i.chain] = detected[rows, i.chain]
-        geometry = geometries[i.chain]
         intervals.append(
             TwistInterval(
-                joint=names[geometry.chain.parent],
-                side=geometry.chain.side,
-                segment=geometry.chain.segment,
-                start_frame=i.start_frame,
-                end_frame=i.end_frame,
-                offset_deg=float(np.rad2deg(i.offset_rad)),
-                confidence=float(i.confidence),
-                id=k,
-                applied=applied,
-                levels=_levels(detected[rows, i.chain], i.start_frame),
-                evidence=evidence,
+                joints[k], chain.side, chain.segment, i.start_frame, i.end_frame,
+                float(np.rad2deg(i.offset_rad)), float(i.confidence), k, applied,
+                _levels(detected[rows, i.chain], i.start_frame), evidence,
             )
-        )
+        )  # fmt: skip
     return offsets, intervals
+
+
+def _reviewed(
+    probability: FloatArray,
+    features: Sequence[Sequence[float]],
+    prior: ReviewerPrior | None,
+    rig: str,
+    joints: Sequence[str],
+) -> tuple[FloatArray, IntArray, IntArray]:
+    """The probability each interval is decided on (after ``prior``, calibrated intervals
+    only) and the accepted and rejected decisions that moved it, each shape (N,)."""
+    n = len(joints)
+    if prior is None:
+        return probability, np.zeros(n, dtype=np.intp), np.zeros(n, dtype=np.intp)
+    moved, accepted, rejected = prior.adjust(probability, rig, joints)
+    calibrated = np.array([len(f) > 0 for f in features], dtype=bool)
+    return (
+        np.where(calibrated, moved, probability),
+        np.where(calibrated, accepted, 0),
+        np.where(calibrated, rejected, 0),
+    )
+
+
+def _with_reviewers(
+    evidence: tuple[tuple[str, float | str], ...],
+    reviewed: tuple[FloatArray, IntArray, IntArray],
+    k: int,
+) -> tuple[tuple[str, float | str], ...]:
+    """``evidence`` with the probability after the reviewer prior and the decisions that moved
+    it, when some did (inserted after ``calibrated``)."""
+    probability, accepted, rejected = reviewed
+    if accepted[k] + rejected[k] == 0:
+        return evidence
+    extra: tuple[tuple[str, float | str], ...] = (
+        ("reviewer_probability", float(probability[k])),
+        ("reviewer_accepted", float(accepted[k])),
+        ("reviewer_rejected", float(rejected[k])),
+    )
+    return evidence[:1] + extra + evidence[1:]
 
 
 def _is_applied(choice: str | frozenset[int], k: int, confident: bool) -> bool:
@@ -298,46 +346,3 @@ def _levels(values: FloatArray, start_frame: int) -> tuple[tuple[int, int, float
         for part in np.split(np.arange(len(values)), cuts)
         if values[part[0]] != 0.0
     )  # fmt: skip
-
-
-_READOUTS = {
-    "calibrated": "{verdict}: calibrated probability {calibrated:.2f} (applied from 0.50)",
-    "anatomy": (
-        "{verdict}: the raw roll is {anatomy_deg:.0f}° further outside the natural range than "
-        "the corrected one (calibrated {calibrated:.2f})"
-    ),
-    "anatomy_against": (
-        "{verdict}: the correction would take a natural roll outside the range "
-        "(calibrated {calibrated:.2f})"
-    ),
-    "repetition": "{verdict}: other strong intervals on this joint (calibrated {calibrated:.2f})",
-    "min_evidence": (
-        "{verdict}: too small, or the roll outside contradicts its jumps "
-        "(calibrated {calibrated:.2f})"
-    ),
-    "end_evidence": (
-        "{verdict}: runs to the take's end with a small level and a poor counter-rotation "
-        "(calibrated {calibrated:.2f})"
-    ),
-    "uncalibrated": "{verdict}: no calibrated probability",
-}
-
-
-def decision_readout(evidence: dict[str, float | str]) -> str:
-    """One line saying what the default (``apply="confident"``) does with an interval and which
-    evidence decided (its ``evidence`` as :meth:`TwistInterval.to_json` writes it): for the
-    findings list and the report, whatever the run applied.
-
-    Examples: ``"default applied: the raw roll is 31° further outside the natural range than
-    the corrected one (calibrated 0.14)"``; ``"default listed: smaller than this rig's natural
-    upper arm roll (p99 16.5°)"``. Empty when nothing was recorded (the paper's method).
-    """
-    rule = str(evidence.get("rule", ""))
-    if not rule:
-        return ""
-    verdict = f"default {evidence.get('default', 'listed')}"
-    if "reason" in evidence:
-        return f"{verdict}: {evidence['reason']}"
-    values = {"calibrated": 0.0, "anatomy_deg": 0.0, **evidence, "verdict": verdict}
-    template = _READOUTS.get(rule, "{verdict}: " + rule.replace("_", " "))
-    return template.format(**values)

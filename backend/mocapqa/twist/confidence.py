@@ -30,6 +30,12 @@ whose correction moves a twist from inside the range to ``ANATOMY_MIN_DEG`` or m
 (on the parent or the child) is not (rule ``"anatomy_against"``). A repetition rule (the other
 strong intervals of the interval's chain, :mod:`mocapqa.twist.repetition`) can be asked for
 with ``min_family``; it is off by default (``REPETITION_MIN_FAMILY`` = 0, see the docs).
+
+The ``probability`` :func:`decide` compares with :data:`APPLY_THRESHOLD` is the calibrated one,
+or, in a run of a shoot whose reviewers decided intervals on the same joint, the calibrated one
+moved by their decisions (:mod:`mocapqa.twist.reviewer_prior`, applied by
+:func:`mocapqa.twist.choice.choose_intervals`): the rules tried before the ``calibrated`` one
+do not read it, so no decision overrides them.
 """
 
 from __future__ import annotations
@@ -134,7 +140,8 @@ duration of at most ``max_s``, applies (``"anatomy"``); with ``min_family`` > 0,
 short and as well counter-rotated with at least ``min_family`` other strong intervals on its
 chain (probability ≥ ``strong_p`` or the anatomy rule,
 :func:`mocapqa.twist.repetition.family_counts`) applies (``"repetition"``); otherwise the
-calibrated probability decides against :data:`APPLY_THRESHOLD` (``"calibrated"``).
+calibrated probability (after a shoot's reviewer prior, when the run has one) decides against
+:data:`APPLY_THRESHOLD` (``"calibrated"``).
 """
 CALIBRATION_FILE = "calibration.json"
 """Name of the stored calibration in the package's ``data/twist`` folder."""
@@ -260,7 +267,7 @@ def decide(
     Parameters
     ----------
     probability : ndarray, shape (N,)
-        Calibrated probabilities.
+        Calibrated probabilities (moved by a reviewer prior, when the run has one).
     features : sequence of sequence of float, length N
         Each interval's :data:`FEATURES` (empty for the paper's method).
     anatomy : AnatomyEvidence or None

@@ -1,5 +1,6 @@
 """``mocapqa bench twist``: the paper's tables on injected errors, ablations, real-error,
-clean-take, calibration and leave-one-rig-out figures, and the speed."""
+clean-take, calibration and leave-one-rig-out figures, the speed, and (``--reviewers``) the
+leave-one-take-out figures of learning from reviewers' decisions."""
 
 from __future__ import annotations
 
@@ -257,6 +258,49 @@ def _print_evidence(data_dir: Path, bench: _Bench) -> None:
         bench.console.print(rows_table(f"Evidence: {title}", rows))
 
 
+def _print_reviewers(data_dir: Path, bench: _Bench) -> None:
+    """Leave-one-take-out removal and wrong-apply rates with and without the reviewer prior,
+    per rig, and the same on the real-error take."""
+    from mocapqa_bench.twist import REAL_ERROR_TAKES
+    from mocapqa_bench.twist_reviewers import leave_one_take_out, real_take_rows, reviewed_takes
+
+    for held_out, side in ((False, "fit (the rule was developed on these)"), (True, "held-out")):
+        takes = reviewed_takes(bench.files, bench.seed, held_out)
+        bench.console.print(
+            rows_table(
+                f"Learning from reviewers, leave one take out, {side}: {len(takes)} takes, one "
+                f"injection each, seed {bench.seed}; 95 % bootstrap over takes",
+                leave_one_take_out(takes),
+            )
+        )
+    for path in sorted(p for p in data_dir.rglob("*.bvh") if p.name in REAL_ERROR_TAKES):
+        bench.console.print(
+            rows_table(
+                f"Learning from reviewers on {path.name} (real errors; even intervals decided, "
+                "odd ones by the default)",
+                real_take_rows(path),
+            )
+        )
+
+
+def _only(
+    bench: _Bench,
+    data_dir: Path,
+    natural_roll: Path | None,
+    calibration: Path | None,
+    reviewers: bool,
+) -> bool:
+    """Run the one task a stopping option asks for (``--fit-natural-roll``,
+    ``--fit-calibration``, ``--reviewers``, in that order); whether one did."""
+    if natural_roll is not None:
+        _fit_natural_roll(bench, natural_roll)
+    elif calibration is not None:
+        _fit_calibration(bench, calibration)
+    elif reviewers:
+        _print_reviewers(data_dir, bench)
+    return natural_roll is not None or calibration is not None or reviewers
+
+
 @bench_app.command("twist")
 def bench_twist(
     data: Annotated[
@@ -287,6 +331,12 @@ def bench_twist(
             help="Read each rig's natural roll level from its clean fit takes, write it here, stop."
         ),
     ] = None,
+    reviewers: Annotated[
+        bool,
+        typer.Option(
+            help="Only the leave-one-take-out figures of learning from reviewers' decisions."
+        ),
+    ] = False,
 ) -> None:
     """The paper's Tables 1 and 2 with bootstrap intervals, real-error, clean-take,
     calibration and (optionally) leave-one-rig-out figures, and the speed."""
@@ -298,11 +348,7 @@ def bench_twist(
     data_dir = data if data is not None else _default_corpus()
     console = Console(highlight=False, width=max(Console().width, 170))
     bench = _Bench(find_bench_files(data_dir, files), seed, repeats, console)
-    if fit_natural_roll is not None:
-        _fit_natural_roll(bench, fit_natural_roll)
-        return
-    if fit_calibration is not None:
-        _fit_calibration(bench, fit_calibration)
+    if _only(bench, data_dir, fit_natural_roll, fit_calibration, reviewers):
         return
     methods: dict[str, tuple[str, Any]] = {m: (m, None) for m in methods_chosen}
     if ablation:
