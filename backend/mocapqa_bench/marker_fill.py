@@ -10,8 +10,9 @@ the gap). A marker's segment is the markers whose distance to it has a standard 
 most ``SEGMENT_STD_MM`` over the take; only events where at least three of them stay visible
 over the target's gap and the frame either side are drawn. Each event is filled by the cubic
 spline (no length limit), the rigid fill, the PCA fill and the automatic choice of
-:func:`~mocapqa.markers.fill.plan_gap`; the RMSE is the root mean square 3-D error in mm over
-every hidden sample of the targets of a bin (pooled). Events are seeded per file and seed.
+:func:`~mocapqa.markers.fill.plan_gap` (one method or their blend); the RMSE is the root mean
+square 3-D error in mm over every hidden sample of the targets of a bin (pooled). Events are
+seeded per file and seed.
 """
 
 from __future__ import annotations
@@ -29,11 +30,13 @@ from mocapqa.errors import InputError
 from mocapqa.io.c3d import read_c3d
 from mocapqa.markers.fill import FillContext, FillParams, plan_gap
 from mocapqa.markers.fill_methods import spline_fill
+from mocapqa.markers.fill_params import CHOICES
 from mocapqa.markers.params import unit_scale
 
 __all__ = [
     "BENCH_FILES",
     "BINS_S",
+    "FILL_CANDIDATES",
     "SEGMENT_STD_MM",
     "FillEvent",
     "fill_errors",
@@ -59,6 +62,15 @@ SEGMENT_STD_MM = 10.0
 """Largest standard deviation (mm) of the distance between two markers of one segment."""
 
 METHOD_COLUMNS = ("spline", "rigid", "pca", "auto")
+
+FILL_CANDIDATES = tuple(
+    FillParams(cv_match=match, blend_power=power)
+    for match in ("spread", "motion")
+    for power in (0.0, 2.0, 3.0)
+)
+"""The settings :func:`tune_leave_one_out` chooses from for the benchmark's held-out table:
+where the cross-validation's other trials go (spread over the take, or where the take moves
+as over the gap) and the blend's power (0: no blend)."""
 
 
 def load_points(path: Path) -> tuple[FloatArray, float, float]:
@@ -277,7 +289,7 @@ def summarise(events: Sequence[FillEvent]) -> list[dict[str, Any]]:
             row[f"{c}_mm"] = float(np.sqrt(total / frames)) if frames else float("nan")
         row["auto_vs_spline"] = row["auto_mm"] / row["spline_mm"] if full else float("nan")
         row["auto_vs_pca"] = row["auto_mm"] / row["pca_mm"] if full else float("nan")
-        row["chosen"] = {c: sum(e.chosen == c for e in full) for c in ("spline", "rigid", "pca")}
+        row["chosen"] = {c: sum(e.chosen == c for e in full) for c in CHOICES}
         rows.append(row)
     return rows
 

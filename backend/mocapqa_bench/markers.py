@@ -14,10 +14,11 @@ two markers and its first and last frames are each within :data:`FRAME_TOLERANCE
 the truth; every other reported swap is false. Clean figures are the swaps and spikes the
 check reports on the unchanged takes, per 10,000 frames.
 
-Choice (leave one file out): for each file, the grid point of (``swap_misfit``,
-``swap_gain``) with the best F1 on the other files' trials, among those with no false swap on
-their clean takes, is applied to the held-out file, whose figures are reported. ``choose``
-over all files gives the defaults of :class:`mocapqa.markers.params.MarkerParams`.
+Choice (leave one file out): every file's trials and clean take are counted once under each
+grid point of (``swap_misfit``, ``swap_gain``, ``swap_held``) (:func:`grid_table`); for each
+file, the grid point with the best F1 on the other files' trials, among those with no false
+swap on their clean takes, is applied to the held-out file, whose figures are reported.
+``choose`` over all files gives the defaults of :class:`mocapqa.markers.params.MarkerParams`.
 """
 
 from __future__ import annotations
@@ -47,10 +48,14 @@ __all__ = [
     "SWAPS_PER_TRIAL",
     "BenchTake",
     "Counts",
+    "GridRow",
     "HeldOut",
+    "best_point",
     "check_speed",
     "choose",
     "clean_flags",
+    "grid_params",
+    "grid_table",
     "leave_one_out",
     "load_takes",
     "spike_recall",
@@ -70,8 +75,8 @@ SWAPS_PER_TRIAL = 2
 """Swaps injected per trial."""
 FRAME_TOLERANCE = 2
 """Largest error of a found swap's first or last frame, frames."""
-GRID = tuple((m, g) for m in (2.5, 3.0, 4.0) for g in (0.35, 0.5))
-"""(``swap_misfit``, ``swap_gain``) pairs tried by :func:`choose`."""
+GRID = tuple((m, g, h) for m in (2.0, 2.5, 3.0, 4.0) for g in (0.35, 0.5) for h in (0.25, 0.5))
+"""(``swap_misfit``, ``swap_gain``, ``swap_held``) points tried by :func:`choose`."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -123,7 +128,7 @@ class HeldOut:
     Parameters
     ----------
     name : str
-    swap_misfit, swap_gain : float
+    swap_misfit, swap_gain, swap_held : float
         Chosen on the other files.
     counts : Counts
         Injected swaps, all reported swaps.
@@ -136,6 +141,7 @@ class HeldOut:
     name: str
     swap_misfit: float
     swap_gain: float
+    swap_held: float
     counts: Counts
     confident: Counts
     false_swaps_per_10k: float
@@ -216,6 +222,63 @@ def clean_flags(take: BenchTake, params: MarkerParams) -> tuple[float, float]:
     return len(report.swaps) * scale, len(report.spikes) * scale
 
 
+def grid_params(base: MarkerParams | None = None) -> list[MarkerParams]:
+    """``base`` with each :data:`GRID` point's ``swap_misfit``, ``swap_gain`` and
+    ``swap_held``."""
+    base = base or MarkerParams()
+    return [dataclasses.replace(base, swap_misfit=m, swap_gain=g, swap_held=h) for m, g, h in GRID]
+
+
+@dataclass(frozen=True, slots=True)
+class GridRow:
+    """One take under one grid point: its trials' counts (all reported swaps, confident
+    ones) and whether its clean take has no swap."""
+
+    counts: Counts
+    confident: Counts
+    clean: bool
+
+
+def grid_table(
+    takes: Sequence[BenchTake], seeds: Sequence[int], grid: Sequence[MarkerParams]
+) -> list[list[GridRow]]:
+    """Every take's :class:`GridRow` under every grid point, ``[take][point]``."""
+    table: list[list[GridRow]] = []
+    for take in takes:
+        stats = pair_stats(take.positions, take.length_unit, grid[0])
+        rows = []
+        for (counts, confident), params in zip(swap_trials(take, seeds, grid), grid, strict=True):
+            found = find_swaps(take.positions, take.names, stats, take.length_unit, params)
+            rows.append(GridRow(counts, confident, not found))
+        table.append(rows)
+    return table
+
+
+def best_point(table: Sequence[Sequence[GridRow]], chosen_on: Sequence[int]) -> tuple[int, Counts]:
+    """The grid point with the best pooled F1 over some takes.
+
+    Parameters
+    ----------
+    table : sequence of sequence of GridRow
+        ``[take][point]`` (:func:`grid_table`).
+    chosen_on : sequence of int
+        The takes (indices into ``table``) that choose.
+
+    Returns
+    -------
+    index : int
+        The point with the best F1 among those with no swap on these takes' clean takes (if
+        none is clean, among all), the first in :data:`GRID` order on a tie.
+    counts : Counts
+        Its pooled counts over ``chosen_on``.
+    """
+    n_points = len(table[0])
+    pooled = [sum((table[t][i].counts for t in chosen_on), Counts()) for i in range(n_points)]
+    clean = [all(table[t][i].clean for t in chosen_on) for i in range(n_points)]
+    best = min(range(n_points), key=lambda i: (not clean[i], -pooled[i].f1, i))
+    return best, pooled[best]
+
+
 def choose(
     takes: Sequence[BenchTake], seeds: Sequence[int], base: MarkerParams | None = None
 ) -> tuple[MarkerParams, Counts]:
@@ -227,36 +290,32 @@ def choose(
     counts : Counts
         Its pooled counts over ``takes``.
     """
-    base = base or MarkerParams()
-    grid = [dataclasses.replace(base, swap_misfit=m, swap_gain=g) for m, g in GRID]
-    pooled = [Counts() for _ in grid]
-    clean_ok = [True for _ in grid]
-    for take in takes:
-        for i, (counts, _) in enumerate(swap_trials(take, seeds, grid)):
-            pooled[i] = pooled[i] + counts
-        for i, params in enumerate(grid):
-            stats = pair_stats(take.positions, take.length_unit, params)
-            if find_swaps(take.positions, take.names, stats, take.length_unit, params):
-                clean_ok[i] = False
-    order = sorted(range(len(grid)), key=lambda i: (not clean_ok[i], -pooled[i].f1))
-    best = order[0]
-    return grid[best], pooled[best]
+    grid = grid_params(base)
+    best, pooled = best_point(grid_table(takes, seeds, grid), range(len(takes)))
+    return grid[best], pooled
+
+
+def _held_out(
+    takes: Sequence[BenchTake], table: Sequence[Sequence[GridRow]], grid: Sequence[MarkerParams]
+) -> list[HeldOut]:
+    held: list[HeldOut] = []
+    for i, take in enumerate(takes):
+        best, _ = best_point(table, [j for j in range(len(takes)) if j != i])
+        params, row = grid[best], table[i][best]
+        swaps, spikes = clean_flags(take, params)
+        held.append(
+            HeldOut(take.name, params.swap_misfit, params.swap_gain, params.swap_held,
+                    row.counts, row.confident, swaps, spikes)
+        )  # fmt: skip
+    return held
 
 
 def leave_one_out(
     takes: Sequence[BenchTake], seeds: Sequence[int], base: MarkerParams | None = None
 ) -> list[HeldOut]:
     """Figures of each take under the parameters :func:`choose` picks on the others."""
-    held: list[HeldOut] = []
-    for i, take in enumerate(takes):
-        params, _ = choose([t for j, t in enumerate(takes) if j != i], seeds, base)
-        [(counts, confident)] = swap_trials(take, seeds, [params])
-        swaps, spikes = clean_flags(take, params)
-        held.append(
-            HeldOut(take.name, params.swap_misfit, params.swap_gain, counts, confident,
-                    swaps, spikes)
-        )  # fmt: skip
-    return held
+    grid = grid_params(base)
+    return _held_out(takes, grid_table(takes, seeds, grid), grid)
 
 
 def spike_recall(
@@ -381,13 +440,16 @@ def swap_figures(
         return {"injected": c.injected, "found": c.found, "false": c.false,
                 "precision": c.precision, "recall": c.recall}  # fmt: skip
 
+    grid = grid_params()
+    table = grid_table(takes, seeds, grid)
     held = [
         {"file": h.name, "swap_misfit": h.swap_misfit, "swap_gain": h.swap_gain,
-         "all": counts(h.counts), "confident": counts(h.confident),
+         "swap_held": h.swap_held, "all": counts(h.counts), "confident": counts(h.confident),
          "clean_swaps_per_10k": h.false_swaps_per_10k, "clean_spikes_per_10k": h.spikes_per_10k}
-        for h in leave_one_out(takes, seeds)
+        for h in _held_out(takes, table, grid)
     ]  # fmt: skip
-    params, pooled = choose(takes, seeds)
+    best, pooled = best_point(table, range(len(takes)))
+    params = grid[best]
     spikes = []
     for take in takes:
         _, per_10k = clean_flags(take, MarkerParams())
@@ -398,7 +460,7 @@ def swap_figures(
     return {
         "held_out": held,
         "chosen": {"swap_misfit": params.swap_misfit, "swap_gain": params.swap_gain,
-                   **counts(pooled)},
+                   "swap_held": params.swap_held, **counts(pooled)},
         "spikes": spikes,
         "speed": {"frames": 10_000, "markers": 60, "wall_s": wall, "cpu_s": cpu},
     }  # fmt: skip

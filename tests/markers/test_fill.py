@@ -60,7 +60,7 @@ def test_each_method_reproduces_a_hidden_real_stretch(cmu: tuple[np.ndarray, flo
         FillContext(hide(positions, MARKER, a, b), fps, FillParams(), 1.0), MARKER, a, b
     )
     truth = positions[a : b + 1, MARKER]
-    assert set(plan.fills) == {"spline", "rigid", "pca"}
+    assert set(plan.fills) == {"spline", "rigid", "pca", "blend"}
     assert plan.donors.size >= 3
     for name, limit in (("spline", 20.0), ("rigid", 15.0), ("pca", 20.0)):
         assert rmse(plan.fills[name], truth) < limit, name
@@ -73,7 +73,7 @@ def test_auto_beats_spline_on_half_second_gap_with_donors(cmu: tuple[np.ndarray,
     hidden = hide(positions, MARKER, a, b)
     result = fill_gaps(hidden, fps, apply="all")
     (gap,) = [g for g in result.gaps if g.marker == MARKER and g.start == a]
-    assert gap.method in ("rigid", "pca")
+    assert gap.method in ("rigid", "pca", "blend")
     assert gap.applied
     context = FillContext(hidden, fps, FillParams(), 1.0)
     plan = plan_gap(context, MARKER, a, b)
@@ -139,7 +139,7 @@ def test_gap_at_the_takes_end(cmu: tuple[np.ndarray, float], where: str) -> None
     assert rmse(plan.fills["rigid"], truth) < 30.0
     result = fill_gaps(hidden, fps, apply="all")
     (gap,) = [g for g in result.gaps if g.marker == MARKER]
-    assert (gap.start, gap.end, gap.method in ("rigid", "pca")) == (a, b, True)
+    assert (gap.start, gap.end, gap.method in ("rigid", "pca", "blend")) == (a, b, True)
     assert result.filled[a : b + 1, MARKER].all()
 
 

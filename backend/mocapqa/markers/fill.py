@@ -2,12 +2,13 @@
 
 Every gap (a run of missing samples of one marker) is filled by whichever of three methods
 (cubic spline and rigid body from donor markers in :mod:`mocapqa.markers.fill_methods`, PCA
-intercorrelation in :mod:`mocapqa.markers.fill_pca`) reproduced the take's own data best: the
-gap's length is hidden again in stretches where the same marker is recorded (and the same donor
-and model markers are visible), each method fills them, and the lowest RMSE (3-D distance, root
-mean square over the hidden samples) is the gap's expected error
-(:mod:`mocapqa.markers.fill_plan`). Gaps no method fills below ``FillParams.max_error_mm`` are
-listed as not fillable; fills below ``FillParams.confident_error_mm`` are confident.
+intercorrelation in :mod:`mocapqa.markers.fill_pca`) or their blend reproduced the take's own
+data best: the gap's length is hidden again in stretches where the same marker is recorded (near
+the gap and where the take moves as it does over the gap; :mod:`mocapqa.markers.fill_cv`), each
+method and the blend fill them, and the lowest RMSE (3-D distance, root mean square over the
+hidden samples) is the gap's expected error (:mod:`mocapqa.markers.fill_plan`). Gaps nothing fills
+below ``FillParams.max_error_mm`` are listed as not fillable; fills below
+``FillParams.confident_error_mm`` are confident.
 
 Lengths in :class:`FillParams` are in mm and converted with ``units_per_mm``; results are in the
 take's own unit. Frames are 0-based, gap ends inclusive.
@@ -26,6 +27,7 @@ from mocapqa.markers.fill_params import FillParams
 from mocapqa.markers.fill_plan import FillContext, GapPlan, plan_gap
 
 __all__ = [
+    "Apply",
     "FillContext",
     "FillParams",
     "FillResult",
@@ -36,6 +38,7 @@ __all__ = [
 ]
 
 Apply = Literal["confident", "all", "none"]
+"""Which fills :func:`fill_gaps` writes: the confident ones, every fillable one, or none."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -49,7 +52,8 @@ class GapFill:
     start, end : int
         First and last missing frame (0-based, inclusive).
     method : str or None
-        The chosen method; None when the gap is not fillable.
+        The chosen method, or ``"blend"`` (the methods' fills weighted by inverse expected
+        error); None when the gap is not fillable.
     expected_error : float
         Cross-validated RMSE of the chosen method in the take's unit (of the best method when
         not fillable; NaN when no method could be tried).
@@ -58,7 +62,8 @@ class GapFill:
     applied : bool
         The fill was written into :attr:`FillResult.positions`.
     errors : dict of str to float
-        Cross-validated RMSE of every method tried (take's unit; NaN where it could not fill).
+        Cross-validated RMSE of every method tried and of the blend (take's unit; NaN where it
+        could not fill).
     """
 
     marker: int
@@ -103,7 +108,8 @@ def fill_gaps(
     *,
     units_per_mm: float = 1.0,
 ) -> FillResult:
-    """Fill every gap of a marker take by the method with the lowest cross-validated error.
+    """Fill every gap of a marker take by the method (or blend) with the lowest cross-validated
+    error.
 
     Parameters
     ----------

@@ -8,11 +8,15 @@ import numpy as np
 
 from mocapqa.errors import OptionError
 
-__all__ = ["METHODS", "FillParams"]
+__all__ = ["CHOICES", "METHODS", "FillParams"]
 
 METHODS = ("spline", "rigid", "pca")
 """The gap-fill methods: cubic spline, rigid-body from donor markers, PCA intercorrelation."""
-"""The fill methods, in the order used to break ties."""
+
+CHOICES = (*METHODS, "blend")
+"""What a gap's fill may be: one method or their blend, in the order used to break ties."""
+
+MATCHES = ("spread", "motion")
 
 
 @dataclass(frozen=True, slots=True)
@@ -49,9 +53,17 @@ class FillParams:
         Artificial gaps per real gap in the cross-validation.
     cv_local : bool
         Hide half of the artificial gaps nearest to the real one (at most one per gap length of
-        frames) and the rest spread over the take, rather than all spread: markers go missing
-        in the hardest moments (fast motion, occlusion), which the neighbouring frames resemble
-        most.
+        frames) rather than none: markers go missing in the hardest moments (fast motion,
+        occlusion), which the neighbouring frames resemble most.
+    cv_match : {"spread", "motion"}
+        Where the other artificial gaps go: spread evenly over the take, or where the
+        ``cv_motion_markers`` markers nearest to the target move at the speed they move at
+        over the gap (nearest in log ratio).
+    cv_motion_markers : int
+        Markers (nearest to the target first) whose mean speed is the motion matched.
+    blend_power : float
+        The blend of the methods' fills weighs each by its expected error to the power
+        ``-blend_power``; 0 leaves the blend out.
     smooth_anchor : bool
         Interpolate the rigid and PCA fills' errors either side of a gap with a cubic spline
         instead of blending the boundary errors linearly.
@@ -71,8 +83,11 @@ class FillParams:
     pca_weight_mm: float = 400.0
     pca_variance: float = 0.9999
     pca_max_train: int = 2000
-    cv_trials: int = 5
+    cv_trials: int = 8
     cv_local: bool = True
+    cv_match: str = "motion"
+    cv_motion_markers: int = 4
+    blend_power: float = 2.0
     smooth_anchor: bool = False
     methods: tuple[str, ...] = METHODS
 
@@ -99,10 +114,19 @@ class FillParams:
             "pca_markers": (self.pca_markers, 1),
             "pca_max_train": (self.pca_max_train, 10),
             "cv_trials": (self.cv_trials, 1),
+            "cv_motion_markers": (self.cv_motion_markers, 1),
         }
         for name, (value, low) in counts.items():
             if value < low:
                 raise OptionError(f"fill_params.{name}", f"Expected at least {low}, got {value}")
+        if self.cv_match not in MATCHES:
+            raise OptionError(
+                "fill_params.cv_match", f"Expected one of {list(MATCHES)}, got {self.cv_match!r}"
+            )
+        if not (np.isfinite(self.blend_power) and self.blend_power >= 0):
+            raise OptionError(
+                "fill_params.blend_power", f"Expected a number ≥ 0, got {self.blend_power}"
+            )
         unknown = [x for x in self.methods if x not in METHODS]
         if unknown or not self.methods:
             raise OptionError(

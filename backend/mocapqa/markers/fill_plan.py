@@ -1,9 +1,12 @@
 """Every method's fill of one gap and its cross-validated error on the take's own samples.
 
 The gap's length is hidden again in stretches where the same marker is recorded (and the same
-donor and model markers are visible): half of the trials nearest to the gap, half spread over the
-take (``FillParams.cv_local``). Each method fills them; its RMSE over the hidden samples (3-D
-distance, root mean square) is its expected error for the gap.
+donor and model markers are visible): half of the trials nearest to the gap, the rest where the
+markers nearest to the target move as fast as they do over the gap (``FillParams.cv_local``,
+``cv_match``; :mod:`mocapqa.markers.fill_cv`). Each method fills them; its RMSE over the hidden
+samples (3-D distance, root mean square) is its expected error for the gap. The methods' fills
+blended by inverse expected error (``FillParams.blend_power``) are a fourth candidate, ``blend``,
+cross-validated on the same stretches with each stretch's weights from the others.
 """
 
 from __future__ import annotations
@@ -13,8 +16,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.markers.fill_cv import (
+    blend_trial_error,
+    blend_weights,
+    marker_speed_sums,
+    trial_starts,
+    window_motion,
+)
 from mocapqa.markers.fill_methods import rigid_fill, spline_fill
-from mocapqa.markers.fill_params import METHODS, FillParams
+from mocapqa.markers.fill_params import CHOICES, FillParams
 from mocapqa.markers.fill_pca import PcaModel, pca_fill, pca_model
 
 __all__ = ["FillContext", "GapPlan", "plan_gap"]
@@ -27,9 +37,11 @@ class GapPlan:
     Parameters
     ----------
     fills : dict of str to ndarray, shape (L, 3)
-        Each method's fill of the gap (methods that cannot fill it are absent).
+        Each method's fill of the gap (methods that cannot fill it are absent), and ``blend``,
+        their blend, when two or more have an expected error.
     errors : dict of str to float
-        Each tried method's cross-validated RMSE in the take's unit (NaN: no trial possible).
+        Each tried method's (and the blend's) cross-validated RMSE in the take's unit (NaN: no
+        trial possible).
     donors : ndarray of int
         The rigid fill's donors.
     model : ndarray of int
@@ -42,9 +54,10 @@ class GapPlan:
     model: IntArray
 
     def best(self) -> tuple[str | None, float]:
-        """The method with the lowest finite error among those that filled, and that error."""
+        """The method (or ``blend``) with the lowest finite error among those that filled, and
+        that error."""
         best: tuple[str | None, float] = (None, float("nan"))
-        for name in METHODS:
+        for name in CHOICES:
             err = self.errors.get(name, float("nan"))
             if name in self.fills and np.isfinite(err) and not err >= best[1]:
                 best = (name, err)
@@ -67,7 +80,9 @@ class FillContext:
 
     Notes
     -----
-    Each marker's distance statistics (:meth:`distance_stats`) are computed on first use.
+    Each marker's distance statistics (:meth:`distance_stats`) are computed on first use;
+    ``speed_sums`` holds the running sums of every marker's speed
+    (:func:`~mocapqa.markers.fill_cv.marker_speed_sums`).
     """
 
     def __init__(self, positions: FloatArray, fps: float, params: FillParams, scale: float):
@@ -81,6 +96,7 @@ class FillContext:
         self.max_std = params.rigid_max_std_mm * scale
         self.min_spread = params.rigid_min_spread_mm * scale
         self.weight_scale = params.pca_weight_mm * scale
+        self.speed_sums = marker_speed_sums(positions, self.visible)
         self._stats: dict[int, tuple[FloatArray, FloatArray]] = {}
 
     def distance_stats(self, m: int) -> tuple[FloatArray, FloatArray]:
@@ -185,34 +201,130 @@ def _donors(take: FillContext, ranked: IntArray, frame: int) -> IntArray:
     return ranked[np.array(chosen, dtype=np.intp)]
 
 
-def _trial_starts(
-    ok: BoolArray, length: int, lead: int, tail: int, trials: int, near: int, local: bool
-) -> IntArray:
-    """Up to ``trials`` starts ``s`` with ``ok`` over ``s - lead .. s + length - 1 + tail``.
+def _motion(
+    take: FillContext, m: int, a: int, b: int, donors: IntArray, model: IntArray
+) -> tuple[FloatArray, float] | None:
+    """The mean speed of the markers nearest to the target over a window of the gap's length
+    starting at every frame, and over the gap itself (see :mod:`mocapqa.markers.fill_cv`)."""
+    if take.params.cv_match != "motion":
+        return None
+    near = model[: take.params.cv_motion_markers] if model.size else donors
+    if near.size == 0:
+        return None
+    length = b - a + 1
+    every = np.arange(take.n, dtype=np.intp)
+    values = window_motion(take.speed_sums, near, every, length)
+    gap = float(values[a]) if a + length <= take.n else float("nan")
+    return (values, gap) if np.isfinite(gap) else None
 
-    With ``local``, the starts nearest to frame ``near``, at most one per block of ``length``
-    frames (so they hardly overlap); otherwise evenly spread over the take.
-    """
-    width = lead + length + tail
-    if width > ok.size:
-        return np.empty(0, dtype=np.intp)
-    c = np.concatenate(([0], np.cumsum(ok, dtype=np.int64)))
-    starts = np.flatnonzero(c[width:] - c[:-width] == width) + lead
-    if starts.size == 0 or not local:
-        pick = np.unique(np.linspace(0, starts.size - 1, min(trials, starts.size)).round())
-        return starts[pick.astype(np.intp)].astype(np.intp)
-    by_distance = starts[np.argsort(np.abs(starts - near), kind="stable")]
-    _, first = np.unique(by_distance // length, return_index=True)
-    nearest = by_distance[np.sort(first)[: (trials + 1) // 2]]
-    spread = starts[
-        np.linspace(0, starts.size - 1, min(trials, starts.size)).round().astype(np.intp)
-    ]
-    spread = spread[~np.isin(spread, nearest)][: trials - nearest.size]
-    return np.sort(np.concatenate((nearest, spread))).astype(np.intp)
+
+@dataclass(slots=True)
+class _Trials:
+    """Each method's fills of the hidden stretches: starts, fills ``(T, L, 3)`` and truth."""
+
+    starts: list[int]
+    fills: list[FloatArray]
+    truth: list[FloatArray]
+
+    def rmse(self) -> float:
+        if not self.starts:
+            return float("nan")
+        return float(np.sqrt(np.mean(np.sum((np.stack(self.fills) - np.stack(self.truth)) ** 2,
+                                            axis=-1))))  # fmt: skip
+
+
+def _trial_fill(
+    take: FillContext,
+    name: str,
+    m: int,
+    s: int,
+    e: int,
+    gap: tuple[IntArray, IntArray, bool, bool],
+    fitted: PcaModel | None,
+) -> FloatArray | None:
+    """One method's fill of a hidden stretch ``s..e`` of marker ``m``; the PCA fill drops the
+    model markers not seen over it (and refits) rather than give up."""
+    donors, model, before, after = gap
+    if name == "pca":
+        seen = take.visible[s : e + 1][:, model].all(axis=0)
+        if not seen.all():
+            model, fitted = model[seen], None
+            if model.size < 3:
+                return None
+    return _fill(take, name, m, s, e, donors, model, before, after, hidden=(s, e), fitted=fitted)
+
+
+def _cross_validate(
+    take: FillContext,
+    m: int,
+    a: int,
+    b: int,
+    methods: list[str],
+    gap: tuple[IntArray, IntArray, bool, bool],
+    fitted: PcaModel | None,
+) -> dict[str, _Trials]:
+    """Each method's fills of up to ``cv_trials`` stretches of the gap's length where marker
+    ``m`` is recorded: the same stretches for every method where possible."""
+    params, vis = take.params, take.visible
+    donors, model, before, after = gap
+    length = b - a + 1
+    lead, tail = (2 if before else 0), (2 if after else 0)
+    need = {"spline": vis[:, m], "rigid": vis[:, m] & vis[:, donors].all(axis=1)}
+    # The PCA trials refit without the model markers not seen over them.
+    need["pca"] = vis[:, m] & (vis[:, model].all(axis=1) if model.size else True)
+    motion = _motion(take, m, a, b, donors, model)
+
+    def starts_where(ok: BoolArray) -> IntArray:
+        return trial_starts(ok, length, lead, tail, params.cv_trials, a,
+                            local=params.cv_local, motion=motion)  # fmt: skip
+
+    shared = starts_where(np.logical_and.reduce([need[x] for x in methods]))
+    if shared.size == 0:
+        shared = starts_where(np.logical_and.reduce([need[x] for x in methods if x != "pca"]))
+    out: dict[str, _Trials] = {}
+    for name in methods:
+        starts = shared if shared.size else starts_where(need[name])
+        if starts.size == 0 and name == "pca":
+            starts = starts_where(need["spline"])
+        trials = _Trials([], [], [])
+        for s in starts.tolist():
+            e = s + length - 1
+            filled = _trial_fill(take, name, m, s, e, gap, fitted)
+            if filled is not None:
+                trials.starts.append(s)
+                trials.fills.append(filled)
+                trials.truth.append(take.positions[s : e + 1, m])
+        out[name] = trials
+    return out
+
+
+def _blend(
+    fills: dict[str, FloatArray],
+    errors: dict[str, float],
+    trials: dict[str, _Trials],
+    params: FillParams,
+) -> tuple[FloatArray, float] | None:
+    """The methods' fills blended by inverse expected error, and the blend's cross-validated
+    error on the stretches every blended method filled; None with fewer than two methods."""
+    names = [x for x in fills if np.isfinite(errors.get(x, np.nan))]
+    if params.blend_power <= 0 or len(names) < 2:
+        return None
+    common = set.intersection(*(set(trials[x].starts) for x in names))
+    if not common:
+        return None
+    rows = [[trials[x].starts.index(s) for s in sorted(common)] for x in names]
+    pairs = zip(names, rows, strict=True)
+    stack = np.stack([np.stack([trials[x].fills[i] for i in row]) for x, row in pairs], axis=1)
+    truth = np.stack([trials[names[0]].truth[i] for i in rows[0]])
+    weights = blend_weights(np.array([errors[x] for x in names]), params.blend_power)
+    squared = np.sum((stack - truth[:, None]) ** 2, axis=(2, 3))
+    error = blend_trial_error(squared, stack, truth, params.blend_power)
+    blended = np.einsum("k,kld->ld", weights, np.stack([fills[x] for x in names]))
+    return blended, error
 
 
 def plan_gap(take: FillContext, m: int, a: int, b: int) -> GapPlan:
-    """Fill one gap by every method and cross-validate each on the take's own samples.
+    """Fill one gap by every method and their blend, and cross-validate each on the take.
 
     Parameters
     ----------
@@ -251,32 +363,10 @@ def plan_gap(take: FillContext, m: int, a: int, b: int) -> GapPlan:
         filled = _fill(take, name, m, a, b, donors, model, before, after, fitted=fitted)
         if filled is not None:
             fills[name] = filled
-    length = b - a + 1
-    lead, tail = (2 if before else 0), (2 if after else 0)
-    need = {
-        "spline": vis[:, m],
-        "rigid": vis[:, m] & vis[:, donors].all(axis=1),
-        "pca": vis[:, m] & vis[:, model].all(axis=1),
-    }
-    common = np.logical_and.reduce([need[name] for name in fills]) if fills else vis[:, m]
-
-    def trial_starts(ok: BoolArray) -> IntArray:
-        return _trial_starts(ok, length, lead, tail, params.cv_trials, a, params.cv_local)
-
-    shared = trial_starts(common)
-    errors: dict[str, float] = {}
-    for name in fills:
-        starts = shared
-        if starts.size == 0:
-            starts = trial_starts(need[name])
-        sq, count = 0.0, 0
-        for s in starts.tolist():
-            e = s + length - 1
-            trial = _fill(
-                take, name, m, s, e, donors, model, before, after, hidden=(s, e), fitted=fitted
-            )
-            if trial is not None:
-                sq += float(np.sum((trial - take.positions[s : e + 1, m]) ** 2))
-                count += length
-        errors[name] = float(np.sqrt(sq / count)) if count else float("nan")
+    gap = (donors, model, before, after)
+    trials = _cross_validate(take, m, a, b, list(fills), gap, fitted)
+    errors = {name: trials[name].rmse() for name in fills}
+    blend = _blend(fills, errors, trials, params)
+    if blend is not None:
+        fills["blend"], errors["blend"] = blend
     return GapPlan(fills=fills, errors=errors, donors=donors, model=model)

@@ -3,9 +3,9 @@
 Lengths are millimetres and are converted to the take's unit (:func:`unit_scale`), so one set
 of values suits takes in metres, centimetres, millimetres and inches; a take in an unknown unit
 is read as millimetres. Times are seconds, so the values hold at any frame rate.
-``swap_misfit`` and ``swap_gain`` are the grid point :func:`mocapqa_bench.markers.choose`
-picks on the bench files; the others were set by hand on them (docs/markers.md, "Thresholds
-and figures").
+``swap_misfit``, ``swap_gain`` and ``swap_held`` are the grid point
+:func:`mocapqa_bench.markers.choose` picks on the bench files; the others were set by hand on
+them (docs/markers.md, "Thresholds and figures").
 """
 
 from __future__ import annotations
@@ -79,6 +79,14 @@ class MarkerParams:
     swap_cross : float
         Crossing cue: at a swap's first frame each marker is nearer the other's previous
         position than this fraction of its own jump.
+    swap_held : float
+        Boundary test: a swap is rejected when, at its first frame or its release, both
+        labels keep their own trajectories over the ``swap_window`` frames either side:
+        at each frame, the two labels' positions miss the other's constant-velocity
+        prediction by more than their own, summed, by over this fraction of the pair's
+        median distance (two labels well apart cannot exchange without a jump).
+    swap_window : int
+        Frames either side of a swap's boundary the boundary test reads.
     swap_report : float
         Swaps with less confidence than this are not reported (0–1).
     swap_confidence : float
@@ -104,9 +112,11 @@ class MarkerParams:
     mate_score: float = 2.0
     neighbours: int = 3
     tolerance_floor: float = 3.0
-    swap_misfit: float = 3.0
+    swap_misfit: float = 2.5
     swap_gain: float = 0.5
     swap_cross: float = 0.5
+    swap_held: float = 0.25
+    swap_window: int = 2
     swap_report: float = 0.5
     swap_confidence: float = 0.8
     static_std: float = 1.0
@@ -125,6 +135,6 @@ class MarkerParams:
                 "gap_error_s",
                 f"Expected ≥ gap_warning_s ({self.gap_warning_s}), got {self.gap_error_s}",
             )
-        for name in ("segment_frames", "spike_max_frames"):
+        for name in ("segment_frames", "spike_max_frames", "swap_window"):
             if not isinstance(getattr(self, name), int) or getattr(self, name) < 1:
                 raise OptionError(name, f"Expected an integer ≥ 1, got {getattr(self, name)!r}")

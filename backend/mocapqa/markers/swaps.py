@@ -24,6 +24,13 @@ Conventions
 * **Crossing cue** (:func:`crossings`): at a swap's first frame ``s`` each label jumps to the
   other's previous position, ``|A(s) − B(s−1)| + |B(s) − A(s−1)| < swap_cross · (|A(s) −
   A(s−1)| + |B(s) − B(s−1)|)``, and back at ``end + 1``.
+* **Boundary test** (:func:`labels_held`): a swap is rejected when, at its first frame or
+  at its release, both markers are seen over the ``swap_window`` frames either side and each
+  label keeps its own trajectory there: each label's position, predicted at constant
+  velocity from its two previous ones, is nearer its own prediction than the other's by more
+  than ``swap_held`` times the pair's median distance (summed over the two labels), at every
+  one of those frames: two labels well apart cannot exchange without a jump. A boundary at
+  a gap, at the take's edge or where the two markers are close together does not reject.
 * **Confidence** in [0, 1]: the share of explained frames among the explained, contradicted
   and neither frames (neither counted up to three frames either side: a tracking glitch is
   not a clean exchange), times ``1 − after / before`` of the median misfits over the
@@ -55,6 +62,7 @@ __all__ = [
     "candidate_pairs",
     "crossings",
     "find_swaps",
+    "labels_held",
     "misfits",
     "repair_swaps",
     "select_swaps",
@@ -310,6 +318,52 @@ def _evidence(
     return _Evidence(explained, contradicted, neither, before, after, crossed)
 
 
+def labels_held(
+    positions: FloatArray, a: int, b: int, usual: float, frame: int, params: MarkerParams
+) -> bool:
+    """Whether labels ``a`` and ``b`` keep their own trajectories around ``frame``.
+
+    Over the frames ``frame − swap_window − 2`` to ``frame + swap_window``, both markers
+    must be visible at the first two and the last; for each frame ``v`` where both are
+    visible after those two, each label's position is predicted at constant velocity from
+    the two visible frames before it (a gap inside is bridged), ``P(v)``, and the exchanged
+    predictions must miss by more than the kept ones, ``|A(v) − P_B(v)| + |B(v) − P_A(v)| −
+    |A(v) − P_A(v)| − |B(v) − P_B(v)| > swap_held · usual``: an exchange of the labels
+    anywhere there would need a jump that is not seen, however fast the two move. False near
+    the take's edges, where a marker is missing at the window's ends, where the two are
+    close together or a label jumps.
+
+    Parameters
+    ----------
+    positions : ndarray, shape (F, M, 3)
+        Take units, NaN where missing.
+    a, b : int
+        Marker indices.
+    usual : float
+        The pair's median distance, take units.
+    frame : int
+        The first frame after the boundary (a swap's start, or its end + 1), 0-based.
+    params : MarkerParams
+
+    Returns
+    -------
+    bool
+    """
+    first, last = frame - params.swap_window - 2, frame + params.swap_window
+    if first < 0 or last >= positions.shape[0] or not np.isfinite(usual):
+        return False
+    window = positions[first : last + 1][:, [a, b]]  # (W, 2, 3)
+    seen = np.flatnonzero(visible(window).all(axis=1))
+    if seen.size < 3 or seen[0] != 0 or seen[1] != 1 or seen[-1] != window.shape[0] - 1:
+        return False
+    older, was, now = seen[:-2], seen[1:-1], seen[2:]
+    ratio = ((now - was) / (was - older))[:, None, None]
+    predicted = window[was] + (window[was] - window[older]) * ratio  # (T, 2, 3)
+    kept = np.linalg.norm(window[now] - predicted, axis=2).sum(axis=1)
+    exchanged = np.linalg.norm(window[now] - predicted[:, ::-1], axis=2).sum(axis=1)
+    return bool((exchanged - kept > params.swap_held * usual).all())
+
+
 def _intervals(evidence: _Evidence) -> list[tuple[int, int, int]]:
     """Candidate intervals ``(column, start, end)``: runs without contradiction trimmed to
     explained frames, and the stretches between successive crossings of one pair."""
@@ -421,9 +475,12 @@ def swaps_and_misfits(
         confidence, level_before, level_after, at_start, at_end = _confidence(
             evidence, column, start, end
         )
-        if confidence < p.swap_report:
-            continue
         ia, ib = int(a[column]), int(b[column])
+        if confidence < p.swap_report or any(
+            labels_held(positions, ia, ib, float(stats.median[ia, ib]), frame, p)
+            for frame in (start, end + 1)
+        ):
+            continue
         severity = "error" if confidence >= p.swap_confidence else "warning"
         swap = Swap(
             (names[ia], names[ib]), (ia, ib), start, end, round(float(confidence), 4),

@@ -4,8 +4,9 @@ Swaps injected between neighbouring markers of real takes (precision and recall 
 thresholds chosen leaving each file out; false swaps and spikes per 10,000 frames of the clean
 takes; injected-spike recall; check speed of a 10,000-frame, 60-marker take), then gap filling
 (gaps of 0.05–2 s injected alone and as occlusions of a segment; fill RMSE in mm per method and
-gap length, :mod:`mocapqa_bench.marker_fill`). ``--fill-only`` and ``--swaps-only`` run one
-part.
+gap length with the fill settings chosen leaving each file out, :mod:`mocapqa_bench.marker_fill`;
+the real gapped take against its clean twin and the fill time of a 10,000-frame, 60-marker take,
+:mod:`mocapqa_bench.marker_fill_real`). ``--fill-only`` and ``--swaps-only`` run one part.
 """
 
 from __future__ import annotations
@@ -31,20 +32,21 @@ def _swap_tables(figures: dict[str, Any]) -> list[Any]:
     from rich.table import Table
 
     held = Table(title="Injected swaps, each file held out (thresholds chosen on the others)")
-    for column in ("file", "misfit / gain", "precision", "recall", "confident P / R",
+    for column in ("file", "misfit / gain / held", "precision", "recall", "confident P / R",
                    "clean swaps /10k fr", "clean spikes /10k fr"):  # fmt: skip
         held.add_column(column, justify="left" if column == "file" else "right")
     for row in figures["held_out"]:
         every, confident = row["all"], row["confident"]
         held.add_row(
-            row["file"], f"{row['swap_misfit']:g} / {row['swap_gain']:g}",
+            row["file"], f"{row['swap_misfit']:g} / {row['swap_gain']:g} / {row['swap_held']:g}",
             _pct(every["precision"]), _pct(every["recall"]),
             f"{_pct(confident['precision'])} / {_pct(confident['recall'])}",
             f"{row['clean_swaps_per_10k']:.1f}", f"{row['clean_spikes_per_10k']:.0f}",
         )  # fmt: skip
     chosen = figures["chosen"]
     held.caption = (
-        f"chosen on every file: misfit {chosen['swap_misfit']:g}, gain {chosen['swap_gain']:g}; "
+        f"chosen on every file: misfit {chosen['swap_misfit']:g}, gain {chosen['swap_gain']:g}, "
+        f"held {chosen['swap_held']:g}; "
         f"pooled precision {_pct(chosen['precision'])}, recall {_pct(chosen['recall'])} "
         f"({chosen['injected']} swaps)"
     )
@@ -63,10 +65,15 @@ def _swap_tables(figures: dict[str, Any]) -> list[Any]:
     return [held, spikes]
 
 
-def _fill_table(rows: list[dict[str, Any]]) -> Any:
+def _fill_table(rows: list[dict[str, Any]], choices: list[dict[str, Any]]) -> Any:
     from rich.table import Table
 
-    table = Table(title="Gap fill RMSE (mm) by gap length, gaps where ≥ 3 segment mates stay seen")
+    from mocapqa_bench.marker_fill import FILL_CANDIDATES
+
+    table = Table(
+        title="Gap fill RMSE (mm) by gap length, each file held out (settings chosen on the "
+        "others), gaps where ≥ 3 segment mates stay seen"
+    )
     for column in ("gap (s)", "gaps (occl.)", "spline", "rigid", "PCA", "auto",
                    "auto / spline", "auto / PCA", "chosen"):  # fmt: skip
         table.add_column(column, justify="left" if column in ("gap (s)", "chosen") else "right")
@@ -77,8 +84,44 @@ def _fill_table(rows: list[dict[str, Any]]) -> Any:
             f"{row['auto_vs_spline']:.2f}", f"{row['auto_vs_pca']:.2f}",
             ", ".join(f"{k} {v}" for k, v in row["chosen"].items() if v),
         )  # fmt: skip
-    table.caption = "targets: auto ≤ 0.5 × spline and ≤ 0.8 × PCA at every length"
+
+    def setting(index: int) -> str:
+        chosen = FILL_CANDIDATES[index]
+        return f"{chosen.cv_match}, blend {chosen.blend_power:g}"
+
+    held = "; ".join(f"{Path(c['file']).stem}: {setting(c['chosen'])}" for c in choices)
+    table.caption = (
+        f"targets: auto ≤ 0.5 × spline and ≤ 0.8 × PCA at every length\n"
+        f"chosen with each file held out (trial placement, blend power): {held}"
+    )
     return table
+
+
+def _fill_figures(console: Any, corpus: Path, seeds: int, events_per_bin: int) -> None:
+    from mocapqa.markers.fill import Apply
+    from mocapqa_bench.marker_fill import FILL_CANDIDATES, summarise, tune_leave_one_out
+    from mocapqa_bench.marker_fill_real import fill_speed, twin_figures
+
+    with console.status(f"gap fill: {seeds} seeds, {events_per_bin} gaps per bin, each file out"):
+        choices, held = tune_leave_one_out(
+            corpus, FILL_CANDIDATES, range(seeds), events_per_bin=events_per_bin
+        )
+    console.print(_fill_table(summarise(held), choices))
+    applies: tuple[Apply, ...] = ("confident", "all")
+    for apply in applies:
+        twin = twin_figures(corpus, apply)
+        console.print(
+            f"real gapped take (--apply {apply}): {twin['filled_gaps']} of {twin['gaps']} gaps, "
+            f"{twin['filled_samples']} samples, RMSE {twin['rmse_mm']:.1f} mm against the clean "
+            f"twin, expected {twin['expected_mm']:.1f} mm ({twin['methods']})"
+        )
+    with console.status("fill time"):
+        speed = fill_speed(corpus)
+    console.print(
+        f"fill of a {speed['frames']:,}-frame, {speed['markers']}-marker take with "
+        f"{100 * speed['missing']:.1f} % missing ({speed['gaps']} gaps): {speed['cpu_s']:.1f} "
+        f"CPU s, {speed['wall_s']:.1f} s wall"
+    )
 
 
 @bench_app.command("markers")
@@ -111,8 +154,4 @@ def bench_markers(
         for table in _swap_tables(figures):
             console.print(table)
     if not swaps_only:
-        from mocapqa_bench.marker_fill import fill_table
-
-        with console.status(f"gap fill: {fill_seeds} seeds, {events_per_bin} gaps per bin"):
-            rows = fill_table(corpus, range(fill_seeds), events_per_bin=events_per_bin)
-        console.print(_fill_table(rows))
+        _fill_figures(console, corpus, fill_seeds, events_per_bin)
