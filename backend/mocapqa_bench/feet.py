@@ -17,11 +17,11 @@ the whole check runs again on the changed take. A slide is found when a skate fi
 foot overlaps the contact; a penetration when a penetration finding does. False flags are the
 skate findings of the clean takes, per minute.
 
-Choice: each ``(plant_height, plant_speed)`` pair of a small grid runs on the fit takes with
-every contact's travel recorded; the skate threshold is then the smallest of a grid whose false
-flags on the fit takes stay at or under :data:`MAX_FLAGS_PER_MINUTE`, and the pair with the best
-recall of slides of 2 cm and more wins. The figures reported are those of the held-back takes
-under the chosen parameters.
+Choice: each ``(plant_height, plant_speed, sole_depth, slide_height)`` of a small grid runs on
+the fit takes with every contact's travel recorded; the skate threshold is then the smallest of
+a grid whose false flags on the fit takes stay at or under :data:`MAX_FLAGS_PER_MINUTE`, and
+the entry with the best recall of slides of 2 cm and more wins (fewer flags on a tie). The
+figures reported are those of the held-back takes under the chosen parameters.
 
 The contact detector against force plates is :mod:`mocapqa_bench.feet_plates`; the foot lock
 on slides injected through the leg is :mod:`mocapqa_bench.feet_cleanup`.
@@ -98,10 +98,13 @@ MIN_CONTACT_S = 0.15
 """Shortest contact given an injected error, seconds."""
 _MAX_SINK_S = 0.5
 _ON_FLOOR_CM = 0.5
-_PLANT_GRID = (
-    (0.006, 0.1), (0.006, 0.15), (0.01, 0.1), (0.01, 0.15), (0.01, 0.2), (0.015, 0.15),
-)  # fmt: skip
-_TRAVEL_GRID = tuple(np.round(np.arange(0.010, 0.0605, 0.002), 3))
+_PLANT_GRID = ((0.006, 0.1), (0.01, 0.15))
+"""(plant_height, plant_speed) pairs tried."""
+_SOLE_GRID = (0.0, 0.03, 0.045, 0.06, 0.075)
+"""sole_depth values tried, leg lengths."""
+_SLIDE_GRID = (0.0, 0.02)
+"""slide_height values tried, leg lengths (slide_speed keeps its default)."""
+_TRAVEL_GRID = tuple(np.round(np.arange(0.010, 0.0605, 0.001), 3))
 
 
 @dataclass(frozen=True, slots=True)
@@ -276,16 +279,16 @@ class Choice:
         Share of fit slides of 2 cm and more found.
     fit_flags_per_minute : float
         Skate findings per minute on the clean fit takes.
-    candidates : tuple of (float, float, float, float, float)
-        Per grid pair: plant_height, plant_speed, the threshold chosen, fit recall ≥ 2 cm
-        and fit flags per minute.
+    candidates : tuple of (float, float, float, float, float, float, float)
+        Per grid entry: plant_height, plant_speed, sole_depth, slide_height, the threshold
+        chosen, fit recall ≥ 2 cm and fit flags per minute.
     """
 
     params: FeetParams
     fit_takes: tuple[str, ...]
     fit_recall: float
     fit_flags_per_minute: float
-    candidates: tuple[tuple[float, float, float, float, float], ...]
+    candidates: tuple[tuple[float, float, float, float, float, float, float], ...]
 
 
 def choose_params(
@@ -304,38 +307,55 @@ def choose_params(
     candidates = []
     best: tuple[float, float, FeetParams] | None = None
     for plant_height, plant_speed in _PLANT_GRID:
-        probe = dataclasses.replace(
-            base, plant_height=plant_height, plant_speed=plant_speed, skate_travel=0.0
-        )
-        # Sizes in leg lengths: the threshold is one.
-        clean = np.array([s / (t.cm_per_unit * t.points.leg_length)
-                          for t in clean_takes for s in clean_flags(t, probe)[0]])  # fmt: skip
-        slides = [
-            (trial.size_cm, trial.measured_cm / (t.cm_per_unit * t.points.leg_length))
-            for t in fit
-            for trial in run_trials(t, probe, seed, depths_cm=())
-        ]
-        sizes = np.array([s for s, _ in slides])
-        measured = np.array([m for _, m in slides])
-        for travel in _TRAVEL_GRID:
-            flags = float(np.sum(clean >= travel)) / minutes
-            if flags <= MAX_FLAGS_PER_MINUTE:
-                big = sizes >= 2.0
-                recall = float(np.mean(measured[big] >= travel)) if big.any() else 0.0
-                candidates.append((plant_height, plant_speed, float(travel), recall, flags))
+        for sole_depth in _SOLE_GRID:
+            for slide_height in _SLIDE_GRID:
+                probe = dataclasses.replace(
+                    base, plant_height=plant_height, plant_speed=plant_speed,
+                    sole_depth=sole_depth, slide_height=slide_height, skate_travel=0.0,
+                )  # fmt: skip
+                travel, recall, flags = _smallest_travel(fit, clean_takes, minutes, probe, seed)
+                if travel is None:
+                    continue
+                candidates.append(
+                    (plant_height, plant_speed, sole_depth, slide_height, travel, recall, flags)
+                )
                 if best is None or (recall, -flags) > (best[0], -best[1]):
-                    chosen = dataclasses.replace(
-                        base, plant_height=plant_height, plant_speed=plant_speed,
-                        skate_travel=float(travel),
-                    )  # fmt: skip
-                    best = (recall, flags, chosen)
-                break
+                    best = (recall, flags, dataclasses.replace(probe, skate_travel=travel))
     if best is None:
         raise InputError(
             f"Expected a skate threshold under {_TRAVEL_GRID[-1]} leg lengths with at most "
             f"{MAX_FLAGS_PER_MINUTE} false flags per minute on the fit takes, got none"
         )
     return Choice(best[2], tuple(t.name for t in fit), best[0], best[1], tuple(candidates))
+
+
+def _smallest_travel(
+    fit: Sequence[BenchTake],
+    clean_takes: Sequence[BenchTake],
+    minutes: float,
+    probe: FeetParams,
+    seed: int,
+) -> tuple[float | None, float, float]:
+    """The smallest skate threshold of the grid with at most :data:`MAX_FLAGS_PER_MINUTE`
+    false flags on the clean fit takes under ``probe`` (None when none qualifies), with its
+    recall of fit slides of 2 cm and more and its flags per minute."""
+    # Sizes in leg lengths: the threshold is one.
+    clean = np.array([s / (t.cm_per_unit * t.points.leg_length)
+                      for t in clean_takes for s in clean_flags(t, probe)[0]])  # fmt: skip
+    slides = [
+        (trial.size_cm, trial.measured_cm / (t.cm_per_unit * t.points.leg_length))
+        for t in fit
+        for trial in run_trials(t, probe, seed, depths_cm=())
+    ]
+    sizes = np.array([s for s, _ in slides])
+    measured = np.array([m for _, m in slides])
+    big = sizes >= 2.0
+    for travel in _TRAVEL_GRID:
+        flags = float(np.sum(clean >= travel)) / minutes
+        if flags <= MAX_FLAGS_PER_MINUTE:
+            recall = float(np.mean(measured[big] >= travel)) if big.any() else 0.0
+            return float(travel), recall, flags
+    return None, 0.0, 0.0
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,5 +1,6 @@
 """``mocapqa bench feet``, foot cleanup: slides injected through the leg into the held-back
-takes' contacts, then ``feet fix --apply all``; what is left of each slide and what else
+takes' contacts, then ``feet fix --apply all`` (the lock holding the sole under the pivot, with
+the heights of the check of the injected take); what is left of each slide and what else
 changed."""
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from mocapqa.feet.fix import FootRig, LockResult, foot_rig, lock_feet, shift_ank
 from mocapqa.feet.ground import UpAxis
 from mocapqa.feet.ik import leg_subtree
 from mocapqa.feet.inject import leg_slide_offsets
-from mocapqa.feet.lock import BLEND_S, Lock
+from mocapqa.feet.lock import BLEND_S, Lock, sole_heights
 from mocapqa.feet.params import FeetParams
 from mocapqa.feet.points import SIDES, FootPoints
 from mocapqa.feet.tracks import horizontal_axes
@@ -56,6 +57,9 @@ class CleanupTrial:
     clean_cm, injected_cm, fixed_cm : float
         The check's travel of the contact (skate measure with no threshold) on the clean
         take, the injected one and the fixed one, centimetres.
+    fixed_joints_cm : float
+        The fixed one's travel read at the joints (``sole_pivot`` False) instead of the sole
+        under them, which the lock holds, centimetres.
     hip_knee_deg_blends : float
         Largest change of a hip or knee local rotation in the blend frames (outside the
         locked contacts), degrees.
@@ -79,6 +83,7 @@ class CleanupTrial:
     clean_cm: float
     injected_cm: float
     fixed_cm: float
+    fixed_joints_cm: float
     hip_knee_deg_blends: float
     hip_knee_deg_outside: float
     upper_body_changed: int
@@ -190,7 +195,11 @@ def _slide_trial(
     in_points, _ = motion_foot_points(injected)
     report = check_feet(in_points, params, take.clean.up)
     locks = [Lock(c.foot, c.start + skipped, c.end + skipped) for c in report.contacts]
-    pops, result, cpu, before, after = _lock_anchors(take, injected, locks)
+    depths = sole_heights(
+        report.elevations, report.floor.point_offsets, in_points.sides,
+        params.sole_depth * in_points.leg_length, skipped, motion.n_frames,
+    ) if params.sole_pivot else None  # fmt: skip
+    pops, result, cpu, before, after = _lock_anchors(take, injected, locks, depths)
     inside = np.zeros((motion.n_frames, 2), dtype=bool)
     for lock in locks:
         inside[lock.start : lock.end + 1, SIDES.index(lock.foot)] = True
@@ -207,6 +216,8 @@ def _slide_trial(
         take.path.name, take.family, contact.foot, size, clean_cm,
         _travel_cm(injected, up, params, contact.foot, start, end, scale),
         _travel_cm(result.motion, up, params, contact.foot, start, end, scale),
+        _travel_cm(result.motion, up, dataclasses.replace(params, sole_pivot=False),
+                   contact.foot, start, end, scale),
         float(per_leg[blends].max(initial=0.0)),
         float(per_leg[untouched].max(initial=0.0)),
         int(np.sum(np.any(after[:, ~legs] != before[:, ~legs], axis=(0, 2)))),
@@ -215,7 +226,7 @@ def _slide_trial(
 
 
 def _lock_anchors(
-    take: _CleanupTake, injected: Motion, locks: list[Lock]
+    take: _CleanupTake, injected: Motion, locks: list[Lock], depths: FloatArray | None
 ) -> tuple[dict[str, float], LockResult, float, FloatArray, FloatArray]:
     """Lock ``injected`` with each anchor ("start", then "middle"): per anchor the largest
     speed the lock adds to an ankle, cm/s; and of the last, the result, its CPU seconds and
@@ -234,6 +245,7 @@ def _lock_anchors(
             take.points.leg_length,
             anchor,
             first=take.skipped,
+            depths=depths,
         )
         cpu = time.process_time() - began
         before = forward_kinematics(injected)[1]

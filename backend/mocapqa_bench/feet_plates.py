@@ -8,6 +8,7 @@ import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -28,6 +29,7 @@ from mocapqa.io.c3d import read_c3d
 from mocapqa.io.c3d_plates import read_force_plates
 
 __all__ = [
+    "EVENT_WINDOWS",
     "MARKER_GRID",
     "PLATE_HEIGHT",
     "PLATE_SPEED",
@@ -44,14 +46,20 @@ PLATE_HEIGHT = 0.1
 PLATE_SPEED = 1.0
 """... and slower than this, leg lengths per second (a swing foot crossing a plate low moves
 at several)."""
-MARKER_GRID: tuple[dict[str, float], ...] = tuple(
+EVENT_WINDOWS = ((0.0, 0.0), (0.04, 0.02), (0.04, 0.04), (0.08, 0.04))
+"""``(event_before_s, event_after_s)`` tried: contact edges as detected, or moved to the heel's
+impact and the toe's push-off within that window (:mod:`mocapqa.feet.events`)."""
+MARKER_GRID: tuple[dict[str, Any], ...] = tuple(
     {
         "contact_speed": cs,
         "release_speed": rs,
         "contact_height": ch,
         "release_height": rh,
         "speed_window_s": w,
+        "event_before_s": before,
+        "event_after_s": after,
     }
+    for before, after in EVENT_WINDOWS
     for w in (0.1, 0.05)
     for ch in (0.04, 0.06)
     for rh in (0.07, 0.1, 0.15)
@@ -183,7 +191,7 @@ class PlateRow:
 
 
 def marker_params_by_leave_one_out(
-    trials: Sequence[PlateTrial], grid: Sequence[dict[str, float]] = MARKER_GRID
+    trials: Sequence[PlateTrial], grid: Sequence[dict[str, Any]] = MARKER_GRID
 ) -> tuple[list[PlateRow], FeetParams]:
     """Score each scorable trial with the contact parameters chosen on the others.
 

@@ -8,10 +8,13 @@ import numpy as np
 import pytest
 from tests.feet.walker import FPS, LEG_CM, stand, walk
 
+from mocapqa.core.arrays import FloatArray
 from mocapqa.errors import InputError
 from mocapqa.feet.check import check_feet
 from mocapqa.feet.ground import UpAxis
 from mocapqa.feet.inject import inject_penetration, inject_slide
+from mocapqa.feet.params import FeetParams
+from mocapqa.feet.points import FootPoints
 
 Y_UP = UpAxis(1, 1, "given", (0.0, 0.0, 0.0))
 
@@ -44,18 +47,45 @@ def test_a_slide_under_the_threshold_is_not_reported() -> None:
     assert [f for f in report.findings if f.kind == "skate"] == []
 
 
-def test_a_foot_rolling_over_its_toe_does_not_skate() -> None:
-    # Push-off: the ankle rises and moves forward about the planted toe.
-    points = stand(seconds=2.0)
+def _rolled_over(points: FootPoints, pivot: FloatArray) -> FloatArray:
+    """Push-off: the left foot (ankle and toe) turns 25° in pitch about ``pivot`` over frames
+    120–199 and stays there."""
     rolled = points.positions.copy()
     frames = np.arange(120, 200)
-    angle = np.radians(np.linspace(0.0, 25.0, frames.size))
-    toe = rolled[0, 1]
-    back = rolled[0, 0] - toe  # ankle from toe: 15 cm behind, 6 cm up
-    rolled[frames, 0, 0] = toe[0] + back[0] * np.cos(angle) - back[1] * np.sin(angle)
-    rolled[frames, 0, 1] = toe[1] + back[0] * np.sin(angle) + back[1] * np.cos(angle)
-    rolled[200:, 0] = rolled[199, 0]
-    report = check_feet(dataclasses.replace(points, positions=rolled))
+    angle = np.radians(np.linspace(0.0, 25.0, frames.size))[:, None]
+    for k in (0, 1):
+        back = rolled[0, k] - pivot
+        rolled[frames, k, 0] = (
+            pivot[0] + back[0] * np.cos(angle[:, 0]) - back[1] * np.sin(angle[:, 0])
+        )
+        rolled[frames, k, 1] = (
+            pivot[1] + back[0] * np.sin(angle[:, 0]) + back[1] * np.cos(angle[:, 0])
+        )
+        rolled[200:, k] = rolled[199, k]
+    return rolled
+
+
+def test_a_foot_rolling_over_the_sole_under_its_toe_does_not_skate() -> None:
+    # The toe joint sits sole_depth above the floor it rolls on: its sole point stays, the
+    # toe joint itself moves forward 2.3 cm.
+    points = stand(seconds=2.0)
+    params = FeetParams()
+    pivot = points.positions[0, 1] - [0.0, params.sole_depth * LEG_CM, 0.0]
+    rolled = _rolled_over(points, pivot)
+    assert np.ptp(rolled[:, 1, 0]) > 2.0
+    report = check_feet(dataclasses.replace(points, positions=rolled), params)
+    assert [f for f in report.findings if f.kind == "skate"] == []
+    # Read at the joints (no sole below them), the same roll slides.
+    flat = dataclasses.replace(params, sole_depth=0.0)
+    report = check_feet(dataclasses.replace(points, positions=rolled), flat)
+    assert [f.foot for f in report.findings if f.kind == "skate"] == ["left"]
+
+
+def test_a_foot_rolling_over_its_toe_joint_does_not_skate_without_a_sole_depth() -> None:
+    points = stand(seconds=2.0)
+    rolled = _rolled_over(points, points.positions[0, 1])
+    params = FeetParams(sole_depth=0.0)
+    report = check_feet(dataclasses.replace(points, positions=rolled), params)
     assert [f for f in report.findings if f.kind == "skate"] == []
 
 

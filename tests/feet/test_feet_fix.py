@@ -17,7 +17,7 @@ from mocapqa.core.motion import Motion
 from mocapqa.feet.check import FeetReport, check_feet
 from mocapqa.feet.contacts import Contact
 from mocapqa.feet.findings import Finding
-from mocapqa.feet.fix import FootRig, foot_rig, lock_feet, shift_ankles
+from mocapqa.feet.fix import FootRig, fix_feet, foot_rig, lock_feet, shift_ankles
 from mocapqa.feet.fix_choice import choose_locks
 from mocapqa.feet.ik import leg_subtree, solve_leg
 from mocapqa.feet.inject import leg_slide_offsets
@@ -69,10 +69,14 @@ def slid(corpus_dir: Path) -> Slid:
     return Slid(raw, motion, rig, report, contact, points.leg_length)
 
 
+JOINTS = FeetParams(sole_pivot=False)
+"""The skate check reading the joints, as the lock holds them (not the sole under them)."""
+
+
 def _travel_cm(motion: Motion, foot: str, start: int, end: int) -> float:
-    """The check's travel of the contact (skate with no threshold), cm."""
+    """The check's travel of the contact (skate with no threshold, read at the joints), cm."""
     points, _ = motion_foot_points(motion)
-    report = check_feet(points, FeetParams(skate_travel=0.0))
+    report = check_feet(points, dataclasses.replace(JOINTS, skate_travel=0.0))
     return max(
         (f.size for f in report.findings
          if f.kind == "skate" and f.foot == foot and f.start <= end and f.end >= start),
@@ -95,7 +99,7 @@ def test_the_injected_slide_is_found_and_the_lock_removes_it(slid: Slid) -> None
     assert _travel_cm(slid.motion, c.foot, c.start, c.end) > 4.0
     fixed, _, _ = _lock_all(slid)
     assert _travel_cm(fixed, c.foot, c.start, c.end) <= 0.5
-    _, after, _ = check_take_feet(fixed)
+    _, after, _ = check_take_feet(fixed, params=JOINTS)
     assert not [f for f in after.findings if f.kind == "skate"]
 
 
@@ -123,6 +127,36 @@ def test_only_the_legs_move_and_frames_away_from_the_locks_stay_bit_for_bit(slid
         joints = leg_subtree(skeleton, leg.hip)
         assert np.array_equal(slid.motion.quats[still][:, joints], fixed.quats[still][:, joints])
         assert np.array_equal(before[still][:, joints], after[still][:, joints])
+
+
+def _sole_travels_cm(motion: Motion) -> list[float]:
+    """The check's travel of every contact (skate with no threshold, read at the sole), cm."""
+    points, _ = motion_foot_points(motion)
+    report = check_feet(points, dataclasses.replace(FeetParams(), skate_travel=0.0))
+    return [f.size for f in report.findings if f.kind == "skate"]
+
+
+def test_the_lock_holds_the_sole_the_check_reads(slid: Slid) -> None:
+    points, report, skipped = check_take_feet(slid.motion)
+    fixed = fix_feet(slid.motion, points, report, skipped, "all", FeetParams())
+    assert isinstance(fixed.take, Motion)
+    assert len(fixed.chosen) == len(report.contacts)
+    # Read at the sole, every locked contact travels at most 0.5 cm; holding the joints
+    # instead leaves the sole under a rolling foot moving (more than 0.5 cm somewhere).
+    at_sole = _sole_travels_cm(fixed.take)
+    assert at_sole
+    assert max(at_sole) <= 0.5
+    joints, _, _ = _lock_all(slid)
+    assert max(_sole_travels_cm(joints)) > max(at_sole)
+    _, after, _ = check_take_feet(fixed.take)
+    assert not [f for f in after.findings if f.kind == "skate"]
+    # Still only the legs: every joint outside the hips' subtrees keeps its world position.
+    skeleton = slid.motion.skeleton
+    legs = leg_subtree(skeleton, slid.rig.legs[0].hip) | leg_subtree(skeleton, slid.rig.legs[1].hip)
+    _, before_world = forward_kinematics(slid.motion)
+    _, after_world = forward_kinematics(fixed.take)
+    assert np.array_equal(before_world[:, ~legs], after_world[:, ~legs])
+    assert np.all(fixed.after <= fixed.before + 1e-9)
 
 
 def test_the_ik_reaches_a_reachable_target_keeps_the_foot_and_clamps_the_rest(
@@ -239,18 +273,12 @@ def test_keypoint_feet_are_pinned_and_nothing_else_moves(
     assert skate["slide_after_cm"] < skate["slide_before_cm"]
 
 
-def test_a_c3d_take_is_refused_for_now(
-    corpus_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    c3d = corpus_dir / "c3d" / "btk" / "Eb015pr.c3d"
-    assert main(["feet", "fix", str(c3d), "-o", str(tmp_path / "out.c3d")]) == 3
-    assert "foot cleanup is for BVH and keypoint takes for now" in capsys.readouterr().err
-
-
 def test_the_cleanup_bench_on_the_cmu_walk(cmu_walk: Path) -> None:
-    trials = cleanup_trials(cmu_walk, "cmu", FeetParams(), seed=0, slides_cm=(5.0,))
+    trials = cleanup_trials(cmu_walk, "cmu", JOINTS, seed=0, slides_cm=(5.0,))
     assert len(trials) == 8
     assert all(t.upper_body_changed == 0 for t in trials)
     assert all(t.hip_knee_deg_outside == 0.0 for t in trials)
     assert np.median([t.injected_cm for t in trials]) > 3.0
     assert np.median([t.fixed_cm for t in trials]) <= 0.5
+    # Checked at the joints, the residual "at the joints" is the same reading.
+    assert [t.fixed_joints_cm for t in trials] == [t.fixed_cm for t in trials]

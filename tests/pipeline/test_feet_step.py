@@ -14,7 +14,7 @@ from mocapqa.pipeline.feet_step import FEET_FINDING_KINDS, feet_findings
 from mocapqa.pipeline.options import AnalysisOptions, describe_options, take_checks
 from mocapqa.pipeline.summary import FEET_FIELDS, qa_summary
 
-SKATING = Path("bvh/bandai/dataset-1_walk-back_old_001.bvh")  # one skate finding
+SKATING = Path("bvh/cmu/iclone/007_04.bvh")  # a real 1.4-cm slide: skate findings
 NO_FEET = Path("c3d/btk/MotionMonitorC3D.c3d")  # markers M1–M7, no foot markers
 SHARED = ("kind", "joint", "start_frame", "end_frame", "value", "unit", "confidence")
 

@@ -1,5 +1,5 @@
 """``mocapqa feet check``: up axis, floor, foot contacts and foot findings of a take;
-``mocapqa feet fix``: the same take with chosen contacts locked (BVH and keypoint takes).
+``mocapqa feet fix``: the same take with chosen contacts locked (BVH, keypoint and C3D takes).
 
 The take is read through :func:`mocapqa.cli.reading.read_input` (the reading limits apply);
 BVH, keypoint and C3D marker takes work (:mod:`mocapqa.pipeline.feet`; a C3D take's heel and
@@ -8,8 +8,9 @@ object of :func:`mocapqa.pipeline.feet.feet_report_json`; without it, Rich table
 code is 0 whatever the take holds; errors exit as in every command (3 for input errors).
 
 ``feet fix`` checks the take, locks the contacts ``--apply`` names
-(:func:`mocapqa.feet.fix_choice.choose_locks`; BVH: :func:`mocapqa.feet.fix.lock_feet`,
-keypoints: :func:`mocapqa.feet.pin.pin_feet`), writes the take and
+(:func:`mocapqa.feet.fix.fix_feet`, what the reviewed download does too; BVH:
+:func:`mocapqa.feet.fix.lock_feet`, keypoints and C3D markers: :func:`mocapqa.feet.pin.pin_feet`),
+writes the take (a C3D with its analogs and force plates) and
 reports every finding and contact with applied or not and its slide before and after
 (:func:`mocapqa.feet.fix_report.fix_report_json`), printed with ``--json`` and written with
 ``--report``.
@@ -17,9 +18,7 @@ reports every finding and contact with applied or not and its slide before and a
 
 from __future__ import annotations
 
-import dataclasses
 import json
-from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
@@ -33,12 +32,6 @@ from mocapqa.errors import InputError
 if TYPE_CHECKING:
     from mocapqa.core.keypoints import KeypointSequence
     from mocapqa.core.motion import Motion
-    from mocapqa.feet.check import FeetReport
-    from mocapqa.feet.contacts import Contact
-    from mocapqa.feet.findings import Finding
-    from mocapqa.feet.lock import Lock
-    from mocapqa.feet.params import FeetParams
-    from mocapqa.feet.points import FootPoints
 
 __all__ = ["feet_app", "feet_check", "feet_fix"]
 
@@ -215,11 +208,13 @@ def _print_fix(path: Path, out: Path, result: dict[str, Any]) -> None:
 
 @feet_app.command("fix")
 def feet_fix(
-    take: Annotated[Path, typer.Argument(help="A BVH or keypoint take.")],
+    take: Annotated[Path, typer.Argument(help="A BVH, keypoint or C3D take.")],
     output: Annotated[
         Path,
         typer.Option(
-            "--output", "-o", help="The file to write (BVH; keypoints: trc, csv, json, npy, npz)."
+            "--output",
+            "-o",
+            help="The file to write (BVH; keypoints and markers: c3d, trc, csv, json, npy, npz).",
         ),
     ],
     apply: Annotated[
@@ -240,36 +235,31 @@ def feet_fix(
     mapping: MappingOption = None,
     root_translation: RootTranslationOption = "auto",
 ) -> None:
-    """Lock planted feet (BVH: two-bone leg IK; keypoints: pinned), blended, and write the take."""
+    """Lock planted feet (BVH: two-bone leg IK; keypoints and markers: pinned), blended, and
+    write the take."""
     from mocapqa.core.motion import Motion
-    from mocapqa.feet.fix_choice import choose_locks
+    from mocapqa.feet.fix import fix_feet
     from mocapqa.feet.fix_report import fix_report_json
-    from mocapqa.feet.params import FeetParams
     from mocapqa.io.atomic import write_text
-    from mocapqa.pipeline.feet import check_take_feet
+    from mocapqa.pipeline.feet import check_take_feet, feet_params_of
 
     if not apply.strip() or (apply.strip().startswith(",") or apply.strip().endswith(",")):
         raise InputError(f"Expected --apply confident, all, none or ids, got {apply!r}")
     read, roles = _read_take(take, fps, length_unit, mapping, root_translation)
-    if not isinstance(read, Motion) and read.source_format == "c3d":
-        raise InputError(
-            "Expected a BVH or keypoint take: foot cleanup is for BVH and keypoint takes for "
-            f"now, got a C3D marker take: {take}"
-        )
-    params = FeetParams()
+    markers = not isinstance(read, Motion) and read.source_format == "c3d"
+    params = feet_params_of(read)
     points, report, skipped = check_take_feet(read, roles, params)
-    chosen = choose_locks(apply.strip(), report.contacts, report.findings, skipped)
-    plan = _Plan(points, report, chosen, skipped, params, output)
-    done = (
-        _fix_motion(read, roles, plan) if isinstance(read, Motion) else _fix_keypoints(read, plan)
-    )
+    done = fix_feet(read, points, report, skipped, apply.strip(), params, mapping=roles)
+    _, after, _ = check_take_feet(done.take, roles, params)
+    _write_fixed(take, output, done.take, markers)
     fixed = {
         "path": str(take),
         "output": str(output),
         "apply": apply.strip(),
         **fix_report_json(
-            points, report.contacts, report.findings, chosen, done.before, done.after,
-            done.clamped, done.miss, done.findings_after, skipped,
+            points, report.contacts, report.findings, done.chosen, done.before.tolist(),
+            done.after.tolist(), done.clamped.tolist(), done.miss.tolist(), after.findings,
+            skipped,
         ),
     }  # fmt: skip
     text = json.dumps(fixed, indent=2)
@@ -281,72 +271,23 @@ def feet_fix(
         _print_fix(take, output, fixed)
 
 
-@dataclasses.dataclass(frozen=True, slots=True)
-class _Fixed:
-    """Per contact of the check: the slide before and after, clamped frames, reach missed;
-    and the findings of the check of the written take."""
+def _write_fixed(take: Path, output: Path, fixed: Motion | KeypointSequence, markers: bool) -> None:
+    """Write a fixed take: BVH, or keypoints in the format of ``output``'s extension; a C3D
+    take to a ``.c3d`` output through the C3D writer with the source's analogs, force plates
+    and residuals carried through, every sample but the pinned ones as read."""
+    import dataclasses
 
-    before: list[float]
-    after: list[float]
-    clamped: list[int]
-    miss: list[float]
-    findings_after: Sequence[Finding]
-
-
-@dataclasses.dataclass(frozen=True, slots=True)
-class _Plan:
-    """The feet check of the take as read, the contacts chosen to lock, and the output."""
-
-    points: FootPoints
-    report: FeetReport
-    chosen: Sequence[Contact]
-    skipped: int
-    params: FeetParams
-    output: Path
-
-    def locks(self, contacts: Sequence[Contact]) -> list[Lock]:
-        """Locks of contacts, in frames of the take as read."""
-        from mocapqa.feet.lock import Lock
-
-        skipped = self.skipped
-        return [Lock(c.foot, c.start + skipped, c.end + skipped) for c in contacts]
-
-    @property
-    def plant_speed(self) -> float:
-        """The planted-foot speed, take units per second."""
-        return self.params.plant_speed * self.points.leg_length
-
-
-def _fix_motion(read: Motion, roles: dict[str, str] | None, plan: _Plan) -> _Fixed:
-    """Lock the chosen contacts of a BVH take by two-bone leg IK, check and write it."""
-    from mocapqa.feet.fix import foot_rig, lock_feet
+    from mocapqa.core.motion import Motion
     from mocapqa.io.bvh_write import write_bvh
-    from mocapqa.pipeline.feet import check_take_feet
-
-    locked = lock_feet(
-        read, foot_rig(read, roles), plan.report.up, plan.locks(plan.chosen), plan.plant_speed,
-        plan.points.leg_length, first=plan.skipped, measure=plan.locks(plan.report.contacts),
-    )  # fmt: skip
-    _, after, _ = check_take_feet(locked.motion, roles, plan.params)
-    write_bvh(plan.output, locked.motion)
-    return _Fixed(locked.before.tolist(), locked.after.tolist(), locked.clamped.tolist(),
-                  locked.miss.tolist(), after.findings)  # fmt: skip
-
-
-def _fix_keypoints(read: KeypointSequence, plan: _Plan) -> _Fixed:
-    """Pin the chosen contacts of a keypoint take, check and write it."""
-    from mocapqa.feet.pin import foot_keypoints, pin_feet
     from mocapqa.io.formats import write_keypoints
-    from mocapqa.pipeline.feet import check_take_feet
 
-    feet, members = foot_keypoints(read.names, plan.points.names, plan.points.sides)
-    pinned = pin_feet(
-        read.positions, feet, members, plan.report.up, plan.locks(plan.chosen), read.fps,
-        plan.plant_speed, measure=plan.locks(plan.report.contacts),
-    )  # fmt: skip
-    moved = dataclasses.replace(read, positions=pinned.positions)
-    _, after, _ = check_take_feet(moved, None, plan.params)
-    write_keypoints(plan.output, moved)
-    n_contacts = len(plan.report.contacts)
-    return _Fixed(pinned.before.tolist(), pinned.after.tolist(), [0] * n_contacts,
-                  [0.0] * n_contacts, after.findings)  # fmt: skip
+    if isinstance(fixed, Motion):
+        write_bvh(output, fixed)
+    elif markers and output.suffix.lower() == ".c3d":
+        from mocapqa.config import get_settings
+        from mocapqa.io.c3d import read_c3d, write_c3d
+
+        source = read_c3d(take, limits=get_settings().read_limits)
+        write_c3d(output, dataclasses.replace(source, points=fixed), source=take)
+    else:
+        write_keypoints(output, fixed)

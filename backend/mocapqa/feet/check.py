@@ -7,8 +7,12 @@
 3. the floor and each point's stance level (:func:`mocapqa.feet.floor.fit_floor`); a tilted
    floor is reported, and heights are then measured from its plane (fitted again on the
    levelled heights for the stance levels and the drift);
-4. point and foot contacts (:mod:`mocapqa.feet.contacts`);
-5. skate, penetration, floating and jitter (:mod:`mocapqa.feet.findings`).
+4. point and foot contacts (:mod:`mocapqa.feet.contacts`), the foot contacts' edges moved to
+   the heel's impact and the toe's push-off when the event window is on (marker takes,
+   :mod:`mocapqa.feet.events`);
+5. skate (over the contacts and the low phases too fast for one, :mod:`mocapqa.feet.slides`,
+   reading the sole under the points, :mod:`mocapqa.feet.sole`), penetration, floating and
+   jitter (:mod:`mocapqa.feet.findings`).
 
 Everything stays in take units; the caller converts sizes (``mocapqa.pipeline.feet``).
 """
@@ -28,6 +32,7 @@ from mocapqa.feet.contacts import (
     foot_contacts,
     point_contact_mask,
 )
+from mocapqa.feet.events import refine_contact_edges
 from mocapqa.feet.findings import (
     FINDING_KINDS,
     Finding,
@@ -40,6 +45,7 @@ from mocapqa.feet.floor import Floor, fit_floor
 from mocapqa.feet.ground import UpAxis, detect_up_axis
 from mocapqa.feet.params import FeetParams
 from mocapqa.feet.points import FootPoints
+from mocapqa.feet.slides import skate_masks
 from mocapqa.feet.tracks import (
     horizontal_axes,
     moving_average,
@@ -79,6 +85,33 @@ class FeetReport:
     findings: tuple[Finding, ...]
     contact_mask: BoolArray
     elevations: FloatArray
+
+
+def _skate(
+    points: FootPoints,
+    p: FeetParams,
+    smooth: FloatArray,
+    velocity: FloatArray,
+    speeds: FloatArray,
+    elevations: FloatArray,
+    point_mask: BoolArray,
+    foot_mask: BoolArray,
+    floor: Floor,
+    up: UpAxis,
+) -> list[Finding]:
+    """The skate findings: over the contacts and the low phases too fast for one (slides that
+    broke their contact, :mod:`mocapqa.feet.slides`), reading the sole under each point, its
+    height above the floor plus ``sole_depth`` (:mod:`mocapqa.feet.sole`)."""
+    leg = points.leg_length
+    skate_points, skate_feet = skate_masks(
+        elevations, speeds, point_mask, foot_mask, points.sides, points.fps, leg, p
+    )
+    depths = elevations + floor.point_offsets + p.sole_depth * leg
+    return find_skate(
+        velocity, speeds, elevations, skate_points, skate_feet, points.sides,
+        horizontal_axes(up.axis), points.fps, leg, p,
+        sole=(smooth, depths, up) if p.sole_pivot else None,
+    )  # fmt: skip
 
 
 def check_feet(
@@ -131,23 +164,16 @@ def check_feet(
     elevations = heights - (floor.level + floor.point_offsets)
     point_mask = point_contact_mask(elevations, speeds, points.fps, leg, p)
     foot_mask = foot_contact_mask(point_mask, points.sides, points.fps, p)
+    foot_mask = refine_contact_edges(foot_mask, positions, points.sides, up, points.fps, p)
     margins = contact_margins(elevations, speeds, leg, p)
     feet, per_point = foot_contacts(
         point_mask, foot_mask, margins, points.sides, points.parts, points.confidence
     )
+    skates = _skate(
+        points, p, smooth, velocity, speeds, elevations, point_mask, foot_mask, floor, up
+    )
     findings = [
-        *find_skate(
-            velocity,
-            speeds,
-            elevations,
-            point_mask,
-            foot_mask,
-            points.sides,
-            flat_axes,
-            points.fps,
-            leg,
-            p,
-        ),
+        *skates,
         *find_penetration(elevations, floor.point_spreads, points.sides, points.fps, leg, p),
         *find_floating(elevations, speeds, foot_mask, points.sides, points.fps, leg, p),
         *find_jitter(positions, speeds, point_mask, foot_mask, points.sides, leg, p),

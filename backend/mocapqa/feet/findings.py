@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray, column_runs
+from mocapqa.feet.ground import UpAxis
 from mocapqa.feet.params import FeetParams
 from mocapqa.feet.points import SIDES, per_foot
 from mocapqa.feet.runs import (
@@ -39,8 +40,12 @@ from mocapqa.feet.runs import (
     close_short_gaps,
     drop_short_runs,
     frames_in,
+    run_argmax,
+    run_frames,
     run_mean,
+    run_median,
 )
+from mocapqa.feet.sole import sole_sweep
 from mocapqa.feet.tracks import norms
 
 __all__ = [
@@ -104,42 +109,6 @@ def foot_pair(sides: tuple[str, ...]) -> tuple[IntArray, IntArray]:
     return rear, toe
 
 
-def _run_frames(runs: Runs) -> tuple[IntArray, IntArray, IntArray]:
-    """Every frame of every run, concatenated: (frame, column, run index)."""
-    columns, starts, ends = runs
-    lengths = ends - starts + 1
-    run_index = np.repeat(np.arange(lengths.size), lengths)
-    offsets = np.arange(int(lengths.sum())) - np.repeat(np.cumsum(lengths) - lengths, lengths)
-    return starts[run_index] + offsets, columns[run_index], run_index
-
-
-def _run_argmax(
-    values: FloatArray, run_index: IntArray, n_runs: int
-) -> tuple[FloatArray, IntArray]:
-    """Largest value per run and its position in the concatenated order (NaN-safe)."""
-    filled = np.where(np.isfinite(values), values, -np.inf)
-    order = np.lexsort((-filled, run_index))
-    first = np.searchsorted(run_index[order], np.arange(n_runs))
-    where = order[first]
-    return filled[where], where
-
-
-def run_median(values: FloatArray, run_index: IntArray) -> FloatArray:
-    """Lower median of ``values`` (N,) per run, NaN values left out (NaN for a run with none).
-
-    ``run_index`` is sorted (runs are contiguous), as :func:`_run_frames` gives it.
-    """
-    n_runs = int(run_index[-1]) + 1 if run_index.size else 0
-    valid = np.isfinite(values)
-    order = np.lexsort((np.where(valid, values, np.inf), run_index))
-    counts = np.bincount(run_index[valid], minlength=n_runs)
-    firsts = np.searchsorted(run_index, np.arange(n_runs))
-    middle = firsts + np.maximum(counts - 1, 0) // 2
-    medians: FloatArray = np.where(counts > 0, values[order][np.minimum(middle, len(values) - 1)],
-                                   np.nan)  # fmt: skip
-    return medians
-
-
 def _findings(
     kind: str, runs: Runs, sizes: FloatArray, peaks: IntArray, speeds: FloatArray | None = None
 ) -> list[Finding]:
@@ -164,6 +133,8 @@ def find_skate(
     fps: float,
     leg_length: float,
     params: FeetParams | None = None,
+    *,
+    sole: tuple[FloatArray, FloatArray, UpAxis] | None = None,
 ) -> list[Finding]:
     """Horizontal travel of planted feet.
 
@@ -185,6 +156,11 @@ def find_skate(
     fps, leg_length, params
         Frames per second, the leg length (take units) and the thresholds (None: the
         defaults).
+    sole : tuple, optional
+        ``(positions, depths, up)``: the smoothed positions ``(F, P, 3)``, each point's
+        height above the sole ``(F, P)`` (take units) and the up axis. The velocities are
+        then those of the sole under each point (:mod:`mocapqa.feet.sole`), so a foot
+        rolling over its heel or toe does not move; None reads the points themselves.
 
     Returns
     -------
@@ -195,13 +171,13 @@ def find_skate(
     runs = column_runs(foot_mask)
     if runs[0].size == 0:
         return []
-    frame, column, run_index = _run_frames(runs)
+    frame, column, run_index = run_frames(runs)
     lengths = runs[2] - runs[1] + 1
     firsts = np.cumsum(lengths) - lengths  # each run's first row in the concatenated order
     low = _low_points(elevations[frame], point_mask[frame], sides, column, run_index, firsts,
                       p.plant_height * leg_length)  # fmt: skip
     foot_velocity, pivot_speed = _pivot_velocity(
-        velocities[..., list(horizontal)], low, sides, frame, column
+        velocities, horizontal, low, sides, frame, column, sole
     )
     # Planted: the pivot is slower than plant_speed, or than 1.5 times the contact's median
     # pivot speed, so a steady slide counts in full while the quick landing and push-off of
@@ -210,26 +186,39 @@ def find_skate(
     limit = np.maximum(p.plant_speed * leg_length, 1.5 * typical[run_index])
     planted = pivot_speed < limit
     step = np.where(planted[:, None], np.nan_to_num(foot_velocity), 0.0)  # (N, 2)
-    # Displacement over the last skate_window_s (or since the contact's first frame).
-    totals = np.cumsum(step / fps, axis=0)
-    lag = max(1, round(p.skate_window_s * fps))
-    since = np.maximum(np.arange(frame.size) - lag, firsts[run_index])
-    travel = norms(totals - totals[since])
-    sizes, where = _run_argmax(travel, run_index, lengths.size)
-    # A steady slide also moves the foot on the frames left out: its median velocity over the
-    # planted frames, over the whole contact.
-    steady_velocity = np.stack(
-        [run_median(np.where(planted, step[:, k], np.nan), run_index) for k in range(2)], axis=1
-    )
-    steady = norms(np.nan_to_num(steady_velocity)) * np.minimum((lengths - 1) / fps,
-                                                                p.skate_window_s)  # fmt: skip
-    sizes = np.maximum(sizes, steady)
+    sizes, where = _travel(step, planted, run_index, firsts, lengths, fps, p.skate_window_s)
     flagged = sizes >= p.skate_travel * leg_length
     durations = np.maximum(lengths - 1, 1) / fps
     kept: Runs = (runs[0][flagged], runs[1][flagged], runs[2][flagged])
     return _findings(
         "skate", kept, sizes[flagged], frame[where][flagged], (sizes / durations)[flagged]
     )
+
+
+def _travel(
+    step: FloatArray,
+    planted: BoolArray,
+    run_index: IntArray,
+    firsts: IntArray,
+    lengths: IntArray,
+    fps: float,
+    window_s: float,
+) -> tuple[FloatArray, IntArray]:
+    """Travel of each contact ``(R,)`` (take units) and the row where it is reached, from the
+    planted velocities ``step`` ``(N, 2)``: the larger of the displacement over any
+    ``window_s`` (or since the contact's first frame) and the median planted velocity over
+    the contact's duration (at most ``window_s``; a steady slide also moves the foot on the
+    frames left out)."""
+    totals = np.cumsum(step / fps, axis=0)
+    lag = max(1, round(window_s * fps))
+    since = np.maximum(np.arange(step.shape[0]) - lag, firsts[run_index])
+    travel = norms(totals - totals[since])
+    sizes, where = run_argmax(travel, run_index, lengths.size)
+    steady_velocity = np.stack(
+        [run_median(np.where(planted, step[:, k], np.nan), run_index) for k in range(2)], axis=1
+    )
+    steady = norms(np.nan_to_num(steady_velocity)) * np.minimum((lengths - 1) / fps, window_s)
+    return np.maximum(sizes, steady), where
 
 
 def _low_points(
@@ -257,7 +246,13 @@ def _low_points(
 
 
 def _pivot_velocity(
-    flat: FloatArray, low: BoolArray, sides: tuple[str, ...], frame: IntArray, column: IntArray
+    velocities: FloatArray,
+    horizontal: tuple[int, int],
+    low: BoolArray,
+    sides: tuple[str, ...],
+    frame: IntArray,
+    column: IntArray,
+    sole: tuple[FloatArray, FloatArray, UpAxis] | None,
 ) -> tuple[FloatArray, FloatArray]:
     """The foot's horizontal velocity ``(N, 2)`` and the pivot's speed ``(N,)`` (inf where no
     point is low).
@@ -265,12 +260,25 @@ def _pivot_velocity(
     The foot's velocity is that of its least-moving low point: on the line from the rear
     point (heel or ankle) to the toe when both are low (velocities of a rigid foot vary
     linearly along it, so a foot rolling over its toe, or turning about its ball or its
-    midfoot, has a point there that stays), else the one low point.
+    midfoot, has a point there that stays), else the one low point. With ``sole`` (as in
+    :func:`find_skate`) the points are those of the sole under the rear point and the toe.
     """
     rear, toe = foot_pair(sides)
     rows = np.arange(frame.size)
-    rear_velocity = flat[frame, rear[column]]
-    toe_velocity = flat[frame, toe[column]]
+    rear_velocity = velocities[frame, rear[column]]
+    toe_velocity = velocities[frame, toe[column]]
+    if sole is not None:
+        positions, depths, up = sole
+        sweep = sole_sweep(
+            positions[frame, toe[column]] - positions[frame, rear[column]],
+            toe_velocity - rear_velocity,
+            up,
+        )
+        drop = np.clip(np.nan_to_num(depths, nan=0.0), 0.0, None)
+        rear_velocity = rear_velocity - drop[frame, rear[column], None] * sweep
+        toe_velocity = toe_velocity - drop[frame, toe[column], None] * sweep
+    rear_velocity = rear_velocity[:, list(horizontal)]
+    toe_velocity = toe_velocity[:, list(horizontal)]
     rear_low = low[rows, rear[column]]
     toe_low = low[rows, toe[column]]
     span = toe_velocity - rear_velocity
@@ -316,8 +324,8 @@ def find_penetration(
     runs = column_runs(mask)
     if runs[0].size == 0:
         return []
-    frame, column, run_index = _run_frames(runs)
-    sizes, where = _run_argmax(depth[frame, column], run_index, runs[0].size)
+    frame, column, run_index = run_frames(runs)
+    sizes, where = run_argmax(depth[frame, column], run_index, runs[0].size)
     return _findings("penetration", runs, sizes, frame[where])
 
 
@@ -358,8 +366,8 @@ def find_floating(
     runs = column_runs(mask)
     if runs[0].size == 0:
         return []
-    frame, column, run_index = _run_frames(runs)
-    _, where = _run_argmax(lowest[frame, column], run_index, runs[0].size)
+    frame, column, run_index = run_frames(runs)
+    _, where = run_argmax(lowest[frame, column], run_index, runs[0].size)
     sizes = run_mean(np.where(np.isfinite(lowest), lowest, np.nan), runs)
     return _findings("floating", runs, sizes, frame[where])
 
@@ -411,13 +419,13 @@ def find_jitter(
     runs = column_runs(foot_mask)
     if runs[0].size == 0:
         return []
-    frame, column, run_index = _run_frames(runs)
+    frame, column, run_index = run_frames(runs)
     rms = np.sqrt(_CHI2_MEAN_OVER_MEDIAN * run_median(noise[frame, column], run_index))
     with np.errstate(invalid="ignore"):
         flagged = rms >= p.jitter_noise * leg_length
     kept: Runs = (runs[0][flagged], runs[1][flagged], runs[2][flagged])
     if kept[0].size == 0:
         return []
-    frame, column, run_index = _run_frames(kept)
-    _, where = _run_argmax(noise[frame, column], run_index, kept[0].size)
+    frame, column, run_index = run_frames(kept)
+    _, where = run_argmax(noise[frame, column], run_index, kept[0].size)
     return _findings("jitter", kept, rms[flagged], frame[where])

@@ -1,4 +1,7 @@
-"""Foot locking on BVH takes: hold a planted foot where it stands, by a two-bone leg IK.
+"""Foot locking: hold a planted foot where it stands, by a two-bone leg IK on BVH takes
+(:func:`lock_feet`), and the one place that chooses the contacts to lock and applies them to
+any take (:func:`fix_feet`: BVH by the IK, keypoint and C3D marker takes pinned,
+:mod:`mocapqa.feet.pin`).
 
 Conventions
 -----------
@@ -13,26 +16,43 @@ Conventions
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
+from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles
 from mocapqa.errors import InputError
+from mocapqa.feet.check import FeetReport
+from mocapqa.feet.contacts import Contact
+from mocapqa.feet.fix_choice import choose_locks
 from mocapqa.feet.ground import UpAxis
 from mocapqa.feet.ik import Leg, solve_leg
-from mocapqa.feet.lock import BLEND_S, Anchor, Lock, lock_offsets, pivot_steps, planted_travel
-from mocapqa.feet.points import SIDES
+from mocapqa.feet.lock import (
+    BLEND_S,
+    Anchor,
+    Lock,
+    lock_offsets,
+    pivot_steps,
+    planted_travel,
+    sole_heights,
+)
+from mocapqa.feet.params import FeetParams
+from mocapqa.feet.pin import foot_keypoints, marker_foot_members, pin_feet
+from mocapqa.feet.points import SIDES, FootPoints
 from mocapqa.feet.tracks import horizontal_axes
 from mocapqa.kinematics.forward import forward_kinematics
 
 __all__ = [
     "REACH_TOLERANCE",
+    "FootFix",
     "FootRig",
     "LockResult",
+    "fix_feet",
     "foot_rig",
     "lock_feet",
     "shift_ankles",
@@ -190,6 +210,7 @@ def lock_feet(
     blend_s: float = BLEND_S,
     first: int = 0,
     measure: Sequence[Lock] | None = None,
+    depths: FloatArray | None = None,
 ) -> LockResult:
     """Lock the feet of a BVH take during the given contacts.
 
@@ -213,6 +234,12 @@ def lock_feet(
         Leading frames (a bind pose) never moved.
     measure : sequence of Lock, optional
         The contacts whose slide and clamped frames are reported (``locks`` when None).
+    depths : ndarray, shape (F, P), optional
+        Each foot point's height above the sole (:func:`mocapqa.feet.lock.sole_heights`, the
+        points of ``rig.points``, left then right), take units: the lock then holds the sole
+        under the pivot, what the skate check reads. The IK keeps each foot's world
+        orientation and its ankle's height, so the heights hold for the result too. None holds
+        the joints.
 
     Returns
     -------
@@ -223,14 +250,14 @@ def lock_feet(
     joints = [j for group in rig.points for j in group]
     columns = np.cumsum([0, len(rig.points[0])])
     local = [list(range(c, c + len(g))) for c, g in zip(columns, rig.points, strict=True)]
-    steps = pivot_steps(world[1][:, joints], local, up)
+    steps = pivot_steps(world[1][:, joints], local, up, depths)
     flat, weights = lock_offsets(steps, locks, motion.fps, plant_speed, anchor, blend_s, first)
     offsets = np.zeros((motion.n_frames, 2, 3))
     offsets[..., list(horizontal_axes(up.axis))] = flat
     changed = weights > 0
     fixed, miss = shift_ankles(motion, rig, offsets, changed, world)
     clamped = miss > REACH_TOLERANCE * leg_length
-    after = pivot_steps(forward_kinematics(fixed)[1][:, joints], local, up)
+    after = pivot_steps(forward_kinematics(fixed)[1][:, joints], local, up, depths)
     blend = max(1, round(blend_s * motion.fps))
     measured = locks if measure is None else measure
     n_clamped, misses = _window_counts(clamped, miss, measured, blend)
@@ -238,3 +265,105 @@ def lock_feet(
     before_travel = planted_travel(steps, measured, fps, plant_speed)
     after_travel = planted_travel(after, measured, fps, plant_speed)
     return LockResult(fixed, changed, n_clamped, misses, before_travel, after_travel)
+
+
+@dataclass(frozen=True, slots=True)
+class FootFix:
+    """A take with its chosen contacts locked, and what the locks did.
+
+    Parameters
+    ----------
+    take : Motion or KeypointSequence
+        The locked take (a BVH motion, or keypoints / markers).
+    chosen : list of Contact
+        The contacts locked, the check's frames.
+    before, after : ndarray, shape (C,)
+        Per contact of the check, the pivot's planted travel in the input and the result
+        (:func:`mocapqa.feet.lock.planted_travel`), take units.
+    clamped : ndarray of int, shape (C,)
+        Per contact of the check, frames out of the leg's reach (0 for pinned takes).
+    miss : ndarray, shape (C,)
+        Per contact of the check, the largest distance by which the ankle fell short of its
+        target (0 for pinned takes), take units.
+    """
+
+    take: Motion | KeypointSequence
+    chosen: list[Contact]
+    before: FloatArray
+    after: FloatArray
+    clamped: IntArray
+    miss: FloatArray
+
+
+def fix_feet(
+    checked: Motion | KeypointSequence,
+    points: FootPoints,
+    report: FeetReport,
+    skipped: int,
+    apply: str,
+    params: FeetParams,
+    target: Motion | KeypointSequence | None = None,
+    mapping: dict[str, str] | None = None,
+) -> FootFix:
+    """Choose the contacts ``apply`` names (:func:`mocapqa.feet.fix_choice.choose_locks`) and
+    lock them: what ``mocapqa feet fix`` and the reviewed download both do.
+
+    A BVH take's legs are solved by :func:`lock_feet`; a keypoint take's foot keypoints
+    (:func:`mocapqa.feet.pin.foot_keypoints`) and a C3D take's foot markers
+    (:func:`mocapqa.feet.pin.marker_foot_members`) are pinned by
+    :func:`mocapqa.feet.pin.pin_feet`. When the check reads the sole (``params.sole_pivot``)
+    the locks hold the sole under the pivot (:func:`mocapqa.feet.lock.sole_heights`).
+
+    Parameters
+    ----------
+    checked : Motion or KeypointSequence
+        The take the feet check read.
+    points, report, skipped
+        Its feet check (:func:`mocapqa.pipeline.feet.check_take_feet`).
+    apply : str
+        ``confident``, ``all``, ``none`` or ids (:func:`mocapqa.feet.fix_choice.choose_locks`).
+    params : FeetParams
+        The check's thresholds (``plant_speed``, ``sole_depth``, ``sole_pivot``).
+    target : Motion or KeypointSequence, optional
+        The take to lock, of the same kind, rig and frames as ``checked`` (a reviewed take with
+        its other corrections); ``checked`` when None.
+    mapping : dict, optional
+        Role key → joint name (BVH).
+
+    Returns
+    -------
+    FootFix
+
+    Raises
+    ------
+    InputError
+        For ``apply`` ids the check does not know, or a rig without legs.
+    """
+    chosen = choose_locks(apply, report.contacts, report.findings, skipped)
+    take = checked if target is None else target
+    locks = [Lock(c.foot, c.start + skipped, c.end + skipped) for c in chosen]
+    measure = [Lock(c.foot, c.start + skipped, c.end + skipped) for c in report.contacts]
+    leg = points.leg_length
+    plant_speed = params.plant_speed * leg
+    depths = sole_heights(
+        report.elevations, report.floor.point_offsets, points.sides, params.sole_depth * leg,
+        skipped, take.n_frames,
+    ) if params.sole_pivot else None  # fmt: skip
+    if isinstance(take, Motion):
+        locked = lock_feet(
+            take, foot_rig(take, mapping), report.up, locks, plant_speed, leg, first=skipped,
+            measure=measure, depths=depths,
+        )  # fmt: skip
+        return FootFix(locked.motion, chosen, locked.before, locked.after,
+                       np.asarray(locked.clamped, dtype=np.intp), locked.miss)  # fmt: skip
+    if take.source_format == "c3d":
+        own, members = marker_foot_members(take.names, points)
+    else:
+        own, members = foot_keypoints(take.names, points.names, points.sides)
+    pinned = pin_feet(
+        take.positions, own, members, report.up, locks, take.fps, plant_speed,
+        measure=measure, depths=depths,
+    )  # fmt: skip
+    moved = dataclasses.replace(take, positions=pinned.positions)
+    zeros = np.zeros(len(measure))
+    return FootFix(moved, chosen, pinned.before, pinned.after, zeros.astype(np.intp), zeros)

@@ -9,6 +9,10 @@ Conventions
   that stays; a foot that slides moves every point. Per frame and foot, the pivot's step is
   the horizontal step of the point of the rear → toe line that moved least since the previous
   frame (a rigid foot's velocities vary linearly along the line), as in the skate check.
+  With the points' heights above the sole (``depths``) the steps are those of the sole under
+  each point (:mod:`mocapqa.feet.sole`), what the skate check reads: a foot rolling over its
+  heel or toe carries its joints forward above a sole point that stays, and holding the
+  joints through the roll would move the sole under them.
 * **Planted.** Over a contact, the pivot's steps count where the pivot (averaged over
   :data:`SPEED_WINDOW_S`) is slower than ``plant_speed`` or than 1.5 times its median speed
   over the contact, the frames the skate check counts; on the other frames (a clean step's
@@ -37,6 +41,7 @@ from mocapqa.core.arrays import FloatArray, IntArray
 from mocapqa.feet.findings import run_median
 from mocapqa.feet.ground import UpAxis
 from mocapqa.feet.points import SIDES
+from mocapqa.feet.sole import sole_sweep
 from mocapqa.feet.tracks import horizontal_axes, smoothing_window
 
 __all__ = [
@@ -48,6 +53,7 @@ __all__ = [
     "pivot_steps",
     "planted_tracks",
     "planted_travel",
+    "sole_heights",
 ]
 
 Anchor = Literal["middle", "start"]
@@ -75,8 +81,51 @@ class Lock:
     end: int
 
 
+def sole_heights(
+    elevations: FloatArray,
+    offsets: FloatArray,
+    sides: Sequence[str],
+    depth: float,
+    skipped: int,
+    n_frames: int,
+) -> FloatArray:
+    """Each foot point's height above the sole, as the skate check reads it, in the order of
+    :func:`pivot_steps`' points (the left foot's points, then the right's).
+
+    Parameters
+    ----------
+    elevations : ndarray, shape (C, P)
+        The feet check's heights of the points above their stance levels over its checked
+        frames, take units.
+    offsets : ndarray, shape (P,)
+        Each point's stance level above the floor, take units.
+    sides : sequence of str
+        Each point's foot.
+    depth : float
+        The sole below the floor (``sole_depth`` times the leg length), take units.
+    skipped : int
+        Leading frames the check left out (a bind pose): their heights are 0.
+    n_frames : int
+        Frames of the take.
+
+    Returns
+    -------
+    ndarray, shape (F, P)
+        Take units, at least 0, 0 where a point is missing.
+    """
+    order = [i for side in SIDES for i, s in enumerate(sides) if s == side]
+    values = elevations[:, order] + np.asarray(offsets)[order] + depth
+    heights = np.zeros((n_frames, len(order)))
+    rows = min(values.shape[0], n_frames - skipped)
+    heights[skipped : skipped + rows] = np.clip(np.nan_to_num(values[:rows], nan=0.0), 0.0, None)
+    return heights
+
+
 def pivot_steps(
-    positions: FloatArray, rig_points: Sequence[Sequence[int]], up: UpAxis
+    positions: FloatArray,
+    rig_points: Sequence[Sequence[int]],
+    up: UpAxis,
+    depths: FloatArray | None = None,
 ) -> FloatArray:
     """Each foot's pivot step per frame (see the module notes).
 
@@ -88,6 +137,9 @@ def pivot_steps(
         Per side (left, right), the indices in ``positions`` of the rear point (ankle) and,
         when the foot has one, the toe.
     up : UpAxis
+    depths : ndarray, shape (F, P), optional
+        Each point's height above the sole (:func:`sole_heights`), take units: the steps are
+        then those of the sole under the points. None reads the points themselves.
 
     Returns
     -------
@@ -95,8 +147,20 @@ def pivot_steps(
         Per frame and foot (left, right), the horizontal step since the previous frame of the
         point of the rear → toe line that moved least (zero at frame 0), take units.
     """
-    flat = positions[..., list(horizontal_axes(up.axis))]
-    steps = np.diff(flat, axis=0)  # (F-1, P, 2)
+    moves = np.diff(positions, axis=0)  # (F-1, P, 3)
+    if depths is not None:
+        rear_index = [points[0] for points in rig_points]
+        toe_index = [points[-1] for points in rig_points]
+        middle = 0.5 * (positions[1:] + positions[:-1])
+        span = (middle[:, toe_index] - middle[:, rear_index]).reshape(-1, 3)
+        change = (moves[:, toe_index] - moves[:, rear_index]).reshape(-1, 3)
+        sweep = sole_sweep(span, change, up).reshape(-1, len(rig_points), 3)
+        side_of = np.zeros(positions.shape[1], dtype=np.intp)
+        for foot, points in enumerate(rig_points):
+            side_of[list(points)] = foot
+        drop = 0.5 * (depths[1:] + depths[:-1])
+        moves = moves - drop[..., None] * sweep[:, side_of]
+    steps = moves[..., list(horizontal_axes(up.axis))]  # (F-1, P, 2)
     rear = steps[:, [points[0] for points in rig_points]]  # (F-1, 2, 2)
     span = steps[:, [points[-1] for points in rig_points]] - rear
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -44,12 +44,23 @@ __all__ = [
     "marker_label",
 ]
 
-MARKER_PARAMS = FeetParams(contact_speed=0.5, release_speed=1.0, speed_window_s=0.05)
-"""Thresholds for marker takes: the contact speeds and smoothing window ``mocapqa bench feet``
-chose against the force plates of the corpus's C3D gait trials (docs/feet.md). A heel marker
-is still slowing down when the plate is first loaded, and a toe marker on the forefoot moves
-with the foot's roll before the toe leaves the plate; the other thresholds keep their
-defaults."""
+MARKER_PARAMS = FeetParams(
+    release_speed=0.8,
+    event_before_s=0.04,
+    event_after_s=0.04,
+    sole_depth=0.0,
+    skate_travel=0.022,
+)
+"""Thresholds for marker takes. The contact thresholds, smoothing window and event window are
+those ``mocapqa bench feet`` chose against the force plates of the corpus's C3D gait trials (on
+all of them; each trial's figures are with the values chosen on the others, docs/feet.md): a
+toe marker on the forefoot rolls with the foot before the toe leaves the plate (a release
+speed of 0.8 leg/s, not 0.6), and each contact's first frame moves to the heel's impact and
+its last to the toe's push-off within 0.04 s of them (:mod:`mocapqa.feet.events`). The skate
+threshold and sole depth chosen on BVH joints do not carry over: markers sit on the shoe, not
+a joint's depth above the sole, so ``sole_depth`` is 0, and ``skate_travel`` keeps its earlier
+0.022 leg (at 0.014 with a 0.06 sole the clean flat-foot gait trial had a skate on every one
+of its 7 contacts). There is no injected-slide bench on marker takes."""
 
 MARKER_TOKENS: dict[str, tuple[str, ...]] = {
     "heel": ("hee", "heel", "hel", "cal", "calc", "fcc"),

@@ -3,9 +3,11 @@
 Every length threshold is a fraction of the take's leg length (hip → knee → ankle), so one set
 of values suits centimetres, metres, inches and unknown units, adults and children; the
 comments give each in centimetres for a 90 cm leg (a 1.83 m adult). Times are seconds, so the
-values hold at any frame rate. ``plant_height``, ``plant_speed`` and ``skate_travel`` are the
-values ``mocapqa bench feet`` chose on the fit takes of the corpus; the others were set by hand
-on the fit takes and synthetic feet (docs/feet.md, "Thresholds and figures").
+values hold at any frame rate. ``plant_height``, ``plant_speed``, ``sole_depth``,
+``slide_height`` and ``skate_travel`` are the values ``mocapqa bench feet`` chose on the fit
+takes of the corpus; the others were set by hand on the fit takes and synthetic feet
+(docs/feet.md, "Thresholds and figures"). The event window is off here: it was chosen on
+force plates, for marker takes (:data:`mocapqa.feet.markers.MARKER_PARAMS`).
 """
 
 from __future__ import annotations
@@ -44,7 +46,7 @@ class FeetParams:
         the others at the median of their still heights in the densest window half
         ``contact_height`` tall.
     skate_travel : float
-        Horizontal travel of a planted foot reported as skate, leg lengths (0.022: 2 cm).
+        Horizontal travel of a planted foot reported as skate, leg lengths (0.014: 1.26 cm).
     skate_window_s : float
         Travel is measured over at most this long, seconds: a foot that creeps by small
         repositionings through a stance of several seconds does not add them up.
@@ -55,6 +57,23 @@ class FeetParams:
     plant_speed : float
         The travel counts the frames where the pivot is slower than this, leg lengths per
         second (0.1: 9 cm/s), or than 1.5 times the contact's median pivot speed.
+    sole_depth : float
+        The sole lies this far below the lowest foot point at rest, leg lengths (0.06:
+        5.4 cm): the skate check reads the velocity of the sole under each point, each
+        point's height above the floor plus this below it (:mod:`mocapqa.feet.sole`).
+    sole_pivot : bool
+        Whether the skate check reads the sole under the points (True) or the points
+        themselves (False: the pivot the foot lock holds, :mod:`mocapqa.feet.lock`).
+    slide_height : float
+        The skate check also reads phases where every point of a foot is below this height
+        above its stance level while moving too fast for a contact, leg lengths (0.02:
+        1.8 cm; 0: only contacts; :mod:`mocapqa.feet.slides`) ...
+    slide_speed : float
+        ... and slower than this, leg lengths per second (a swing at floor level is faster).
+    event_before_s, event_after_s : float
+        Each contact's first frame moves to the heel's impact, and its last to the toe's
+        push-off, within this long before and after them, seconds (0 and 0: not moved;
+        :mod:`mocapqa.feet.events`).
     penetration_depth : float
         Depth below the floor reported as penetration, leg lengths (0.015: 1.35 cm).
     float_height : float
@@ -85,10 +104,16 @@ class FeetParams:
     min_contact_s: float = 0.1
     max_gap_s: float = 0.05
     stance_percentile: float = 5.0
-    skate_travel: float = 0.022
+    skate_travel: float = 0.014
     skate_window_s: float = 1.0
     plant_height: float = 0.006
     plant_speed: float = 0.1
+    sole_depth: float = 0.06
+    sole_pivot: bool = True
+    slide_height: float = 0.02
+    slide_speed: float = 1.0
+    event_before_s: float = 0.0
+    event_after_s: float = 0.0
     penetration_depth: float = 0.015
     float_height: float = 0.15
     min_float_s: float = 0.25

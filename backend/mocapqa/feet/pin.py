@@ -1,6 +1,6 @@
-"""Foot pinning on keypoint takes: every keypoint of a foot moves horizontally by the lock's
-offset (:mod:`mocapqa.feet.lock`) during the chosen contacts, blended in and out; missing
-samples stay missing."""
+"""Foot pinning on keypoint and marker takes: every keypoint (marker) of a foot moves
+horizontally by the lock's offset (:mod:`mocapqa.feet.lock`) during the chosen contacts,
+blended in and out; missing samples stay missing."""
 
 from __future__ import annotations
 
@@ -13,10 +13,18 @@ from mocapqa.core.arrays import BoolArray, FloatArray
 from mocapqa.core.rig_names import split_side, token_of
 from mocapqa.feet.ground import UpAxis
 from mocapqa.feet.lock import BLEND_S, Anchor, Lock, lock_offsets, pivot_steps, planted_travel
-from mocapqa.feet.points import SIDES
+from mocapqa.feet.markers import CLUSTER_TOKENS, MARKER_TOKENS, marker_label
+from mocapqa.feet.points import SIDES, FootPoints
 from mocapqa.feet.tracks import horizontal_axes
 
-__all__ = ["FOOT_TOKENS", "PinResult", "foot_keypoints", "pin_feet"]
+__all__ = [
+    "FOOT_MARKER_ROLES",
+    "FOOT_TOKENS",
+    "PinResult",
+    "foot_keypoints",
+    "marker_foot_members",
+    "pin_feet",
+]
 
 FOOT_TOKENS = frozenset({"ankle", "heel", "bigtoe", "smalltoe", "footindex", "toe", "toes"})
 """Name tokens (after the side, :func:`mocapqa.core.rig_names.split_side`) of the keypoints a
@@ -60,6 +68,46 @@ def foot_keypoints(
     return points, members
 
 
+FOOT_MARKER_ROLES = ("heel", "toe", "ankle")
+"""The roles of :data:`mocapqa.feet.markers.MARKER_TOKENS` whose markers move with a pinned
+foot (with the markers of a foot cluster, ``LFT1``…)."""
+
+
+def marker_foot_members(
+    names: Sequence[str], points: FootPoints
+) -> tuple[list[list[int]], list[list[int]]]:
+    """The foot points of a marker take and, per foot, every marker pinned with it.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The take's marker names (subject prefixes allowed).
+    points : FootPoints
+        The feet check's (:func:`mocapqa.feet.markers.marker_foot_points`).
+
+    Returns
+    -------
+    points : list of list of int
+        Per side (left, right), the indices of its foot points in ``names``.
+    members : list of list of int
+        Per side, the foot points and the markers of that side whose label (without a subject
+        prefix) names a heel, toe or ankle (:data:`FOOT_MARKER_ROLES`) or a foot cluster.
+    """
+    own, _ = foot_keypoints(names, points.names, points.sides)
+    tokens = {t for role in FOOT_MARKER_ROLES for t in MARKER_TOKENS[role]}
+    members = []
+    for side, indices in zip(SIDES, own, strict=True):
+        named = set(indices)
+        for index, name in enumerate(names):
+            named_side, rest = split_side(marker_label(name))
+            if named_side == side and (
+                rest in tokens or rest.rstrip("0123456789") in CLUSTER_TOKENS["foot"]
+            ):
+                named.add(index)
+        members.append(sorted(named))
+    return own, members
+
+
 @dataclass(frozen=True, slots=True)
 class PinResult:
     """Pinned keypoints and what the pin did.
@@ -92,6 +140,7 @@ def pin_feet(
     anchor: Anchor = "middle",
     blend_s: float = BLEND_S,
     measure: Sequence[Lock] | None = None,
+    depths: FloatArray | None = None,
 ) -> PinResult:
     """Pin the feet of a keypoint take during the given contacts: every keypoint of a foot
     moves horizontally by the lock's offset (see the module notes), blended in and out.
@@ -113,6 +162,10 @@ def pin_feet(
     blend_s : float
     measure : sequence of Lock, optional
         The contacts whose slide is reported (``locks`` when None).
+    depths : ndarray, shape (F, P), optional
+        Each foot point's height above the sole (:func:`mocapqa.feet.lock.sole_heights`, the
+        points of ``points``, left then right), take units: the pin then holds the sole under
+        the pivot, what the skate check reads. None holds the points.
 
     Returns
     -------
@@ -123,7 +176,7 @@ def pin_feet(
     local = [list(range(c, c + len(g))) for c, g in zip(columns, points, strict=True)]
 
     def steps_of(values: FloatArray) -> FloatArray:
-        return np.nan_to_num(pivot_steps(values[:, joints], local, up))
+        return np.nan_to_num(pivot_steps(values[:, joints], local, up, depths))
 
     steps = steps_of(positions)
     flat, weights = lock_offsets(steps, locks, fps, plant_speed, anchor, blend_s)

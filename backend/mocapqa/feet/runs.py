@@ -24,8 +24,11 @@ __all__ = [
     "frames_in",
     "hysteresis",
     "paint_runs",
+    "run_argmax",
+    "run_frames",
     "run_maximum",
     "run_mean",
+    "run_median",
 ]
 
 Runs = tuple[IntArray, IntArray, IntArray]
@@ -128,3 +131,49 @@ def run_mean(values: FloatArray, runs: Runs) -> FloatArray:
 def frames_in(seconds: float, fps: float) -> int:
     """Whole frames (at least one) in ``seconds`` at ``fps`` frames per second."""
     return max(1, round(seconds * fps))
+
+
+def run_frames(runs: Runs) -> tuple[IntArray, IntArray, IntArray]:
+    """Every frame of every run, concatenated: ``(frame, column, run index)``, each ``(N,)``
+    (runs in their order, frames in order within each)."""
+    columns, starts, ends = runs
+    lengths = ends - starts + 1
+    run_index = np.repeat(np.arange(lengths.size), lengths)
+    offsets = np.arange(int(lengths.sum())) - np.repeat(np.cumsum(lengths) - lengths, lengths)
+    return starts[run_index] + offsets, columns[run_index], run_index
+
+
+def run_argmax(values: FloatArray, run_index: IntArray, n_runs: int) -> tuple[FloatArray, IntArray]:
+    """Largest value of ``values`` ``(N,)`` per run and its position in the concatenated
+    order of :func:`run_frames` (NaN and inf left out, −inf for a run with none: its first
+    position); ``run_index`` is sorted and every run has a frame."""
+    filled = np.where(np.isfinite(values), values, -np.inf)
+    if n_runs == 0:
+        return filled[:0], np.zeros(0, dtype=np.intp)
+    # Runs are contiguous and never empty: reduce over each, then its first row at the top.
+    firsts = np.searchsorted(run_index, np.arange(n_runs))
+    top = np.maximum.reduceat(filled, firsts)
+    rows = np.where(filled == top[run_index], np.arange(filled.size), filled.size)
+    where = np.minimum.reduceat(rows, firsts)
+    return filled[where], where
+
+
+def run_median(values: FloatArray, run_index: IntArray) -> FloatArray:
+    """Lower median of ``values`` (N,) per run, NaN values left out (NaN for a run with none).
+
+    ``run_index`` is sorted (runs are contiguous), as :func:`run_frames` gives it.
+    """
+    n_runs = int(run_index[-1]) + 1 if run_index.size else 0
+    valid = np.isfinite(values)
+    # One float sort instead of a lexsort: each run's values scaled into [0, 0.5] and added
+    # to its index (the missing ones at 0.75, after them), so runs stay apart and in order.
+    low, high = (float(v.min()), float(v.max())) if (v := values[valid]).size else (0.0, 0.0)
+    scale = 0.5 / (high - low) if high > low else 0.0
+    keys = run_index + np.where(valid, (np.where(valid, values, low) - low) * scale, 0.75)
+    order = np.argsort(keys)
+    counts = np.bincount(run_index[valid], minlength=n_runs)
+    firsts = np.searchsorted(run_index, np.arange(n_runs))
+    middle = firsts + np.maximum(counts - 1, 0) // 2
+    medians: FloatArray = np.where(counts > 0, values[order][np.minimum(middle, len(values) - 1)],
+                                   np.nan)  # fmt: skip
+    return medians

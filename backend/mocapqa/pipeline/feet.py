@@ -51,6 +51,7 @@ from mocapqa.kinematics.forward import forward_kinematics
 __all__ = [
     "KEYPOINT_TOKENS",
     "check_take_feet",
+    "feet_params_of",
     "feet_report_json",
     "keypoint_foot_points",
     "motion_foot_points",
@@ -258,9 +259,17 @@ def check_take_feet(
         markers = take.source_format == "c3d"
         points = marker_foot_points(take) if markers else keypoint_foot_points(take)
         skipped = 0
-        if params is None and markers:
-            params = MARKER_PARAMS
-    return points, check_feet(points, params), skipped
+    return points, check_feet(points, feet_params_of(take) if params is None else params), skipped
+
+
+def feet_params_of(take: Motion | KeypointSequence) -> FeetParams:
+    """The feet check's thresholds for a take, the one choice the run's feet step, ``mocapqa
+    feet check/fix`` and the decided download share: :data:`mocapqa.feet.markers.MARKER_PARAMS`
+    for a C3D take's markers, the defaults for a BVH take and for keypoints (a TRC take's
+    points are read as keypoints, by their names)."""
+    if isinstance(take, KeypointSequence) and take.source_format == "c3d":
+        return MARKER_PARAMS
+    return FeetParams()
 
 
 def _round(value: float | None, digits: int = 4) -> float | None:

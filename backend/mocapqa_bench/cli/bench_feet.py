@@ -64,6 +64,7 @@ def _plates_table(console: Console, root: Path) -> None:
         "offset ms",
         "speeds",
         "window s",
+        "events s",
     ):
         table.add_column(column, justify="left" if column == "trial" else "right")  # fmt: skip
     pooled_on: list[FloatArray] = []
@@ -86,21 +87,27 @@ def _plates_table(console: Console, root: Path) -> None:
             f"{_ms(score.offset_ms, 50)} / {_ms(score.offset_ms, 90)}",
             f"{row.params.contact_speed:g} / {row.params.release_speed:g}",
             f"{row.params.speed_window_s:g}",
+            f"{row.params.event_before_s:g} / {row.params.event_after_s:g}",
         )  # fmt: skip
     onsets = np.concatenate(pooled_on) if pooled_on else np.zeros(0)
     offsets = np.concatenate(pooled_off) if pooled_off else np.zeros(0)
     table.caption = (
-        "strikes: plate contacts of one foot (+ those with no foot, not counted); right/judged: "
-        "detected contacts standing on a plate that overlap a strike of their foot; onset and "
-        "offset: |detected − plate| median / 90th percentile; speeds (leg/s) and smoothing "
-        "window: contact / release speed and speed_window_s chosen on the other trials"
+        "strikes: plate contacts of one foot (+ those with no foot, not counted); right/judged:"
+        " detected contacts standing on a plate that overlap a strike of their foot; onset and "
+        "offset: |detected − plate| median / 90th percentile; speeds (leg/s), smoothing window "
+        "and events: contact / release speed, speed_window_s and the window before / after an "
+        "edge in which it moves to the heel's impact or the toe's push-off (event_before_s / "
+        "event_after_s, 0 / 0: not moved), chosen on the other trials"
     )
     console.print(table)
     console.print(
         f"all trials: onset {_ms(onsets, 50)} / {_ms(onsets, 90)} ms, offset "
         f"{_ms(offsets, 50)} / {_ms(offsets, 90)} ms (median / 90th percentile); chosen on all "
         f"trials: contact_speed {chosen.contact_speed:g}, release_speed "
-        f"{chosen.release_speed:g} leg/s, speed_window_s {chosen.speed_window_s:g}"
+        f"{chosen.release_speed:g} leg/s, speed_window_s {chosen.speed_window_s:g}, "
+        f"contact_height {chosen.contact_height:g}, release_height {chosen.release_height:g} "
+        f"leg, event_before_s {chosen.event_before_s:g}, event_after_s "
+        f"{chosen.event_after_s:g}"
     )
     for line in skipped:
         console.print(f"not scored: {line}")
@@ -122,7 +129,7 @@ def _cleanup_table(console: Console, root: Path, takes: list[Any], params: Any, 
         title_justify="left",
     )
     columns = (
-        "family", "takes", "trials", "injected cm", "residual cm", "≤ 0.5 cm",
+        "family", "takes", "trials", "injected cm", "residual cm", "≤ 0.5 cm", "at joints cm",
         "clean cm", "hip/knee ° blends", "° elsewhere", "upper body", "clamped",
         "pop cm/s", "foot-frames/s",
     )  # fmt: skip
@@ -145,6 +152,7 @@ def _cleanup_table(console: Console, root: Path, takes: list[Any], params: Any, 
             f"{np.median(values('injected_cm')):.2f}",
             f"{np.median(residual):.2f} / {residual.max():.2f}",
             f"{np.mean(residual <= 0.5):.1%}",
+            f"{np.median(values('fixed_joints_cm')):.2f} / {values('fixed_joints_cm').max():.2f}",
             f"{np.median(values('clean_cm')):.2f}",
             f"{values('hip_knee_deg_blends').max():.1f}",
             f"{values('hip_knee_deg_outside').max():.1f}",
@@ -156,13 +164,14 @@ def _cleanup_table(console: Console, root: Path, takes: list[Any], params: Any, 
     table.caption = (
         "injected / residual / clean: the check's travel of the contact (skate measure, no "
         "threshold), median (residual: median / max) on the injected take, after the lock, and "
-        "on the clean take; hip/knee °: largest change of a hip or knee rotation in the blend "
-        "frames around locked contacts, and anywhere else outside them; upper body: joints "
-        "outside the legs whose world position changed; clamped: solved foot-frames whose "
-        "ankle missed its target by more than 0.001 leg; pop: median over trials of the "
-        "largest speed the lock adds to an ankle, anchor at the contact's middle (at its "
-        "start); foot-frames/s: solved foot-frames per CPU second of the lock (forward "
-        "kinematics, IK and the slide after, each take locked twice)"
+        "on the clean take; at joints: the residual read at the joints (median / max, "
+        "sole_pivot off; the lock holds the sole); hip/knee °: largest change of a hip or knee "
+        "rotation in the blend frames around locked contacts, and anywhere else outside them; "
+        "upper body: joints outside the legs whose world position changed; clamped: solved "
+        "foot-frames whose ankle missed its target by more than 0.001 leg; pop: median over "
+        "trials of the largest speed the lock adds to an ankle, anchor at the contact's "
+        "middle (at its start); foot-frames/s: solved foot-frames per CPU second of the lock "
+        "(forward kinematics, IK and the slide after, each take locked twice)"
     )
     console.print(table)
 
@@ -178,10 +187,16 @@ def _choice_table(choice: Any) -> Table:
         f"{', '.join(CLEAN_FAMILIES)})",
         title_justify="left",
     )
-    for column in ("plant_height", "plant_speed", "skate_travel", "recall ≥ 2 cm", "flags/min"):
+    for column in (
+        "plant_height", "plant_speed", "sole_depth", "slide_height", "skate_travel",
+        "recall ≥ 2 cm", "flags/min",
+    ):  # fmt: skip
         grid.add_column(column, justify="right")
-    for height, speed, travel, recall, flags in choice.candidates:
-        grid.add_row(f"{height:g}", f"{speed:g}", f"{travel:g}", f"{recall:.3f}", f"{flags:.2f}")
+    for height, speed, sole, slide, travel, recall, flags in choice.candidates:
+        grid.add_row(
+            f"{height:g}", f"{speed:g}", f"{sole:g}", f"{slide:g}", f"{travel:g}",
+            f"{recall:.3f}", f"{flags:.2f}",
+        )  # fmt: skip
     grid.caption = f"fit takes: {', '.join(choice.fit_takes)}"
     return grid
 
@@ -280,7 +295,9 @@ def bench_feet(
         console.print(_choice_table(choice))
     console.print(
         f"parameters: skate_travel={params.skate_travel:g}, plant_height="
-        f"{params.plant_height:g}, plant_speed={params.plant_speed:g} (leg lengths), "
+        f"{params.plant_height:g}, plant_speed={params.plant_speed:g}, sole_depth="
+        f"{params.sole_depth:g}, slide_height={params.slide_height:g} (leg lengths), "
+        f"slide_speed={params.slide_speed:g} leg/s, "
         f"skate_window_s={params.skate_window_s:g}, penetration_depth="
         f"{params.penetration_depth:g}"
     )
