@@ -5,11 +5,11 @@ import { fmt } from "./format.js";
 /** Filters and paging the take table understands, with their defaults (the server's). */
 export const TABLE_DEFAULTS = {
   sort: "score", order: "asc", limit: 25, offset: 0,
-  status: "", review_status: "", rig: "", min_score: "", max_score: "", has_findings: "", search: "",
+  status: "", review_status: "", rig: "", min_score: "", max_score: "", has_findings: "", has_skates: "", search: "",
 };
 
 /** The take table's filters (the keys of TABLE_DEFAULTS that narrow the takes). */
-export const TABLE_FILTERS = ["status", "review_status", "rig", "min_score", "max_score", "has_findings", "search"];
+export const TABLE_FILTERS = ["status", "review_status", "rig", "min_score", "max_score", "has_findings", "has_skates", "search"];
 
 /** The table's state from the view's URL parameters (unknown keys ignored, numbers parsed). */
 export function tableState(params) {
@@ -84,6 +84,19 @@ export function pageInfo(offset, limit, total) {
 const percent = (v) => (v == null ? "–" : `${fmt(100 * v, 1)} %`);
 const count = (v) => (v == null ? "–" : String(v));
 
+/** The unit the worst-skate column's header names; a size in another unit says its own. */
+export const SKATE_HEADER_UNIT = "cm";
+
+/** A take's largest foot skate as its cell shows it: the number alone in the header's unit
+ * (cm), the number and its unit otherwise ("2.4 % height": a BVH stores no unit, so the feet
+ * check sizes it against the body height); "–" when there is none (no skate found, the feet
+ * not checked, or a run made before the figure). */
+export function skateSize(value, unit) {
+  if (value == null || !Number.isFinite(Number(value))) return "–";
+  const number = fmt(Number(value), 1);
+  return unit == null || unit === SKATE_HEADER_UNIT ? number : `${number} ${unit}`;
+}
+
 /** The take table's summary columns: the server's sort key, a header, a formatter, and
  * whether a narrow window hides it. */
 export const TAKE_COLUMNS = [
@@ -100,6 +113,11 @@ export const TAKE_COLUMNS = [
   { key: "filter_residual_mm", label: "filter mm", format: (v) => fmt(v, 2), narrow: true },
   { key: "missing_share", label: "missing", format: percent, narrow: true },
   { key: "n_findings", label: "findings", format: count },
+  { key: "foot_skates", label: "skates", format: count, title: "foot skate findings: a planted foot sliding (– when the feet were not checked)" },
+  { key: "foot_worst_skate", label: `worst skate (${SKATE_HEADER_UNIT})`, format: (v, row) => skateSize(v, row.foot_skate_unit),
+    title: "the largest foot skate, in cm; in % of the body height, marked, when the take's unit does not convert to cm (a BVH stores none)" },
+  { key: "foot_penetrations", label: "below floor", format: count, narrow: true, title: "floor penetration findings: a foot below the floor" },
+  { key: "foot_floating", label: "floating", format: count, narrow: true, title: "floating findings: a still foot above the floor" },
   { key: "review_status", label: "review", format: (v) => (v || "unreviewed").replace("_", " ") },
   { key: "reviewer", label: "reviewer", format: (v) => v || "–", narrow: true },
 ];
@@ -110,7 +128,7 @@ export function formatCell(key, row) {
   // found): say so, rather than a dash that reads as "not yet".
   if (key === "score" && row.status === "done" && row.score == null) return "not checked";
   const column = TAKE_COLUMNS.find((c) => c.key === key);
-  return column ? column.format(row[key]) : String(row[key] ?? "–");
+  return column ? column.format(row[key], row) : String(row[key] ?? "–");
 }
 
 /** A QA score's colour: red at 0, amber at 50, green at 100 (HSL hue 0→120); grey when the

@@ -34,6 +34,7 @@ export function filterBar(state, apply, allColumns) {
     select("status", "run", [["", "any"], ["queued", "queued"], ["running", "running"], ["done", "done"], ["failed", "failed"]]),
     select("review_status", "review", [["", "any"], ...Object.entries(REVIEW)]),
     select("has_findings", "findings", [["", "any"], ["true", "some"], ["false", "none"]]),
+    select("has_skates", "foot skates", [["", "any"], ["true", "some"], ["false", "none"]]),
     labelled("rig", input("rig", { class: "short" })),
     labelled("min score", input("min_score", { type: "number", min: 0, max: 100, step: "any", placeholder: "0", class: "short" }, () => checkScores())),
     labelled("max score", input("max_score", { type: "number", min: 0, max: 100, step: "any", placeholder: "100", class: "short" }, () => checkScores())),
@@ -46,7 +47,7 @@ export function filterBar(state, apply, allColumns) {
  * marks the table area, the choice kept in the browser. */
 export function allColumnsToggle(area) {
   const button = h("button", { type: "button", id: "shoot-all-columns", class: "columns-toggle", "aria-pressed": "false",
-    title: "show the duration, rig, spins, worst joint, filter, missing and reviewer columns too (the table scrolls sideways in its box)" }, "all columns");
+    title: "show the duration, rig, spins, worst joint, filter, missing, below floor, floating and reviewer columns too (the table scrolls sideways in its box)" }, "all columns");
   const set = (on) => {
     button.setAttribute("aria-pressed", String(on));
     area.classList.toggle("all-columns", on);

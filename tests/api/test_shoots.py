@@ -14,6 +14,7 @@ from typing import Any
 
 import pytest
 from fastapi.testclient import TestClient
+from tests.store.skating_take import drifted_bvh
 
 from mocapqa.api.app import create_app
 from mocapqa.config import Settings
@@ -397,3 +398,75 @@ def test_demo_shoot_beside_the_single_takes(tmp_path: Path, renderer: RenderServ
         n_shoot = len(DEMO_FILES) + len(DEMO_SHOOT_CORPUS_FILES)
         assert shoots[0]["status_counts"]["done"] == shoots[0]["n_takes"] == n_shoot
         assert client.get(f"{API}/takes").json()["total"] == len(DEMO_FILES) + n_shoot
+
+
+BALANCING_TRC = (
+    "keypoints/pose2sim/S00_P00_T01_BalancingTrial/pose-3d/S00_P00_T01_BalancingTrial_0-100.trc"
+)
+"""A keypoint take in metres with a skate (sized in cm)."""
+CLEAN_BVH = "bvh/bandai/dataset-1_dash_normal_001.bvh"  # feet checked, nothing found
+FEET = ("foot_skates", "foot_worst_skate", "foot_skate_unit", "foot_penetrations", "foot_floating")
+
+
+def test_the_take_table_sorts_filters_and_exports_the_feet_figures(
+    client: TestClient, corpus_dir: Path, tmp_path: Path
+) -> None:
+    sid = _shoot(client, "feet")["id"]
+    skating = drifted_bvh(corpus_dir, tmp_path)
+    paths = [skating, corpus_dir / BALANCING_TRC, corpus_dir / CLEAN_BVH]
+    response = client.post(
+        f"{API}/shoots/{sid}/takes", files=[("files", (p.name, p.read_bytes())) for p in paths]
+    )
+    assert response.status_code == 201, response.text
+    assert _wait_finished(client, sid)["status_counts"]["done"] == 3
+    by_worst = {"sort": "foot_worst_skate", "order": "desc"}
+    rows = client.get(f"{API}/shoots/{sid}/takes", params=by_worst).json()["items"]
+    by_name = {r["name"]: r for r in rows}
+    bvh, trc, clean = (by_name[p.name] for p in paths)
+    assert bvh["foot_skates"] >= 1
+    assert bvh["foot_skate_unit"] == "% height"
+    assert trc["foot_skates"] >= 1
+    assert trc["foot_skate_unit"] == "cm"
+    assert (clean["foot_skates"], clean["foot_worst_skate"], clean["foot_skate_unit"]) == (
+        0, None, None,
+    )  # fmt: skip
+    # Largest first whatever the unit; the take without a skate last.
+    worst = sorted((bvh, trc), key=lambda r: -float(r["foot_worst_skate"]))
+    assert [r["name"] for r in rows] == [worst[0]["name"], worst[1]["name"], clean["name"]]
+    # The figures are the run's own findings (what the take view lists).
+    for row in (bvh, trc):
+        findings = client.get(f"{API}/runs/{row['run_id']}/result").json()["findings"]
+        skates = [f for f in findings if f["kind"] == "skate"]
+        assert row["foot_skates"] == len(skates)
+        assert row["foot_worst_skate"] == max(f["value"] for f in skates)
+        assert {f["unit"] for f in skates} == {row["foot_skate_unit"]}
+        assert row["foot_penetrations"] == sum(f["kind"] == "penetration" for f in findings)
+    for sort in ("foot_skates", "foot_penetrations", "foot_floating"):
+        answer = client.get(f"{API}/shoots/{sid}/takes", params={"sort": sort, "order": "desc"})
+        assert answer.status_code == 200, answer.text
+        values = [r[sort] for r in answer.json()["items"]]
+        assert values == sorted(values, reverse=True)
+    skating = client.get(f"{API}/shoots/{sid}/takes", params={"has_skates": "true"}).json()
+    assert sorted(r["name"] for r in skating["items"]) == sorted((bvh["name"], trc["name"]))
+    none = client.get(f"{API}/shoots/{sid}/takes", params={"has_skates": "false"}).json()
+    assert [r["name"] for r in none["items"]] == [clean["name"]]
+    assert client.get(f"{API}/shoots/{sid}/takes", params={"has_skates": "x"}).status_code == 422
+
+    exported = list(csv.DictReader(io.StringIO(client.get(f"{API}/shoots/{sid}/summary.csv").text)))
+    cells = {r["name"]: r for r in exported}
+    assert cells[bvh["name"]]["foot_skate_unit"] == "% height"
+    assert float(cells[trc["name"]]["foot_worst_skate"]) == trc["foot_worst_skate"]
+    assert cells[clean["name"]]["foot_worst_skate"] == ""
+    as_json = client.get(f"{API}/shoots/{sid}/summary.json", params={"has_skates": "true"}).json()
+    assert as_json["filters"] == {"has_skates": True}
+    assert {t["name"]: tuple(t[k] for k in FEET) for t in as_json["takes"]} == {
+        r["name"]: tuple(r[k] for k in FEET) for r in (bvh, trc)
+    }
+
+    # A run that does not check the feet leaves the figures empty, not 0.
+    again = client.post(f"{API}/takes/{bvh['take_id']}/runs", json={"checks": ["twist", "limits"]})
+    assert again.status_code == 201, again.text
+    _wait_finished(client, sid)
+    rows = client.get(f"{API}/shoots/{sid}/takes", params={"sort": "foot_skates"}).json()["items"]
+    assert [r["name"] for r in rows][-1] == bvh["name"]  # no value: last
+    assert all(rows[-1][k] is None for k in FEET)

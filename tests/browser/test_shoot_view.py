@@ -16,6 +16,7 @@ from typing import Any
 
 import httpx
 import pytest
+from tests.store.skating_take import drifted_bvh
 
 from mocapqa.api.routes.shoots import EXPORT_COLUMNS
 from mocapqa.jobs.demo import demo_paths
@@ -150,8 +151,9 @@ def test_import_progress_sort_review_export(
     columns = p.locator("#shoot-takes th[data-sort]").evaluate_all(
         "(ths) => ths.map((th) => th.dataset.sort)"
     )
-    assert len(columns) == 15
+    assert len(columns) == 19
     assert "limb_spins" in columns
+    assert "foot_worst_skate" in columns
     for column in columns:
         header = f"#shoot-takes th[data-sort='{column}']"
         for _ in range(2):
@@ -344,7 +346,7 @@ def test_import_progress_sort_review_export(
     narrow.page.keyboard.press("Enter")
     narrow.page.wait_for_selector(rig, state="visible")
     assert narrow.page.get_attribute("#shoot-all-columns", "aria-pressed") == "true"
-    assert narrow.page.locator("#shoot-takes thead th:visible").count() == 16
+    assert narrow.page.locator("#shoot-takes thead th:visible").count() == 20
     assert narrow.no_sideways_scroll()
     narrow.page.screenshot(path=str(ARTIFACTS / "shoot-900px-all-columns.png"), full_page=True)
     narrow.page.keyboard.press("Enter")
@@ -458,3 +460,92 @@ def test_dropped_files_are_imported(live_server: str, page: Page, corpus_dir: Pa
     assert heat["top"] == heat["x"]
     assert heat["width"] >= 26 * len(heat["x"])
     p.screenshot(path=str(ARTIFACTS / "shoot-long-name-800px.png"), full_page=True)
+
+
+def test_feet_columns_show_sort_and_filter_the_skates(
+    live_server: str, page: Page, corpus_dir: Path, tmp_path: Path
+) -> None:
+    """A shoot with a real BVH take given a slide (its root drifts while both feet are planted),
+    a keypoint take whose skate is in cm, a take with none and a take whose latest run did not
+    check the feet: the skate columns say their unit in the header, sort on the server, filter,
+    and show a dash (not 0) where there is no figure."""
+    base = f"{live_server}/api/v1"
+    shoot = httpx.post(f"{base}/shoots", json={"name": "Feet day"}, timeout=30)
+    shoot.raise_for_status()
+    sid = shoot.json()["id"]
+    skating = drifted_bvh(corpus_dir, tmp_path)
+    paths = [skating, *(corpus_dir / p for p in (TAKES[2], TAKES[0], TAKES[1]))]
+    files = [("files", (path.name, path.read_bytes())) for path in paths]
+    imported = httpx.post(f"{base}/shoots/{sid}/takes", files=files, timeout=120)
+    assert imported.status_code == 201, imported.text
+    unchecked = next(c for c in imported.json()["created"] if c["name"] == paths[3].name)
+    page.open(f"{live_server}/#/shoot/{sid}")
+    p = page.page
+    p.wait_for_selector("#progress-panel[data-finished='1']", timeout=ANALYSIS_MS)
+    again = httpx.post(
+        f"{base}/takes/{unchecked['take_id']}/runs",
+        json={"checks": ["twist", "limits"]},
+        timeout=30,
+    )
+    assert again.status_code == 201, again.text
+    page.open(f"{live_server}/#/shoot/{sid}?sort=foot_worst_skate&order=desc")
+    p.wait_for_selector("#progress-panel[data-finished='1']", timeout=ANALYSIS_MS)
+    p.wait_for_function(
+        "() => document.querySelectorAll('#shoot-takes tbody .badge.done').length === 4",
+        timeout=ANALYSIS_MS,
+    )
+    header = p.inner_text("#shoot-takes th[data-sort='foot_worst_skate']")
+    assert header.startswith("worst skate (cm)")
+    assert p.get_attribute("#shoot-takes th[data-sort='foot_worst_skate']", "aria-sort") == (
+        "descending"
+    )
+    rows = httpx.get(
+        f"{base}/shoots/{sid}/takes", params={"sort": "foot_worst_skate", "order": "desc"}
+    ).json()["items"]
+    api_names = [r["name"] for r in rows]
+    assert p.locator("#shoot-takes tbody td.name").all_inner_texts() == api_names
+
+    def cells(name: str) -> dict[str, str]:
+        row = p.locator("#shoot-takes tbody tr", has=p.locator("td.name", has_text=name))
+        keys = p.locator("#shoot-takes th[data-sort]").evaluate_all(
+            "(ths) => ths.map((th) => th.dataset.sort)"
+        )
+        texts = row.locator("td").all_inner_texts()[1:]  # after the thumbnail
+        return dict(zip(keys, texts, strict=True))
+
+    bvh = next(r for r in rows if r["name"] == paths[0].name)
+    shown = cells(paths[0].name)
+    assert bvh["foot_skate_unit"] == "% height"
+    assert shown["foot_skates"] == str(bvh["foot_skates"])
+    # The count is the run's skate findings (what the take view's findings list shows).
+    result = httpx.get(f"{base}/runs/{bvh['run_id']}/result", timeout=30).json()
+    skates = [f for f in result["findings"] if f["kind"] == "skate"]
+    assert bvh["foot_skates"] == len(skates) >= 1
+    assert bvh["foot_worst_skate"] == max(f["value"] for f in skates)
+    assert shown["foot_worst_skate"] == f"{bvh['foot_worst_skate']:.1f} % height"
+    trc = cells(paths[1].name)
+    assert trc["foot_worst_skate"].replace(".", "", 1).isdigit()  # cm: the number alone
+    clean = cells(paths[2].name)
+    assert (clean["foot_skates"], clean["foot_worst_skate"]) == ("0", "–")
+    # The take whose run did not check the feet: a dash in every feet cell, never 0. Takes
+    # without a largest skate come last (by name) in either order.
+    assert api_names[2:] == sorted((paths[2].name, paths[3].name))
+    assert [cells(paths[3].name)[k] for k in ("foot_skates", "foot_worst_skate")] == ["–", "–"]
+    ARTIFACTS.mkdir(exist_ok=True)
+    p.screenshot(path=str(ARTIFACTS / "shoot-feet-columns.png"), full_page=True)
+
+    # Sorting by the skate count from the header; the skates filter keeps the two skating takes.
+    p.click("#shoot-takes th[data-sort='foot_skates']")
+    p.wait_for_selector("#shoot-takes th[data-sort='foot_skates'][aria-sort='ascending']")
+    counts = [
+        cells(n)["foot_skates"] for n in p.locator("#shoot-takes tbody td.name").all_inner_texts()
+    ]
+    assert counts[-1] == "–"
+    assert [int(c) for c in counts[:-1]] == sorted(int(c) for c in counts[:-1])
+    p.select_option("#shoot-has_skates", "true")
+    p.wait_for_function(
+        "() => document.getElementById('page-info')?.innerText === '1–2 of 2'", timeout=30_000
+    )
+    names = set(p.locator("#shoot-takes tbody td.name").all_inner_texts())
+    assert names == {paths[0].name, paths[1].name}
+    assert "has_skates=true" in p.url

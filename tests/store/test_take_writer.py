@@ -22,7 +22,17 @@ from mocapqa.store.take_writer import DoneTake
 
 SUMMARY = {
     "n_findings": 2,
-    "qa": {"score": 71.5, "rig": "cmu", "violation_share": 0.1, "joint_violations": {"knee": 0.1}},
+    "qa": {
+        "score": 71.5,
+        "rig": "cmu",
+        "violation_share": 0.1,
+        "joint_violations": {"knee": 0.1},
+        "foot_skates": 2,
+        "foot_worst_skate": 3.25,
+        "foot_skate_unit": "cm",
+        "foot_penetrations": 1,
+        "foot_floating": 0,
+    },
 }
 
 
@@ -70,6 +80,10 @@ def test_a_new_take_s_summary_row_is_the_one_the_store_would_rebuild(
     row = qa_row(repository, str(done["id"]))
     assert (row["status"], row["score"], row["n_findings"]) == ("done", 71.5, 2)
     assert row["joint_violations"] == {"knee": 0.1}
+    feet = ("foot_skates", "foot_worst_skate", "foot_skate_unit", "foot_penetrations")
+    assert tuple(row[k] for k in feet) == (2, 3.25, "cm", 1)
+    assert row["foot_floating"] == 0
+    assert qa_row(repository, queued)["foot_skates"] is None  # not analysed yet: no figure
 
 
 def test_a_new_run_checks_limits_with_the_named_then_the_shoot_s_then_the_default_model(

@@ -90,6 +90,27 @@ class ShootTakeOut(BaseModel):
     filter_residual_mm: float | None
     missing_share: float | None
     n_findings: int | None
+    foot_skates: int | None = Field(
+        default=None,
+        description="Foot skate findings (a planted foot sliding); null when the feet were not "
+        "checked (or the run was made before these figures)",
+    )
+    foot_worst_skate: float | None = Field(
+        default=None,
+        description="The largest foot skate, in `foot_skate_unit`; null when no skate was found "
+        "(or the feet were not checked)",
+    )
+    foot_skate_unit: str | None = Field(
+        default=None,
+        description="Unit of `foot_worst_skate`: cm, or % of the body height estimated from the "
+        "leg length when the take's unit does not convert to cm (BVH stores none)",
+    )
+    foot_penetrations: int | None = Field(
+        default=None, description="Floor penetration findings (a foot below the floor)"
+    )
+    foot_floating: int | None = Field(
+        default=None, description="Floating findings (a still foot above the floor)"
+    )
     joint_violations: dict[str, float] | None
 
 

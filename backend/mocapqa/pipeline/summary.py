@@ -18,8 +18,11 @@ One flat, JSON-ready dict per take, the same for the batch table, the API and th
   table (its score counts them)
 * ``foot_contacts``, ``foot_skates``, ``foot_penetrations``, ``foot_floating`` and
   ``foot_jitter`` — the feet step's contacts and findings by kind, for takes it checked (None
-  otherwise); in the run's summary and the report, not columns of the shoot table (its score
-  counts the findings)
+  otherwise); in the run's summary and the report; the shoot table has the skate,
+  penetration and floating counts (its score counts every kind)
+* ``foot_worst_skate`` and ``foot_skate_unit`` — the largest skate finding's size and its unit
+  (``"cm"``, or ``"% height"`` when the take's unit does not convert to cm), as the feet step
+  reports it; None when the step did not run or found no skate
 * ``score`` — 0–100, see :func:`qa_score`; None for a motion take on which none of the twist,
   limits and feet checks ran (nothing was checked, so nothing can be called clean)
 
@@ -40,6 +43,7 @@ if TYPE_CHECKING:  # the store reads SUMMARY_FIELDS without loading the analysis
 
 __all__ = [
     "FEET_FIELDS",
+    "FEET_SIZE_FIELDS",
     "MARKER_FIELDS",
     "MM_PER_UNIT",
     "SCORE_TERMS",
@@ -94,6 +98,8 @@ MARKER_FIELDS = (
 """The summary's marker counts (marker takes; None for others)."""
 FEET_FIELDS = ("foot_contacts", "foot_skates", "foot_penetrations", "foot_floating", "foot_jitter")
 """The summary's feet counts (takes the feet step checked; None for others)."""
+FEET_SIZE_FIELDS = ("foot_worst_skate", "foot_skate_unit")
+"""The summary's largest skate and its unit (takes with a skate finding; None for others)."""
 _FEET_KINDS = {
     "skate": "foot_skates",
     "penetration": "foot_penetrations",
@@ -169,6 +175,20 @@ def _feet_counts(findings: list[dict[str, Any]], contacts: int) -> dict[str, int
         if field is not None and "foot" in finding:
             counts[field] += 1
     return counts
+
+
+def _worst_skate(findings: list[dict[str, Any]]) -> dict[str, Any]:
+    """The largest skate finding's size and unit (:data:`FEET_SIZE_FIELDS`; None when none has
+    a size)."""
+    sizes = [
+        (float(f["value"]), str(f["unit"]))
+        for f in findings
+        if f["kind"] == "skate" and "foot" in f and f.get("value") is not None
+    ]
+    if not sizes:
+        return dict.fromkeys(FEET_SIZE_FIELDS)
+    value, unit = max(sizes, key=lambda size: size[0])
+    return {"foot_worst_skate": value, "foot_skate_unit": unit}
 
 
 def _residual_mm(result: AnalysisResult, unit: str) -> float | None:
@@ -286,6 +306,7 @@ def qa_summary(result: AnalysisResult) -> dict[str, Any]:
         "joint_violations": joint_violations,
         **(markers or dict.fromkeys(MARKER_FIELDS)),
         **(feet or dict.fromkeys(FEET_FIELDS)),
+        **(_worst_skate(findings) if feet_ran else dict.fromkeys(FEET_SIZE_FIELDS)),
     }
     # A motion take on which none of the twist, limits and feet checks ran (a rig whose roles
     # were not found, a run of the filter only) has no score: 100 would read as "checked and

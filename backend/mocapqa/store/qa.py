@@ -14,12 +14,16 @@ from typing import Any
 from sqlalchemy import delete, insert, select
 from sqlalchemy.engine import Connection
 
-from mocapqa.pipeline.summary import SUMMARY_FIELDS
+from mocapqa.pipeline.summary import FEET_SIZE_FIELDS, SUMMARY_FIELDS
 from mocapqa.store.tables import reviews, runs, take_qa, takes
 
-__all__ = ["QA_COLUMNS", "lock_take", "qa_row", "qa_values", "sync_take"]
+__all__ = ["FEET_COLUMNS", "QA_COLUMNS", "lock_take", "qa_row", "qa_values", "sync_take"]
 
-QA_COLUMNS = (*SUMMARY_FIELDS, "joint_violations")
+FEET_COLUMNS = ("foot_skates", *FEET_SIZE_FIELDS, "foot_penetrations", "foot_floating")
+"""The feet figures of a take's row: skate, penetration and floating counts and the largest
+skate with its unit (null when the run did not check the feet, or was made before the largest
+skate was in the summary)."""
+QA_COLUMNS = (*SUMMARY_FIELDS, *FEET_COLUMNS, "joint_violations")
 """Columns of ``take_qa`` copied from a done run's ``summary["qa"]``."""
 
 

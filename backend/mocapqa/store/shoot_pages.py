@@ -28,10 +28,16 @@ SORT_COLUMNS = (
     "status",
     *SUMMARY_FIELDS,
     "n_findings",
+    "foot_skates",
+    "foot_worst_skate",
+    "foot_penetrations",
+    "foot_floating",
     "review_status",
     "reviewer",
 )
-"""Columns a shoot's take table can be sorted by."""
+"""Columns a shoot's take table can be sorted by. ``foot_worst_skate`` sorts by the number
+whatever its unit (``foot_skate_unit``: cm, or % of the body height for a take whose unit does
+not convert)."""
 
 
 class TakeFilter:
@@ -49,6 +55,9 @@ class TakeFilter:
         Only takes with (True) or without (False) findings.
     search : str, optional
         Case-insensitive substring of the take name.
+    has_skates : bool, optional
+        Only takes whose feet check found a foot skate (True) or found none (False; takes the
+        feet check did not look at are in neither).
     """
 
     def __init__(
@@ -60,6 +69,7 @@ class TakeFilter:
         max_score: float | None = None,
         has_findings: bool | None = None,
         search: str | None = None,
+        has_skates: bool | None = None,
     ) -> None:
         self.status = checked_choice("status", status, RUN_STATUSES)
         self.review_status = review_status
@@ -68,11 +78,12 @@ class TakeFilter:
         self.max_score = max_score
         self.has_findings = has_findings
         self.search = search
+        self.has_skates = has_skates
 
     def chosen(self) -> dict[str, Any]:
         """The filters that are set, by name (for an export to say what it holds)."""
         names = ("status", "review_status", "rig", "min_score", "max_score", "has_findings",
-                 "search")  # fmt: skip
+                 "search", "has_skates")  # fmt: skip
         return {n: getattr(self, n) for n in names if getattr(self, n) is not None}
 
     def clauses(self) -> list[ColumnElement[bool]]:
@@ -92,6 +103,10 @@ class TakeFilter:
             found.append(take_qa.c.n_findings > 0)
         elif self.has_findings is False:
             found.append(take_qa.c.n_findings == 0)
+        if self.has_skates is True:
+            found.append(take_qa.c.foot_skates > 0)
+        elif self.has_skates is False:
+            found.append(take_qa.c.foot_skates == 0)
         if self.search:
             pattern = "%" + self.search.lower().replace("%", r"\%").replace("_", r"\_") + "%"
             found.append(func.lower(take_qa.c.name).like(pattern, escape="\\"))

@@ -136,6 +136,11 @@ take_qa = Table(
     Column("filter_residual_mm", Float, nullable=True),
     Column("missing_share", Float, nullable=True),
     Column("n_findings", Integer, nullable=True),
+    Column("foot_skates", Integer, nullable=True),
+    Column("foot_worst_skate", Float, nullable=True),
+    Column("foot_skate_unit", String(16), nullable=True),
+    Column("foot_penetrations", Integer, nullable=True),
+    Column("foot_floating", Integer, nullable=True),
     Column("joint_violations", JSON, nullable=True),
     Index("ix_take_qa_shoot_score", "shoot_id", "score"),
     Index("ix_take_qa_shoot_status", "shoot_id", "status"),
@@ -144,7 +149,11 @@ take_qa = Table(
     Index("ix_take_qa_shoot_name", "shoot_id", "name"),
 )
 """One row per take: its latest run's status and QA summary and its latest review, kept in step
-by the repository so that a shoot's take table sorts and filters on indexed columns."""
+by the repository so that a shoot's take table sorts and filters on indexed columns. The
+``foot_*`` columns are the feet step's skate, penetration and floating counts and its largest
+skate (``foot_worst_skate`` in ``foot_skate_unit``: cm, or % of the body height when the take's
+unit does not convert); null for a run that did not check the feet (or was made before these
+columns), and the largest skate null too when no skate was found."""
 
 source_hashes = Table(
     "source_hashes",

@@ -30,6 +30,7 @@ from mocapqa.api.shoot_schemas import (
 from mocapqa.errors import InputError, OptionError
 from mocapqa.jobs.batch_output import COLUMNS
 from mocapqa.jobs.shoot_import import ImportLimits, import_uploads
+from mocapqa.store.qa import FEET_COLUMNS
 from mocapqa.store.repository import ReviewStatus, RunStatus
 from mocapqa.store.roles import Action
 from mocapqa.store.shoot_pages import SORT_COLUMNS, TakeFilter
@@ -180,6 +181,10 @@ def take_filter(
     max_score: Annotated[float | None, Query(ge=0, le=100)] = None,
     has_findings: bool | None = None,
     search: Annotated[str | None, Query(max_length=255)] = None,
+    has_skates: Annotated[
+        bool | None,
+        Query(description="Only takes whose feet check found a foot skate (true) or none (false)"),
+    ] = None,
 ) -> TakeFilter:
     """The take table's filters from the query (the take table, the heat map and the
     exports share them); a ``min_score`` above ``max_score`` is 422, not an empty page."""
@@ -187,7 +192,9 @@ def take_filter(
         raise OptionError(
             "min_score", f"Expected min_score at most max_score ({max_score:g}), got {min_score:g}"
         )
-    return TakeFilter(status, review_status, rig, min_score, max_score, has_findings, search)
+    return TakeFilter(
+        status, review_status, rig, min_score, max_score, has_findings, search, has_skates
+    )
 
 
 Filters = Annotated[TakeFilter, Depends(take_filter)]
@@ -250,8 +257,10 @@ EXPORT_COLUMNS = (
     "status",
     *(name for name, _ in COLUMNS if name not in ("source", "status", "error")),
     "reviewer",
+    *FEET_COLUMNS,
 )
-"""Columns of the shoot summary export, in order."""
+"""Columns of the shoot summary export, in order (the feet figures last, so the columns
+before them keep their places)."""
 
 
 _FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
