@@ -99,8 +99,10 @@ export function prefetchTake(takeId, runId) {
 export const startRun = (takeId, options) => request("POST", `/takes/${takeId}/runs`, options);
 export const addReview = (takeId, review) => request("POST", `/takes/${takeId}/reviews`, review);
 export const getDecisions = (runId) => request("GET", `/runs/${runId}/decisions`);
-// `item` is "interval" (a twist interval) or "swap"; the decided take is BVH or C3D.
+// `item` is "interval" (a twist interval) or "swap"; the decided take is BVH, C3D or TRC.
 export const addDecision = (runId, itemId, body, item = "interval") => request("POST", `/runs/${runId}/${item === "swap" ? "swaps" : "intervals"}/${itemId}/decisions`, body);
+/** Accept or reject the foot lock of a skate finding (its id, `skate-left-120`). */
+export const addLockDecision = (runId, lockId, body) => request("POST", `/runs/${runId}/feet/${encodeURIComponent(lockId)}/decisions`, body);
 export const decidedUrl = (runId, format = "bvh") => `${BASE}/runs/${runId}/decisions/${format}`;
 export const listFilters = () => request("GET", "/filters");
 export const getRunOptions = () => request("GET", "/run-options");

@@ -54,7 +54,8 @@ function sortHead(sort, decided, render) {
 function findingRow(f, isCurrent, decided, open) {
   return activatable(h("tr", {
     class: `clickable finding${isCurrent ? " current" : ""}`, "data-start": f.start_frame, "data-joint": f.joint, "data-kind": f.kind,
-    "data-interval": f.kind === decided.kind ? f.id : null, "aria-current": isCurrent ? "true" : null,
+    "data-interval": f.kind === decided.kind ? f.id : null, "data-lock": decided.isLock?.(f) ? f.id : null,
+    "aria-current": isCurrent ? "true" : null,
   },
   h("td", {}, f.kind), h("td", {}, f.joint, f.readout ? h("div", { class: "muted readout" }, f.readout) : null), h("td", { class: "frames" }, `${f.start_frame}–${f.end_frame}`), h("td", {}, f.end_frame - f.start_frame + 1),
   h("td", { class: "value" }, f.value == null ? "–" : `${fmt(f.value, 1)} ${unitOf(f)}`), h("td", {}, f.kind === "twist" ? `${fmt(100 * f.confidence, 0)} %` : fmt(f.confidence, 2)),
@@ -73,7 +74,7 @@ function groupHeadRow(g, open, span, toggle) {
 
 /**
  * @param findings  the run's findings
- * @param decided   the decisions (cells of twist or swap rows, footer)
+ * @param decided   the decisions (cells of twist, swap and foot-lock rows, footer)
  * @param onOpen    called with a finding opened by a click or Enter
  * @param initial   the filter to start with ({kinds, joint, minValue, text}, as filterFromParams)
  * @param onFilter  called with the filter's link parameters (filterParams) when it changes

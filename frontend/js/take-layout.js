@@ -6,7 +6,7 @@ import { badge, h } from "./dom.js";
 import { fmt, runOptionsLabel } from "./format.js";
 import { takeLine, uncheckedSteps, viewLegend } from "./take-format.js";
 
-export const KEYS_HELP = "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · I/O in/out point · L loop in/out · shift+L loop the finding · C close-in · A/F/R approve, needs fix, reject the take (saves) · Y/X accept, reject the focused or last opened twist interval or swap (saves) · Enter on a row opens it · ? shows or hides this line";
+export const KEYS_HELP = "Keys: space play/pause · ←/→ one frame (shift: 10) · N/P next/previous finding · I/O in/out point · L loop in/out · shift+L loop the finding · C close-in · A/F/R approve, needs fix, reject the take (saves) · Y/X accept, reject the focused or last opened twist interval, swap or foot lock (saves) · Enter on a row opens it · ? shows or hides this line";
 
 /** The take's name with its run's state, and what the take is. */
 export function takeHeader(take, run) {

@@ -217,3 +217,39 @@ def test_a_decision_records_the_client_address_of_a_signed_in_reviewer(
         f"/api/v1/runs/{knees_run['id']}/decisions", headers={"Authorization": f"Bearer {token}"}
     ).json()["history"]
     assert [h["client"] for h in history] == ["testclient"]
+
+
+def test_accepted_foot_locks_apply_on_top_of_the_accepted_intervals(
+    client: TestClient, knees: Path, knees_run: dict[str, Any]
+) -> None:
+    """The decided BVH removes the decided intervals' levels, then locks the accepted feet
+    (tests/api/test_feet_decisions.py): against the same intervals without the lock, only the
+    legs move."""
+    from tests.api.test_feet_decisions import decide_lock, leg_joints
+
+    from mocapqa.kinematics.forward import forward_kinematics
+
+    run_id = knees_run["id"]
+    body = client.get(f"/api/v1/runs/{run_id}/decisions").json()
+    intervals, locks = body["intervals"], body["locks"]
+    assert locks
+    first = intervals[0]["id"]
+    decide(client, run_id, first, "accept")
+    ids = {first} | {i["id"] for i in intervals if i["applied"]}
+    without_lock = client.get(f"/api/v1/runs/{run_id}/decisions/bvh").content
+    assert without_lock == expected_bvh(knees, intervals, ids)
+
+    lock = locks[-1]
+    decide_lock(client, run_id, lock["id"], "accept")
+    with_lock = client.get(f"/api/v1/runs/{run_id}/decisions/bvh").content
+    assert with_lock != without_lock
+    old = parse_bvh(without_lock.decode(), "intervals.bvh")
+    new = parse_bvh(with_lock.decode(), "locked.bvh")
+    upper = [j for j in range(new.skeleton.n_joints) if j not in leg_joints(knees)]
+    np.testing.assert_array_equal(
+        forward_kinematics(new)[1][:, upper], forward_kinematics(old)[1][:, upper]
+    )
+    assert body["history"] == []
+    history = client.get(f"/api/v1/runs/{run_id}/decisions").json()
+    assert [h["interval_id"] for h in history["history"]] == [first]
+    assert [h["lock_id"] for h in history["lock_history"]] == [lock["id"]]

@@ -211,3 +211,65 @@ def test_undecided_the_decided_c3d_is_the_runs_corrected_take_gaps_filled_alike(
     assert np.isnan(raw).any()
     assert (np.isnan(raw) & ~np.isnan(decided)).any()  # some gaps filled
     np.testing.assert_array_equal(decided, ours.points.positions)
+
+
+def test_an_accepted_foot_lock_pins_that_foots_markers_only(
+    client: TestClient, swap_run: dict[str, Any], tmp_path: Path
+) -> None:
+    """The decided C3D pins the foot markers of each accepted foot lock (a skate finding of the
+    feet step) after the swaps; undecided locks are not applied (tests/api/test_feet_decisions.py
+    for BVH takes)."""
+    from tests.api.test_feet_decisions import decide_lock
+
+    from mocapqa.feet.markers import marker_label
+
+    run_id = swap_run["id"]
+    body = client.get(f"/api/v1/runs/{run_id}/decisions").json()
+    locks = body["locks"]
+    assert locks
+    assert all(lock["decision"] is None and not lock["applied"] for lock in locks)
+    before = decided_positions(client, run_id, tmp_path)
+    lock = locks[0]
+    decide_lock(client, run_id, lock["id"], "accept")
+    after = decided_positions(client, run_id, tmp_path)
+    names = [marker_label(n) for n in read_c3d(tmp_path / "decided.c3d").points.names]
+    moved = np.nan_to_num(np.abs(after - before)).max(axis=(0, 2)) > 0
+    side = lock["foot"][0].upper()
+    assert moved.any()
+    # The foot's heel, toe and ankle markers move together; no other marker does.
+    assert {names[m] for m in np.flatnonzero(moved)} == {f"{side}HEE", f"{side}TOE", f"{side}ANK"}
+    assert lock["joint"].endswith(f"{side}HEE")
+    # Horizontally only (one axis, the up axis, keeps every value), on the contact and its blends.
+    axes = np.nan_to_num(np.abs(after - before)).max(axis=(0, 1)) > 0
+    assert axes.sum() == 2
+    frames = np.flatnonzero(np.nan_to_num(np.abs(after - before)).max(axis=(1, 2)) > 0)
+    assert frames.min() >= lock["start_frame"] - 10
+    assert frames.max() <= lock["end_frame"] + 10
+    decide_lock(client, run_id, lock["id"], "reject")
+    np.testing.assert_array_equal(decided_positions(client, run_id, tmp_path), before)
+
+
+def test_a_c3d_takes_decided_take_is_also_served_as_trc(
+    client: TestClient, swap_run: dict[str, Any], tmp_path: Path
+) -> None:
+    """For OpenSim: the decided C3D's markers, names, rate and unit as TRC, decided alike."""
+    from mocapqa.io.trc import parse_trc
+
+    run_id = swap_run["id"]
+
+    def both() -> tuple[np.ndarray, Any]:
+        response = client.get(f"/api/v1/runs/{run_id}/decisions/trc")
+        assert response.status_code == 200, response.text
+        assert "decided.trc" in response.headers["content-disposition"]
+        return decided_positions(client, run_id, tmp_path), parse_trc(response.content)
+
+    c3d, trc = both()
+    points = read_c3d(tmp_path / "decided.c3d").points
+    assert (trc.names, trc.fps, trc.length_unit) == (points.names, points.fps, points.length_unit)
+    assert trc.start_frame == points.start_frame  # the C3D's first frame, as OrigDataStartFrame
+    np.testing.assert_array_equal(trc.positions, c3d)
+    swaps = client.get(f"/api/v1/runs/{run_id}/decisions").json()["swaps"]
+    decide(client, run_id, swaps[0]["id"], "reject")
+    rejected, trc = both()
+    assert not np.array_equal(rejected, c3d, equal_nan=True)
+    np.testing.assert_array_equal(trc.positions, rejected)

@@ -3,34 +3,48 @@
 A motion run's corrections are its twist intervals; a marker run's (the ``markers`` check of a
 C3D or TRC take) its swaps. An item's newest decision wins; an item with none follows the run's
 own choice (its ``applied`` flag: ``twist_apply`` for intervals, the confident rule for swaps).
+Beside them, a run with the feet check has foot locks, one per skate finding
+(:func:`run_locks`): cleanup is off by default, so only an accepted lock is applied
+(:mod:`mocapqa.jobs.decided_feet`), after the other corrections.
 
 * The decided motion is the raw take with exactly the levels of the intervals kept corrected
-  removed (:func:`mocapqa.twist.levels.remove_levels`). No motion filter is applied, whatever
-  the run's options.
+  removed (:func:`mocapqa.twist.levels.remove_levels`), then its accepted foot locks solved
+  (leg joints only). No motion filter is applied, whatever the run's options. A motion run
+  with the feet check but without the twist check has locks only.
 * The decided marker take is the raw take with exactly the swaps kept corrected exchanged, then
   its gaps filled by the run's rule (the confident fills, chosen again on that take:
-  :func:`mocapqa.pipeline.marker_step.decided_repair`), written as C3D like the run's
-  ``corrected.c3d`` (:func:`mocapqa.jobs.run_folder.write_corrected_c3d`). No filter.
+  :func:`mocapqa.pipeline.marker_step.decided_repair`), then its accepted foot locks pinned,
+  written as C3D like the run's ``corrected.c3d``
+  (:func:`mocapqa.jobs.run_folder.write_corrected_c3d`), or as TRC (a TRC take's, or a C3D
+  take's for OpenSim: :func:`decided_trc`). No filter.
 
 Neither touches the stored take, the run's own files or the take's review.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import json
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
+
+import numpy as np
 
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import ConflictError, NotFoundError
 from mocapqa.io.bvh_write import format_bvh
+from mocapqa.io.trc import format_trc
+from mocapqa.jobs.decided_feet import accepted_locks, lock_accepted_markers, lock_accepted_motion
 from mocapqa.jobs.run_folder import RunFolder, read_options_of, write_corrected_c3d
+from mocapqa.markers.repair import MarkerRepair
+from mocapqa.markers.swaps import repair_swaps
 from mocapqa.pipeline.loading import ReadLimits, read_take_file
 from mocapqa.pipeline.marker_step import decided_repair
-from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.pipeline.options import MARKER_FORMATS, AnalysisOptions
 from mocapqa.store.decisions import DecidedItem
 from mocapqa.store.files import FileStore
 from mocapqa.twist.levels import remove_levels
@@ -39,14 +53,37 @@ __all__ = [
     "decided_bvh",
     "decided_c3d",
     "decided_motion",
+    "decided_trc",
+    "run_decidables",
     "run_intervals",
     "run_items",
+    "run_locks",
     "run_swaps",
     "with_decisions",
 ]
 
 _SWAP_FIELDS = ("id", "markers", "start_frame", "end_frame", "confidence", "applied")
 """The fields of a ``swap`` finding a decision list shows."""
+_LOCK_FIELDS = (
+    "id", "foot", "joint", "start_frame", "end_frame", "value", "unit", "confidence",
+    "speed_cm_s",
+)  # fmt: skip
+"""The fields of a ``skate`` finding a decision list shows of its foot lock."""
+
+
+class _ReportItems(NamedTuple):
+    """What a run's report holds to decide on (None for a check the run did not finish)."""
+
+    kind: str | None
+    intervals: tuple[dict[str, Any], ...] | None
+    swaps: tuple[dict[str, Any], ...] | None
+    locks: tuple[dict[str, Any], ...] | None
+
+
+def _items_of(files: FileStore, run_id: str) -> _ReportItems:
+    path = files.existing(RunFolder.of(files, run_id).report, "the report")
+    stat = path.stat()
+    return _report_items(str(path), stat.st_mtime_ns, stat.st_size)
 
 
 def run_items(files: FileStore, run_id: str) -> tuple[DecidedItem, list[dict[str, Any]]]:
@@ -60,9 +97,7 @@ def run_items(files: FileStore, run_id: str) -> tuple[DecidedItem, list[dict[str
     ConflictError
         For a run without the twist check (motion) or the markers check (keypoints).
     """
-    path = files.existing(RunFolder.of(files, run_id).report, "the report")
-    stat = path.stat()
-    kind, intervals, swaps = _report_items(str(path), stat.st_mtime_ns, stat.st_size)
+    kind, intervals, swaps, _ = _items_of(files, run_id)
     if kind == "motion":
         if intervals is None:
             raise ConflictError(
@@ -80,6 +115,11 @@ def run_items(files: FileStore, run_id: str) -> tuple[DecidedItem, list[dict[str
 
 
 def _require(files: FileStore, run_id: str, item: DecidedItem) -> list[dict[str, Any]]:
+    if item == "swap" and _items_of(files, run_id).kind == "motion":
+        raise ConflictError(
+            f"Expected a run of a marker take (C3D or TRC), got run {run_id} of a motion take: "
+            "its reviewed take is GET /runs/{id}/decisions/bvh"
+        )
     found, items = run_items(files, run_id)
     if found != item:
         have = "twist intervals" if found == "interval" else "swaps"
@@ -113,29 +153,64 @@ def run_swaps(files: FileStore, run_id: str) -> list[dict[str, Any]]:
     return _require(files, run_id, "swap")
 
 
+def run_decidables(
+    files: FileStore, run_id: str
+) -> tuple[DecidedItem, list[dict[str, Any]], list[dict[str, Any]]]:
+    """Everything a finished run's reviewers decide on: what its corrections are, those items
+    (:func:`run_items`) and its foot locks (:func:`run_locks`, empty without the feet check).
+    A run with foot locks but neither twist intervals nor swaps to decide has no corrections:
+    ``"interval"`` (a motion take) or ``"swap"`` (a keypoint take) with no items.
+
+    Raises
+    ------
+    ConflictError
+        For a run with neither corrections (:func:`run_items`) nor foot locks to decide.
+    """
+    found = _items_of(files, run_id)
+    locks = [dict(lock) for lock in found.locks or ()]
+    try:
+        item, items = run_items(files, run_id)
+    except ConflictError:
+        if not locks:
+            raise
+        return ("interval" if found.kind == "motion" else "swap"), [], locks
+    return item, items, locks
+
+
+def run_locks(files: FileStore, run_id: str) -> list[dict[str, Any]] | None:
+    """The foot locks of a finished run: its feet step's skate findings (``id`` as
+    ``mocapqa feet fix --apply`` takes it, ``foot``, ``joint``, ``start_frame``,
+    ``end_frame``, ``value``, ``unit``, ``confidence``, ``speed_cm_s``), or None for a run
+    whose feet step did not run to the end."""
+    locks = _items_of(files, run_id).locks
+    return None if locks is None else [dict(lock) for lock in locks]
+
+
 @functools.lru_cache(maxsize=64)
-def _report_items(
-    path: str, mtime_ns: int, size: int
-) -> tuple[str | None, tuple[dict[str, Any], ...] | None, tuple[dict[str, Any], ...] | None]:
-    """A report's take kind, twist intervals (None without the twist check) and swaps (None
-    without the markers check), read once per version of the file (its path, change time and
-    size): a finished run's report is written once, and parsing it (a few MB) was most of the
-    cost of a decisions request."""
+def _report_items(path: str, mtime_ns: int, size: int) -> _ReportItems:
+    """A report's take kind, twist intervals (None without the twist check), swaps (None
+    without the markers check) and foot locks (None without the feet check), read once per
+    version of the file (its path, change time and size): a finished run's report is written
+    once, and parsing it (a few MB) was most of the cost of a decisions request."""
     del mtime_ns, size  # the cache key only
     with open(path, "rb") as handle:
         report = json.loads(handle.read())
     twist = (report.get("series") or {}).get("twist")
-    markers = (report.get("steps") or {}).get("markers") or {}
-    swaps = (
-        tuple(
-            {k: f[k] for k in _SWAP_FIELDS}
-            for f in report.get("findings") or []
-            if f.get("kind") == "swap"
-        )
-        if markers.get("state") == "done"
-        else None
+    steps = report.get("steps") or {}
+    findings = report.get("findings") or []
+
+    def of_kind(step: str, kind: str, fields: tuple[str, ...]) -> tuple[dict[str, Any], ...] | None:
+        if ((steps.get(step) or {}).get("state")) != "done":
+            return None
+        return tuple({k: f.get(k) for k in fields} for f in findings if f.get("kind") == kind)
+
+    skates = of_kind("feet", "skate", _LOCK_FIELDS)
+    return _ReportItems(
+        report.get("kind"),
+        None if twist is None else tuple(twist["intervals"]),
+        of_kind("markers", "swap", _SWAP_FIELDS),
+        None if skates is None else tuple(s for s in skates if isinstance(s["id"], str)),
     )
-    return report.get("kind"), None if twist is None else tuple(twist["intervals"]), swaps
 
 
 def with_decisions(intervals: list[dict[str, Any]], latest: dict[int, str]) -> list[dict[str, Any]]:
@@ -156,17 +231,36 @@ def decided_motion(
     take: dict[str, Any],
     latest: dict[int, str],
     limits: ReadLimits | None = None,
+    locks: Mapping[str, str] | None = None,
 ) -> Motion:
-    """The raw take with the levels of the intervals the decisions keep corrected removed.
+    """The raw take with the levels of the intervals the decisions keep corrected removed,
+    then the accepted foot locks solved.
+
+    Parameters
+    ----------
+    files, run, take
+        The run's files, the run's row and its take's row.
+    latest : dict of int to str
+        Twist interval id → its newest decision.
+    limits : ReadLimits, optional
+    locks : mapping of str to str, optional
+        Foot lock id → its newest decision; only accepted locks are applied.
 
     Raises
     ------
     ConflictError
-        For a keypoint take or a run without the twist check.
+        For a keypoint take, a run with neither the twist nor the feet check, or accepted
+        locks the take's feet check no longer finds.
     NotFoundError
         When the take's file is gone.
     """
-    intervals = with_decisions(run_intervals(files, str(run["id"])), latest)
+    run_id = str(run["id"])
+    found = _items_of(files, run_id)
+    if found.kind == "motion" and found.intervals is None and found.locks is not None:
+        listed: list[dict[str, Any]] = []  # the feet check without the twist check
+    else:
+        listed = run_intervals(files, run_id)
+    intervals = with_decisions(listed, latest)
     _, raw = _raw_take(files, take, limits)
     if not isinstance(raw, Motion):  # pragma: no cover - run_intervals refused keypoint runs
         raise ConflictError(f"Expected a motion take, got {take['format']}")
@@ -177,7 +271,9 @@ def decided_motion(
                 (int(a), int(b), float(v)) for a, b, v in interval["levels"]
             )
     mapping = AnalysisOptions.from_json(run["options"]).mapping
-    return remove_levels(raw, levels, mapping)
+    decided = remove_levels(raw, levels, mapping)
+    accepted = accepted_locks(found.locks or (), locks or {})
+    return lock_accepted_motion(raw, decided, accepted, mapping, run_id)
 
 
 def _raw_take(
@@ -191,30 +287,18 @@ def _raw_take(
     return path, read_take_file(path, str(take["format"]), str(take["name"]), options, limits)
 
 
-def decided_c3d(
+def _decided_markers(
     files: FileStore,
     run: dict[str, Any],
     take: dict[str, Any],
     latest: dict[int, str],
-    limits: ReadLimits | None = None,
-) -> bytes:
-    """The C3D of a marker take with exactly the swaps the decisions keep corrected repaired,
-    then its gaps filled by the run's rule, as the run's ``corrected.c3d`` is written.
-
-    Raises
-    ------
-    ConflictError
-        For a run without swaps to decide, a take that is not a C3D, or a take whose swaps
-        are no longer the run's (found again by another version of the check).
-    NotFoundError
-        When the take's file is gone.
-    """
+    limits: ReadLimits | None,
+    locks: Mapping[str, str] | None,
+) -> tuple[Path, KeypointSequence, MarkerRepair]:
+    """The stored file of a marker take, the take as the run read it, and its repair with
+    exactly the swaps the decisions keep corrected, its gaps filled by the run's rule and its
+    accepted foot locks pinned (:func:`decided_c3d`)."""
     swaps = with_decisions(run_swaps(files, str(run["id"])), latest)
-    if str(take["format"]) != "c3d":
-        raise ConflictError(
-            f"Expected a C3D take for the decided C3D, got a {take['format']} take: the "
-            "decided download of a marker take is written as C3D only"
-        )
     path, raw = _raw_take(files, take, limits)
     if not isinstance(raw, KeypointSequence):  # pragma: no cover - run_swaps refused others
         raise ConflictError(f"Expected a marker take, got {take['format']}")
@@ -226,10 +310,88 @@ def decided_c3d(
             f"Expected the swaps of run {run['id']} in its take, found others ({len(found)} "
             f"against {len(listed)}): start a new run of the take to decide on its swaps"
         )
+    accepted = accepted_locks(_items_of(files, str(run["id"])).locks or (), locks or {})
+    if accepted:
+        pinned = lock_accepted_markers(raw, repair.positions, accepted, str(run["id"]))
+        repair = dataclasses.replace(repair, positions=pinned)
+    return path, raw, repair
+
+
+def decided_c3d(
+    files: FileStore,
+    run: dict[str, Any],
+    take: dict[str, Any],
+    latest: dict[int, str],
+    limits: ReadLimits | None = None,
+    locks: Mapping[str, str] | None = None,
+) -> bytes:
+    """The C3D of a marker take with exactly the swaps the decisions keep corrected repaired,
+    then its gaps filled by the run's rule, as the run's ``corrected.c3d`` is written, then
+    its accepted foot locks pinned (``locks``: lock id → its newest decision).
+
+    Raises
+    ------
+    ConflictError
+        For a run without swaps to decide, a take that is not a C3D, or a take whose swaps
+        are no longer the run's (found again by another version of the check).
+    NotFoundError
+        When the take's file is gone.
+    """
+    run_swaps(files, str(run["id"]))
+    if str(take["format"]) != "c3d":
+        raise ConflictError(
+            f"Expected a C3D take for the decided C3D, got a {take['format']} take: the "
+            f"decided download of a {take['format']} marker take is /decisions/trc"
+        )
+    path, _, repair = _decided_markers(files, run, take, latest, limits, locks)
     with tempfile.TemporaryDirectory(prefix="mocapqa-decided-") as folder:
         target = Path(folder) / "decided.c3d"
         write_corrected_c3d(target, path, repair)
         return target.read_bytes()
+
+
+def decided_trc(
+    files: FileStore,
+    run: dict[str, Any],
+    take: dict[str, Any],
+    latest: dict[int, str],
+    limits: ReadLimits | None = None,
+    locks: Mapping[str, str] | None = None,
+) -> bytes:
+    """The TRC of a marker take (a TRC or a C3D take) decided as :func:`decided_c3d` decides
+    it: exactly the swaps the decisions keep corrected repaired, its gaps filled by the run's
+    rule, its accepted foot locks pinned; written by :func:`mocapqa.io.trc.format_trc` with the
+    take's rate, unit, marker names, frame numbers and times as the run read them. TRC has no
+    residual: a filled sample is a value like any other (the run's ``gap`` findings list the
+    filled gaps) and a sample still missing is ``NaN``.
+
+    Raises
+    ------
+    ConflictError
+        For a take that is not a marker take (C3D or TRC), a run without the markers check, or
+        a take whose swaps are no longer the run's.
+    NotFoundError
+        When the take's file is gone.
+    """
+    if str(take["format"]) not in MARKER_FORMATS:
+        kind = "motion" if str(take["format"]) == "bvh" else "keypoint"
+        raise ConflictError(
+            f"Expected a marker take ({', '.join(f.upper() for f in MARKER_FORMATS)}) for the "
+            f"decided TRC, got a {kind} take ({take['format']}): "
+            + (
+                "a motion take's decided download is /decisions/bvh"
+                if kind == "motion"
+                else "only marker takes have swaps and fills to decide"
+            )
+        )
+    _, raw, repair = _decided_markers(files, run, take, latest, limits, locks)
+    exchanged = repair_swaps(raw.confidence, repair.repaired)
+    decided = dataclasses.replace(
+        raw, positions=repair.positions, confidence=np.where(repair.filled, 1.0, exchanged)
+    )
+    name = str(take.get("name") or take["file_name"])
+    stem = name.rsplit(".", 1)[0] if "." in name else name
+    return format_trc(decided, f"{stem}.decided.trc").encode()
 
 
 def decided_bvh(motion: Motion) -> bytes:

@@ -171,15 +171,20 @@ interval_decisions = Table(
     metadata,
     Column("id", Integer, primary_key=True, autoincrement=True),
     Column("run_id", String(32), ForeignKey("runs.id", ondelete="CASCADE"), index=True),
-    Column("interval_id", Integer, nullable=False),
+    Column("interval_id", Integer, nullable=True),
     Column("decision", String(16), nullable=False),
     Column("note", Text, nullable=False, default=""),
     Column("reviewer", String(255), nullable=False),
     Column("client", String(255), nullable=False),
     Column("created_at", DateTime(timezone=True), nullable=False),
+    Column("item_kind", String(16), nullable=False, server_default="correction"),
+    Column("lock_id", String(64), nullable=True),
 )
-"""A reviewer's accept / reject of one twist interval of a run, kept as history (the newest row
-per interval is the decision; ``client`` is where it came from)."""
+"""A reviewer's accept / reject of one item of a run, kept as history (the newest row per item
+is the decision; ``client`` is where it came from). ``item_kind`` says what the row decides:
+``"correction"``, the run's twist interval or swap ``interval_id`` (every row made before
+revision 0011), or ``"lock"``, the foot lock of the run's skate finding ``lock_id``
+(``interval_id`` null)."""
 
 users = Table(
     "users",

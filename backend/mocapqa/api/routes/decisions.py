@@ -1,5 +1,5 @@
-"""Reviewers' accept / reject decisions on a run's twist intervals or swaps, and the decided
-take."""
+"""Reviewers' accept / reject decisions on a run's twist intervals or swaps and its foot locks,
+and the decided take."""
 
 from __future__ import annotations
 
@@ -11,19 +11,21 @@ from fastapi import APIRouter, Depends, Path, Request
 from fastapi.responses import Response
 
 from mocapqa.api.auth import Principal, audit, client_address, require
-from mocapqa.api.decision_schemas import DecisionIn, DecisionOut, DecisionsOut
+from mocapqa.api.decision_schemas import DecisionIn, DecisionOut, DecisionsOut, LockDecisionOut
 from mocapqa.api.deps import Services, ServicesDep
 from mocapqa.api.disposition import attachment, download_stem
 from mocapqa.api.errors import responses
 from mocapqa.core.text import display_name
-from mocapqa.errors import NotFoundError
+from mocapqa.errors import ConflictError, NotFoundError
 from mocapqa.io.guards import ReadLimits
 from mocapqa.jobs.accepted import (
     decided_bvh,
     decided_c3d,
     decided_motion,
+    decided_trc,
+    run_decidables,
     run_intervals,
-    run_items,
+    run_locks,
     run_swaps,
     with_decisions,
 )
@@ -57,6 +59,11 @@ DoneRunDep = Annotated[dict[str, Any], Depends(_done_run)]
 def _out(row: dict[str, Any], item: DecidedItem) -> DecisionOut:
     reviewer = display_name(str(row["reviewer"]))
     return DecisionOut.model_validate({**row, "item": item, "reviewer": reviewer})
+
+
+def _lock_out(row: dict[str, Any]) -> LockDecisionOut:
+    reviewer = display_name(str(row["reviewer"]))
+    return LockDecisionOut.model_validate({**row, "item": "lock", "reviewer": reviewer})
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,11 +123,13 @@ _DECISION_POST: dict[str, Any] = {
 
 @router.get("/decisions", responses=responses(401, 404, 409))
 def list_decisions(run: DoneRunDep, services: ServicesDep, decisions: DecisionsDep) -> DecisionsOut:
-    """The run's twist intervals (a motion take) or swaps (a marker take) with their newest
-    decision, and every decision (newest first). 409 for a run with neither check."""
+    """The run's twist intervals (a motion take) or swaps (a marker take) and its foot locks
+    (the skate findings of its feet step) with their newest decision, and every decision
+    (newest first). 409 for a run with none of these to decide."""
     run_id = str(run["id"])
-    item, items = run_items(services.files, run_id)
+    item, items, locks = run_decidables(services.files, run_id)
     decided = with_decisions(items, decisions.latest(run_id))
+    latest_locks = decisions.latest_locks(run_id)
     twist_apply = AnalysisOptions.from_json(run["options"]).twist_apply
     return DecisionsOut.model_validate(
         {
@@ -130,6 +139,15 @@ def list_decisions(run: DoneRunDep, services: ServicesDep, decisions: DecisionsD
             "intervals": decided if item == "interval" else [],
             "swaps": decided if item == "swap" else [],
             "history": [_out(r, item) for r in decisions.history(run_id)],
+            "locks": [
+                {
+                    **lock,
+                    "decision": latest_locks.get(str(lock["id"])),
+                    "applied": latest_locks.get(str(lock["id"])) == "accept",
+                }
+                for lock in locks
+            ],
+            "lock_history": [_lock_out(r) for r in decisions.history(run_id, "lock")],
         }
     )
 
@@ -156,6 +174,38 @@ def add_swap_decision(
     return _decide(review, "swap", swap_id, body)
 
 
+@router.post("/feet/{lock_id}/decisions", **_DECISION_POST)
+def add_lock_decision(
+    review: ReviewDep,
+    lock_id: Annotated[str, Path(min_length=1, max_length=64)],
+    body: DecisionIn,
+) -> LockDecisionOut:
+    """Accept or reject the foot lock of one skate finding of the run (its ``id`` in the run's
+    findings, ``skate-left-120``), kept as the interval decisions are. Cleanup is off by
+    default: the decided download locks the accepted ones only. 409 for a run without the
+    feet check."""
+    run_id = str(review.run["id"])
+    locks = run_locks(review.services.files, run_id)
+    if locks is None:
+        raise ConflictError(
+            f"Expected a run with the feet check to decide on foot locks, got run {run_id} "
+            "without it: start a run with 'feet' in checks"
+        )
+    known = [str(lock["id"]) for lock in locks]
+    if lock_id not in known:
+        raise NotFoundError(
+            f"Expected the id of a skate finding of run {run_id} ({len(known)} foot lock(s)"
+            f"{': ' + ', '.join(known[:6]) if known else ''}), got {lock_id!r}"
+        )
+    request, principal = review.request, review.principal
+    address = client_address(request)
+    row = review.decisions.add_lock(
+        run_id, lock_id, body.decision, body.note, principal.name, address
+    )
+    audit(request, principal, "decision", run_id, f"lock {lock_id}: {body.decision}")
+    return _lock_out(row)
+
+
 @router.get(
     "/decisions/bvh",
     response_class=Response,
@@ -163,9 +213,18 @@ def add_swap_decision(
 )
 def download_decided(run: DoneRunDep, services: ServicesDep, decisions: DecisionsDep) -> Response:
     """The raw take with exactly the accepted corrections, as BVH: the levels of accepted
-    intervals removed; an undecided interval follows the run's ``twist_apply`` choice. No
-    motion filter is applied."""
+    intervals removed (an undecided interval follows the run's ``twist_apply`` choice), then
+    the accepted foot locks solved on the legs (an undecided lock is not applied). No motion
+    filter is applied."""
     return _decided_download(run, services, decisions, _decided_bvh, "bvh")
+
+
+Content = Callable[
+    [FileStore, dict[str, Any], dict[str, Any], dict[int, str], ReadLimits | None, dict[str, str]],
+    bytes,
+]
+"""A decided take's bytes from the run's files, the run, its take, the newest decisions on its
+corrections, the reading limits and the newest decisions on its foot locks."""
 
 
 def _decided_bvh(
@@ -174,8 +233,9 @@ def _decided_bvh(
     take: dict[str, Any],
     latest: dict[int, str],
     limits: ReadLimits | None,
+    locks: dict[str, str],
 ) -> bytes:
-    return decided_bvh(decided_motion(files, run, take, latest, limits))
+    return decided_bvh(decided_motion(files, run, take, latest, limits, locks))
 
 
 @router.get(
@@ -188,31 +248,50 @@ def download_decided_c3d(
 ) -> Response:
     """The C3D of a marker take with exactly the accepted swaps repaired (an undecided swap
     follows the run's ``applied``), then its gaps filled by the run's rule (the confident
-    fills), as the run's ``corrected.c3d`` is written. No filter."""
+    fills), as the run's ``corrected.c3d`` is written, then the accepted foot locks pinned
+    (an undecided lock is not applied). No filter."""
     return _decided_download(run, services, decisions, decided_c3d, "c3d")
 
 
-_MEDIA_TYPES = {"bvh": "text/plain", "c3d": "application/octet-stream"}
+@router.get(
+    "/decisions/trc",
+    response_class=Response,
+    responses={200: {"content": {"text/plain": {}}}, **responses(401, 404, 409)},
+)
+def download_decided_trc(
+    run: DoneRunDep, services: ServicesDep, decisions: DecisionsDep
+) -> Response:
+    """The TRC of a marker take (a TRC take, or a C3D take for OpenSim) decided as the C3D is:
+    the accepted swaps repaired (an undecided swap follows the run's ``applied``), its gaps
+    filled by the run's rule, the accepted foot locks pinned; the take's rate, unit, marker
+    names and frame numbers. TRC has no residual: the run's ``gap`` findings list the filled
+    samples; a sample still missing is ``NaN``. 409 for a motion or keypoint take. No
+    filter."""
+    return _decided_download(run, services, decisions, decided_trc, "trc")
+
+
+_MEDIA_TYPES = {"bvh": "text/plain", "c3d": "application/octet-stream", "trc": "text/plain"}
 
 
 def _decided_download(
     run: dict[str, Any],
     services: Services,
     decisions: IntervalDecisions,
-    content: Callable[
-        [FileStore, dict[str, Any], dict[str, Any], dict[int, str], ReadLimits | None], bytes
-    ],
-    suffix: Literal["bvh", "c3d"],
+    content: Content,
+    suffix: Literal["bvh", "c3d", "trc"],
 ) -> Response:
     """The decided take of a run as an attachment ``<take>.decided.<suffix>``: ``content``
-    of the run's files, the run, its take, the newest decisions and the reading limits."""
+    of the run's files, the run, its take, the newest decisions, the reading limits and the
+    newest lock decisions."""
     take = services.repository.get_take(str(run["take_id"]))
+    run_id = str(run["id"])
     data = content(
         services.files,
         run,
         take,
-        decisions.latest(str(run["id"])),
+        decisions.latest(run_id),
         services.settings.read_limits,
+        decisions.latest_locks(run_id),
     )
     return Response(
         data,

@@ -1,0 +1,74 @@
+// Foot locks in the findings table: each skate finding of the feet step has a lock (the foot
+// held where it stands during the contact) a reviewer accepts or rejects like a twist interval.
+// Cleanup is off by default: the reviewed download locks the accepted ones only. Pure helpers
+// of decisions.js (unit-tested).
+
+/** The finding kind whose rows carry a foot lock. */
+export const LOCK_KIND = "skate";
+
+/** The run's foot locks: its skate findings that have an id (`skate-left-120`), in findings order. */
+export function decidableLocks(result) {
+  return (result.findings || []).filter((f) => f.kind === LOCK_KIND && typeof f.id === "string" && f.id);
+}
+
+/** How a lock is named in the history and the messages. */
+export function lockLabel(lock) {
+  return `${lock.foot} foot lock frames ${lock.start_frame}–${lock.end_frame}`;
+}
+
+/** The formats of the run's reviewed download, the take's own first: ["bvh"] for a motion
+ * take; for a marker take whose markers check ran, ["c3d", "trc"] for a C3D take (the run wrote
+ * a corrected C3D of it; TRC for OpenSim) and ["trc"] for a TRC take (`take.format`); none for
+ * other keypoint takes. */
+export function reviewedFormats(result, take = null) {
+  if (result.kind === "motion") return ["bvh"];
+  if ((result.downloads || []).includes("c3d")) return ["c3d", "trc"];
+  const markers = result.steps && result.steps.markers && result.steps.markers.state === "done";
+  return markers && take && take.format === "trc" ? ["trc"] : [];
+}
+
+/** The format of the run's first reviewed download (reviewedFormats), or null when it has none. */
+export function reviewedFormat(result, take = null) {
+  return reviewedFormats(result, take)[0] || null;
+}
+
+/** The reviewed download links of `formats` (reviewedFormats), the first one's id
+ * `download-decided`, the others' `download-decided-<format>`; `named` is the format a link
+ * names (a marker take's: "c3d" or "trc"), null for BVH. */
+export function decidedLinks(formats) {
+  return formats.map((format, k) => ({ format, id: k ? `download-decided-${format}` : "download-decided", named: format === "bvh" ? null : format }));
+}
+
+/** How many of the newest decisions (`latest`: id -> "accept" | "reject") accept. */
+export function acceptedCount(latest) {
+  let n = 0;
+  for (const decision of latest.values()) if (decision === "accept") n += 1;
+  return n;
+}
+
+/** The reviewed download link's text: its format when a marker take has it named (`format`,
+ * "c3d" or "trc"; null for BVH), and how many foot locks it applies, when the run has any. */
+export function downloadText(nLocks, accepted, format = null) {
+  const base = format ? `Download reviewed take as ${format.toUpperCase()}` : "Download reviewed take";
+  if (!nLocks) return base;
+  const locks = accepted === 1 ? "1 foot lock" : `${accepted} foot locks`;
+  return `${base} (${accepted ? locks : "no foot lock"} applied of ${nLocks})`;
+}
+
+/** Both decision histories (twist intervals or swaps, and foot locks) as one list, newest first
+ * (ids grow with time: they are rows of one table). */
+export function mergedHistory(history, lockHistory) {
+  return [...history, ...(lockHistory || [])].sort((a, b) => b.id - a.id);
+}
+
+/** What Y / X act on when it is a foot lock: `{ lock }` (its id), `{ message }` when a skate
+ * row has no lock to decide, or null when the key is not about a foot lock (the focused row, or
+ * without one the last opened finding, is of another kind). `focused` is the focused findings
+ * row's `{ kind, lock }` (its data attributes) or null, `current` the last opened lock's id. */
+export function lockKeyTarget(focused, current, lastKind, ids) {
+  const kind = focused ? focused.kind : lastKind;
+  if (kind !== LOCK_KIND) return null;
+  const id = focused ? focused.lock : current;
+  if (id && ids.has(id)) return { lock: id };
+  return { message: "this skate finding has no foot lock to accept or reject" };
+}

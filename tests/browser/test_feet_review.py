@@ -1,0 +1,104 @@
+"""Accepting and rejecting a foot lock in the take view, on a real BVH walk with a slide
+injected into one contact (tests/api/test_feet_decisions.py): the reviewed download locks the
+accepted foot and leaves everything above the hips as it was."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import httpx
+import numpy as np
+import pytest
+from tests.api.test_feet_decisions import injected_skate, leg_joints, write_slid_walk
+from tests.browser.test_workstation import ARTIFACTS, Page, upload
+
+from mocapqa.core.rig import find_roles
+from mocapqa.io.bvh import parse_bvh
+from mocapqa.kinematics.forward import forward_kinematics
+
+pytestmark = pytest.mark.browser
+
+
+@pytest.fixture
+def page(chromium: Any) -> Iterator[Page]:
+    opened = Page(chromium)
+    yield opened
+    opened.close()
+
+
+def cell(page: Page, lock: str) -> str:
+    return page.page.inner_text(f"#findings tr[data-lock='{lock}'] td.decision")
+
+
+def decided(server: str, run_id: str) -> bytes:
+    response = httpx.get(f"{server}/api/v1/runs/{run_id}/decisions/bvh", timeout=120)
+    response.raise_for_status()
+    return response.content
+
+
+def test_accepting_a_foot_lock_changes_the_foot_and_nothing_above_the_hips(
+    live_server: str, corpus_dir: Path, tmp_path: Path, page: Page
+) -> None:
+    path, foot, start, end = write_slid_walk(corpus_dir, tmp_path)
+    take = upload(live_server, path)
+    skates = [f for f in take["result"]["findings"] if f["kind"] == "skate"]
+    skate = injected_skate(take["result"], foot, start, end)
+    lock, n = skate["id"], len(skates)
+    run_id = take["run"]
+    p = page.page
+    page.open_take(live_server, take)
+    p.wait_for_selector(f"#findings tr[data-lock='{lock}'] button.decide-accept")
+    assert p.locator("#findings tr[data-lock]").count() == n
+    # Undecided: cleanup is off, the run locks nothing and the download applies no lock.
+    assert cell(page, lock).startswith("run: cleanup off")
+    assert "undecided" in cell(page, lock)
+    assert "→ left as recorded" in cell(page, lock)
+    link = p.locator("#download-decided")
+    assert link.inner_text() == f"Download reviewed take (no foot lock applied of {n})"
+    before = decided(live_server, run_id)
+
+    p.click(f"#findings tr[data-lock='{lock}'] button.decide-accept")
+    assert "accepted" in cell(page, lock)
+    assert "→ locked" in cell(page, lock)
+    p.wait_for_function("() => document.getElementById('download-decided').dataset.locks === '1'")
+    assert link.inner_text() == f"Download reviewed take (1 foot lock applied of {n})"
+    p.wait_for_selector("#decision-history li")
+    latest = p.inner_text("#decision-history").splitlines()[0]
+    assert f"{foot} foot lock frames {skate['start_frame']}–{skate['end_frame']}" in latest
+    p.locator(f"#findings tr[data-lock='{lock}']").scroll_into_view_if_needed()
+    ARTIFACTS.mkdir(exist_ok=True)
+    p.locator("#findings").locator("xpath=..").screenshot(
+        path=str(ARTIFACTS / "feet-lock-accepted.png")
+    )
+
+    # The link serves the API's decided take: the foot held, the upper body untouched.
+    with p.expect_download() as download:
+        p.click("#download-decided")
+    served = Path(download.value.path()).read_bytes()
+    assert served == decided(live_server, run_id)
+    assert served != before
+    old, new = parse_bvh(before.decode(), "before.bvh"), parse_bvh(served.decode(), "after.bvh")
+    legs = leg_joints(path)
+    upper = [j for j in range(new.skeleton.n_joints) if j not in legs]
+    old_quats, old_positions = forward_kinematics(old)
+    new_quats, new_positions = forward_kinematics(new)
+    np.testing.assert_array_equal(new_positions[:, upper], old_positions[:, upper])
+    np.testing.assert_array_equal(new_quats[:, upper], old_quats[:, upper])
+    ankle = find_roles(new.skeleton).joint(foot, "foot")
+    assert ankle is not None
+    assert np.abs(new_positions[:, ankle] - old_positions[:, ankle]).max() > 1e-3
+
+    # Undo from the keyboard: focus the lock's row, press X; the download is the one before.
+    p.locator(f"#findings tr[data-lock='{lock}']").focus()
+    p.keyboard.press("x")
+    assert "rejected" in cell(page, lock)
+    p.wait_for_function("() => document.querySelectorAll('#decision-history li').length === 2")
+    assert link.inner_text() == f"Download reviewed take (no foot lock applied of {n})"
+    assert decided(live_server, run_id) == before
+    # After a reload the newest decision is still there (it comes from the server).
+    page.open_take(live_server, take)
+    p.wait_for_selector("#decision-history li")
+    assert "rejected" in cell(page, lock)
+    assert not page.errors, page.errors
