@@ -40,6 +40,8 @@ Conventions
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
@@ -171,40 +173,53 @@ def _merge_overlapping(frames: IntArray, groups: list[list[int]]) -> list[list[i
     return merged
 
 
-def _free_first_release(
-    frames: IntArray,
-    jumps: FloatArray,
-    groups: list[list[int]],
-    threshold: float,
-    closure_fraction: float,
-    max_frames: int,
-) -> list[list[int]]:
-    """Groups with the take's first event freed when it reads better as a release with no
-    onset.
+def _without_end(chain: ChainEvents, groups: list[list[int]], end: int) -> list[list[int]]:
+    """``groups`` read again with event ``end`` (the chain's first or last) left out, when that
+    reading pairs the other events better; else ``groups``.
 
-    Bracket matching pairs the chain's first event A with the next one B whenever their jumps
+    Bracket matching pairs the chain's first event A with a later event B whenever their jumps
     cancel, but near the start A may be the release of an error the take began with and B the
-    onset of another interval. When the first group is exactly A and B, A lies within
-    ``max_frames`` of frame 0, and a later event C that no group holds, before any other group,
-    cancels B (within the closure tolerance) and lies within ``max_frames`` of it, both readings
-    fit the jumps: A–B an interval (and C an unmatched event), or A the release of a head and
-    B–C an interval. An onset and the release of one error read the same jump twice, so the
-    pair that cancels better is taken: B is paired with C, and A left for :func:`one_sided`,
-    only when ``|wrap(B + C)| < |wrap(A + B)|``.
+    onset of another interval, whose own release C is then left unmatched or paired with the
+    next interval's onset, and so on down the chain (each interval read between the release
+    of one error and the onset of the next). Both readings fit the jumps; an onset and the
+    release of one error read the same jump twice. The events are matched again without A
+    (the same rules, so pairs nested between A and B stay), and that reading is taken when it
+    leaves no other event unmatched that the first held, keeps every burst whose flips return
+    (events within ``burst_gap`` of each other whose jumps cancel: a head's release pairs with
+    a level shift's onset, not with one flip of a burst) and its new groups cancel better than the
+    groups it replaces (the sum of their net jumps beyond the chain's jump threshold: nets
+    within it are as good as exact). The same at the take's end, for a
+    tail's onset. The caller keeps it only when the freed event then forms its one-sided
+    interval.
     """
-    if not groups or groups[0] != [0, 1] or frames[0] > max_frames:
+    if not any(end in g for g in groups):
         return groups
-    held = {k for g in groups for k in g}
-    stop = frames[min(groups[1])] if len(groups) > 1 else np.inf
-    for k in range(2, len(frames)):
-        if frames[k] > stop or frames[k] - frames[1] > max_frames:
-            break
-        net = float(wrap_angle(np.array(jumps[1] + jumps[k])))
-        largest = max(abs(float(jumps[1])), abs(float(jumps[k])))
-        if k not in held and _closes(net, largest, threshold, closure_fraction):
-            first = abs(float(wrap_angle(np.array(jumps[0] + jumps[1]))))
-            return [[1, k], *groups[1:]] if abs(net) < first else groups
-    return groups
+    keep = np.flatnonzero(np.arange(len(chain.frames)) != end)
+    rest = replace(
+        chain, frames=chain.frames[keep], jumps=chain.jumps[keep],
+        mismatch=chain.mismatch[keep], sigma=chain.sigma[keep],
+    )  # fmt: skip
+    regrouped = [[int(keep[i]) for i in g] for g in _groups(rest)]
+    held = {k for g in groups for k in g} - {end}
+    settings = chain.settings
+    bursts = [
+        g for g in groups
+        if end not in g and np.any(np.diff(chain.frames[g]) <= settings.burst_gap)
+        and _closes(float(wrap_angle(np.array(np.sum(chain.jumps[g])))),
+                    float(np.max(np.abs(chain.jumps[g]))), settings.threshold,
+                    settings.closure_fraction)
+    ]  # fmt: skip
+    kept = all([h for h in regrouped if set(h) & set(g)] == [g] for g in bursts)
+    if not held <= {k for g in regrouped for k in g} or not kept:
+        return groups
+    old = [g for g in groups if g not in regrouped]
+    new = [g for g in regrouped if g not in groups]
+
+    def residual(chosen: list[list[int]]) -> float:
+        nets = [abs(float(wrap_angle(np.array(np.sum(chain.jumps[g]))))) for g in chosen]
+        return sum(max(net - settings.threshold, 0.0) for net in nets)
+
+    return regrouped if new and residual(new) < residual(old) else groups
 
 
 def _spread(values: FloatArray) -> float:
@@ -316,23 +331,15 @@ def chain_intervals(
 
 
 def _free_ends(chain: ChainEvents, groups: list[list[int]]) -> list[list[int]]:
-    """``groups`` with the first (last) event freed from its pair where it may be a head's
-    release (a tail's onset): re-paired only when it then forms that one-sided interval."""
-    last = len(chain.frames) - 1
-    settings = chain.settings
-    for side in ("head", "tail"):
-        if side == "head":
-            freed = _free_first_release(
-                chain.frames, chain.jumps, groups, settings.threshold, settings.closure_fraction,
-                settings.max_frames,
-            )  # fmt: skip
-        else:
-            backwards = _free_first_release(
-                chain.n_frames - 1 - chain.frames[::-1], -chain.jumps[::-1],
-                [[last - k for k in g[::-1]] for g in groups[::-1]],
-                settings.threshold, settings.closure_fraction, settings.max_frames,
-            )  # fmt: skip
-            freed = [[last - k for k in g[::-1]] for g in backwards[::-1]]
+    """``groups`` with the first (last) event freed from its group where it may be a head's
+    release (a tail's onset, :func:`_without_end`): re-paired only when it then forms that
+    one-sided interval."""
+    for side, end in (("head", 0), ("tail", len(chain.frames) - 1)):
+        if abs(int(chain.frames[end]) - (0 if side == "head" else chain.n_frames)) > (
+            chain.settings.max_frames
+        ):
+            continue
+        freed = _without_end(chain, groups, end)
         if freed != groups and any(e.side == side for e in one_sided(chain, freed)):
             groups = freed
     return groups

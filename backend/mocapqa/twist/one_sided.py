@@ -35,7 +35,8 @@ def one_sided(chain: ChainEvents, groups: list[list[int]]) -> list[IntervalEstim
     onset.
 
     The chain's last event (a *tail*'s onset) or first event (a *head*'s release) qualifies
-    when it belongs to no group, no other event lies within ``burst_gap`` frames of it and it
+    when it belongs to no group, no other event lies within ``burst_gap`` frames of it (the
+    onset and release of a returning level shift, :func:`_explained`, do not count) and it
     lies within ``max_frames`` of the take's end on its side; it gives ``[onset, F − 1]`` at
     level ``jump`` or ``[0, release − 1]`` at ``−jump`` when the parent's level next to it
     (:func:`_held_end`) is within ``agreement`` × |jump| of that level and the child's mirrors
@@ -43,9 +44,10 @@ def one_sided(chain: ChainEvents, groups: list[list[int]]) -> list[IntervalEstim
     burst (:func:`_releases_burst`), an unmatched event cancels it (:func:`_cancels_loose`) or
     its roll steps back where no event was found (:func:`_returned`, ``end_return``). One
     event is weaker evidence than two that cancel, so its jump must also be ``end_contrast``
-    times every raw roll step of the parent within ``burst_gap`` frames (the peak of a fast
-    natural roll the child partly counter-rotates is no onset; the child's own roll beside it
-    is not compared: a hand turning under a still forearm leaves the parent's step a step).
+    times every raw roll step of the parent within ``burst_gap`` frames other than the
+    explained events' (the peak of a fast natural roll the child partly counter-rotates is
+    no onset; the child's own roll beside it is not compared: a hand turning under a still
+    forearm leaves the parent's step a step).
 
     Parameters
     ----------
@@ -70,11 +72,13 @@ def one_sided(chain: ChainEvents, groups: list[list[int]]) -> list[IntervalEstim
     found: list[IntervalEstimate] = []
     grouped = np.zeros(len(frames), dtype=bool)
     grouped[[k for g in groups for k in g]] = True
+    # A returning level shift's onset and release are no burst of the end event's.
+    explained = frames[[k for g in groups if _explained(chain, g) for k in g]]
     taken = -1
     for side, k in (("tail", len(frames) - 1), ("head", 0)):
         frame = int(frames[k])
         reach = n_frames - frame if side == "tail" else frame
-        near = frames[np.abs(frames - frame) <= burst_gap]
+        near = frames[(np.abs(frames - frame) <= burst_gap) & ~np.isin(frames, explained)]
         if k == taken or grouped[k] or len(near) > 1 or reach > max_frames:
             continue
         # The anchor on the event's natural side, moved past the other intervals and events.
@@ -82,7 +86,8 @@ def one_sided(chain: ChainEvents, groups: list[list[int]]) -> list[IntervalEstim
         before, after = anchors(forbidden, frame, frame)
         jump = float(jumps[k])
         if (
-            abs(jump) < settings.end_contrast * _largest_step_beside(parent[0], frame, burst_gap)
+            abs(jump)
+            < settings.end_contrast * _largest_step_beside(parent[0], frame, burst_gap, explained)
             or _releases_burst(
                 frames, jumps, k, side, burst_gap, max_frames, settings.closure_fraction
             )
@@ -105,6 +110,19 @@ def one_sided(chain: ChainEvents, groups: list[list[int]]) -> list[IntervalEstim
         features = _features(chain, k, gap, level, stretch.stop - stretch.start)
         found.append(IntervalEstimate(stretch.start, stretch.stop - 1, level, features, side))
     return found
+
+
+def _explained(chain: ChainEvents, group: list[int]) -> bool:
+    """Whether a group of events is a level shift that returns: no two of its events within
+    ``burst_gap`` frames of each other, its jumps cancelling (within ``max(threshold,
+    closure_fraction × largest)``). Its events are then its onset and release, not steps of a
+    burst that an end event next to them would belong to."""
+    jumps, settings = chain.jumps[group], chain.settings
+    net = abs(float(wrap_angle(np.array(np.sum(jumps)))))
+    spread = bool(np.all(np.diff(chain.frames[group]) > settings.burst_gap))
+    return spread and net <= max(
+        settings.threshold, settings.closure_fraction * float(np.max(np.abs(jumps)))
+    )
 
 
 def _held_level(roll: FloatArray, natural: FloatArray, stretch: slice, reference: slice) -> float:
@@ -208,12 +226,16 @@ def _next_events(frames: IntArray, frame: int, max_frames: int) -> tuple[int, in
     return max(bounds[0], frame - max_frames), min(bounds[1], frame + max_frames)
 
 
-def _largest_step_beside(roll: FloatArray, frame: int, burst_gap: int) -> float:
-    """The largest raw roll step within ``burst_gap`` frames of ``frame`` (its own step left
-    out), radians; 0 when there is none."""
+def _largest_step_beside(
+    roll: FloatArray, frame: int, burst_gap: int, explained: IntArray | None = None
+) -> float:
+    """The largest raw roll step within ``burst_gap`` frames of ``frame`` (its own step and
+    those of the ``explained`` event frames left out), radians; 0 when there is none."""
     n_frames = len(roll)
     beside = np.r_[max(frame - burst_gap, 1) : frame, frame + 1 : min(frame + burst_gap + 1,
                                                                         n_frames)]  # fmt: skip
+    if explained is not None:
+        beside = beside[~np.isin(beside, explained)]
     steps = np.abs(wrap_angle(roll[beside] - roll[beside - 1]))
     return float(np.max(steps, initial=0.0))
 

@@ -183,12 +183,7 @@ def _print_robust_kinds(bench: _Bench, levels: Any) -> list[Any]:
     clusters = bench.run(ROBUST, kind="cluster").methods
     console.print("Clusters of separate flips and holds (injected, kind=cluster):")
     console.print(rates_table(clusters))
-    console.print(
-        ends_table([
-            (where, apply_choice, bench.run(ROBUST, apply_choice, ends=where).methods["robust"])
-            for where in ("tail", "head") for apply_choice in ("confident", "all")
-        ])
-    )  # fmt: skip
+    _print_ends(bench)
     kinds = (
         ("level shifts", levels.records),
         ("bursts", bursts["robust"].records),
@@ -199,6 +194,17 @@ def _print_robust_kinds(bench: _Bench, levels: Any) -> list[Any]:
     disagreements = disagreement_loro([*levels.records, *bursts["robust"].records])
     console.print(disagreement_table(disagreements))
     return [r for _, records in kinds for r in records]
+
+
+def _print_ends(bench: _Bench) -> None:
+    """Only the table of errors at the take's ends (tail and head injections, ``apply``
+    confident and all; per rig on the held-out takes, then all held-out and all fit takes)."""
+    bench.console.print(
+        ends_table([
+            (where, apply_choice, bench.run(ROBUST, apply_choice, ends=where).methods["robust"])
+            for where in ("tail", "head") for apply_choice in ("confident", "all")
+        ])
+    )  # fmt: skip
 
 
 def _print_unpaired(bench: _Bench, injected: list[Any]) -> None:
@@ -289,16 +295,19 @@ def _only(
     natural_roll: Path | None,
     calibration: Path | None,
     reviewers: bool,
+    ends_only: bool = False,
 ) -> bool:
     """Run the one task a stopping option asks for (``--fit-natural-roll``,
-    ``--fit-calibration``, ``--reviewers``, in that order); whether one did."""
+    ``--fit-calibration``, ``--reviewers``, ``--ends-only``, in that order); whether one did."""
     if natural_roll is not None:
         _fit_natural_roll(bench, natural_roll)
     elif calibration is not None:
         _fit_calibration(bench, calibration)
     elif reviewers:
         _print_reviewers(data_dir, bench)
-    return natural_roll is not None or calibration is not None or reviewers
+    elif ends_only:
+        _print_ends(bench)
+    return natural_roll is not None or calibration is not None or reviewers or ends_only
 
 
 @bench_app.command("twist")
@@ -337,6 +346,9 @@ def bench_twist(
             help="Only the leave-one-take-out figures of learning from reviewers' decisions."
         ),
     ] = False,
+    ends_only: Annotated[
+        bool, typer.Option(help="Only the table of errors at the take's ends (fit and held-out).")
+    ] = False,
 ) -> None:
     """The paper's Tables 1 and 2 with bootstrap intervals, real-error, clean-take,
     calibration and (optionally) leave-one-rig-out figures, and the speed."""
@@ -348,7 +360,7 @@ def bench_twist(
     data_dir = data if data is not None else _default_corpus()
     console = Console(highlight=False, width=max(Console().width, 170))
     bench = _Bench(find_bench_files(data_dir, files), seed, repeats, console)
-    if _only(bench, data_dir, fit_natural_roll, fit_calibration, reviewers):
+    if _only(bench, data_dir, fit_natural_roll, fit_calibration, reviewers, ends_only):
         return
     methods: dict[str, tuple[str, Any]] = {m: (m, None) for m in methods_chosen}
     if ablation:
