@@ -32,7 +32,7 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray
 from mocapqa.errors import InputError, ParseError
-from mocapqa.io.c3d import check_for_ezc3d, inspect_c3d
+from mocapqa.io.c3d_layout import check_for_ezc3d, inspect_c3d
 
 __all__ = ["ForcePlate", "ForcePlates", "read_force_plates"]
 
