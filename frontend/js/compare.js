@@ -32,11 +32,11 @@ export async function compareView(main, params, onTeardown = () => {}) {
 
 /** Every run of every take (up to 500 takes), as [run id, label] choices. */
 async function runChoices() {
-  const page = await api.listTakes({ limit: 500 });
+  const [page, described] = await Promise.all([api.listTakes({ limit: 500 }), api.getRunOptions()]);
   const takes = await Promise.all(page.items.map((t) => api.getTake(t.id)));
   const options = [];
   takes.forEach((take, k) => take.runs.forEach((r, i) => options.push([r.id,
-    `${page.items[k].name} (${String(take.id).slice(0, 6)}) · run ${i + 1} (${r.status}) · ${runOptionsLabel(r)}`])));
+    `${page.items[k].name} (${String(take.id).slice(0, 6)}) · run ${i + 1} (${r.status}) · ${runOptionsLabel(r, described)}`])));
   return options;
 }
 

@@ -1,4 +1,5 @@
 // Pure formatting and ordering helpers shared by the views (no DOM).
+import { optionDefaults } from "./run-options.js";
 
 export const fmt = (v, digits = 1) => (v == null || Number.isNaN(v) ? "–" : Number(v).toFixed(digits));
 
@@ -41,11 +42,12 @@ export function stepsRan(run) {
 }
 
 /** What tells two runs of a take apart in a list: the steps that ran, the twist choice when it
- * is not the default, the filter ("twist+limits · apply all · quat-pd"). */
-export function runOptionsLabel(run) {
+ * is not its default in `described` (GET /run-options), the filter ("twist+limits · apply all ·
+ * quat-pd"). */
+export function runOptionsLabel(run, described) {
   const parts = [stepsRan(run)];
   const apply = run.options && run.options.twist_apply;
-  if (apply && apply !== "confident") parts.push(`apply ${apply}`);
+  if (apply && apply !== optionDefaults(described).twist_apply) parts.push(`apply ${apply}`);
   if (run.options && run.options.filter_method) parts.push(run.options.filter_method);
   return parts.filter(Boolean).join(" · ");
 }

@@ -4,8 +4,8 @@
 // named presets, and the values checked in the page before anything is sent.
 import * as api from "./api.js";
 import { h } from "./dom.js";
-import { checksFor } from "./format.js";
-import { formOptions, paramLabel, usablePresets } from "./run-options.js";
+import { checksFor, takeChecksKind } from "./format.js";
+import { formOptions, paramLabel, takeFilters, usablePresets } from "./run-options.js";
 
 const SHOWN_PARAMS = 4; // filter parameters shown before "more parameters"
 
@@ -60,18 +60,18 @@ function paramRow(p, given) {
   return h("label", { class: "option-field", title: p.name }, h("span", { class: "option-name" }, paramLabel(p.name)), input, unitText(p.unit));
 }
 
-// The filter: its method (the registry's filters for this kind of take), the filter's presets and
-// its parameters (with units; past the first few, folded), refilled when the method changes.
-function filterControls(take, run, filters) {
-  const target = take.kind === "motion" ? "rotations" : "keypoints";
-  const usable = filters.filter((f) => f.applies_to.includes(target));
-  const method = h("select", { id: "filter-method", "aria-label": "filter" }, h("option", { value: "" }, take.kind === "motion" ? "no filter" : "adaptive (default)"),
+// The filter: its method (the registry's filters for this kind of take, and the one run when none
+// is chosen, as GET /run-options serves them), the filter's presets and its parameters (with
+// units; past the first few, folded), refilled when the method changes.
+function filterControls(take, run, filters, described) {
+  const { usable, fallback } = takeFilters(takeChecksKind(take, described), described, filters);
+  const method = h("select", { id: "filter-method", "aria-label": "filter" }, h("option", { value: "" }, fallback ? `${fallback} (default)` : "no filter"),
     usable.map((f) => h("option", { value: f.name, selected: f.name === run.options.filter_method }, f.label)));
   const preset = h("select", { id: "filter-preset", "aria-label": "filter preset" });
   const params = h("div", { id: "filter-params", class: "option-fields" });
   let paramFields = [];
   const fill = () => {
-    const entry = usable.find((f) => f.name === method.value) || (take.kind === "keypoints" ? usable.find((f) => f.name === "adaptive") : null);
+    const entry = usable.find((f) => f.name === (method.value || fallback)) || null;
     preset.replaceChildren(...(entry ? entry.presets : []).map((p) => h("option", { value: p, selected: p === run.options.filter_preset }, p)));
     paramFields = entry ? entry.parameters : [];
     const given = method.value === (run.options.filter_method || "") ? run.options.filter_params || {} : {};
@@ -171,7 +171,7 @@ export function rerunPanel(take, run, filters, described, context = {}) {
   const fields = Object.fromEntries(described.groups.flatMap((g) => g.fields).map((f) => [f.name, f]));
   const joints = (take.reading && take.reading.joints) || [];
   const form = {
-    run, available, filter: filterControls(take, run, filters),
+    run, available, filter: filterControls(take, run, filters, described),
     inputs: {}, // option name -> its control
     checks: {}, // check name -> its box
     roles: take.kind === "motion" && context.summary && joints.length && described.role_keys

@@ -76,5 +76,21 @@ export function formOptions(values, fields) {
   return errors.length ? { errors } : { options };
 }
 
+/** The served default of every run-option field, by name (the fields of GET /run-options'
+ * `groups`), e.g. {twist_apply: ..., max_points: ...}. */
+export const optionDefaults = (described) =>
+  Object.fromEntries(described.groups.flatMap((g) => g.fields).map((f) => [f.name, f.default]));
+
+/**
+ * The filters of the registry (GET /filters) a take of `kind` (a key of GET /run-options
+ * `take_checks`: "motion", "markers" or "keypoints") can run, and the name of the one its run
+ * uses when none is chosen (null: no filter), as GET /run-options serves them in `take_filters`
+ * ({target: what the filters must apply to, default}).
+ */
+export function takeFilters(kind, described, filters) {
+  const { target, default: fallback } = described.take_filters[kind];
+  return { usable: filters.filter((f) => f.applies_to.includes(target)), fallback };
+}
+
 /** A parameter's label: its dotted name made readable ("kalman.process_noise" → "kalman · process noise"). */
 export const paramLabel = (name) => name.split(".").map((part) => part.replace(/_/g, " ")).join(" · ");

@@ -88,12 +88,13 @@ export function uncheckedNote(steps) {
     unchecked.some(([, st]) => st.state === "no_roles") ? " — name the rig's joints in \u201cRig roles (mapping)\u201d below and re-run." : "");
 }
 
-/** The run list; another run opens at the frame shown now (`frameNow()`), as a reviewer
+/** The run list, each run labelled by what differs from the defaults of `described` (GET
+ * /run-options); another run opens at the frame shown now (`frameNow()`), as a reviewer
  * comparing runs expects, rather than at frame 0. */
-export function runPicker(take, run, frameNow) {
+export function runPicker(take, run, frameNow, described) {
   const select = h("select", { id: "run-pick", "aria-label": "run", onchange: (e) => { location.hash = `${api.takeLink(take.id, e.target.value)}&frame=${frameNow()}`; } },
     take.runs.map((r, i) => h("option", { value: r.id, selected: r.id === run.id },
-      `run ${i + 1} · ${r.status} · ${runOptionsLabel(r)}`)));
+      `run ${i + 1} · ${r.status} · ${runOptionsLabel(r, described)}`)));
   return h("div", { class: "controls" }, "Run ", select,
     run.server_time_s != null ? h("span", { class: "muted" }, `server time ${fmt(run.server_time_s, 2)} s`) : null,
     h("a", { href: `#/compare?a=${run.id}` }, "compare…"));

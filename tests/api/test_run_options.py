@@ -79,6 +79,19 @@ def served_fields(client: TestClient) -> dict[str, dict[str, Any]]:
     return {f["name"]: f for group in body["groups"] for f in group["fields"]}
 
 
+def test_the_api_serves_each_take_kinds_filters_and_default(client: TestClient) -> None:
+    body = client.get("/api/v1/run-options").json()
+    assert body["take_filters"] == {
+        "motion": {"target": "rotations", "default": None},
+        "markers": {"target": "keypoints", "default": "adaptive"},
+        "keypoints": {"target": "keypoints", "default": "adaptive"},
+    }
+    registry = {f["name"]: f for f in client.get("/api/v1/filters").json()}
+    for served in body["take_filters"].values():
+        default = served["default"]
+        assert default is None or served["target"] in registry[default]["applies_to"]
+
+
 def test_the_api_serves_the_form(client: TestClient) -> None:
     served = client.get("/api/v1/run-options")
     assert served.status_code == 200

@@ -73,7 +73,8 @@ test("the options diff lists only what differs, as readable values", () => {
 test("runOptionsLabel tells two runs of a take apart by what differs", () => {
   const done = (options, steps) => ({ status: "done", options, summary: { steps } });
   const ran = { twist: "done", limits: "done", filter: "skipped" };
-  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "confident" }, ran)), "twist+limits");
-  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "all" }, ran)), "twist+limits · apply all");
-  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits", "filter"], twist_apply: "none", filter_method: "quat-pd" }, { ...ran, filter: "done" })), "twist+limits+filter · apply none · quat-pd");
+  const described = { groups: [{ name: "twist", fields: [{ name: "twist_apply", type: "choice", default: "confident" }] }] };
+  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "confident" }, ran), described), "twist+limits");
+  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "all" }, ran), described), "twist+limits · apply all");
+  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits", "filter"], twist_apply: "none", filter_method: "quat-pd" }, { ...ran, filter: "done" }), described), "twist+limits+filter · apply none · quat-pd");
 });

@@ -237,11 +237,13 @@ class FilterInfo(BaseModel):
 
 class RunOptionsInfo(BaseModel):
     """The run options for the UI form: fields grouped by check, the checks each kind of take
-    can run (``motion``, ``markers``: a take of one of ``marker_formats``, ``keypoints``),
-    named presets, and the rig role keys a ``mapping`` may name."""
+    can run (``motion``, ``markers``: a take of one of ``marker_formats``, ``keypoints``) and
+    the filters (``target`` as ``GET /filters`` names it, ``default`` the filter run when none
+    is chosen), named presets, and the rig role keys a ``mapping`` may name."""
 
     checks: list[str]
     take_checks: dict[str, list[str]]
+    take_filters: dict[str, dict[str, str | None]]
     marker_formats: list[str]
     groups: list[dict[str, Any]]
     presets: dict[str, dict[str, Any]]

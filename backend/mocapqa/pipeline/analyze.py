@@ -37,7 +37,7 @@ from mocapqa.pipeline.feet_step import run_feet
 from mocapqa.pipeline.frames import motion_pose, rigid_bones
 from mocapqa.pipeline.loading import Take
 from mocapqa.pipeline.marker_step import run_markers
-from mocapqa.pipeline.options import AnalysisOptions, take_checks
+from mocapqa.pipeline.options import DEFAULT_KEYPOINT_FILTER, AnalysisOptions, take_checks
 from mocapqa.pipeline.step_log import StepLog, requested
 from mocapqa.pipeline.steps import (
     StepOutcome,
@@ -311,7 +311,7 @@ def _keypoint_filter(
     progress(30, "filtering keypoints")
     outcome = run_filter_keypoints(
         corrected,
-        options.filter_method or "adaptive",
+        options.filter_method or DEFAULT_KEYPOINT_FILTER,
         options.filter_preset,
         options.filter_params,
     )

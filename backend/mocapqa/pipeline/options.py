@@ -41,6 +41,7 @@ from mocapqa.twist.choice import APPLY_CHOICES
 
 __all__ = [
     "CHECKS",
+    "DEFAULT_KEYPOINT_FILTER",
     "DEFAULT_OPTIONS",
     "FORM_GROUPS",
     "MARKER_FORMATS",
@@ -57,6 +58,7 @@ __all__ = [
     "describe_options",
     "option_fields",
     "take_checks",
+    "take_filter",
 ]
 
 ParamValue = float | int | bool | str
@@ -78,6 +80,20 @@ def take_checks(kind: str, source_format: str | None = None) -> tuple[Check, ...
     if source_format in MARKER_FORMATS:
         return ("markers", "feet", "filter")
     return ("feet", "filter")
+
+
+DEFAULT_KEYPOINT_FILTER = "adaptive"
+"""The filter a keypoint take's run uses when none is chosen (a motion take's uses none)."""
+
+
+def take_filter(kind: str) -> dict[str, str | None]:
+    """The filters a take of ``kind`` ("motion" or "keypoints") can run and the one its run
+    uses when none is chosen: ``target`` as the filter registry names what a filter applies to
+    (``"rotations"``, a motion take's joint rotations; ``"keypoints"``), ``default`` the
+    registry's name of the filter (:data:`DEFAULT_KEYPOINT_FILTER`), None for no filter."""
+    if kind == "motion":
+        return {"target": "rotations", "default": None}
+    return {"target": "keypoints", "default": DEFAULT_KEYPOINT_FILTER}
 
 
 TwistMethod = Method
@@ -257,7 +273,7 @@ class AnalysisOptions:
             if checked is not value:
                 object.__setattr__(self, declared.name, checked)
         check_filter_params(
-            self.filter_method or "adaptive", self.filter_preset, self.filter_params
+            self.filter_method or DEFAULT_KEYPOINT_FILTER, self.filter_preset, self.filter_params
         )
 
     def check_take_kind(self, kind: str, fps: float | None = None) -> None:
@@ -451,6 +467,13 @@ def _take_kinds() -> dict[str, list[str]]:
     }
 
 
+def _take_filters() -> dict[str, dict[str, str | None]]:
+    """The filters each kind of take can run and its default (:func:`take_filter`), by the
+    kinds of :func:`_take_kinds`."""
+    return {"motion": take_filter("motion"), "markers": take_filter("keypoints"),
+            "keypoints": take_filter("keypoints")}  # fmt: skip
+
+
 def describe_options(cls: type[AnalysisOptions] = AnalysisOptions) -> dict[str, Any]:
     """The run options for a form: fields grouped by check, with types, units, choices, bounds,
     defaults, help and the check each field belongs to, :data:`RUN_PRESETS` as JSON options,
@@ -465,6 +488,7 @@ def describe_options(cls: type[AnalysisOptions] = AnalysisOptions) -> dict[str, 
     return {
         "checks": list(CHECKS),
         "take_checks": _take_kinds(),
+        "take_filters": _take_filters(),
         "marker_formats": list(MARKER_FORMATS),
         "groups": _form_groups(option_fields(cls)),
         "presets": {name: options.request_json() for name, options in RUN_PRESETS.items()},
