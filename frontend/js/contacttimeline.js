@@ -1,8 +1,11 @@
 // The foot contact timeline under the time bar of a take the feet step checked: two rows (left
 // and right foot), one bar per contact, the feet findings (skate, penetration, floating, jitter)
-// marked over them. A click on a bar or a mark jumps to its first frame. `contactRows` is pure
+// marked over them, and under each row the foot locks of its skate findings, drawn by their
+// newest decision (lock-events.js keeps them in step with the findings table). A click on a bar
+// or a mark jumps to its first frame. `contactRows`, `lockMarks` and `lockStyle` are pure
 // (unit-tested).
 import { h } from "./dom.js";
+import { onLockDecisions } from "./lock-events.js";
 import { spanOf } from "./timebar.js";
 
 /** Colours of the feet step's findings (the time bar's marks, the contact timeline's marks). */
@@ -14,6 +17,63 @@ export const FEET_COLORS = {
 };
 
 const FEET = ["left", "right"];
+
+/** What each decision of a foot lock means for the reviewed download, as its mark's title says. */
+const LOCK_STATES = {
+  accept: "accepted: the reviewed download locks it",
+  reject: "rejected: left as recorded",
+  undecided: "undecided: left as recorded",
+};
+const LOCK_COLOR = "#1e8449"; // an accepted lock: solid; a rejected one: hatched and dim
+
+/**
+ * The inline style of a foot lock's mark by its newest decision: an accepted lock solid, a
+ * rejected one hatched and dim, an undecided one an outline.
+ *
+ * @param decision "accept", "reject", or null / undefined for undecided
+ * @returns {{background: string, border: string, opacity: string}} CSS values
+ */
+export function lockStyle(decision) {
+  if (decision === "accept") return { background: LOCK_COLOR, border: `1px solid ${LOCK_COLOR}`, opacity: "1" };
+  if (decision === "reject") return { background: "repeating-linear-gradient(135deg, #95a5a6 0 2px, transparent 2px 5px)", border: "1px dashed #95a5a6", opacity: "0.6" };
+  return { background: "transparent", border: `1px solid ${LOCK_COLOR}`, opacity: "1" };
+}
+
+/**
+ * The foot locks of a foot's row: one per skate finding with an id, over the frames the lock
+ * holds the foot (as `mocapqa feet fix` chooses them: the first contact of that foot the
+ * finding overlaps, else the finding's own frames).
+ *
+ * @param contacts  the run's `series.feet.contacts`: [{foot, start, end}], frames inclusive
+ * @param findings  the run's findings; the skate ones with a string `id` have a lock
+ * @param foot      "left" or "right"
+ * @param nFrames   frames in the take
+ * @param decisions lock id -> "accept" | "reject" (newest; absent ids are undecided)
+ * @returns [{id, foot, start, end, left, width, decision, style, label}] by start frame; `left`,
+ *   `width` in % of the row, `decision` "accept" | "reject" | "undecided", `style` lockStyle(…)
+ */
+export function lockMarks(contacts, findings, foot, nFrames, decisions = {}) {
+  return findings.filter((f) => f.kind === "skate" && f.foot === foot && typeof f.id === "string" && f.id)
+    .map((f) => {
+      const contact = contacts.find((c) => c.foot === foot && c.start <= f.end_frame && c.end >= f.start_frame);
+      const [start, end] = contact ? [contact.start, contact.end] : [f.start_frame, f.end_frame];
+      const [left, width] = spanOf(start, end, nFrames);
+      return decidedLock({ id: f.id, foot, start, end, left, width }, decisions[f.id]);
+    })
+    .sort((a, b) => a.start - b.start);
+}
+
+/**
+ * A lock mark (lockMarks) drawn by `decision`: its `decision`, `style` and `label` set.
+ *
+ * @param lock     {id, foot, start, end, left, width, …}
+ * @param decision "accept", "reject", or null / undefined for undecided
+ */
+export function decidedLock(lock, decision) {
+  const state = decision === "accept" || decision === "reject" ? decision : "undecided";
+  return { ...lock, decision: state, style: lockStyle(decision),
+    label: `${lock.foot} foot lock · frames ${lock.start}–${lock.end} · ${LOCK_STATES[state]}` };
+}
 
 /**
  * The rows of the contact timeline.
@@ -41,7 +101,23 @@ export function contactRows(contacts, findings, nFrames) {
         return { kind: f.kind, start: f.start_frame, end: f.end_frame, left, width, color: FEET_COLORS[f.kind], label: `${foot} foot · ${f.kind} · frames ${f.start_frame}–${f.end_frame}${size}` };
       })
       .sort((a, b) => a.start - b.start);
-    return { foot, contacts: bars.length, findings: marks.length, bars, marks };
+    return { foot, contacts: bars.length, findings: marks.length, bars, marks, locks: lockMarks(contacts, findings, foot, nFrames) };
+  });
+}
+
+/** Give a lock's mark the look and title of its decision. */
+function styleLock(el, lock) {
+  Object.assign(el.style, lock.style);
+  el.dataset.decision = lock.decision;
+  el.title = lock.label;
+}
+
+/** The legend's keys of the foot locks (only when the take has any). */
+function lockLegend() {
+  return ["accept", "reject", null].flatMap((d) => {
+    const key = h("span", { class: "ct-key" });
+    Object.assign(key.style, lockStyle(d), { height: "5px" });
+    return [key, ` lock ${d ? LOCK_STATES[d].split(":")[0] : "undecided"} `];
   });
 }
 
@@ -54,6 +130,7 @@ export function contactRows(contacts, findings, nFrames) {
  */
 export function createContactTimeline(rows, nFrames, onJump) {
   const cursors = [];
+  const locks = new Map(); // lock id -> [its mark, its data]
   const place = (el, item) => {
     el.style.left = `${item.left}%`;
     el.style.width = `${item.width}%`;
@@ -70,7 +147,16 @@ export function createContactTimeline(rows, nFrames, onJump) {
     const cursor = h("div", { class: "ct-cursor" });
     cursors.push(cursor);
     const track = h("div", { class: "ct-track" }, bars, marks, cursor);
-    return h("div", { class: "ct-row", "data-foot": row.foot }, h("span", { class: "ct-name" }, `${row.foot} foot`), track);
+    const lockEls = (row.locks || []).map((lock) => {
+      const el = place(h("div", { class: "ct-lock", "data-lock": lock.id, "data-start": lock.start, "data-end": lock.end }), lock);
+      Object.assign(el.style, { position: "absolute", top: "0", bottom: "0", minWidth: "3px", boxSizing: "border-box", cursor: "pointer" });
+      styleLock(el, lock);
+      locks.set(lock.id, [el, lock]);
+      return el;
+    });
+    const lane = lockEls.length ? h("div", { class: "ct-locks", "aria-label": `${row.foot} foot locks` }, lockEls) : "";
+    if (lane) Object.assign(lane.style, { position: "relative", height: "6px", marginTop: "1px" });
+    return h("div", { class: "ct-row", "data-foot": row.foot }, h("span", { class: "ct-name" }, `${row.foot} foot`), track, lane);
   };
   const legend = h("p", { class: "muted ct-legend" }, h("span", { class: "ct-key ct-bar-key" }), " contact (foot planted) · ",
     Object.entries(FEET_COLORS).flatMap(([kind, color]) => {
@@ -79,8 +165,16 @@ export function createContactTimeline(rows, nFrames, onJump) {
       return [key, ` ${kind} `];
     }), "· click to go to it");
   const el = h("div", { class: "contact-timeline", id: "contact-timeline", role: "group", "aria-label": "foot contacts" }, rows.map(rowEl), legend);
+  if (locks.size) legend.append(h("br"), ...lockLegend());
+  /** Draw each lock by its newest decision (lock id -> "accept" | "reject"; absent: undecided). */
+  const setLockDecisions = (decisions) => {
+    for (const [id, [mark, lock]] of locks) styleLock(mark, decidedLock(lock, decisions[id]));
+  };
+  // Until the timeline leaves the page (another take or run opened).
+  const stop = locks.size ? onLockDecisions((detail) => { if (el.isConnected) setLockDecisions(detail.decisions); else stop(); }) : () => {};
   return {
     el,
     setFrame(f) { for (const c of cursors) c.style.left = `${(100 * (f + 0.5)) / Math.max(1, nFrames)}%`; },
+    setLockDecisions,
   };
 }

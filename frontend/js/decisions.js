@@ -8,6 +8,7 @@
 import * as api from "./api.js";
 import { badge, h, toast } from "./dom.js";
 import { acceptedCount, decidableLocks, decidedLinks, downloadText, LOCK_KIND, lockKeyTarget, lockLabel, mergedHistory, reviewedFormats } from "./lock-decisions.js";
+import { announceLockDecisions } from "./lock-events.js";
 
 export const DECISION_KEYS = { y: "accept", x: "reject" }; // on the focused or last opened decidable row
 const LABELS = { accept: "accepted", reject: "rejected" };
@@ -29,7 +30,7 @@ const DECIDED = {
   [LOCK_KIND]: {
     item: "lock", name: "foot lock", notApplied: "run: cleanup off", corrected: " → locked",
     applied: "foot cleanup is off by default: the run locks no foot, the reviewed take locks the accepted ones",
-    explain: "Foot locks are cleanup, off by default: the reviewed take holds the foot of each accepted skate finding where it stands during its contact, eased in and out over 0.1 s (BVH: a two-bone leg IK, only the hips, knees and ankles turn; C3D and TRC: the foot markers are pinned), after the other corrections. Undecided and rejected ones are left as recorded. Keypoint takes other than C3D and TRC marker takes have no reviewed download.",
+    explain: "Foot locks are cleanup, off by default: the reviewed take holds the foot of each accepted skate finding where it stands during its contact, eased in and out over 0.1 s (BVH: a two-bone leg IK, only the hips, knees and ankles turn; C3D and TRC: the foot markers are pinned), after the other corrections. Undecided and rejected ones are left as recorded. A C3D or TRC take's run without the markers check has locks only: its reviewed take is the raw take with the accepted locks pinned, no swap repaired and no gap filled. Keypoint takes other than C3D and TRC marker takes have no reviewed download.",
   },
 };
 
@@ -173,6 +174,8 @@ export function intervalDecisions(run, result, take = null) {
       d.link.dataset.locks = String(acceptedCount(locks.latest));
     }
   };
+  // The contact timeline draws the locks: it hears of every change (lock-events.js).
+  const announce = (g) => { if (g && g === locks) announceLockDecisions(run.id, locks.latest); };
   const fill = (g, id) => {
     const cell = g.cells.get(id);
     const f = g.byId.get(id);
@@ -184,6 +187,7 @@ export function intervalDecisions(run, result, take = null) {
     const before = g.latest.get(id);
     g.latest.set(id, decision); // shows at once; undone if the server refuses
     fill(g, id);
+    announce(g);
     if (g === locks) opened.lock = id; else opened.main = id;
     try {
       // The server records the signed-in user as the reviewer.
@@ -196,6 +200,7 @@ export function intervalDecisions(run, result, take = null) {
     } catch (e) {
       if (before) g.latest.set(id, before); else g.latest.delete(id);
       fill(g, id);
+      announce(g);
       showDownload();
       say(e.message, "error");
       toast(e.message);
@@ -207,6 +212,7 @@ export function intervalDecisions(run, result, take = null) {
     if (main) for (const i of main.kind === "swap" ? body.swaps : body.intervals) if (i.decision) main.latest.set(i.id, i.decision);
     if (locks) for (const l of body.locks || []) if (l.decision) locks.latest.set(l.id, l.decision);
     for (const g of groups) for (const id of g.cells.keys()) fill(g, id);
+    announce(locks);
     showDownload();
     showHistory(body);
     if (!body.history.length && !(body.lock_history || []).length && take) await showElsewhere(take, run, (main || locks).spec, parts.elsewhere);

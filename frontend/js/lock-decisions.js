@@ -17,14 +17,17 @@ export function lockLabel(lock) {
 }
 
 /** The formats of the run's reviewed download, the take's own first: ["bvh"] for a motion
- * take; for a marker take whose markers check ran, ["c3d", "trc"] for a C3D take (the run wrote
- * a corrected C3D of it; TRC for OpenSim) and ["trc"] for a TRC take (`take.format`); none for
- * other keypoint takes. */
+ * take; for a marker take whose markers check ran, or whose feet check found foot locks (the
+ * raw take with the accepted locks pinned), ["c3d", "trc"] for a C3D take (TRC for OpenSim)
+ * and ["trc"] for a TRC take (`take.format`); none for other keypoint takes. */
 export function reviewedFormats(result, take = null) {
   if (result.kind === "motion") return ["bvh"];
   if ((result.downloads || []).includes("c3d")) return ["c3d", "trc"];
-  const markers = result.steps && result.steps.markers && result.steps.markers.state === "done";
-  return markers && take && take.format === "trc" ? ["trc"] : [];
+  const done = (step) => Boolean(result.steps && result.steps[step] && result.steps[step].state === "done");
+  const decided = done("markers") || (done("feet") && decidableLocks(result).length > 0);
+  if (!decided || !take) return [];
+  if (take.format === "c3d") return ["c3d", "trc"];
+  return take.format === "trc" ? ["trc"] : [];
 }
 
 /** The format of the run's first reviewed download (reviewedFormats), or null when it has none. */

@@ -88,3 +88,37 @@ export function hoverLabel(name, frame, j, corrected) {
   const filled = frame.filled && frame.filled[j] > 0 && corrected ? " · filled" : "";
   return `${name} · confidence ${frame.confidence[j].toFixed(2)}${bridged}${filled}`;
 }
+
+const AXES_BY_NAME = { X: 0, Y: 1, Z: 2 };
+
+/**
+ * The floor plane of the run's feet step, in the take's coordinates (as the views draw them):
+ * perpendicular to the up axis at the floor's height, over the take's horizontal extent.
+ *
+ * @param feet      the run's `series.feet` ({up_axis: "Y", "-Y", "Z", …, floor: take units}),
+ *   or null / undefined when the feet step did not run or was skipped
+ * @param frameSets lists of frames (each frame a list of [x, y, z] points, null or NaN where
+ *   missing) whose horizontal extent the plane covers
+ * @param pad       share of the larger horizontal extent added around it
+ * @returns null without a feet step, a floor or a present point, else {axis (0, 1 or 2, the up
+ *   axis), level (the plane's coordinate on that axis: the floor times the axis' sign),
+ *   positions (Float32Array of 4 corners × x, y, z), index ([0, 1, 2, 0, 2, 3]: two triangles)}
+ */
+export function floorPlane(feet, frameSets, pad = 0.1) {
+  const named = feet && typeof feet.up_axis === "string" ? /^([+-]?)([XYZ])$/i.exec(feet.up_axis.trim()) : null;
+  if (!named || !Number.isFinite(feet.floor)) return null;
+  const axis = AXES_BY_NAME[named[2].toUpperCase()];
+  const level = (named[1] === "-" ? -1 : 1) * feet.floor;
+  const across = [0, 1, 2].filter((a) => a !== axis);
+  const lo = [Infinity, Infinity], hi = [-Infinity, -Infinity];
+  for (const frames of frameSets) for (const points of frames) for (const p of points) {
+    if (!present(p)) continue;
+    across.forEach((a, k) => { if (p[a] < lo[k]) lo[k] = p[a]; if (p[a] > hi[k]) hi[k] = p[a]; });
+  }
+  if (!Number.isFinite(lo[0])) return null;
+  const margin = pad * Math.max(hi[0] - lo[0], hi[1] - lo[1]) || 1;
+  const corners = [[lo[0] - margin, lo[1] - margin], [hi[0] + margin, lo[1] - margin], [hi[0] + margin, hi[1] + margin], [lo[0] - margin, hi[1] + margin]];
+  const positions = new Float32Array(12);
+  corners.forEach(([u, w], c) => { positions[3 * c + axis] = level; positions[3 * c + across[0]] = u; positions[3 * c + across[1]] = w; });
+  return { axis, level, positions, index: [0, 1, 2, 0, 2, 3] };
+}

@@ -8,6 +8,7 @@ import * as THREE from "/static/vendor/three/three.module.min.js";
 import * as geo from "./geometry.js";
 import { canvasLayout, sameLayout } from "./viewports.js";
 import { dragged, drawnSkeleton, hoverLabel, writePoints, writeSegments, writeTriads, zoomed } from "./scene-data.js";
+import { floorControls, floorMesh } from "./scene-floor.js";
 
 const BODY = new THREE.Color("#5b84b1");
 const MARKED = new THREE.Color("#f39c12");
@@ -93,8 +94,8 @@ function sharedCanvas(row) {
   return { canvas, renderer };
 }
 
-/** Each view's scene (viewScene) with the floor's grid and, for an oriented take, the root's
- * path on the floor. */
+/** Each view's scene (viewScene) with the floor's grid, for an oriented take the root's path on
+ * the floor, and the feet step's floor plane (hidden until setFloor). */
 function buildViews(divs, v, overview) {
   const views = {};
   for (const [name, div] of Object.entries(divs)) {
@@ -110,7 +111,7 @@ function buildViews(divs, v, overview) {
         new THREE.LineBasicMaterial({ color: 0x95a5a6 }));
       parts.scene.add(line);
     }
-    views[name] = { div, ...parts };
+    views[name] = { div, ...parts, floor: floorMesh(parts.scene) };
   }
   return views;
 }
@@ -324,7 +325,7 @@ function viewsState(skeleton, overview) {
     orbit: { ...geo.PRESETS.front, distance: framing.distance, target: [0, framing.height, 0] },
     camera: new THREE.PerspectiveCamera(FOV, 1, size / 100, size * 200),
     root: oriented ? drawnRoot : -1,
-    focus: "body", frame: null, triadsOn: false, overlayOn: false,
+    focus: "body", frame: null, triadsOn: false, overlayOn: false, floorPlane: null, floorOn: true,
     renders: 0, drawn: 0, scheduled: 0, marked: false, filledShown: 0, layout: null, colorCache: new Map(),
   };
 }
@@ -388,6 +389,7 @@ function viewsApi(v, resized) {
     setCamera(name) { Object.assign(orbit, geo.PRESETS[name]); v.requestRender(); },
     setTriads(on) { v.triadsOn = on && oriented; for (const view of Object.values(views)) view.axes.visible = v.triadsOn; if (v.frame) show(v, v.frame); },
     setOverlay(on) { v.overlayOn = on; views.corrected.ghost.visible = on; if (v.frame) show(v, v.frame); },
+    ...floorControls(v), // setFloor, setFloorShown, floorDrawn
     /** The canvas's box and each view's viewport (CSS pixels, y from the bottom), as last drawn. */
     get layout() { return v.layout && { box: { ...v.layout.box }, viewports: v.layout.viewports.map((port) => port && { ...port }) }; },
     dispose() { resized.disconnect(); v.tooltip.remove(); v.renderer.dispose(); v.canvas.remove(); },

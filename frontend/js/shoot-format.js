@@ -88,17 +88,22 @@ const count = (v) => (v == null ? "–" : String(v));
 export const SKATE_HEADER_UNIT = "cm";
 
 /** A take's largest foot skate as its cell shows it: the number alone in the header's unit
- * (cm), the number and its unit otherwise ("2.4 % height": a BVH stores no unit, so the feet
- * check sizes it against the body height); "–" when there is none (no skate found, the feet
- * not checked, or a run made before the figure). */
-export function skateSize(value, unit) {
+ * (cm), with its share of the body height beside it when known (`share`, in %: "8.6 (5.2 %
+ * height)"), the number and its unit otherwise ("2.4 % height": a BVH stores no unit, so the
+ * feet check sizes it against the body height); "–" when there is none (no skate found, the
+ * feet not checked, or a run made before the figure). The column sorts by the share, the one
+ * measure of every take. */
+export function skateSize(value, unit, share = null) {
   if (value == null || !Number.isFinite(Number(value))) return "–";
   const number = fmt(Number(value), 1);
-  return unit == null || unit === SKATE_HEADER_UNIT ? number : `${number} ${unit}`;
+  if (unit != null && unit !== SKATE_HEADER_UNIT) return `${number} ${unit}`;
+  const known = share != null && Number.isFinite(Number(share));
+  return known ? `${number} (${fmt(Number(share), 1)} % height)` : number;
 }
 
-/** The take table's summary columns: the server's sort key, a header, a formatter, and
- * whether a narrow window hides it. */
+/** The take table's summary columns: the server's sort key, a header, a formatter, whether a
+ * narrow window hides it, and whether its text (a name of any length) may break anywhere, so
+ * the table fits its box from 1440 px. */
 export const TAKE_COLUMNS = [
   { key: "name", label: "name", format: (v) => v },
   { key: "status", label: "run", format: (v) => v || "none" },
@@ -109,13 +114,13 @@ export const TAKE_COLUMNS = [
   { key: "twist_intervals", label: "twist", format: count },
   { key: "limb_spins", label: "spins", format: count, narrow: true, title: "limb spins and flips reported (never corrected)" },
   { key: "violation_share", label: "outside limits", format: percent },
-  { key: "worst_joint", label: "worst joint", format: (v) => v || "–", narrow: true },
+  { key: "worst_joint", label: "worst joint", format: (v) => v || "–", narrow: true, wraps: true },
   { key: "filter_residual_mm", label: "filter mm", format: (v) => fmt(v, 2), narrow: true },
   { key: "missing_share", label: "missing", format: percent, narrow: true },
   { key: "n_findings", label: "findings", format: count },
   { key: "foot_skates", label: "skates", format: count, title: "foot skate findings: a planted foot sliding (– when the feet were not checked)" },
-  { key: "foot_worst_skate", label: `worst skate (${SKATE_HEADER_UNIT})`, format: (v, row) => skateSize(v, row.foot_skate_unit),
-    title: "the largest foot skate, in cm; in % of the body height, marked, when the take's unit does not convert to cm (a BVH stores none)" },
+  { key: "foot_worst_skate", label: `worst skate (${SKATE_HEADER_UNIT})`, format: (v, row) => skateSize(v, row.foot_skate_unit, row.foot_worst_skate_pct),
+    title: "the largest foot skate, in cm with its % of the body height beside it; in % of the body height alone, marked, when the take's unit does not convert to cm (a BVH stores none). Sorted by the % of the body height, the same measure in every take" },
   { key: "foot_penetrations", label: "below floor", format: count, narrow: true, title: "floor penetration findings: a foot below the floor" },
   { key: "foot_floating", label: "floating", format: count, narrow: true, title: "floating findings: a still foot above the floor" },
   { key: "review_status", label: "review", format: (v) => (v || "unreviewed").replace("_", " ") },

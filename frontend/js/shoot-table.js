@@ -87,7 +87,8 @@ function takeTable(page, state, apply) {
       const text = formatCell(c.key, t);
       const cell = c.key === "status" ? badge(text) : c.key === "review_status" ? badge(text, t.review_status)
         : c.key === "score" ? h("span", { class: "score", style: null, "data-score": t.score ?? "" }, text) : text;
-      const td = h("td", { class: `${c.key === "name" ? "name" : ""}${c.narrow ? " narrow-hide" : ""}` || null }, cell);
+      const classes = [c.key === "name" ? "name" : "", c.narrow ? "narrow-hide" : "", c.wraps ? "wraps" : ""].filter(Boolean);
+      const td = h("td", { class: classes.join(" ") || null }, cell);
       if (c.key === "score") td.firstChild.style.color = scoreColor(t.score);
       return td;
     })), () => { location.hash = api.takeLink(t.take_id, t.run_id); }));

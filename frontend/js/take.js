@@ -15,6 +15,7 @@ import { intervalDecisions } from "./decisions.js";
 import { createGapTimeline, gapRows } from "./gaptimeline.js";
 import { contactRows, createContactTimeline } from "./contacttimeline.js";
 import { drawCharts } from "./take-charts.js";
+import { floorPlane } from "./scene-data.js";
 import {
   focusCharts, jump, loadDetail, onKey, pauseAndJump, remember, render, selectJoint, setRange, wireControls,
 } from "./take-controls.js";
@@ -53,11 +54,12 @@ export async function takeView(main, takeId, params, onTeardown) {
 /** The run's result and first frames, and the view's state `t` made from them: the first, light
  * overview is drawn at once (the skeletons do not wait for the full one, `t.fuller`). */
 async function openRun(main, take, run, params) {
-  const [result, first] = await Promise.all([
+  // The run options' description labels the run list; the filter list waits for nothing on screen.
+  const [result, first, described] = await Promise.all([
     api.getResult(run.id).then((r) => { performance.mark("result-fetched"); return r; }),
-    api.getFirstFrames(run.id).then((f) => { performance.mark("frames-fetched"); return f; })]);
-  // The re-run form's lists wait for nothing on screen.
-  const formLists = Promise.all([api.listFilters(), api.getRunOptions()]);
+    api.getFirstFrames(run.id).then((f) => { performance.mark("frames-fetched"); return f; }),
+    api.getRunOptions()]);
+  const formLists = Promise.all([api.listFilters(), described]);
   const fuller = first.step > 1 ? api.getFramesPacked(run.id, { maxFrames: OVERVIEW_FRAMES }) : Promise.resolve(first);
   const nFrames = result.summary.n_frames;
   const names = result.points.names;
@@ -69,7 +71,7 @@ async function openRun(main, take, run, params) {
   // confident gaps filled (then filtered), filled samples marked.
   const markersRan = Boolean(result.steps.markers && result.steps.markers.state === "done");
   return {
-    main, take, run, result, params, formLists, fuller, overview: first, detail: null,
+    main, take, run, result, params, described, formLists, fuller, overview: first, detail: null,
     fps: result.summary.fps, nFrames, names, jointIndex, oriented: Array.isArray(first.raw_rotations), markersRan,
     // Keypoints are filtered, not corrected: the right-hand view says which it shows.
     outcome: result.kind === "keypoints" && !markersRan ? "filtered" : "corrected",
@@ -82,7 +84,7 @@ async function openRun(main, take, run, params) {
  * steps, downloads and the re-run form (once its lists arrive). */
 function layOut(t) {
   const { main, take, run, result } = t;
-  t.ui = viewsLayout(main, runPicker(take, run, () => store.state.frame), t);
+  t.ui = viewsLayout(main, runPicker(take, run, () => store.state.frame, t.described), t);
   t.timelines = h("div", {});
   t.review = reviewPanel(take);
   t.decided = intervalDecisions(run, result, take);
@@ -132,6 +134,8 @@ function startViews(t, createViews) {
   t.views = createViews({ raw: ui.rawDiv, corrected: ui.corrDiv },
     { names, parents: result.points.parents, bones: result.points.bones, nJoints: result.points.n_joints, oriented: t.oriented }, t.overview,
     (j) => selectJoint(t, names[j]));
+  // The feet step's floor, under both skeletons (none when the step did not run).
+  t.views.setFloor(floorPlane(result.series.feet, [t.overview.raw, t.overview.corrected]));
   // Playback draws in the animation frame that picked the frame (not one later): nothing is left
   // pending for the frame after a pause, which then shows "paused" at once.
   t.player = createPlayer({ fps: t.fps, nFrames: t.nFrames, getFrame: () => store.state.frame, onFrame: (f) => { store.state.frame = f; render(t); t.views.renderNow(); } });

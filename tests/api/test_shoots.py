@@ -405,7 +405,14 @@ BALANCING_TRC = (
 )
 """A keypoint take in metres with a skate (sized in cm)."""
 CLEAN_BVH = "bvh/bandai/dataset-1_dash_normal_001.bvh"  # feet checked, nothing found
-FEET = ("foot_skates", "foot_worst_skate", "foot_skate_unit", "foot_penetrations", "foot_floating")
+FEET = (
+    "foot_skates",
+    "foot_worst_skate",
+    "foot_skate_unit",
+    "foot_penetrations",
+    "foot_floating",
+    "foot_worst_skate_pct",
+)
 
 
 def test_the_take_table_sorts_filters_and_exports_the_feet_figures(
@@ -430,9 +437,20 @@ def test_the_take_table_sorts_filters_and_exports_the_feet_figures(
     assert (clean["foot_skates"], clean["foot_worst_skate"], clean["foot_skate_unit"]) == (
         0, None, None,
     )  # fmt: skip
-    # Largest first whatever the unit; the take without a skate last.
-    worst = sorted((bvh, trc), key=lambda r: -float(r["foot_worst_skate"]))
-    assert [r["name"] for r in rows] == [worst[0]["name"], worst[1]["name"], clean["name"]]
+    # Largest first in % of the body height, the one measure of every take (cm and % height
+    # are not compared as numbers); a BVH's largest skate is in % height already. Takes
+    # without the share (no skate) last, by name.
+    assert bvh["foot_worst_skate_pct"] == bvh["foot_worst_skate"]
+    shared = sorted(
+        (r for r in (bvh, trc) if r["foot_worst_skate_pct"] is not None),
+        key=lambda r: -float(r["foot_worst_skate_pct"]),
+    )
+    assert [r["name"] for r in rows[: len(shared)]] == [r["name"] for r in shared]
+    assert rows[-1]["name"] == clean["name"]
+    assert clean["foot_worst_skate_pct"] is None
+    by_share = {"sort": "foot_worst_skate_pct", "order": "desc"}
+    again = client.get(f"{API}/shoots/{sid}/takes", params=by_share).json()["items"]
+    assert [r["name"] for r in again] == [r["name"] for r in rows]
     # The figures are the run's own findings (what the take view lists).
     for row in (bvh, trc):
         findings = client.get(f"{API}/runs/{row['run_id']}/result").json()["findings"]
@@ -457,6 +475,7 @@ def test_the_take_table_sorts_filters_and_exports_the_feet_figures(
     assert cells[bvh["name"]]["foot_skate_unit"] == "% height"
     assert float(cells[trc["name"]]["foot_worst_skate"]) == trc["foot_worst_skate"]
     assert cells[clean["name"]]["foot_worst_skate"] == ""
+    assert float(cells[bvh["name"]]["foot_worst_skate_pct"]) == bvh["foot_worst_skate_pct"]
     as_json = client.get(f"{API}/shoots/{sid}/summary.json", params={"has_skates": "true"}).json()
     assert as_json["filters"] == {"has_skates": True}
     assert {t["name"]: tuple(t[k] for k in FEET) for t in as_json["takes"]} == {

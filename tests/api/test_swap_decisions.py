@@ -177,7 +177,7 @@ def test_swap_decision_errors_name_the_problem(
     assert answer.status_code == 409
     assert "start a new run" in answer.json()["detail"]
 
-    # A motion run has twist intervals, not swaps, and no decided C3D.
+    # A motion run has twist intervals, not swaps, and no decided C3D: its download is BVH.
     bvh = upload(client, corpus_dir / "bvh" / "cmu" / "iclone" / "005_05.bvh")
     motion_id = bvh["run_id"]
     assert wait_for_run(client, motion_id)["status"] == "done"
@@ -186,7 +186,8 @@ def test_swap_decision_errors_name_the_problem(
         client.get(f"/api/v1/runs/{motion_id}/decisions/c3d"),
     ):
         assert answer.status_code == 409
-        assert "twist intervals" in answer.json()["detail"]
+        assert "motion take" in answer.json()["detail"]
+        assert "/decisions/bvh" in answer.json()["detail"]
 
     # A marker run without the markers check has nothing to decide.
     filtered = client.post(
@@ -273,3 +274,48 @@ def test_a_c3d_takes_decided_take_is_also_served_as_trc(
     rejected, trc = both()
     assert not np.array_equal(rejected, c3d, equal_nan=True)
     np.testing.assert_array_equal(trc.positions, rejected)
+
+
+def test_a_feet_only_run_of_a_c3d_take_gives_the_raw_take_with_its_accepted_locks(
+    client: TestClient,
+    swapped: Path,
+    swap_run: dict[str, Any],
+    wait_for_run: Waiter,
+    tmp_path: Path,
+) -> None:
+    """A C3D take's run with the feet check and no markers check: no swap repaired, no gap
+    filled; the decided C3D (and its TRC) is the raw take with the accepted locks pinned."""
+    from tests.api.test_feet_decisions import decide_lock
+
+    from mocapqa.feet.markers import marker_label
+    from mocapqa.io.trc import parse_trc
+
+    response = client.post(f"/api/v1/takes/{swap_run['take_id']}/runs", json={"checks": ["feet"]})
+    assert response.status_code in (200, 201, 202), response.text
+    run = wait_for_run(client, response.json()["id"])
+    assert run["status"] == "done", run["error"]
+    run_id = run["id"]
+    body = client.get(f"/api/v1/runs/{run_id}/decisions").json()
+    assert (body["item"], body["swaps"]) == ("swap", [])
+    locks = body["locks"]
+    assert locks
+
+    # No lock accepted: the markers as recorded, the injected swaps left in.
+    raw = read_c3d(swapped).points
+    undecided = decided_positions(client, run_id, tmp_path)
+    np.testing.assert_array_equal(undecided, raw.positions)
+    trc = client.get(f"/api/v1/runs/{run_id}/decisions/trc")
+    assert trc.status_code == 200, trc.text
+    np.testing.assert_array_equal(parse_trc(trc.content).positions, raw.positions)
+
+    lock = locks[0]
+    decide_lock(client, run_id, lock["id"], "accept")
+    after = decided_positions(client, run_id, tmp_path)
+    change = np.nan_to_num(np.abs(after - undecided))
+    names = [marker_label(n) for n in raw.names]
+    side = lock["foot"][0].upper()
+    moved = {names[m] for m in np.flatnonzero(change.max(axis=(0, 2)) > 0)}
+    assert moved == {f"{side}HEE", f"{side}TOE", f"{side}ANK"}
+    assert (change.max(axis=(0, 1)) > 0).sum() == 2
+    frames = np.flatnonzero(change.max(axis=(1, 2)) > 0)
+    assert lock["start_frame"] - 10 <= frames.min() <= frames.max() <= lock["end_frame"] + 10

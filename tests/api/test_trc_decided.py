@@ -249,3 +249,48 @@ def test_every_foot_lock_the_run_lists_can_be_downloaded(
     response = client.get(f"/api/v1/runs/{run_id}/decisions/trc")
     assert response.status_code == 200, response.text
     assert response.text.startswith("PathFileType")
+
+
+FOOT_POINTS = ("Ankle", "Heel", "BigToe", "SmallToe")
+"""The foot keypoints of the Pose2Sim take the feet check uses, after the side's letter."""
+
+
+def test_a_feet_only_run_of_a_trc_take_gives_the_raw_take_with_its_accepted_locks(
+    client: TestClient, swapped: Path, trc_run: dict[str, Any], wait_for_run: Waiter
+) -> None:
+    """A TRC take's run with the feet check and no markers check: its reviewers decide foot
+    locks, and its decided TRC is the raw take (the swap left, the gaps NaN) with the accepted
+    locks pinned, only the foot points of the lock's foot moving."""
+    response = client.post(f"/api/v1/takes/{trc_run['take_id']}/runs", json={"checks": ["feet"]})
+    assert response.status_code in (200, 201, 202), response.text
+    run = wait_for_run(client, response.json()["id"])
+    assert run["status"] == "done", run["error"]
+    body = client.get(f"/api/v1/runs/{run['id']}/decisions").json()
+    assert (body["item"], body["swaps"]) == ("swap", [])
+    locks = body["locks"]
+    assert locks
+
+    # No lock accepted: the take's markers as read, every sample (NaN where missing).
+    raw = read_trc(swapped)
+    text, undecided = decided_trc(client, run["id"])
+    assert parse_trc(text, "decided.trc").names == raw.names
+    assert np.isnan(raw.positions).any()
+    np.testing.assert_array_equal(undecided, raw.positions)
+
+    lock = locks[0]
+    response = client.post(
+        f"/api/v1/runs/{run['id']}/feet/{lock['id']}/decisions", json={"decision": "accept"}
+    )
+    assert response.status_code == 201, response.text
+    _, after = decided_trc(client, run["id"])
+    change = np.nan_to_num(np.abs(after - undecided))
+    moved = {raw.names[m] for m in np.flatnonzero(change.max(axis=(0, 2)) > 0)}
+    side = lock["foot"][0].upper()
+    assert moved == {f"{side}{point}" for point in FOOT_POINTS}
+    assert (change.max(axis=(0, 1)) > 0).sum() == 2  # horizontally: the up axis keeps its values
+    frames = np.flatnonzero(change.max(axis=(1, 2)) > 0)
+    assert lock["start_frame"] - 10 <= frames.min() <= frames.max() <= lock["end_frame"] + 10
+    # The C3D download is a C3D take's only.
+    answer = client.get(f"/api/v1/runs/{run['id']}/decisions/c3d")
+    assert answer.status_code == 409
+    assert "/decisions/trc" in answer.json()["detail"]

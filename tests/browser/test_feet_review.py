@@ -32,6 +32,15 @@ def cell(page: Page, lock: str) -> str:
     return page.page.inner_text(f"#findings tr[data-lock='{lock}'] td.decision")
 
 
+def timeline_lock(page: Page, lock: str) -> dict[str, str]:
+    """The contact timeline's mark of a foot lock: its decision and drawn background."""
+    mark = page.page.locator(f"#contact-timeline .ct-lock[data-lock='{lock}']")
+    background: str = mark.evaluate(
+        "(el) => getComputedStyle(el).backgroundImage + ' ' + getComputedStyle(el).backgroundColor"
+    )
+    return {"decision": mark.get_attribute("data-decision") or "", "background": background}
+
+
 def decided(server: str, run_id: str) -> bytes:
     response = httpx.get(f"{server}/api/v1/runs/{run_id}/decisions/bvh", timeout=120)
     response.raise_for_status()
@@ -58,10 +67,26 @@ def test_accepting_a_foot_lock_changes_the_foot_and_nothing_above_the_hips(
     link = p.locator("#download-decided")
     assert link.inner_text() == f"Download reviewed take (no foot lock applied of {n})"
     before = decided(live_server, run_id)
+    # The contact timeline draws each lock, undecided as an outline, over the contact the skate
+    # overlaps.
+    assert p.locator("#contact-timeline .ct-lock").count() == n
+    undecided = timeline_lock(page, lock)
+    assert undecided["decision"] == "undecided"
+    mark = p.locator(f"#contact-timeline .ct-lock[data-lock='{lock}']")
+    assert int(mark.get_attribute("data-start") or -1) <= skate["end_frame"]
+    assert int(mark.get_attribute("data-end") or -1) >= skate["start_frame"]
 
     p.click(f"#findings tr[data-lock='{lock}'] button.decide-accept")
     assert "accepted" in cell(page, lock)
     assert "→ locked" in cell(page, lock)
+    # The timeline's mark follows the decision at once: filled.
+    p.wait_for_selector(f"#contact-timeline .ct-lock[data-lock='{lock}'][data-decision='accept']")
+    accepted = timeline_lock(page, lock)
+    assert accepted["background"] != undecided["background"]
+    assert "accepted" in (mark.get_attribute("title") or "")
+    p.locator("#contact-timeline").scroll_into_view_if_needed()
+    ARTIFACTS.mkdir(exist_ok=True)
+    p.locator("#contact-timeline").screenshot(path=str(ARTIFACTS / "feet-lock-timeline.png"))
     p.wait_for_function("() => document.getElementById('download-decided').dataset.locks === '1'")
     assert link.inner_text() == f"Download reviewed take (1 foot lock applied of {n})"
     p.wait_for_selector("#decision-history li")
@@ -94,6 +119,10 @@ def test_accepting_a_foot_lock_changes_the_foot_and_nothing_above_the_hips(
     p.locator(f"#findings tr[data-lock='{lock}']").focus()
     p.keyboard.press("x")
     assert "rejected" in cell(page, lock)
+    rejected = timeline_lock(page, lock)
+    assert rejected["decision"] == "reject"
+    assert "repeating-linear-gradient" in rejected["background"]
+    assert len({rejected["background"], accepted["background"], undecided["background"]}) == 3
     p.wait_for_function("() => document.querySelectorAll('#decision-history li').length === 2")
     assert link.inner_text() == f"Download reviewed take (no foot lock applied of {n})"
     assert decided(live_server, run_id) == before
@@ -101,4 +130,5 @@ def test_accepting_a_foot_lock_changes_the_foot_and_nothing_above_the_hips(
     page.open_take(live_server, take)
     p.wait_for_selector("#decision-history li")
     assert "rejected" in cell(page, lock)
+    p.wait_for_selector(f"#contact-timeline .ct-lock[data-lock='{lock}'][data-decision='reject']")
     assert not page.errors, page.errors

@@ -1,12 +1,16 @@
 """A BVH take with feet in the take view: its contact timeline under the time bar, a row per
-foot with a bar per contact of the run's feet step."""
+foot with a bar per contact of the run's feet step, and the step's floor plane in both 3D
+views (none for a run without the feet step)."""
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import httpx
+import numpy as np
 import pytest
 from tests.browser.test_workstation import ARTIFACTS, Page, upload
 
@@ -58,3 +62,49 @@ def test_a_walk_shows_the_contacts_of_each_foot(
     ARTIFACTS.mkdir(exist_ok=True)
     p.locator("#player").scroll_into_view_if_needed()
     p.screenshot(path=str(ARTIFACTS / "feet-contacts.png"), full_page=False)
+
+
+def test_the_floor_plane_lies_at_the_feet_steps_floor_in_both_views(
+    live_server: str, corpus_dir: Path, page: Page
+) -> None:
+    take = upload(live_server, corpus_dir / WALK)
+    feet = take["result"]["series"]["feet"]
+    assert feet["up_axis"] == "Y"
+    page.open_take(live_server, take)
+    p = page.page
+    floor = p.evaluate("() => window.mocapqaViews.floorDrawn()")
+    assert floor is not None
+    assert floor["axis"] == 1
+    assert floor["shown"] == [True, True]
+    corners = np.asarray(floor["corners"]).reshape(4, 3)
+    np.testing.assert_allclose(corners[:, 1], feet["floor"], rtol=1e-6)
+    # Over the walk's horizontal extent: the root's travel lies inside the plane.
+    frames = httpx.get(
+        f"{live_server}/api/v1/runs/{take['run']}/frames", params={"max_frames": 50}, timeout=60
+    ).json()
+    points = np.asarray(
+        [[np.nan] * 3 if q is None else q for f in frames["raw"] for q in f], dtype=float
+    )
+    for axis in (0, 2):
+        assert corners[:, axis].min() <= np.nanmin(points[:, axis])
+        assert corners[:, axis].max() >= np.nanmax(points[:, axis])
+    ARTIFACTS.mkdir(exist_ok=True)
+    p.locator("#player").scroll_into_view_if_needed()
+    p.screenshot(path=str(ARTIFACTS / "feet-floor-plane.png"), full_page=False)
+    # Turned off, neither view shows it.
+    p.evaluate("() => window.mocapqaViews.setFloorShown(false)")
+    assert p.evaluate("() => window.mocapqaViews.floorDrawn().shown") == [False, False]
+
+    # A run without the feet step has no floor plane.
+    created = httpx.post(
+        f"{live_server}/api/v1/takes/{take['id']}/runs", json={"checks": ["twist"]}, timeout=30
+    )
+    created.raise_for_status()
+    other = created.json()["id"]
+    deadline = time.monotonic() + 300
+    while httpx.get(f"{live_server}/api/v1/runs/{other}", timeout=30).json()["status"] != "done":
+        assert time.monotonic() < deadline
+        time.sleep(0.3)
+    page.open_take(live_server, {**take, "run": other})
+    assert p.evaluate("() => window.mocapqaViews.floorDrawn()") is None
+    assert not page.errors, page.errors

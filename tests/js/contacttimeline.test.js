@@ -1,7 +1,7 @@
 // Unit tests of the contact timeline's rows (node --test).
 import assert from "node:assert/strict";
 import { test } from "node:test";
-import { FEET_COLORS, contactRows } from "../../frontend/js/contacttimeline.js";
+import { FEET_COLORS, contactRows, decidedLock, lockMarks, lockStyle } from "../../frontend/js/contacttimeline.js";
 
 const contact = (foot, start, end, confidence = 0.8) => ({ foot, start, end, confidence, id: `contact-${foot}-${start}` });
 const finding = (kind, foot, start, end, value = 2.5, unit = "cm") => ({
@@ -32,4 +32,42 @@ test("feet findings are marked on their foot's row; other findings are not", () 
 
 test("no contacts and no findings: two empty rows", () => {
   assert.deepEqual(contactRows([], [], 10).map((r) => [r.foot, r.bars.length, r.marks.length]), [["left", 0, 0], ["right", 0, 0]]);
+});
+
+test("each skate finding with an id has a lock over the contact it overlaps, else its own frames", () => {
+  const skate = (foot, start, end) => ({ ...finding("skate", foot, start, end), id: `skate-${foot}-${start}` });
+  const findings = [skate("left", 70, 75), skate("left", 10, 19), skate("left", 200, 204), finding("skate", "left", 30, 31), skate("right", 10, 12), finding("penetration", "left", 12, 12)];
+  const contacts = [contact("left", 0, 39), contact("left", 60, 99), contact("right", 50, 80)];
+  const [left, right] = contactRows(contacts, findings, 400);
+  // The skate without an id (none to decide) has no lock; penetrations have none.
+  assert.deepEqual(left.locks.map((l) => [l.id, l.start, l.end]), [["skate-left-10", 0, 39], ["skate-left-70", 60, 99], ["skate-left-200", 200, 204]]);
+  assert.deepEqual(left.locks.map((l) => l.decision), ["undecided", "undecided", "undecided"]);
+  assert.equal(left.locks[1].left, 15);
+  assert.equal(left.locks[1].width, 10);
+  assert.match(left.locks[0].label, /left foot lock · frames 0–39 · undecided/);
+  // A right contact that does not overlap the right skate: the lock holds the finding's frames.
+  assert.deepEqual(right.locks.map((l) => [l.start, l.end]), [[10, 12]]);
+});
+
+test("a lock is drawn by its newest decision: accepted solid, rejected hatched and dim, undecided an outline", () => {
+  const findings = [{ ...finding("skate", "left", 10, 19), id: "skate-left-10" }, { ...finding("skate", "left", 50, 55), id: "skate-left-50" }, { ...finding("skate", "left", 70, 72), id: "skate-left-70" }];
+  const locks = lockMarks([contact("left", 0, 39)], findings, "left", 100, { "skate-left-10": "accept", "skate-left-50": "reject" });
+  assert.deepEqual(locks.map((l) => l.decision), ["accept", "reject", "undecided"]);
+  const [accepted, rejected, undecided] = locks.map((l) => l.style);
+  assert.equal(accepted.background, accepted.border.split(" ").at(-1));
+  assert.equal(accepted.opacity, "1");
+  assert.match(rejected.background, /repeating-linear-gradient/);
+  assert.ok(Number(rejected.opacity) < 1);
+  assert.equal(undecided.background, "transparent");
+  assert.match(undecided.border, /solid/);
+  // Three looks, none alike.
+  assert.equal(new Set(locks.map((l) => JSON.stringify(l.style))).size, 3);
+  assert.match(locks[0].label, /accepted: the reviewed download locks it/);
+  assert.match(locks[1].label, /rejected: left as recorded/);
+  // Deciding again redraws the same lock: its frames kept, its look and title changed.
+  const undone = decidedLock(locks[0], "reject");
+  assert.deepEqual([undone.start, undone.end, undone.left, undone.width], [locks[0].start, locks[0].end, locks[0].left, locks[0].width]);
+  assert.deepEqual(undone.style, lockStyle("reject"));
+  assert.match(undone.label, /left foot lock · frames 0–39 · rejected/);
+  assert.equal(decidedLock(locks[0], null).decision, "undecided");
 });

@@ -2,7 +2,7 @@
 // moves and the hover label (node --test).
 import assert from "node:assert/strict";
 import { test } from "node:test";
-import { dragged, drawnSkeleton, hoverLabel, writePoints, writeSegments, writeTriads, zoomed } from "../../frontend/js/scene-data.js";
+import { dragged, drawnSkeleton, floorPlane, hoverLabel, writePoints, writeSegments, writeTriads, zoomed } from "../../frontend/js/scene-data.js";
 
 test("bones come from the take, else from the parents", () => {
   const parents = [-1, 0, 1];
@@ -66,4 +66,43 @@ test("the hover label adds the confidence, and in the corrected view bridged or 
   assert.equal(hoverLabel("nose", frame, 0, true), "nose · confidence 0.46 · bridged");
   assert.equal(hoverLabel("nose", frame, 0, false), "nose · confidence 0.46");
   assert.equal(hoverLabel("LFHD", frame, 1, true), "LFHD · confidence 1.00 · filled");
+});
+
+test("the floor plane lies at the floor's height across the up axis, over the take's horizontal extent", () => {
+  const frames = [[[0, 5, 0], [2, 9, 1], null], [[4, 1, -3], [NaN, NaN, NaN]]];
+  const plane = floorPlane({ up_axis: "Y", floor: 0.8 }, [frames], 0.1);
+  assert.equal(plane.axis, 1);
+  assert.ok(Math.abs(plane.level - 0.8) < 1e-9);
+  assert.deepEqual(plane.index, [0, 1, 2, 0, 2, 3]);
+  const corners = [0, 1, 2, 3].map((c) => [...plane.positions.slice(3 * c, 3 * c + 3)]);
+  for (const c of corners) assert.ok(Math.abs(c[1] - 0.8) < 1e-6);
+  // x spans 0..4 and z -3..1 (the larger span, 4, sets a margin of 0.4 on each side).
+  const xs = corners.map((c) => c[0]), zs = corners.map((c) => c[2]);
+  assert.ok(Math.abs(Math.min(...xs) + 0.4) < 1e-6 && Math.abs(Math.max(...xs) - 4.4) < 1e-6);
+  assert.ok(Math.abs(Math.min(...zs) + 3.4) < 1e-6 && Math.abs(Math.max(...zs) - 1.4) < 1e-6);
+});
+
+test("a Z-up or downward axis moves the plane onto that axis, signed", () => {
+  const frames = [[[0, 0, 10], [3, 6, 20]]];
+  const zUp = floorPlane({ up_axis: "Z", floor: 10 }, [frames]);
+  assert.equal(zUp.axis, 2);
+  for (let c = 0; c < 4; c++) assert.equal(zUp.positions[3 * c + 2], 10);
+  // y down (MediaPipe's world): heights are -y, so the floor at height 0.9 is the plane y = -0.9.
+  const yDown = floorPlane({ up_axis: "-Y", floor: 0.9 }, [frames]);
+  assert.equal(yDown.axis, 1);
+  assert.ok(Math.abs(yDown.level + 0.9) < 1e-9);
+  for (let c = 0; c < 4; c++) assert.ok(Math.abs(yDown.positions[3 * c + 1] + 0.9) < 1e-6);
+});
+
+test("no plane without a feet step, a floor or a present point; a flat take still gets an area", () => {
+  const frames = [[[0, 0, 0], [1, 2, 0]]];
+  assert.equal(floorPlane(null, [frames]), null);
+  assert.equal(floorPlane(undefined, [frames]), null);
+  assert.equal(floorPlane({ up_axis: "Y", floor: null }, [frames]), null);
+  assert.equal(floorPlane({ up_axis: "W", floor: 0 }, [frames]), null);
+  assert.equal(floorPlane({ up_axis: "Y", floor: 0 }, [[[null, [NaN, 0, 0]]]]), null);
+  // A 2D take (z = 0 throughout), Y up: the plane still spans some depth.
+  const flat = floorPlane({ up_axis: "Y", floor: 0 }, [frames]);
+  const zs = [0, 1, 2, 3].map((c) => flat.positions[3 * c + 2]);
+  assert.ok(Math.max(...zs) - Math.min(...zs) > 0);
 });

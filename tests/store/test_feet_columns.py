@@ -1,8 +1,9 @@
 """The feet figures of a take's row on SQLite and PostgreSQL: skate, penetration and floating
-counts and the largest skate with its unit, from real analyses of a BVH take given a slide and
-a TRC take with a skate (the same figures as ``mocapqa feet check``); sorted and filtered in the
-shoot table, empty (not 0) for a run that did not check the feet, and filled by migration 0010
-from the summaries runs made before it."""
+counts, the largest skate with its unit and in % of the body height, from real analyses of a
+BVH take given a slide and a TRC take with a skate (the same figures as ``mocapqa feet
+check``); sorted (the largest skate by its % of the body height, whatever the take's unit) and
+filtered in the shoot table, empty (not 0) for a run that did not check the feet, and filled by
+migrations 0010 and 0012 from the summaries runs made before them."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from mocapqa.io.formats import read_take
 from mocapqa.jobs.take_task import analyse_path
 from mocapqa.pipeline.feet import check_take_feet, feet_report_json
 from mocapqa.pipeline.options import AnalysisOptions
+from mocapqa.pipeline.summary import skate_pct_height
 from mocapqa.store.qa import FEET_COLUMNS, sync_take
 from mocapqa.store.repository import Repository
 from mocapqa.store.shoot_pages import TakeFilter
@@ -101,6 +103,8 @@ def test_a_take_s_row_has_the_feet_check_s_skates_and_its_largest(
         sizes = [f["size_cm"] if unit == "cm" else 100 * f["size_rel_height"] for f in skates]
         assert row["foot_worst_skate"] == pytest.approx(max(sizes), abs=1e-3)
         assert row["foot_skate_unit"] == unit
+        if unit == "% height":  # in % of the body height already: the same figure
+            assert row["foot_worst_skate_pct"] == row["foot_worst_skate"]
         for column, kind in (("foot_penetrations", "penetration"), ("foot_floating", "floating")):
             assert row[column] == sum(f["kind"] == kind for f in check["findings"])
         # The row written with the take is the one the store rebuilds.
@@ -109,15 +113,54 @@ def test_a_take_s_row_has_the_feet_check_s_skates_and_its_largest(
         assert _row(repository, take_id) == row
 
 
+def test_a_skate_s_share_of_the_body_height_is_the_same_measure_in_every_take(
+    folders: dict[str, Path],
+) -> None:
+    """A % height skate's value; a cm skate's ``size_rel_height`` (the feet check's) × 100;
+    nothing for a cm skate without it: a number in cm is never read as a share."""
+    check = _feet_check(folders[TRC], TRC)
+    skates = [f for f in check["findings"] if f["kind"] == "skate"]
+    assert skates
+    for f in skates:
+        finding = {"kind": "skate", "foot": f["foot"], "value": f["size_cm"], "unit": "cm"}
+        assert skate_pct_height(finding) is None
+        share = skate_pct_height({**finding, "size_rel_height": f["size_rel_height"]})
+        assert share == pytest.approx(100 * f["size_rel_height"], abs=1e-3)
+        # The share and the size agree through the check's body height estimate (cm).
+        height_cm = check["body_height_estimate"] * check["cm_per_unit"]
+        assert share == pytest.approx(100 * f["size_cm"] / height_cm, rel=1e-3)
+    assert skate_pct_height({"kind": "skate", "value": 2.217, "unit": "% height"}) == 2.217
+    assert skate_pct_height({"kind": "skate", "value": None, "unit": "% height"}) is None
+
+
+def _with_share(outcome: dict[str, Any], check: dict[str, Any]) -> dict[str, Any]:
+    """A TRC take's analysis, checked: its summary has its largest skate in % of the body
+    height, the feet check's largest ``size_rel_height`` of its skates (its findings carry it)."""
+    shares = [100 * f["size_rel_height"] for f in check["findings"] if f["kind"] == "skate"]
+    found = outcome["summary"]["qa"]["foot_worst_skate_pct"]
+    assert found == pytest.approx(max(shares), abs=1e-3)
+    return outcome
+
+
 def _shoot_of_five(
-    store: ShootStore, analysed: dict[str, dict[str, Any]]
+    store: ShootStore, analysed: dict[str, dict[str, Any]], trc: dict[str, Any]
 ) -> tuple[str, dict[str, str]]:
-    """A shoot with the BVH and TRC takes, a clean take (feet checked, no skate), a take whose
-    run did not check the feet and one whose run was made before the feet figures."""
+    """A shoot with the BVH and TRC (``trc``) takes, a BVH take whose skate is larger in % of
+    the height than the TRC's but smaller as a number than its size in cm, a clean take (feet
+    checked, no skate), a take whose run did not check the feet and one whose run was made
+    before the feet figures."""
     shoot = str(store.create("five")["id"])
+    bvh_qa = analysed[BVH]["summary"]["qa"]
+    assert bvh_qa["foot_worst_skate"] < trc["summary"]["qa"]["foot_worst_skate_pct"]
+    larger = copy.deepcopy(analysed[BVH])
+    share = (
+        trc["summary"]["qa"]["foot_worst_skate_pct"] + trc["summary"]["qa"]["foot_worst_skate"]
+    ) / 2
+    larger["summary"]["qa"].update(foot_worst_skate=share, foot_worst_skate_pct=share)
     clean = copy.deepcopy(analysed[BVH])
     clean["summary"]["qa"].update(foot_skates=0, foot_worst_skate=None, foot_skate_unit=None,
-                                  foot_penetrations=0, foot_floating=0)  # fmt: skip
+                                  foot_penetrations=0, foot_floating=0,
+                                  foot_worst_skate_pct=None)  # fmt: skip
     unchecked = copy.deepcopy(analysed[BVH])
     unchecked["summary"]["qa"].update(dict.fromkeys(FEET_COLUMNS))
     older = copy.deepcopy(analysed[BVH])
@@ -125,7 +168,8 @@ def _shoot_of_five(
         del older["summary"]["qa"][column]
     names = {
         "bvh": (analysed[BVH], "a_bvh.bvh"),
-        "trc": (analysed[TRC], "b_trc.trc"),
+        "trc": (trc, "b_trc.trc"),
+        "larger": (larger, "b_larger.bvh"),
         "clean": (clean, "c_clean.bvh"),
         "unchecked": (unchecked, "d_unchecked.bvh"),
         "older": (older, "e_older.bvh"),
@@ -134,39 +178,48 @@ def _shoot_of_five(
 
 
 def test_the_shoot_table_sorts_and_filters_by_the_feet_figures(
-    repository: Repository, analysed: dict[str, dict[str, Any]]
+    repository: Repository, folders: dict[str, Path], analysed: dict[str, dict[str, Any]]
 ) -> None:
     store = ShootStore(repository.engine)
-    shoot, ids = _shoot_of_five(store, analysed)
+    trc = _with_share(analysed[TRC], _feet_check(folders[TRC], TRC))
+    shoot, ids = _shoot_of_five(store, analysed, trc)
     rows = {r["take_id"]: r for r in store.page(shoot, 50)[0]}
     # No feet figures: empty, not 0; a clean take: 0 skates and no largest.
     for key in ("unchecked", "older"):
         assert _feet(rows[ids[key]]) == (None,) * len(FEET_COLUMNS)
-    assert _feet(rows[ids["clean"]]) == (0, None, None, 0, 0)
+    assert _feet(rows[ids["clean"]]) == (0, None, None, 0, 0, None)
+    # The TRC's largest skate in cm is the largest number, its share of the height is not.
+    worst = {k: rows[ids[k]]["foot_worst_skate"] for k in ("bvh", "trc", "larger")}
+    assert max(worst, key=lambda k: worst[k]) == "trc"
+    assert rows[ids["trc"]]["foot_skate_unit"] == "cm"
+    shares = {k: rows[ids[k]]["foot_worst_skate_pct"] for k in ("bvh", "trc", "larger")}
+    assert shares["bvh"] < shares["trc"] < shares["larger"]
 
+    # Largest share of the height first, takes without a value last (by name) either way.
     by_worst = [r["take_id"] for r in store.page(shoot, 50, 0, "foot_worst_skate", True)[0]]
-    bvh, trc = rows[ids["bvh"]]["foot_worst_skate"], rows[ids["trc"]]["foot_worst_skate"]
-    larger, smaller = ("bvh", "trc") if bvh > trc else ("trc", "bvh")
-    # Largest first, takes without a value last (by name) in either direction.
-    assert by_worst == [ids[k] for k in (larger, smaller, "clean", "unchecked", "older")]
+    rest = ("clean", "unchecked", "older")
+    assert by_worst == [ids[k] for k in ("larger", "trc", "bvh", *rest)]
     by_worst = [r["take_id"] for r in store.page(shoot, 50, 0, "foot_worst_skate")[0]]
-    assert by_worst == [ids[k] for k in (smaller, larger, "clean", "unchecked", "older")]
-    by_count = [r["take_id"] for r in store.page(shoot, 2, 0, "foot_skates", True)[0]]
-    assert set(by_count) == {ids["bvh"], ids["trc"]}
-    assert store.page(shoot, 2, 2, "foot_skates", True)[0][0]["take_id"] == ids["clean"]
+    assert by_worst == [ids[k] for k in ("bvh", "trc", "larger", *rest)]
+    by_share = [r["take_id"] for r in store.page(shoot, 50, 0, "foot_worst_skate_pct", True)[0]]
+    assert by_share == [ids[k] for k in ("larger", "trc", "bvh", *rest)]
+    by_count = [r["take_id"] for r in store.page(shoot, 3, 0, "foot_skates", True)[0]]
+    assert set(by_count) == {ids["bvh"], ids["trc"], ids["larger"]}
+    assert store.page(shoot, 3, 3, "foot_skates", True)[0][0]["take_id"] == ids["clean"]
 
     some, total = store.page(shoot, 50, 0, "name", filters=TakeFilter(has_skates=True))
-    assert ([r["take_id"] for r in some], total) == ([ids["bvh"], ids["trc"]], 2)
+    assert ([r["take_id"] for r in some], total) == ([ids[k] for k in ("bvh", "larger", "trc")], 3)
     none, total = store.page(shoot, 50, 0, "name", filters=TakeFilter(has_skates=False))
     assert ([r["take_id"] for r in none], total) == ([ids["clean"]], 1)
     assert TakeFilter(has_skates=False).chosen() == {"has_skates": False}
 
 
 def test_migration_0010_fills_the_rows_of_runs_made_before_it(
-    repository: Repository, analysed: dict[str, dict[str, Any]]
+    repository: Repository, folders: dict[str, Path], analysed: dict[str, dict[str, Any]]
 ) -> None:
     store = ShootStore(repository.engine)
-    shoot, ids = _shoot_of_five(store, analysed)
+    trc = _with_share(analysed[TRC], _feet_check(folders[TRC], TRC))
+    shoot, ids = _shoot_of_five(store, analysed, trc)
     before = {take_id: _row(repository, take_id) for take_id in ids.values()}
     downgrade_database(repository.engine, "0009")
     assert upgrade_database(repository.engine)[0] == f"migrated 0009 → {head_revision()}"
@@ -175,3 +228,42 @@ def test_migration_0010_fills_the_rows_of_runs_made_before_it(
     assert store.page(shoot, 50, 0, "foot_worst_skate", True)[0][0]["foot_skate_unit"] in (
         "cm", "% height",
     )  # fmt: skip
+
+
+def test_migration_0012_gives_rows_the_largest_skate_in_pct_of_the_height(
+    repository: Repository, folders: dict[str, Path], analysed: dict[str, dict[str, Any]]
+) -> None:
+    """Rows of runs that have the share take it; rows of runs made before it take their largest
+    skate when it is in % height already, and stay empty when it is in cm: as the store
+    rebuilds them."""
+    store = ShootStore(repository.engine)
+    shoot, ids = _shoot_of_five(
+        store, analysed, _with_share(analysed[TRC], _feet_check(folders[TRC], TRC))
+    )
+    made_before = {}
+    for key, outcome, name in (
+        ("bvh", analysed[BVH], "f_bvh.bvh"),
+        ("trc", analysed[TRC], "g_trc.trc"),
+    ):
+        older = copy.deepcopy(outcome)
+        del older["summary"]["qa"]["foot_worst_skate_pct"]
+        made_before[key] = _record(store, shoot, older, name)
+    before = {
+        take_id: _row(repository, take_id) for take_id in (*ids.values(), *made_before.values())
+    }
+    assert (
+        before[made_before["bvh"]]["foot_worst_skate_pct"] == before[ids["bvh"]]["foot_worst_skate"]
+    )
+    assert before[made_before["trc"]]["foot_worst_skate_pct"] is None
+    assert before[ids["trc"]]["foot_worst_skate_pct"] is not None
+
+    downgrade_database(repository.engine, "0011")
+    with repository.engine.connect() as conn:
+        columns = conn.exec_driver_sql("SELECT * FROM take_qa").keys()
+        assert "foot_worst_skate_pct" not in list(columns)
+    assert upgrade_database(repository.engine)[0] == f"migrated 0011 → {head_revision()}"
+    for take_id, row in before.items():
+        assert _row(repository, take_id) == row
+        with repository.engine.begin() as conn:
+            sync_take(conn, take_id)
+        assert _row(repository, take_id) == row

@@ -111,6 +111,13 @@ class ShootTakeOut(BaseModel):
     foot_floating: int | None = Field(
         default=None, description="Floating findings (a still foot above the floor)"
     )
+    foot_worst_skate_pct: float | None = Field(
+        default=None,
+        description="The largest foot skate in % of the body height estimated from the leg "
+        "length, whatever the take's unit: the figure that compares across takes (sorting by "
+        "`foot_worst_skate` sorts by it); null when no skate was found, the feet were not "
+        "checked, or the run (a take in cm) was made before this figure",
+    )
     joint_violations: dict[str, float] | None
 
 

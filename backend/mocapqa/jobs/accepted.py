@@ -16,7 +16,9 @@ Beside them, a run with the feet check has foot locks, one per skate finding
   :func:`mocapqa.pipeline.marker_step.decided_repair`), then its accepted foot locks pinned,
   written as C3D like the run's ``corrected.c3d``
   (:func:`mocapqa.jobs.run_folder.write_corrected_c3d`), or as TRC (a TRC take's, or a C3D
-  take's for OpenSim: :func:`decided_trc`). No filter.
+  take's for OpenSim: :func:`decided_trc`). No filter. A marker run with the feet check but
+  without the markers check has locks only: its decided take is the raw take (no swap
+  exchanged, no gap filled) with its accepted foot locks pinned.
 
 Neither touches the stored take, the run's own files or the take's review.
 """
@@ -40,6 +42,7 @@ from mocapqa.io.bvh_write import format_bvh
 from mocapqa.io.trc import format_trc
 from mocapqa.jobs.decided_feet import accepted_locks, lock_accepted_markers, lock_accepted_motion
 from mocapqa.jobs.run_folder import RunFolder, read_options_of, write_corrected_c3d
+from mocapqa.markers.fill import FillResult
 from mocapqa.markers.repair import MarkerRepair
 from mocapqa.markers.swaps import repair_swaps
 from mocapqa.pipeline.loading import ReadLimits, read_take_file
@@ -287,6 +290,26 @@ def _raw_take(
     return path, read_take_file(path, str(take["format"]), str(take["name"]), options, limits)
 
 
+def _marker_swaps(
+    files: FileStore, run_id: str, take: dict[str, Any]
+) -> list[dict[str, Any]] | None:
+    """A marker run's swaps (:func:`run_swaps`), or None for a marker take's (C3D or TRC) run
+    with the feet check but without the markers check: foot locks only."""
+    found = _items_of(files, run_id)
+    markers = str(take["format"]) in MARKER_FORMATS and found.kind != "motion"
+    if markers and found.swaps is None and found.locks is not None:
+        return None
+    return run_swaps(files, run_id)
+
+
+def _as_read(raw: KeypointSequence) -> MarkerRepair:
+    """A marker take's "repair" that changes nothing: no swap exchanged, no gap filled."""
+    positions = np.array(raw.positions, dtype=np.float64)
+    nothing = np.zeros(positions.shape[:2], dtype=bool)
+    residuals = np.where(raw.missing, -1.0, 1.0)
+    return MarkerRepair(positions, residuals, (), (), FillResult(positions, nothing, ()))
+
+
 def _decided_markers(
     files: FileStore,
     run: dict[str, Any],
@@ -297,24 +320,41 @@ def _decided_markers(
 ) -> tuple[Path, KeypointSequence, MarkerRepair]:
     """The stored file of a marker take, the take as the run read it, and its repair with
     exactly the swaps the decisions keep corrected, its gaps filled by the run's rule and its
-    accepted foot locks pinned (:func:`decided_c3d`)."""
-    swaps = with_decisions(run_swaps(files, str(run["id"])), latest)
+    accepted foot locks pinned (:func:`decided_c3d`); a run without the markers check
+    (:func:`_marker_swaps`) has the take as read with its accepted foot locks pinned."""
+    run_id = str(run["id"])
+    listed = _marker_swaps(files, run_id, take)
     path, raw = _raw_take(files, take, limits)
     if not isinstance(raw, KeypointSequence):  # pragma: no cover - run_swaps refused others
         raise ConflictError(f"Expected a marker take, got {take['format']}")
+    if listed is None:
+        return path, raw, _pinned(raw, _as_read(raw), files, run_id, locks)
+    swaps = with_decisions(listed, latest)
     repair = decided_repair(raw, {int(s["id"]) for s in swaps if s["corrected"]})
     found = [(list(s.markers), s.start, s.end) for s in repair.swaps]
-    listed = [(list(s["markers"]), s["start_frame"], s["end_frame"]) for s in swaps]
-    if found != listed:
+    wanted = [(list(s["markers"]), s["start_frame"], s["end_frame"]) for s in swaps]
+    if found != wanted:
         raise ConflictError(
             f"Expected the swaps of run {run['id']} in its take, found others ({len(found)} "
-            f"against {len(listed)}): start a new run of the take to decide on its swaps"
+            f"against {len(wanted)}): start a new run of the take to decide on its swaps"
         )
-    accepted = accepted_locks(_items_of(files, str(run["id"])).locks or (), locks or {})
-    if accepted:
-        pinned = lock_accepted_markers(raw, repair.positions, accepted, str(run["id"]))
-        repair = dataclasses.replace(repair, positions=pinned)
-    return path, raw, repair
+    return path, raw, _pinned(raw, repair, files, run_id, locks)
+
+
+def _pinned(
+    raw: KeypointSequence,
+    repair: MarkerRepair,
+    files: FileStore,
+    run_id: str,
+    locks: Mapping[str, str] | None,
+) -> MarkerRepair:
+    """``repair`` with the run's accepted foot locks (``locks``: id → newest decision)
+    pinned on its positions."""
+    accepted = accepted_locks(_items_of(files, run_id).locks or (), locks or {})
+    if not accepted:
+        return repair
+    pinned = lock_accepted_markers(raw, repair.positions, accepted, run_id)
+    return dataclasses.replace(repair, positions=pinned)
 
 
 def decided_c3d(
@@ -327,17 +367,18 @@ def decided_c3d(
 ) -> bytes:
     """The C3D of a marker take with exactly the swaps the decisions keep corrected repaired,
     then its gaps filled by the run's rule, as the run's ``corrected.c3d`` is written, then
-    its accepted foot locks pinned (``locks``: lock id → its newest decision).
+    its accepted foot locks pinned (``locks``: lock id → its newest decision). A run of the
+    feet check without the markers check gives the raw take with its accepted locks pinned.
 
     Raises
     ------
     ConflictError
-        For a run without swaps to decide, a take that is not a C3D, or a take whose swaps
-        are no longer the run's (found again by another version of the check).
+        For a run with neither swaps nor foot locks to decide, a take that is not a C3D, or a
+        take whose swaps are no longer the run's (found again by another version of the check).
     NotFoundError
         When the take's file is gone.
     """
-    run_swaps(files, str(run["id"]))
+    _marker_swaps(files, str(run["id"]), take)
     if str(take["format"]) != "c3d":
         raise ConflictError(
             f"Expected a C3D take for the decided C3D, got a {take['format']} take: the "
@@ -361,15 +402,16 @@ def decided_trc(
     """The TRC of a marker take (a TRC or a C3D take) decided as :func:`decided_c3d` decides
     it: exactly the swaps the decisions keep corrected repaired, its gaps filled by the run's
     rule, its accepted foot locks pinned; written by :func:`mocapqa.io.trc.format_trc` with the
-    take's rate, unit, marker names, frame numbers and times as the run read them. TRC has no
+    take's rate, unit, marker names, frame numbers and times as the run read them (a run of the
+    feet check without the markers check: the raw take with its accepted locks pinned). TRC has no
     residual: a filled sample is a value like any other (the run's ``gap`` findings list the
     filled gaps) and a sample still missing is ``NaN``.
 
     Raises
     ------
     ConflictError
-        For a take that is not a marker take (C3D or TRC), a run without the markers check, or
-        a take whose swaps are no longer the run's.
+        For a take that is not a marker take (C3D or TRC), a run with neither the markers nor
+        the feet check, or a take whose swaps are no longer the run's.
     NotFoundError
         When the take's file is gone.
     """

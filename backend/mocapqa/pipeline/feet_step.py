@@ -14,7 +14,9 @@ unit, confidence``; frames 0-based and inclusive, counted in the take as read):
   from the leg length, in % (``unit`` ``"% height"``);
 * ``confidence`` — that of the contact a skate lies in (None for the other kinds);
 * ``id`` (``skate-left-120``, as ``mocapqa feet fix --apply`` takes), ``peak`` and, for a
-  skate, ``speed_cm_s``; a one-line ``readout`` for the findings list.
+  skate, ``speed_cm_s``; ``size_rel_height``, the size over the estimated body height (a
+  ratio, whatever the unit: what compares across takes); a one-line ``readout`` for the
+  findings list.
 
 The step's plotted series (``series.feet`` of the report) hold the contacts
 (``{"id", "foot", "start", "end", "confidence"}``), the up axis, the floor and its check, and
@@ -85,6 +87,7 @@ def feet_findings(check: Mapping[str, Any], joints: Mapping[str, str]) -> list[d
             "id": item["id"],
             "peak": item["peak"],
             "speed_cm_s": speed,
+            "size_rel_height": item["size_rel_height"],
             "readout": readout,
         })  # fmt: skip
     return findings

@@ -23,6 +23,10 @@ One flat, JSON-ready dict per take, the same for the batch table, the API and th
 * ``foot_worst_skate`` and ``foot_skate_unit`` — the largest skate finding's size and its unit
   (``"cm"``, or ``"% height"`` when the take's unit does not convert to cm), as the feet step
   reports it; None when the step did not run or found no skate
+* ``foot_worst_skate_pct`` — the largest skate as % of the body height the feet check estimates
+  from the leg length, whatever the take's unit (a ``"% height"`` finding's value, a cm
+  finding's ``size_rel_height`` × 100): the one skate figure that compares across takes; None
+  when no skate has it
 * ``score`` — 0–100, see :func:`qa_score`; None for a motion take on which none of the twist,
   limits and feet checks ran (nothing was checked, so nothing can be called clean)
 
@@ -46,10 +50,12 @@ __all__ = [
     "FEET_SIZE_FIELDS",
     "MARKER_FIELDS",
     "MM_PER_UNIT",
+    "PCT_HEIGHT",
     "SCORE_TERMS",
     "SUMMARY_FIELDS",
     "qa_score",
     "qa_summary",
+    "skate_pct_height",
 ]
 
 MM_PER_UNIT = {"m": 1000.0, "cm": 10.0, "mm": 1.0}
@@ -98,8 +104,11 @@ MARKER_FIELDS = (
 """The summary's marker counts (marker takes; None for others)."""
 FEET_FIELDS = ("foot_contacts", "foot_skates", "foot_penetrations", "foot_floating", "foot_jitter")
 """The summary's feet counts (takes the feet step checked; None for others)."""
-FEET_SIZE_FIELDS = ("foot_worst_skate", "foot_skate_unit")
-"""The summary's largest skate and its unit (takes with a skate finding; None for others)."""
+FEET_SIZE_FIELDS = ("foot_worst_skate", "foot_skate_unit", "foot_worst_skate_pct")
+"""The summary's largest skate, its unit and its share of the body height in % (takes with a
+skate finding; None for others)."""
+PCT_HEIGHT = "% height"
+"""The unit of a feet size given as % of the body height estimated from the leg length."""
 _FEET_KINDS = {
     "skate": "foot_skates",
     "penetration": "foot_penetrations",
@@ -177,18 +186,39 @@ def _feet_counts(findings: list[dict[str, Any]], contacts: int) -> dict[str, int
     return counts
 
 
+def skate_pct_height(finding: dict[str, Any]) -> float | None:
+    """A skate finding's size in % of the body height the feet check estimates.
+
+    Parameters
+    ----------
+    finding : dict
+        A feet step finding: ``value`` in ``unit`` (``"cm"`` or :data:`PCT_HEIGHT`) and,
+        when given, ``size_rel_height`` (the size over the estimated body height, a ratio).
+
+    Returns
+    -------
+    float or None
+        % of the body height, rounded to 0.001; None when the finding has no size, or is in
+        cm without ``size_rel_height``.
+    """
+    rel = finding.get("size_rel_height")
+    if rel is not None:
+        return round(100.0 * float(rel), 3)
+    value = finding.get("value")
+    return None if value is None or finding.get("unit") != PCT_HEIGHT else float(value)
+
+
 def _worst_skate(findings: list[dict[str, Any]]) -> dict[str, Any]:
-    """The largest skate finding's size and unit (:data:`FEET_SIZE_FIELDS`; None when none has
-    a size)."""
-    sizes = [
-        (float(f["value"]), str(f["unit"]))
-        for f in findings
-        if f["kind"] == "skate" and "foot" in f and f.get("value") is not None
-    ]
+    """The largest skate finding's size and unit, and the largest in % of the body height
+    (:data:`FEET_SIZE_FIELDS`; None when none has a size)."""
+    skates = [f for f in findings if f["kind"] == "skate" and "foot" in f]
+    sizes = [(float(f["value"]), str(f["unit"])) for f in skates if f.get("value") is not None]
     if not sizes:
         return dict.fromkeys(FEET_SIZE_FIELDS)
     value, unit = max(sizes, key=lambda size: size[0])
-    return {"foot_worst_skate": value, "foot_skate_unit": unit}
+    shares = [p for p in map(skate_pct_height, skates) if p is not None]
+    share = max(shares) if shares else None
+    return {"foot_worst_skate": value, "foot_skate_unit": unit, "foot_worst_skate_pct": share}
 
 
 def _residual_mm(result: AnalysisResult, unit: str) -> float | None:

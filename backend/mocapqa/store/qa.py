@@ -14,15 +14,23 @@ from typing import Any
 from sqlalchemy import delete, insert, select
 from sqlalchemy.engine import Connection
 
-from mocapqa.pipeline.summary import FEET_SIZE_FIELDS, SUMMARY_FIELDS
+from mocapqa.pipeline.summary import PCT_HEIGHT, SUMMARY_FIELDS
 from mocapqa.store.tables import reviews, runs, take_qa, takes
 
 __all__ = ["FEET_COLUMNS", "QA_COLUMNS", "lock_take", "qa_row", "qa_values", "sync_take"]
 
-FEET_COLUMNS = ("foot_skates", *FEET_SIZE_FIELDS, "foot_penetrations", "foot_floating")
-"""The feet figures of a take's row: skate, penetration and floating counts and the largest
-skate with its unit (null when the run did not check the feet, or was made before the largest
-skate was in the summary)."""
+FEET_COLUMNS = (
+    "foot_skates",
+    "foot_worst_skate",
+    "foot_skate_unit",
+    "foot_penetrations",
+    "foot_floating",
+    "foot_worst_skate_pct",
+)
+"""The feet figures of a take's row: skate, penetration and floating counts, the largest
+skate with its unit, and the largest skate in % of the estimated body height, the figure that
+compares across takes (null when the run did not check the feet, or was made before the
+figure was in the summary; last, so the columns before it keep their places in exports)."""
 QA_COLUMNS = (*SUMMARY_FIELDS, *FEET_COLUMNS, "joint_violations")
 """Columns of ``take_qa`` copied from a done run's ``summary["qa"]``."""
 
@@ -39,6 +47,9 @@ def qa_values(take: Mapping[str, Any], run: Mapping[str, Any] | None) -> dict[st
             if column in qa:
                 values[column] = qa[column]
         values["n_findings"] = run["summary"].get("n_findings")
+        if "foot_worst_skate_pct" not in qa and qa.get("foot_skate_unit") == PCT_HEIGHT:
+            # A summary made before the figure: its largest skate is in % height already.
+            values["foot_worst_skate_pct"] = qa.get("foot_worst_skate")
     return values
 
 

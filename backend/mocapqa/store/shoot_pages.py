@@ -20,7 +20,7 @@ from mocapqa.store.shoot_base import ShootTables
 from mocapqa.store.tables import take_qa
 from mocapqa.store.take_listing import TABLE_ROWS, checked_choice
 
-__all__ = ["SORT_COLUMNS", "ShootPages", "TakeFilter"]
+__all__ = ["SORT_BY", "SORT_COLUMNS", "ShootPages", "TakeFilter"]
 
 SORT_COLUMNS = (
     "name",
@@ -32,12 +32,16 @@ SORT_COLUMNS = (
     "foot_worst_skate",
     "foot_penetrations",
     "foot_floating",
+    "foot_worst_skate_pct",
     "review_status",
     "reviewer",
 )
-"""Columns a shoot's take table can be sorted by. ``foot_worst_skate`` sorts by the number
-whatever its unit (``foot_skate_unit``: cm, or % of the body height for a take whose unit does
-not convert)."""
+"""Columns a shoot's take table can be sorted by. ``foot_worst_skate`` (cm, or % of the body
+height for a take whose unit does not convert: ``foot_skate_unit``) sorts by
+``foot_worst_skate_pct`` (:data:`SORT_BY`), the largest skate in % of the body height, which
+means the same in every take."""
+SORT_BY = {"foot_worst_skate": "foot_worst_skate_pct"}
+"""A sort key → the column it sorts by, where they differ."""
 
 
 class TakeFilter:
@@ -142,7 +146,7 @@ class ShootPages(ShootTables):
             raise InputError(f"Expected sort in {list(SORT_COLUMNS)}, got {sort!r}")
         self.require(shoot_id)
         where = and_(take_qa.c.shoot_id == shoot_id, *(filters or TakeFilter()).clauses())
-        column = take_qa.c[sort]
+        column = take_qa.c[SORT_BY.get(sort, sort)]
         ties = (take_qa.c.name, take_qa.c.take_id)
         with self.engine.connect() as conn:
             counted = conn.execute(select(func.count(), func.count(column)).where(where)).one()

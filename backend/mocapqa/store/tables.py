@@ -141,6 +141,7 @@ take_qa = Table(
     Column("foot_skate_unit", String(16), nullable=True),
     Column("foot_penetrations", Integer, nullable=True),
     Column("foot_floating", Integer, nullable=True),
+    Column("foot_worst_skate_pct", Float, nullable=True),
     Column("joint_violations", JSON, nullable=True),
     Index("ix_take_qa_shoot_score", "shoot_id", "score"),
     Index("ix_take_qa_shoot_status", "shoot_id", "status"),
@@ -152,8 +153,10 @@ take_qa = Table(
 by the repository so that a shoot's take table sorts and filters on indexed columns. The
 ``foot_*`` columns are the feet step's skate, penetration and floating counts and its largest
 skate (``foot_worst_skate`` in ``foot_skate_unit``: cm, or % of the body height when the take's
-unit does not convert); null for a run that did not check the feet (or was made before these
-columns), and the largest skate null too when no skate was found."""
+unit does not convert) and, in ``foot_worst_skate_pct``, the largest skate in % of the body
+height the feet check estimates, the same measure for every take (the table sorts by it;
+revision 0012); null for a run that did not check the feet (or was made before these columns),
+and the largest skate null too when no skate was found."""
 
 source_hashes = Table(
     "source_hashes",
