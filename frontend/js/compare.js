@@ -67,6 +67,7 @@ function metricsTable(results, label) {
       metric("largest removed offset", maxOffset),
       metric("limb spins (reported, not corrected)", (x) => x.summary.findings_by_kind.spin || 0),
       metric("joint-limit intervals", (x) => (x.steps.limits.state === "done" ? x.summary.findings_by_kind.limits || 0 : x.steps.limits.state)),
+      metric("foot locks applied", (x) => (x.steps.feet && x.steps.feet.state === "done" ? `${x.findings.filter((f) => f.kind === "skate" && f.applied).length} of ${x.summary.findings_by_kind.skate || 0} skates (${(x.options && x.options.feet_apply) || "none"})` : x.steps.feet ? x.steps.feet.state : "–")),
       metric("filter", (x) => (x.steps.filter.state === "done" ? x.series.filter?.method || x.options.filter_method : x.steps.filter.state)),
       metric("server time (s)", (x, run) => fmt(run.server_time_s, 3))));
 }

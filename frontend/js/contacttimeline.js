@@ -23,19 +23,23 @@ const LOCK_STATES = {
   accept: "accepted: the reviewed download locks it",
   reject: "rejected: left as recorded",
   undecided: "undecided: left as recorded",
+  followed: "undecided: the run locked it, and so does the reviewed download",
 };
 const LOCK_COLOR = "#1e8449"; // an accepted lock: solid; a rejected one: hatched and dim
 
 /**
  * The inline style of a foot lock's mark by its newest decision: an accepted lock solid, a
- * rejected one hatched and dim, an undecided one an outline.
+ * rejected one hatched and dim, an undecided one an outline, filled half when the run locked it
+ * (its feet_apply choice: the reviewed download follows the run).
  *
- * @param decision "accept", "reject", or null / undefined for undecided
+ * @param decision  "accept", "reject", or null / undefined for undecided
+ * @param runLocked whether the run locked it
  * @returns {{background: string, border: string, opacity: string}} CSS values
  */
-export function lockStyle(decision) {
+export function lockStyle(decision, runLocked = false) {
   if (decision === "accept") return { background: LOCK_COLOR, border: `1px solid ${LOCK_COLOR}`, opacity: "1" };
   if (decision === "reject") return { background: "repeating-linear-gradient(135deg, #95a5a6 0 2px, transparent 2px 5px)", border: "1px dashed #95a5a6", opacity: "0.6" };
+  if (runLocked) return { background: `linear-gradient(${LOCK_COLOR} 0 50%, transparent 50%)`, border: `1px solid ${LOCK_COLOR}`, opacity: "1" };
   return { background: "transparent", border: `1px solid ${LOCK_COLOR}`, opacity: "1" };
 }
 
@@ -49,7 +53,7 @@ export function lockStyle(decision) {
  * @param foot      "left" or "right"
  * @param nFrames   frames in the take
  * @param decisions lock id -> "accept" | "reject" (newest; absent ids are undecided)
- * @returns [{id, foot, start, end, left, width, decision, style, label}] by start frame; `left`,
+ * @returns [{id, foot, start, end, left, width, runLocked, decision, style, label}] by start frame; `left`,
  *   `width` in % of the row, `decision` "accept" | "reject" | "undecided", `style` lockStyle(…)
  */
 export function lockMarks(contacts, findings, foot, nFrames, decisions = {}) {
@@ -58,7 +62,7 @@ export function lockMarks(contacts, findings, foot, nFrames, decisions = {}) {
       const contact = contacts.find((c) => c.foot === foot && c.start <= f.end_frame && c.end >= f.start_frame);
       const [start, end] = contact ? [contact.start, contact.end] : [f.start_frame, f.end_frame];
       const [left, width] = spanOf(start, end, nFrames);
-      return decidedLock({ id: f.id, foot, start, end, left, width }, decisions[f.id]);
+      return decidedLock({ id: f.id, foot, start, end, left, width, runLocked: f.applied === true }, decisions[f.id]);
     })
     .sort((a, b) => a.start - b.start);
 }
@@ -66,13 +70,14 @@ export function lockMarks(contacts, findings, foot, nFrames, decisions = {}) {
 /**
  * A lock mark (lockMarks) drawn by `decision`: its `decision`, `style` and `label` set.
  *
- * @param lock     {id, foot, start, end, left, width, …}
+ * @param lock     {id, foot, start, end, left, width, runLocked, …} (`runLocked`: the run locked it)
  * @param decision "accept", "reject", or null / undefined for undecided
  */
 export function decidedLock(lock, decision) {
   const state = decision === "accept" || decision === "reject" ? decision : "undecided";
-  return { ...lock, decision: state, style: lockStyle(decision),
-    label: `${lock.foot} foot lock · frames ${lock.start}–${lock.end} · ${LOCK_STATES[state]}` };
+  const meaning = state === "undecided" && lock.runLocked ? "followed" : state;
+  return { ...lock, decision: state, style: lockStyle(decision, Boolean(lock.runLocked)),
+    label: `${lock.foot} foot lock · frames ${lock.start}–${lock.end} · ${LOCK_STATES[meaning]}` };
 }
 
 /**

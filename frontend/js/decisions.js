@@ -3,11 +3,11 @@
 // decision shows at once and is saved as a row of the run's decision history (the newest per
 // item counts; the other choice undoes one). Each row says what the reviewed download does with
 // the item: an accepted one is corrected, a rejected one left as recorded, an undecided one
-// follows the run's own choice ("run: applied"); foot locks are cleanup, off by default: only an
-// accepted one is applied.
+// follows the run's own choice ("run: applied"; for a foot lock the run's feet_apply, "none" by
+// default: cleanup is off).
 import * as api from "./api.js";
 import { badge, h, toast } from "./dom.js";
-import { acceptedCount, decidableLocks, decidedLinks, downloadText, LOCK_KIND, lockKeyTarget, lockLabel, mergedHistory, reviewedFormats } from "./lock-decisions.js";
+import { decidableLocks, decidedLinks, downloadText, keptCount, LOCK_KIND, lockKeyTarget, lockLabel, mergedHistory, reviewedFormats, runLockText } from "./lock-decisions.js";
 import { announceLockDecisions } from "./lock-events.js";
 
 export const DECISION_KEYS = { y: "accept", x: "reject" }; // on the focused or last opened decidable row
@@ -28,9 +28,9 @@ const DECIDED = {
     explain: "The reviewed take (C3D, or TRC for OpenSim; a TRC take's as TRC) is the raw take with the swaps marked \u201c\u2192 corrected\u201d repaired: every accepted one, and each undecided one the run repaired; rejected ones are left as recorded. Its gaps are then filled as the run fills them (the confident fills, chosen again on that take): a C3D marks each filled sample (residual 0); TRC has no residual, so the filled samples are the gap findings listed above (the run's report lists them too), and samples still missing are NaN. No filter. A C3D take's run has its own corrected C3D (Downloads): its choice before review.",
   },
   [LOCK_KIND]: {
-    item: "lock", name: "foot lock", notApplied: "run: cleanup off", corrected: " → locked",
-    applied: "foot cleanup is off by default: the run locks no foot, the reviewed take locks the accepted ones",
-    explain: "Foot locks are cleanup, off by default: the reviewed take holds the foot of each accepted skate finding where it stands during its contact, eased in and out over 0.1 s (BVH: a two-bone leg IK, only the hips, knees and ankles turn; C3D and TRC: the foot markers are pinned), after the other corrections. Undecided and rejected ones are left as recorded. A C3D or TRC take's run without the markers check has locks only: its reviewed take is the raw take with the accepted locks pinned, no swap repaired and no gap filled. Keypoint takes other than C3D and TRC marker takes have no reviewed download.",
+    item: "lock", name: "foot lock", corrected: " → locked",
+    ...(({ locked, notLocked, title }) => ({ appliedText: locked, notApplied: notLocked, applied: title }))(runLockText("none")),
+    explain: "Foot locks are cleanup, off by default (a run's feet_apply option: none, confident, skates): the reviewed take holds the foot of each accepted skate finding, and of each undecided one the run locked, where it stands during its contact, eased in and out over 0.1 s (BVH: a two-bone leg IK, only the hips, knees and ankles turn; C3D and TRC: the foot markers are pinned), after the other corrections. Rejected ones, and undecided ones the run did not lock, are left as recorded. A C3D or TRC take's run without the markers check has locks only: its reviewed take is the raw take with the accepted locks pinned, no swap repaired and no gap filled. Keypoint takes other than C3D and TRC marker takes have no reviewed download.",
   },
 };
 
@@ -97,7 +97,7 @@ function fillCell(cell, f, decision, spec, onDecide) {
   // The read-out wraps on the left; the buttons keep to the cell's right, side by side.
   cell.replaceChildren(h("div", { class: "decision-cell" },
     h("span", { class: "decision-state" },
-      h("span", { class: "applied muted", title: spec.applied }, f.applied ? "run: applied" : spec.notApplied || "run: not applied"), " · ",
+      h("span", { class: "applied muted", title: spec.applied }, f.applied ? spec.appliedText || "run: applied" : spec.notApplied || "run: not applied"), " · ",
       decision ? badge(LABELS[decision], BADGE[decision]) : h("span", { class: "muted" }, "undecided"),
       h("span", { class: "outcome muted", title: `what the reviewed download does with this ${spec.name}` }, corrected ? spec.corrected || " → corrected" : " → left as recorded")),
     h("span", { class: "decision-buttons" }, ...buttons)));
@@ -148,6 +148,10 @@ function runGroups(run, result) {
   const locks = lockItems.length
     ? decidedGroup(LOCK_KIND, lockItems, (id, body) => api.addLockDecision(run.id, id, body))
     : null;
+  if (locks) {
+    const { locked, notLocked, title } = runLockText(run.options && run.options.feet_apply);
+    locks.spec = { ...locks.spec, appliedText: locked, notApplied: notLocked, applied: title };
+  }
   return { main, locks };
 }
 
@@ -170,8 +174,9 @@ export function intervalDecisions(run, result, take = null) {
   const showDownload = () => {
     if (!locks) return;
     for (const d of parts.downloads) {
-      d.link.textContent = downloadText(locks.byId.size, acceptedCount(locks.latest), d.named);
-      d.link.dataset.locks = String(acceptedCount(locks.latest));
+      const kept = keptCount(locks.byId, locks.latest);
+      d.link.textContent = downloadText(locks.byId.size, kept, d.named);
+      d.link.dataset.locks = String(kept);
     }
   };
   // The contact timeline draws the locks: it hears of every change (lock-events.js).

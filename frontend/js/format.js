@@ -41,13 +41,15 @@ export function stepsRan(run) {
   return ran.length ? ran.join("+") : "no step ran";
 }
 
-/** What tells two runs of a take apart in a list: the steps that ran, the twist choice when it
- * is not its default in `described` (GET /run-options), the filter ("twist+limits · apply all ·
- * quat-pd"). */
+/** What tells two runs of a take apart in a list: the steps that ran, the twist choice and the
+ * foot locks when they are not their defaults in `described` (GET /run-options), the filter
+ * ("twist+limits · apply all · feet locked confident · quat-pd"). */
 export function runOptionsLabel(run, described) {
   const parts = [stepsRan(run)];
   const apply = run.options && run.options.twist_apply;
   if (apply && apply !== optionDefaults(described).twist_apply) parts.push(`apply ${apply}`);
+  const feet = run.options && run.options.feet_apply;
+  if (feet && feet !== optionDefaults(described).feet_apply) parts.push(`feet locked ${feet}`);
   if (run.options && run.options.filter_method) parts.push(run.options.filter_method);
   return parts.filter(Boolean).join(" · ");
 }

@@ -1,7 +1,8 @@
 // Foot locks in the findings table: each skate finding of the feet step has a lock (the foot
 // held where it stands during the contact) a reviewer accepts or rejects like a twist interval.
-// Cleanup is off by default: the reviewed download locks the accepted ones only. Pure helpers
-// of decisions.js (unit-tested).
+// The reviewed download locks the accepted ones, and the undecided ones the run locked (its
+// feet_apply choice, the finding's `applied`; cleanup is off by default, so a default run locks
+// none). Pure helpers of decisions.js (unit-tested).
 
 /** The finding kind whose rows carry a foot lock. */
 export const LOCK_KIND = "skate";
@@ -42,20 +43,42 @@ export function decidedLinks(formats) {
   return formats.map((format, k) => ({ format, id: k ? `download-decided-${format}` : "download-decided", named: format === "bvh" ? null : format }));
 }
 
-/** How many of the newest decisions (`latest`: id -> "accept" | "reject") accept. */
-export function acceptedCount(latest) {
+/** Whether the reviewed download locks `lock` (a skate finding, `applied` when the run locked
+ * it) under its newest `decision` ("accept" | "reject" | undefined): accepted, or undecided and
+ * locked by the run. */
+export function lockKept(lock, decision) {
+  return decision ? decision === "accept" : Boolean(lock.applied);
+}
+
+/** How many of `locks` (a Map of id -> skate finding) the reviewed download locks under the
+ * newest decisions `latest` (id -> "accept" | "reject"). */
+export function keptCount(locks, latest) {
   let n = 0;
-  for (const decision of latest.values()) if (decision === "accept") n += 1;
+  for (const [id, lock] of locks) if (lockKept(lock, latest.get(id))) n += 1;
   return n;
 }
 
+/** What a foot lock's decision cell says of the run's own choice, by the run's `feet_apply`
+ * ("none" by default; "confident", "skates" or skate ids): `locked` / `notLocked` the cell's
+ * text for a lock the run locked or did not, `title` its explanation. */
+export function runLockText(feetApply) {
+  const choice = feetApply || "none";
+  if (choice === "none") {
+    return { locked: "run: locked", notLocked: "run: cleanup off",
+      title: "foot cleanup is off by default: the run locks no foot, the reviewed take locks the accepted ones" };
+  }
+  return { locked: "run: locked", notLocked: "run: not locked",
+    title: `the run's feet_apply choice (${choice}), in its corrected take; the reviewed take locks the accepted ones and the undecided ones the run locked` };
+}
+
 /** The reviewed download link's text: its format when a marker take has it named (`format`,
- * "c3d" or "trc"; null for BVH), and how many foot locks it applies, when the run has any. */
-export function downloadText(nLocks, accepted, format = null) {
+ * "c3d" or "trc"; null for BVH), and how many foot locks it applies (`kept`: keptCount), when
+ * the run has any. */
+export function downloadText(nLocks, kept, format = null) {
   const base = format ? `Download reviewed take as ${format.toUpperCase()}` : "Download reviewed take";
   if (!nLocks) return base;
-  const locks = accepted === 1 ? "1 foot lock" : `${accepted} foot locks`;
-  return `${base} (${accepted ? locks : "no foot lock"} applied of ${nLocks})`;
+  const locks = kept === 1 ? "1 foot lock" : `${kept} foot locks`;
+  return `${base} (${kept ? locks : "no foot lock"} applied of ${nLocks})`;
 }
 
 /** Both decision histories (twist intervals or swaps, and foot locks) as one list, newest first

@@ -1,6 +1,7 @@
 // Pure data of the 3D views (scene3d.js): which joints are drawn and which root is followed,
-// the vertex buffers a frame's points and axes are written into, the orbit's moves and a
-// joint's hover label. No three.js, no DOM: unit-tested with node --test.
+// the vertex buffers a frame's points and axes are written into, the orbit's moves, a joint's
+// hover label and the feet step's floor plane and its label. No three.js, no DOM: unit-tested
+// with node --test.
 import { bonesOf, present } from "./geometry.js";
 
 /** Orbit limits: the elevation range (radians) and the zoom range (shares of the body's size). */
@@ -91,24 +92,40 @@ export function hoverLabel(name, frame, j, corrected) {
 
 const AXES_BY_NAME = { X: 0, Y: 1, Z: 2 };
 
+/** The fitted plane's gradient of a tilted floor ([gu, gw], finite), else null: level. */
+function tiltOf(check) {
+  if (!check || check.tilted !== true) return null;
+  const g = check.plane_gradient, o = check.plane_origin;
+  const finite = (pair) => Array.isArray(pair) && pair.length === 2 && pair.every(Number.isFinite);
+  return finite(g) ? { gradient: g, origin: finite(o) ? o : [0, 0] } : null;
+}
+
 /**
- * The floor plane of the run's feet step, in the take's coordinates (as the views draw them):
- * perpendicular to the up axis at the floor's height, over the take's horizontal extent.
+ * The floor plane of the run's feet step, in the take's coordinates (as the views draw them),
+ * over the take's horizontal extent: perpendicular to the up axis at the floor, or, when the
+ * step found the floor tilted, the plane it fitted (its coordinate on the up axis at the
+ * horizontal point p = (u, w), the two other axes in increasing order, is
+ * `floor + sign(up) × (p − plane_origin) · plane_gradient`).
  *
- * @param feet      the run's `series.feet` ({up_axis: "Y", "-Y", "Z", …, floor: take units}),
- *   or null / undefined when the feet step did not run or was skipped
+ * @param feet      the run's `series.feet` ({up_axis: "Y", "-Y", "Z", …, floor: the floor's
+ *   coordinate on the up axis (through plane_origin when tilted), take units, floor_check:
+ *   {tilted, plane_gradient: [gu, gw] height per unit or null, plane_origin: [ou, ow]}}), or
+ *   null / undefined when the feet step did not run or was skipped
  * @param frameSets lists of frames (each frame a list of [x, y, z] points, null or NaN where
  *   missing) whose horizontal extent the plane covers
  * @param pad       share of the larger horizontal extent added around it
  * @returns null without a feet step, a floor or a present point, else {axis (0, 1 or 2, the up
- *   axis), level (the plane's coordinate on that axis: the floor times the axis' sign),
- *   positions (Float32Array of 4 corners × x, y, z), index ([0, 1, 2, 0, 2, 3]: two triangles)}
+ *   axis), level (the plane's coordinate on that axis: the floor; at plane_origin when tilted),
+ *   tilted (whether the fitted tilted plane is drawn), positions (Float32Array of 4 corners × x,
+ *   y, z), index ([0, 1, 2, 0, 2, 3]: two triangles)}
  */
 export function floorPlane(feet, frameSets, pad = 0.1) {
   const named = feet && typeof feet.up_axis === "string" ? /^([+-]?)([XYZ])$/i.exec(feet.up_axis.trim()) : null;
   if (!named || !Number.isFinite(feet.floor)) return null;
   const axis = AXES_BY_NAME[named[2].toUpperCase()];
-  const level = (named[1] === "-" ? -1 : 1) * feet.floor;
+  const sign = named[1] === "-" ? -1 : 1;
+  const level = feet.floor;
+  const tilt = tiltOf(feet.floor_check);
   const across = [0, 1, 2].filter((a) => a !== axis);
   const lo = [Infinity, Infinity], hi = [-Infinity, -Infinity];
   for (const frames of frameSets) for (const points of frames) for (const p of points) {
@@ -118,7 +135,18 @@ export function floorPlane(feet, frameSets, pad = 0.1) {
   if (!Number.isFinite(lo[0])) return null;
   const margin = pad * Math.max(hi[0] - lo[0], hi[1] - lo[1]) || 1;
   const corners = [[lo[0] - margin, lo[1] - margin], [hi[0] + margin, lo[1] - margin], [hi[0] + margin, hi[1] + margin], [lo[0] - margin, hi[1] + margin]];
+  const upAt = tilt
+    ? (u, w) => level + sign * ((u - tilt.origin[0]) * tilt.gradient[0] + (w - tilt.origin[1]) * tilt.gradient[1])
+    : () => level;
   const positions = new Float32Array(12);
-  corners.forEach(([u, w], c) => { positions[3 * c + axis] = level; positions[3 * c + across[0]] = u; positions[3 * c + across[1]] = w; });
-  return { axis, level, positions, index: [0, 1, 2, 0, 2, 3] };
+  corners.forEach(([u, w], c) => { positions[3 * c + axis] = upAt(u, w); positions[3 * c + across[0]] = u; positions[3 * c + across[1]] = w; });
+  return { axis, level, tilted: Boolean(tilt), positions, index: [0, 1, 2, 0, 2, 3] };
+}
+
+/** The floor toggle's label: "floor", or "floor (tilted 3.2°)" when the feet step found the
+ * floor tilted (`feet`: the run's `series.feet`; the tilt in degrees when it has one). */
+export function floorLabel(feet) {
+  const check = feet && feet.floor_check;
+  if (!check || check.tilted !== true) return "floor";
+  return Number.isFinite(check.tilt_deg) ? `floor (tilted ${check.tilt_deg.toFixed(1)}°)` : "floor (tilted)";
 }

@@ -1,6 +1,6 @@
 // The floor plane of the feet step in the 3D views: a translucent quad at the floor's height,
-// perpendicular to the up axis the step found, in each view's scene (scene3d.js). Its corners
-// come from scene-data.js: floorPlane.
+// perpendicular to the up axis the step found (or the plane it fitted to a tilted floor), in
+// each view's scene (scene3d.js). Its corners come from scene-data.js: floorPlane.
 import * as THREE from "/static/vendor/three/three.module.min.js";
 
 const FLOOR = new THREE.Color("#27ae60");
@@ -51,10 +51,11 @@ export function floorControls(v) {
     },
     /** Show or hide the floor plane (shown by default when there is one). */
     setFloorShown(on) { showFloor(v, on); },
-    /** The floor plane: its up axis, level, corners and whether each view shows it; null for none. */
+    /** The floor plane: its up axis, level, whether it is the tilted plane, its corners and
+     * whether each view shows it; null for none. */
     floorDrawn() {
       const p = v.floorPlane;
-      return p && { axis: p.axis, level: p.level, corners: [...p.positions], shown: Object.values(v.views).map((view) => view.floor.visible) };
+      return p && { axis: p.axis, level: p.level, tilted: p.tilted, corners: [...p.positions], shown: Object.values(v.views).map((view) => view.floor.visible) };
     },
   };
 }

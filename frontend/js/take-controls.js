@@ -4,6 +4,7 @@ import * as api from "./api.js";
 import { nextFinding } from "./format.js";
 import { findingAt, loopOfFinding } from "./findings.js";
 import * as store from "./state.js";
+import { floorLabel } from "./scene-data.js";
 import { clampFrame, frameAt, frameText, keyCommand, LOOP_MARGIN_S, loopText, takeQuery } from "./take-format.js";
 import { parseRange, withIn, withOut } from "./timebar.js";
 
@@ -132,6 +133,26 @@ export function wireControls(t) {
     views.setOverlay(ui.overlayBox.checked);
     render(t);
   });
+  wireFloorToggle(t);
+}
+
+/** The floor plane's checkbox, shown when the views draw the feet step's floor; its label says
+ * when the floor is tilted (the views then draw the plane fitted to the feet). */
+function wireFloorToggle(t) {
+  const { ui, views } = t;
+  const floor = views.floorDrawn();
+  ui.floorToggle.hidden = !floor;
+  ui.floorBox.disabled = !floor;
+  if (!floor) return;
+  const feet = t.result.series.feet;
+  const tilted = Boolean(feet.floor_check && feet.floor_check.tilted);
+  ui.floorBox.checked = floor.shown.some(Boolean);
+  ui.floorText.textContent = floorLabel(feet);
+  ui.floorToggle.classList.toggle("tilted", tilted);
+  ui.floorToggle.title = tilted
+    ? "show or hide the feet step's floor; the floor is tilted: the plane drawn is the one fitted to the feet at rest"
+    : "show or hide the feet step's floor";
+  ui.floorBox.addEventListener("change", () => views.setFloorShown(ui.floorBox.checked));
 }
 
 /** N/P walk the findings the list's filters keep, across its groups. */

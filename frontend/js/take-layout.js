@@ -46,7 +46,16 @@ function viewControls(oriented) {
     followButton: h("button", { id: "camera-follow", class: "small", "aria-pressed": "false", title: "keep the root in the centre while playing" }, "follow"),
     triadsBox: h("input", { type: "checkbox", id: "show-axes", disabled: !oriented }),
     overlayBox: h("input", { type: "checkbox", id: "overlay" }),
+    ...floorToggle(),
   };
+}
+
+/** The floor plane's checkbox: hidden and disabled until the views draw a floor (wireControls
+ * shows it and says there when the floor is tilted). */
+function floorToggle() {
+  const floorBox = h("input", { type: "checkbox", id: "show-floor", checked: true, disabled: true });
+  const floorText = h("span", { id: "floor-label" }, "floor");
+  return { floorBox, floorText, floorToggle: h("label", { id: "floor-toggle", hidden: true }, floorBox, " ", floorText) };
 }
 
 /**
@@ -70,7 +79,7 @@ export function viewsLayout(main, picker, { nFrames, oriented, markersRan, outco
   main.append(
     picker,
     h("div", { class: "controls view-options" }, "camera ", ui.presets, ui.closeButton, ui.followButton,
-      h("label", {}, ui.triadsBox, " joint axes"), h("label", {}, ui.overlayBox, " overlay (raw as ghost)"),
+      h("label", {}, ui.triadsBox, " joint axes"), h("label", {}, ui.overlayBox, " overlay (raw as ghost)"), ui.floorToggle,
       h("span", { class: "muted", id: "view-legend" }, viewLegend(oriented, markersRan))),
     ui.viewsRow,
     ui.player,

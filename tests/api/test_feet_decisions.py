@@ -19,6 +19,7 @@ from tests.api.conftest import Uploader, Waiter
 from tests.api.test_decisions import expected_bvh
 from tests.store.conftest import database_params, database_url
 
+from mocapqa.core.motion import Motion
 from mocapqa.core.rig import find_roles
 from mocapqa.feet.fix import foot_rig, shift_ankles
 from mocapqa.feet.inject import leg_slide_offsets
@@ -255,6 +256,75 @@ def test_lock_decision_errors(
         headers={"Authorization": f"Bearer {token}"},
     )
     assert refused.status_code == 403
+
+
+def test_a_run_that_locks_feet_writes_them_and_undecided_locks_follow_the_run(
+    client: TestClient,
+    slid: tuple[Path, str, int, int],
+    skate_run: dict[str, Any],
+    wait_for_run: Waiter,
+) -> None:
+    take_path, take_id = slid[0], skate_run["take_id"]
+    lock_id = skate_run["skate"]["id"]
+    runs = f"/api/v1/takes/{take_id}/runs"
+    # The option is checked before a run is queued: contact ids and junk are refused.
+    for bad in ("contact-left-3", "skate-up-3", "all", "", "skate-left-3,"):
+        answer = client.post(runs, json={"checks": ["feet"], "feet_apply": bad})
+        assert answer.status_code == 422, (bad, answer.text)
+        assert "feet_apply" in answer.text
+    # An id the take does not have fails the run, naming it.
+    unknown = client.post(runs, json={"checks": ["feet"], "feet_apply": "skate-left-99999"})
+    failed = wait_for_run(client, unknown.json()["id"])
+    assert failed["status"] == "failed"
+    assert "skate-left-99999" in failed["error"]
+
+    created = client.post(runs, json={"checks": ["feet"], "feet_apply": "skates"}).json()
+    run = wait_for_run(client, created["id"])
+    assert run["status"] == "done", run["error"]
+    assert run["options"]["feet_apply"] == "skates"
+    result = client.get(f"/api/v1/runs/{run['id']}/result").json()
+    skates = [f for f in result["findings"] if f["kind"] == "skate"]
+    assert lock_id in [f["id"] for f in skates]
+    assert all(f["applied"] is True and "locked" in f["readout"] for f in skates)
+    assert all(f["applied"] is None for f in result["findings"] if f["kind"] != "skate")
+
+    # The run's corrected take has every skate's contact locked, the legs only.
+    corrected = parse_bvh(client.get(f"/api/v1/runs/{run['id']}/download/bvh").content, "c.bvh")
+    raw = read_bvh(take_path)
+    legs = leg_joints(take_path)
+    upper = [j for j in range(raw.skeleton.n_joints) if j not in legs]
+    positions_raw = forward_kinematics(raw)[1]
+    positions_fixed = forward_kinematics(corrected)[1]
+    np.testing.assert_allclose(positions_fixed[:, upper], positions_raw[:, upper], atol=1e-4)
+    contact = contact_of(skate_run["result"], skate_run["skate"])
+
+    def slide(motion: Motion) -> float:
+        """The largest skate the feet check finds on the injected contact, take units."""
+        return max(
+            (f.size for f in check_take_feet(motion)[1].findings
+             if f.kind == "skate" and f.foot == contact["foot"] and f.start <= contact["end"]
+             and f.end >= contact["start"]),
+            default=0.0,
+        )  # fmt: skip
+
+    assert slide(corrected) < 0.5 * slide(raw)
+
+    # Undecided, every lock follows the run, so the reviewed take locks what the run locked.
+    body = client.get(f"/api/v1/runs/{run['id']}/decisions").json()
+    assert body["lock_apply"] == "skates"
+    assert body["locks"]
+    assert all(lock["run_applied"] and lock["applied"] for lock in body["locks"])
+    decided_url = f"/api/v1/runs/{run['id']}/decisions/bvh"
+    following = parse_bvh(client.get(decided_url).content, "d.bvh")
+    np.testing.assert_allclose(forward_kinematics(following)[1], positions_fixed, atol=1e-3)
+    # A rejected lock is undone in the reviewed take; the others stay.
+    decide_lock(client, run["id"], lock_id, "reject")
+    body = client.get(f"/api/v1/runs/{run['id']}/decisions").json()
+    kept = {lock["id"]: lock["applied"] for lock in body["locks"]}
+    assert kept.pop(lock_id) is False
+    assert all(kept.values())
+    undone = parse_bvh(client.get(decided_url).content, "u.bvh")
+    assert slide(undone) > 0.9 * slide(raw)
 
 
 def take_values(name: str) -> dict[str, Any]:

@@ -31,6 +31,10 @@ FIELDS: dict[str, dict[str, Any]] = {
         "type": "choice", "choices": ["confident", "all", "none"], "default": "confident",
         "unit": "", "check": "twist",
     },
+    "feet_apply": {
+        "type": "choice", "choices": ["none", "confident", "skates"], "default": "none",
+        "unit": "", "check": "feet",
+    },
     "filter_method": {"type": "filter", "default": None, "unit": "", "check": "filter"},
     "filter_preset": {"type": "filter_preset", "default": None, "unit": "", "check": "filter"},
     "max_points": {
@@ -42,7 +46,7 @@ GROUPS = [
     ("twist", "twist", ["twist_method", "twist_apply"]),
     ("limits", "limits", []),
     ("markers", "markers", []),
-    ("feet", "feet", []),
+    ("feet", "feet", ["feet_apply"]),
     ("filter", "filter", ["filter_method", "filter_preset"]),
     ("advanced", None, ["max_points"]),
 ]
@@ -51,6 +55,7 @@ DEFAULT_REQUEST: dict[str, Any] = {
     "checks": ["twist", "limits", "filter", "markers", "feet"],
     "twist_method": "robust",
     "twist_apply": "confident",
+    "feet_apply": "none",
     "filter_method": None,
     "filter_preset": None,
     "filter_params": {},
@@ -67,6 +72,7 @@ PRESETS: dict[str, dict[str, Any]] = {
     "filter only": {"checks": ["filter"]},
     "markers only": {"checks": ["markers"]},
     "feet only": {"checks": ["feet"]},
+    "full check, confident foot locks applied": {"feet_apply": "confident"},
 }
 """Each preset's difference from :data:`DEFAULT_REQUEST`."""
 SIDES = ("left", "right")

@@ -4,6 +4,7 @@ accepted foot and leaves everything above the hips as it was."""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -131,4 +132,57 @@ def test_accepting_a_foot_lock_changes_the_foot_and_nothing_above_the_hips(
     p.wait_for_selector("#decision-history li")
     assert "rejected" in cell(page, lock)
     p.wait_for_selector(f"#contact-timeline .ct-lock[data-lock='{lock}'][data-decision='reject']")
+    assert not page.errors, page.errors
+
+
+def test_a_run_that_locks_the_skates_is_chosen_in_the_form_and_reviewed_lock_by_lock(
+    live_server: str, corpus_dir: Path, tmp_path: Path, page: Page
+) -> None:
+    path, foot, start, end = write_slid_walk(corpus_dir, tmp_path)
+    take = upload(live_server, path)
+    skate = injected_skate(take["result"], foot, start, end)
+    lock = skate["id"]
+    n = sum(f["kind"] == "skate" for f in take["result"]["findings"])
+    p = page.page
+    page.open_take(live_server, take)
+    # The re-run form offers the cleanup in the feet group, off by default; chosen by keyboard.
+    field = p.locator("#option-feet_apply")
+    field.scroll_into_view_if_needed()
+    assert p.input_value("#option-feet_apply") == "none"
+    assert field.locator("xpath=ancestor::fieldset").get_attribute("data-group") == "feet"
+    field.focus()
+    p.keyboard.type("skates")
+    assert p.input_value("#option-feet_apply") == "skates"
+    p.click("#rerun")
+    p.wait_for_url(re.compile(r".*run=(?!" + take["run"] + r").*"), timeout=60_000)
+    run_id = re.search(r"run=([0-9a-f]+)", p.url).group(1)  # type: ignore[union-attr]
+    run = httpx.get(f"{live_server}/api/v1/runs/{run_id}", timeout=30).json()
+    assert run["options"]["feet_apply"] == "skates"
+    p.wait_for_selector(f"#findings tr[data-lock='{lock}'] button.decide-accept", timeout=120_000)
+    # Undecided, each lock follows the run: locked in its corrected take and the reviewed one.
+    assert cell(page, lock).startswith("run: locked")
+    assert "undecided" in cell(page, lock)
+    assert "→ locked" in cell(page, lock)
+    link = p.locator("#download-decided")
+    assert (
+        link.inner_text()
+        == f"Download reviewed take ({n} foot lock{'s' if n > 1 else ''} applied of {n})"
+    )
+    mark = p.locator(f"#contact-timeline .ct-lock[data-lock='{lock}']")
+    assert "the run locked it" in (mark.get_attribute("title") or "")
+    assert "linear-gradient" in timeline_lock(page, lock)["background"]
+    assert "feet locked skates" in p.inner_text("#run-pick")
+    p.locator("#contact-timeline").scroll_into_view_if_needed()
+    ARTIFACTS.mkdir(exist_ok=True)
+    p.screenshot(path=str(ARTIFACTS / "feet-locks-run.png"))
+    # Rejecting one undoes it in the reviewed take only.
+    p.click(f"#findings tr[data-lock='{lock}'] button.decide-reject")
+    assert "→ left as recorded" in cell(page, lock)
+    p.wait_for_function(
+        "(n) => document.getElementById('download-decided').dataset.locks === String(n)",
+        arg=n - 1,
+    )
+    body = httpx.get(f"{live_server}/api/v1/runs/{run_id}/decisions", timeout=30).json()
+    assert {x["id"]: x["applied"] for x in body["locks"]}[lock] is False
+    assert all(x["applied"] for x in body["locks"] if x["id"] != lock)
     assert not page.errors, page.errors

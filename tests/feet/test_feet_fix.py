@@ -14,11 +14,17 @@ import pytest
 from mocapqa.cli.main import main
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
+from mocapqa.errors import InputError
 from mocapqa.feet.check import FeetReport, check_feet
 from mocapqa.feet.contacts import Contact
 from mocapqa.feet.findings import Finding
 from mocapqa.feet.fix import FootRig, fix_feet, foot_rig, lock_feet, shift_ankles
-from mocapqa.feet.fix_choice import choose_locks
+from mocapqa.feet.fix_choice import (
+    check_apply,
+    choose_locks,
+    finding_confidence,
+    locked_findings,
+)
 from mocapqa.feet.ik import leg_subtree, solve_leg
 from mocapqa.feet.inject import leg_slide_offsets
 from mocapqa.feet.lock import BLEND_S, Lock
@@ -206,6 +212,32 @@ def test_choosing_locks_by_confidence_ids_and_errors(slid: Slid) -> None:
     assert by_id[0].foot == skate.foot
     first = contacts[0]
     assert choose_locks(f"contact-{first.foot}-{first.start}", contacts, findings) == [first]
+    # `skates`: the contact of every skate finding, whatever its confidence; the skate findings
+    # a choice locks are the run's `applied` ones.
+    skates = [f for f in findings if f.kind == "skate"]
+    every = {(c.foot, c.start) for f in skates for c in by_id_of(f)}
+    assert {(c.foot, c.start) for c in choose_locks("skates", contacts, findings)} == every
+    ids = {f"skate-{f.foot}-{f.start}" for f in skates}
+    assert locked_findings("skates", contacts, findings) == ids
+    assert locked_findings("none", contacts, findings) == set()
+    confident_ids = locked_findings("confident", contacts, findings)
+    assert confident_ids <= ids
+    assert confident_ids == {
+        f"skate-{f.foot}-{f.start}" for f in skates if (finding_confidence(f, contacts) or 0) >= 0.5
+    }
+    assert locked_findings(f"skate-{skate.foot}-{skate.start}", contacts, findings) >= {
+        f"skate-{skate.foot}-{skate.start}"
+    }
+
+
+def test_a_run_option_names_a_choice_or_skate_ids_only() -> None:
+    assert check_apply(" skates ") == "skates"
+    assert check_apply("skate-left-120, skate-right-3") == "skate-left-120,skate-right-3"
+    for bad in ("all", "contact-left-3", "skate-left-", "skate-up-3", "", ",", "x" * 5000):
+        with pytest.raises(InputError, match="skate findings"):
+            check_apply(bad)
+    with pytest.raises(InputError):
+        check_apply(",".join(["skate-left-1"] * 1001))
 
 
 def test_feet_fix_writes_the_take_and_the_report(

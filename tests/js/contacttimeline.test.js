@@ -70,4 +70,19 @@ test("a lock is drawn by its newest decision: accepted solid, rejected hatched a
   assert.deepEqual(undone.style, lockStyle("reject"));
   assert.match(undone.label, /left foot lock · frames 0–39 · rejected/);
   assert.equal(decidedLock(locks[0], null).decision, "undecided");
+  assert.match(decidedLock(locks[0], null).label, /undecided: left as recorded/);
+});
+
+test("an undecided lock the run locked is drawn half filled, and says the reviewed download follows the run", () => {
+  const followed = decidedLock({ id: "skate-left-0", foot: "left", start: 0, end: 39, left: 0, width: 10, runLocked: true }, null);
+  assert.equal(followed.decision, "undecided");
+  assert.match(followed.label, /the run locked it, and so does the reviewed download/);
+  assert.deepEqual(followed.style, lockStyle(null, true));
+  const looks = [lockStyle("accept"), lockStyle("reject"), lockStyle(null), lockStyle(null, true)];
+  assert.equal(new Set(looks.map((l) => JSON.stringify(l))).size, 4);
+  // lockMarks reads the run's choice from the skate finding's `applied`.
+  const marks = lockMarks([contact("left", 0, 39)], [{ ...finding("skate", "left", 10, 19), id: "skate-left-10", applied: true }, { ...finding("skate", "left", 50, 55), id: "skate-left-50", applied: false }], "left", 100);
+  assert.deepEqual(marks.map((l) => l.runLocked), [true, false]);
+  // A decision overrides the run: rejected, it is drawn as any rejected lock.
+  assert.deepEqual(decidedLock({ ...followed, decision: undefined }, "reject").style, lockStyle("reject"));
 });

@@ -77,4 +77,7 @@ test("runOptionsLabel tells two runs of a take apart by what differs", () => {
   assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "confident" }, ran), described), "twist+limits");
   assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "all" }, ran), described), "twist+limits · apply all");
   assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits", "filter"], twist_apply: "none", filter_method: "quat-pd" }, { ...ran, filter: "done" }), described), "twist+limits+filter · apply none · quat-pd");
+  const withFeet = { groups: [...described.groups, { name: "feet", fields: [{ name: "feet_apply", type: "choice", default: "none" }] }] };
+  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "confident", feet_apply: "none" }, ran), withFeet), "twist+limits");
+  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "confident", feet_apply: "confident" }, ran), withFeet), "twist+limits · feet locked confident");
 });

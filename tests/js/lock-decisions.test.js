@@ -1,7 +1,7 @@
 // Unit tests of the foot-lock decisions' pure helpers (node --test).
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { acceptedCount, decidableLocks, downloadText, lockKeyTarget, lockLabel, mergedHistory, reviewedFormat } from "../../frontend/js/lock-decisions.js";
+import { decidableLocks, downloadText, keptCount, lockKept, lockKeyTarget, lockLabel, mergedHistory, reviewedFormat, runLockText } from "../../frontend/js/lock-decisions.js";
 
 const skate = { kind: "skate", id: "skate-left-32", foot: "left", start_frame: 32, end_frame: 47, joint: "CC_Base_L_Foot" };
 
@@ -19,14 +19,32 @@ test("the reviewed download is BVH for a motion take, C3D for a take the run wro
   assert.equal(reviewedFormat({ kind: "keypoints" }), null);
 });
 
-test("the download link says how many foot locks it applies: accepted ones only", () => {
+test("the download link says how many foot locks it applies: accepted ones, and undecided ones the run locked", () => {
   const latest = new Map([["skate-left-32", "accept"], ["skate-right-9", "reject"], ["skate-left-80", "accept"]]);
-  assert.equal(acceptedCount(latest), 2);
-  assert.equal(acceptedCount(new Map()), 0);
+  const cleanupOff = new Map(["skate-left-32", "skate-right-9", "skate-left-80", "skate-right-99"].map((id) => [id, { id, applied: false }]));
+  assert.equal(keptCount(cleanupOff, latest), 2);
+  assert.equal(keptCount(cleanupOff, new Map()), 0);
+  const runLocked = new Map([...cleanupOff].map(([id, lock]) => [id, { ...lock, applied: true }]));
+  // The run locked all four: the rejected one is undone, the undecided one follows the run.
+  assert.equal(keptCount(runLocked, latest), 3);
+  assert.equal(keptCount(runLocked, new Map()), 4);
+  assert.equal(lockKept({ applied: true }, "reject"), false);
+  assert.equal(lockKept({ applied: false }, "accept"), true);
+  assert.equal(lockKept({ applied: true }, undefined), true);
+  assert.equal(lockKept({}, undefined), false); // a run recorded before the flag locked none
   assert.equal(downloadText(0, 0), "Download reviewed take");
   assert.equal(downloadText(3, 0), "Download reviewed take (no foot lock applied of 3)");
   assert.equal(downloadText(3, 1), "Download reviewed take (1 foot lock applied of 3)");
   assert.equal(downloadText(3, 2), "Download reviewed take (2 foot locks applied of 3)");
+});
+
+test("a lock's cell says what the run chose: cleanup off by default, else locked or not", () => {
+  assert.equal(runLockText(undefined).notLocked, "run: cleanup off");
+  assert.equal(runLockText("none").notLocked, "run: cleanup off");
+  const confident = runLockText("confident");
+  assert.equal(confident.locked, "run: locked");
+  assert.equal(confident.notLocked, "run: not locked");
+  assert.match(confident.title, /confident/);
 });
 
 test("both histories merge newest first", () => {

@@ -2,7 +2,7 @@
 // moves and the hover label (node --test).
 import assert from "node:assert/strict";
 import { test } from "node:test";
-import { dragged, drawnSkeleton, floorPlane, hoverLabel, writePoints, writeSegments, writeTriads, zoomed } from "../../frontend/js/scene-data.js";
+import { dragged, drawnSkeleton, floorLabel, floorPlane, hoverLabel, writePoints, writeSegments, writeTriads, zoomed } from "../../frontend/js/scene-data.js";
 
 test("bones come from the take, else from the parents", () => {
   const parents = [-1, 0, 1];
@@ -87,11 +87,79 @@ test("a Z-up or downward axis moves the plane onto that axis, signed", () => {
   const zUp = floorPlane({ up_axis: "Z", floor: 10 }, [frames]);
   assert.equal(zUp.axis, 2);
   for (let c = 0; c < 4; c++) assert.equal(zUp.positions[3 * c + 2], 10);
-  // y down (MediaPipe's world): heights are -y, so the floor at height 0.9 is the plane y = -0.9.
+  // y down (MediaPipe's world, origin at the hips): `floor` is the floor's coordinate on the axis,
+  // the feet's y (0.9, below the hips), not their height (-0.9).
   const yDown = floorPlane({ up_axis: "-Y", floor: 0.9 }, [frames]);
   assert.equal(yDown.axis, 1);
-  assert.ok(Math.abs(yDown.level + 0.9) < 1e-9);
-  for (let c = 0; c < 4; c++) assert.ok(Math.abs(yDown.positions[3 * c + 1] + 0.9) < 1e-6);
+  assert.ok(Math.abs(yDown.level - 0.9) < 1e-9);
+  for (let c = 0; c < 4; c++) assert.ok(Math.abs(yDown.positions[3 * c + 1] - 0.9) < 1e-6);
+});
+
+/** The four corners of a plane as [x, y, z] lists. */
+const cornersOf = (plane) => [0, 1, 2, 3].map((c) => [...plane.positions.slice(3 * c, 3 * c + 3)]);
+
+test("a level floor stays level, whatever its check says besides", () => {
+  const frames = [[[0, 5, 0], [4, 9, -3]]];
+  const bare = floorPlane({ up_axis: "Y", floor: 0.8 }, [frames]);
+  const level = { up_axis: "Y", floor: 0.8, floor_check: { tilted: false, tilt_deg: 0.1, plane_gradient: null, plane_origin: [1, 2] } };
+  // A gradient of a floor not found tilted is not drawn either.
+  const untilted = { ...level, floor_check: { ...level.floor_check, plane_gradient: [0.5, 0.5] } };
+  for (const feet of [level, untilted]) {
+    const plane = floorPlane(feet, [frames]);
+    assert.equal(plane.tilted, false);
+    assert.deepEqual([...plane.positions], [...bare.positions]);
+  }
+  assert.equal(bare.tilted, false);
+  for (const c of cornersOf(bare)) assert.ok(Math.abs(c[1] - 0.8) < 1e-6);
+  // Tilted but without a fitted plane: drawn level.
+  const noPlane = floorPlane({ ...level, floor_check: { tilted: true, tilt_deg: 3, plane_gradient: null, plane_origin: [0, 0] } }, [frames]);
+  assert.equal(noPlane.tilted, false);
+  assert.deepEqual([...noPlane.positions], [...bare.positions]);
+});
+
+test("a tilted floor is drawn as the fitted plane: every corner on it, not level", () => {
+  const frames = [[[0, 5, 0], [4, 9, -3]], [[2, 1, 1]]];
+  const check = { tilted: true, tilt_deg: 3.2, plane_gradient: [0.05, -0.02], plane_origin: [1.5, -1] };
+  const plane = floorPlane({ up_axis: "Y", floor: 0.8, floor_check: check }, [frames]);
+  assert.equal(plane.tilted, true);
+  assert.equal(plane.axis, 1);
+  assert.ok(Math.abs(plane.level - 0.8) < 1e-9);
+  const corners = cornersOf(plane);
+  // u = x, w = z (the axes other than Y, in order): y = floor + (x - 1.5) 0.05 + (z + 1) (-0.02).
+  for (const [x, y, z] of corners) assert.ok(Math.abs(y - (0.8 + (x - 1.5) * 0.05 - (z + 1) * 0.02)) < 1e-6);
+  const heights = corners.map((c) => c[1]);
+  assert.ok(Math.max(...heights) - Math.min(...heights) > 0.1);
+  // The horizontal extent is the level plane's.
+  const level = floorPlane({ up_axis: "Y", floor: 0.8 }, [frames]);
+  for (const [k, c] of cornersOf(level).entries()) { assert.equal(c[0], corners[k][0]); assert.equal(c[2], corners[k][2]); }
+});
+
+test("a tilted floor on a Z-up or downward axis follows the axis' sign", () => {
+  const frames = [[[0, 0, 10], [3, 6, 20]]];
+  const check = { tilted: true, tilt_deg: 2, plane_gradient: [0.1, 0.03], plane_origin: [1, 2] };
+  // Z up: u = x, w = y.
+  const zUp = floorPlane({ up_axis: "Z", floor: 10, floor_check: check }, [frames]);
+  assert.equal(zUp.axis, 2);
+  for (const [x, y, z] of cornersOf(zUp)) assert.ok(Math.abs(z - (10 + (x - 1) * 0.1 + (y - 2) * 0.03)) < 1e-5);
+  // y down: heights are -y, so a floor rising (in height) along +x has y falling along +x.
+  const yDown = floorPlane({ up_axis: "-Y", floor: 0.9, floor_check: check }, [frames]);
+  assert.equal(yDown.axis, 1);
+  assert.equal(yDown.tilted, true);
+  for (const [x, y, z] of cornersOf(yDown)) assert.ok(Math.abs(y - (0.9 - ((x - 1) * 0.1 + (z - 2) * 0.03))) < 1e-6);
+  const byX = cornersOf(yDown).sort((a, b) => a[0] - b[0]);
+  assert.ok(byX[3][1] < byX[0][1]);
+  // X up: u = y, w = z.
+  const xUp = floorPlane({ up_axis: "X", floor: -1, floor_check: check }, [frames]);
+  assert.equal(xUp.axis, 0);
+  for (const [x, y, z] of cornersOf(xUp)) assert.ok(Math.abs(x - (-1 + (y - 1) * 0.1 + (z - 2) * 0.03)) < 1e-5);
+});
+
+test("the floor's label says when the floor is tilted, by how much", () => {
+  assert.equal(floorLabel(null), "floor");
+  assert.equal(floorLabel({ up_axis: "Y", floor: 0 }), "floor");
+  assert.equal(floorLabel({ floor_check: { tilted: false, tilt_deg: 0.4 } }), "floor");
+  assert.equal(floorLabel({ floor_check: { tilted: true, tilt_deg: 3.24 } }), "floor (tilted 3.2°)");
+  assert.equal(floorLabel({ floor_check: { tilted: true, tilt_deg: null } }), "floor (tilted)");
 });
 
 test("no plane without a feet step, a floor or a present point; a flat take still gets an area", () => {

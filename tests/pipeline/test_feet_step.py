@@ -5,8 +5,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from mocapqa.errors import InputError
+from mocapqa.feet.pin import marker_foot_members
 from mocapqa.io.formats import read_take
 from mocapqa.pipeline.analyze import AnalysisResult, analyze
 from mocapqa.pipeline.feet import check_take_feet, feet_report_json
@@ -15,6 +18,7 @@ from mocapqa.pipeline.options import AnalysisOptions, describe_options, take_che
 from mocapqa.pipeline.summary import FEET_FIELDS, qa_summary
 
 SKATING = Path("bvh/cmu/iclone/007_04.bvh")  # a real 1.4-cm slide: skate findings
+TENNIS = Path("c3d/optitrack/kinematics_tennis_serve.c3d")  # skate findings on marker feet
 NO_FEET = Path("c3d/btk/MotionMonitorC3D.c3d")  # markers M1–M7, no foot markers
 SHARED = ("kind", "joint", "start_frame", "end_frame", "value", "unit", "confidence")
 
@@ -94,3 +98,25 @@ def test_a_take_without_feet_skips_the_step_with_the_reason(corpus_dir: Path) ->
     assert result.report["series"].get("feet") is None
     summary = qa_summary(result)
     assert all(summary[k] is None for k in FEET_FIELDS)
+
+
+def test_a_run_that_locks_feet_pins_only_the_foot_markers_of_its_skates(corpus_dir: Path) -> None:
+    take = read_take(corpus_dir / TENNIS)
+    plain = analyze(take, AnalysisOptions(checks=("feet",)))
+    locked = analyze(take, AnalysisOptions(checks=("feet",), feet_apply="skates"))
+    skates = [f for f in locked.report["findings"] if f["kind"] == "skate"]
+    assert skates
+    assert all(f["applied"] is True for f in skates)
+    assert all(f["applied"] is False for f in plain.report["findings"] if f["kind"] == "skate")
+    # Only the foot markers move (the heel, toe, ankle and foot-cluster ones of each side).
+    points, _, _ = check_take_feet(take)
+    _, members = marker_foot_members(take.names, points)
+    feet = sorted({m for side in members for m in side})
+    moved = np.flatnonzero(
+        np.nanmax(np.abs(locked.corrected_points - plain.corrected_points), axis=(0, 2)) > 0
+    )
+    assert moved.size
+    assert set(moved.tolist()) <= set(feet)
+    # Nothing is locked for a choice that names no skate of the take's: the run fails, naming it.
+    with pytest.raises(InputError, match="skate-left-99999"):
+        analyze(take, AnalysisOptions(checks=("feet",), feet_apply="skate-left-99999"))

@@ -94,7 +94,8 @@ class SwapOut(BaseModel):
 
 class LockOut(BaseModel):
     """The foot lock of a skate finding of the run (its feet step) with its newest decision.
-    Cleanup is off by default: only an accepted lock is applied by the decided download."""
+    The decided download locks it when accepted, or undecided and locked by the run (its
+    ``feet_apply``; cleanup is off by default, so a default run locks none)."""
 
     id: str = Field(description="The skate finding's id, as ``mocapqa feet fix --apply`` takes it")
     foot: Literal["left", "right"]
@@ -106,7 +107,12 @@ class LockOut(BaseModel):
     confidence: float | None = Field(description="That of the contact the skate lies in")
     speed_cm_s: float | None
     decision: Decision | None = Field(description="The newest decision, None without one")
-    applied: bool = Field(description="Whether the decided download locks it: accepted only")
+    run_applied: bool = Field(
+        False, description="Whether the run's own corrected take locks it (its feet_apply choice)"
+    )
+    applied: bool = Field(
+        description="Whether the decided download locks it: accepted, or undecided and run_applied"
+    )
 
 
 class DecisionsOut(BaseModel):
@@ -123,6 +129,9 @@ class DecisionsOut(BaseModel):
     swaps: list[SwapOut] = Field(description="A marker run's swaps")
     history: list[DecisionOut] = Field(
         description="Every decision on a twist interval or swap, newest first"
+    )
+    lock_apply: str = Field(
+        "none", description="The run's rule for undecided foot locks: its feet_apply choice"
     )
     locks: list[LockOut] = Field(
         [], description="The foot locks of the run's skate findings (empty without the feet check)"

@@ -222,7 +222,8 @@ def feet_fix(
         typer.Option(
             "--apply",
             help="Which contacts to lock: confident (skate findings whose contact confidence is "
-            "at least 0.5), all (every contact), none, or comma-separated ids from "
+            "at least 0.5), skates (every skate finding's), all (every contact), none, or "
+            "comma-separated ids from "
             "`mocapqa feet check --json` (skate findings, contacts).",
         ),
     ] = "confident",
@@ -244,7 +245,7 @@ def feet_fix(
     from mocapqa.pipeline.feet import check_take_feet, feet_params_of
 
     if not apply.strip() or (apply.strip().startswith(",") or apply.strip().endswith(",")):
-        raise InputError(f"Expected --apply confident, all, none or ids, got {apply!r}")
+        raise InputError(f"Expected --apply confident, skates, all, none or ids, got {apply!r}")
     read, roles = _read_take(take, fps, length_unit, mapping, root_translation)
     markers = not isinstance(read, Motion) and read.source_format == "c3d"
     params = feet_params_of(read)

@@ -3,6 +3,7 @@ confidence of a skate finding, and the choice itself."""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from typing import Any
 
@@ -12,12 +13,23 @@ from mocapqa.feet.findings import Finding
 
 __all__ = [
     "CONFIDENT",
+    "RUN_APPLY_CHOICES",
     "add_ids",
+    "check_apply",
     "choose_locks",
     "contact_id",
     "finding_confidence",
     "finding_id",
+    "locked_findings",
 ]
+
+RUN_APPLY_CHOICES = ("none", "confident", "skates")
+"""The named choices of a run's ``feet_apply`` (besides ids): no lock (the default: cleanup is
+off), the contacts of the confident skate findings, the contacts of every skate finding. A run
+offers no ``all`` (every contact): its locks are its skate findings, each one a reviewer can
+accept or reject."""
+
+_SKATE_ID = re.compile(r"^skate-(left|right)-\d{1,9}$")
 
 CONFIDENT = 0.5
 """Contact confidence (:mod:`mocapqa.feet.contacts`) at and above which ``--apply confident``
@@ -71,8 +83,9 @@ def choose_locks(
     ----------
     apply : str
         ``"confident"`` (the contacts of skate findings whose contact confidence is at least
-        ``confident``), ``"all"`` (every foot contact), ``"none"``, or comma-separated ids of
-        skate findings (:func:`finding_id`) and contacts (:func:`contact_id`).
+        ``confident``), ``"skates"`` (the contacts of every skate finding), ``"all"`` (every
+        foot contact), ``"none"``, or comma-separated ids of skate findings
+        (:func:`finding_id`) and contacts (:func:`contact_id`).
     contacts, findings : sequence
         From the feet check.
     skipped : int
@@ -95,6 +108,8 @@ def choose_locks(
         chosen = []
     elif apply == "all":
         chosen = list(contacts)
+    elif apply == "skates":
+        chosen = [_contact_of(f, contacts) for f in skates]
     elif apply == "confident":
         chosen = [
             _contact_of(f, contacts)
@@ -119,12 +134,54 @@ def choose_locks(
             else:
                 known = [finding_id(f, skipped) for f in skates] + list(by_contact)[:4]
                 raise InputError(
-                    "Expected --apply confident, all, none or comma-separated ids from "
+                    "Expected --apply confident, skates, all, none or comma-separated ids from "
                     f"`mocapqa feet check --json`, got {key!r} (ids here: "
                     f"{', '.join(known) or 'none'}{', ...' if len(by_contact) > 4 else ''})"
                 )
     unique = {(c.foot, c.start): c for c in chosen}
     return [unique[k] for k in sorted(unique, key=lambda k: (k[1], k[0]))]
+
+
+def locked_findings(
+    apply: str, contacts: Sequence[Contact], findings: Sequence[Finding], skipped: int = 0
+) -> set[str]:
+    """The ids (:func:`finding_id`) of the skate findings whose contact ``apply`` locks
+    (:func:`choose_locks`): a run's ``applied`` foot locks.
+
+    Raises
+    ------
+    InputError
+        As :func:`choose_locks`.
+    """
+    chosen = {(c.foot, c.start) for c in choose_locks(apply, contacts, findings, skipped)}
+    return {
+        finding_id(f, skipped)
+        for f in findings
+        if f.kind == "skate" and ((c := _contact_of(f, contacts)).foot, c.start) in chosen
+    }
+
+
+def check_apply(apply: str, named: Sequence[str] = RUN_APPLY_CHOICES) -> str:
+    """``apply`` stripped when it is one of ``named`` or comma-separated ids of skate findings
+    (``skate-left-120``), whether the take has them or not (:func:`choose_locks` checks that on
+    the take). A run's locks are its skate findings, each one decided on its own: contact ids,
+    which ``mocapqa feet fix --apply`` also takes, are refused here.
+
+    Raises
+    ------
+    InputError
+        Naming what was expected.
+    """
+    value = apply.strip()
+    if value in named:
+        return value
+    keys = [key.strip() for key in value.split(",")]
+    if not value or len(keys) > 1000 or not all(_SKATE_ID.match(key) for key in keys):
+        raise InputError(
+            f"Expected {', '.join(named)} or comma-separated ids of skate findings "
+            f"('skate-left-120,skate-right-348'), got {apply[:80]!r}"
+        )
+    return ",".join(keys)
 
 
 def add_ids(

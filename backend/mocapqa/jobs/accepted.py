@@ -4,21 +4,22 @@ A motion run's corrections are its twist intervals; a marker run's (the ``marker
 C3D or TRC take) its swaps. An item's newest decision wins; an item with none follows the run's
 own choice (its ``applied`` flag: ``twist_apply`` for intervals, the confident rule for swaps).
 Beside them, a run with the feet check has foot locks, one per skate finding
-(:func:`run_locks`): cleanup is off by default, so only an accepted lock is applied
-(:mod:`mocapqa.jobs.decided_feet`), after the other corrections.
+(:func:`run_locks`): a lock is kept when accepted, or undecided and locked by the run (its
+``feet_apply`` choice; cleanup is off by default, so a default run's undecided locks are not),
+and applied after the other corrections (:mod:`mocapqa.jobs.decided_feet`).
 
 * The decided motion is the raw take with exactly the levels of the intervals kept corrected
-  removed (:func:`mocapqa.twist.levels.remove_levels`), then its accepted foot locks solved
+  removed (:func:`mocapqa.twist.levels.remove_levels`), then its kept foot locks solved
   (leg joints only). No motion filter is applied, whatever the run's options. A motion run
   with the feet check but without the twist check has locks only.
 * The decided marker take is the raw take with exactly the swaps kept corrected exchanged, then
   its gaps filled by the run's rule (the confident fills, chosen again on that take:
-  :func:`mocapqa.pipeline.marker_step.decided_repair`), then its accepted foot locks pinned,
+  :func:`mocapqa.pipeline.marker_step.decided_repair`), then its kept foot locks pinned,
   written as C3D like the run's ``corrected.c3d``
   (:func:`mocapqa.jobs.run_folder.write_corrected_c3d`), or as TRC (a TRC take's, or a C3D
   take's for OpenSim: :func:`decided_trc`). No filter. A marker run with the feet check but
   without the markers check has locks only: its decided take is the raw take (no swap
-  exchanged, no gap filled) with its accepted foot locks pinned.
+  exchanged, no gap filled) with its kept foot locks pinned.
 
 Neither touches the stored take, the run's own files or the take's review.
 """
@@ -40,7 +41,7 @@ from mocapqa.core.motion import Motion
 from mocapqa.errors import ConflictError, NotFoundError
 from mocapqa.io.bvh_write import format_bvh
 from mocapqa.io.trc import format_trc
-from mocapqa.jobs.decided_feet import accepted_locks, lock_accepted_markers, lock_accepted_motion
+from mocapqa.jobs.decided_feet import kept_locks, lock_kept_markers, lock_kept_motion
 from mocapqa.jobs.run_folder import RunFolder, read_options_of, write_corrected_c3d
 from mocapqa.markers.fill import FillResult
 from mocapqa.markers.repair import MarkerRepair
@@ -69,7 +70,7 @@ _SWAP_FIELDS = ("id", "markers", "start_frame", "end_frame", "confidence", "appl
 """The fields of a ``swap`` finding a decision list shows."""
 _LOCK_FIELDS = (
     "id", "foot", "joint", "start_frame", "end_frame", "value", "unit", "confidence",
-    "speed_cm_s",
+    "speed_cm_s", "applied",
 )  # fmt: skip
 """The fields of a ``skate`` finding a decision list shows of its foot lock."""
 
@@ -237,7 +238,7 @@ def decided_motion(
     locks: Mapping[str, str] | None = None,
 ) -> Motion:
     """The raw take with the levels of the intervals the decisions keep corrected removed,
-    then the accepted foot locks solved.
+    then the kept foot locks solved.
 
     Parameters
     ----------
@@ -247,12 +248,13 @@ def decided_motion(
         Twist interval id → its newest decision.
     limits : ReadLimits, optional
     locks : mapping of str to str, optional
-        Foot lock id → its newest decision; only accepted locks are applied.
+        Foot lock id → its newest decision; the locks kept are applied
+        (:func:`mocapqa.jobs.decided_feet.lock_kept`).
 
     Raises
     ------
     ConflictError
-        For a keypoint take, a run with neither the twist nor the feet check, or accepted
+        For a keypoint take, a run with neither the twist nor the feet check, or kept
         locks the take's feet check no longer finds.
     NotFoundError
         When the take's file is gone.
@@ -275,8 +277,8 @@ def decided_motion(
             )
     mapping = AnalysisOptions.from_json(run["options"]).mapping
     decided = remove_levels(raw, levels, mapping)
-    accepted = accepted_locks(found.locks or (), locks or {})
-    return lock_accepted_motion(raw, decided, accepted, mapping, run_id)
+    kept = kept_locks(found.locks or (), locks or {})
+    return lock_kept_motion(raw, decided, kept, mapping, run_id)
 
 
 def _raw_take(
@@ -320,8 +322,8 @@ def _decided_markers(
 ) -> tuple[Path, KeypointSequence, MarkerRepair]:
     """The stored file of a marker take, the take as the run read it, and its repair with
     exactly the swaps the decisions keep corrected, its gaps filled by the run's rule and its
-    accepted foot locks pinned (:func:`decided_c3d`); a run without the markers check
-    (:func:`_marker_swaps`) has the take as read with its accepted foot locks pinned."""
+    kept foot locks pinned (:func:`decided_c3d`); a run without the markers check
+    (:func:`_marker_swaps`) has the take as read with its kept foot locks pinned."""
     run_id = str(run["id"])
     listed = _marker_swaps(files, run_id, take)
     path, raw = _raw_take(files, take, limits)
@@ -348,12 +350,12 @@ def _pinned(
     run_id: str,
     locks: Mapping[str, str] | None,
 ) -> MarkerRepair:
-    """``repair`` with the run's accepted foot locks (``locks``: id → newest decision)
+    """``repair`` with the run's kept foot locks (``locks``: id → newest decision)
     pinned on its positions."""
-    accepted = accepted_locks(_items_of(files, run_id).locks or (), locks or {})
-    if not accepted:
+    kept = kept_locks(_items_of(files, run_id).locks or (), locks or {})
+    if not kept:
         return repair
-    pinned = lock_accepted_markers(raw, repair.positions, accepted, run_id)
+    pinned = lock_kept_markers(raw, repair.positions, kept, run_id)
     return dataclasses.replace(repair, positions=pinned)
 
 
@@ -367,8 +369,8 @@ def decided_c3d(
 ) -> bytes:
     """The C3D of a marker take with exactly the swaps the decisions keep corrected repaired,
     then its gaps filled by the run's rule, as the run's ``corrected.c3d`` is written, then
-    its accepted foot locks pinned (``locks``: lock id → its newest decision). A run of the
-    feet check without the markers check gives the raw take with its accepted locks pinned.
+    its kept foot locks pinned (``locks``: lock id → its newest decision). A run of the
+    feet check without the markers check gives the raw take with its kept locks pinned.
 
     Raises
     ------
@@ -401,9 +403,9 @@ def decided_trc(
 ) -> bytes:
     """The TRC of a marker take (a TRC or a C3D take) decided as :func:`decided_c3d` decides
     it: exactly the swaps the decisions keep corrected repaired, its gaps filled by the run's
-    rule, its accepted foot locks pinned; written by :func:`mocapqa.io.trc.format_trc` with the
+    rule, its kept foot locks pinned; written by :func:`mocapqa.io.trc.format_trc` with the
     take's rate, unit, marker names, frame numbers and times as the run read them (a run of the
-    feet check without the markers check: the raw take with its accepted locks pinned). TRC has no
+    feet check without the markers check: the raw take with its kept locks pinned). TRC has no
     residual: a filled sample is a value like any other (the run's ``gap`` findings list the
     filled gaps) and a sample still missing is ``NaN``.
 

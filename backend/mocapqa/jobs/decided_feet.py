@@ -1,14 +1,16 @@
-"""The foot locks of a run that reviewers accepted, applied to its decided take.
+"""The foot locks a run's decided take keeps (accepted, or undecided and locked by the run),
+applied to it.
 
 A run's foot locks are its feet step's skate findings (``id`` ``skate-left-120``, as
-``mocapqa feet fix --apply`` takes them). Cleanup is off by default: a lock is applied only
-when its newest decision is ``accept``; an undecided or rejected lock leaves the foot as
-recorded.
+``mocapqa feet fix --apply`` takes them). A lock is applied when its newest decision is
+``accept``, or when it has none and the run locked it (its ``applied`` flag, the run's
+``feet_apply`` choice: ``"none"`` by default, cleanup is off); a rejected lock, and an
+undecided one the run did not lock, leave the foot as recorded.
 
 The locks are chosen and applied by the code of ``mocapqa feet fix --apply ID,ID``
 (:func:`mocapqa.feet.fix.fix_feet`): the feet check runs again on the take as the run read it
 (:func:`mocapqa.pipeline.feet.check_take_feet`, the check of the run's feet step, so the ids
-are the run's), each accepted skate finding gives its foot contact
+are the run's), each kept skate finding gives its foot contact
 (:func:`mocapqa.feet.fix_choice.choose_locks`), and
 
 * a BVH take's decided motion (its accepted twist intervals removed) has those contacts
@@ -37,29 +39,38 @@ from mocapqa.pipeline.feet import check_take_feet, feet_params_of
 
 __all__ = [
     "FOOT_MARKER_ROLES",
-    "accepted_locks",
-    "lock_accepted_markers",
-    "lock_accepted_motion",
+    "kept_locks",
+    "lock_kept",
+    "lock_kept_markers",
+    "lock_kept_motion",
     "marker_foot_members",
 ]
 
 
-def accepted_locks(locks: Sequence[Mapping[str, Any]], latest: Mapping[str, str]) -> list[str]:
-    """The ids of the locks whose newest decision is ``accept``, in the order of ``locks``.
+def lock_kept(lock: Mapping[str, Any], decision: str | None) -> bool:
+    """Whether the decided take locks ``lock`` (a skate finding of the run, with its ``applied``
+    flag; a run recorded before the flag has none, and locked nothing): accepted, or undecided
+    and locked by the run."""
+    return bool(lock.get("applied")) if decision is None else decision == "accept"
+
+
+def kept_locks(locks: Sequence[Mapping[str, Any]], latest: Mapping[str, str]) -> list[str]:
+    """The ids of the locks the decided take locks (:func:`lock_kept`), in the order of
+    ``locks``.
 
     Parameters
     ----------
     locks : sequence of mapping
-        The run's foot locks (its skate findings), each with its ``id``.
+        The run's foot locks (its skate findings), each with its ``id`` and ``applied``.
     latest : mapping of str to str
         Lock id → its newest decision (``"accept"`` or ``"reject"``); an id without one is
-        undecided, and not applied.
+        undecided, and follows the run.
     """
-    return [str(lock["id"]) for lock in locks if latest.get(str(lock["id"])) == "accept"]
+    return [str(lock["id"]) for lock in locks if lock_kept(lock, latest.get(str(lock["id"])))]
 
 
 def _check_found(report: FeetReport, skipped: int, ids: Sequence[str], run_id: str) -> None:
-    """Raise unless the check of the take still finds every accepted skate finding ``ids``.
+    """Raise unless the check of the take still finds every kept skate finding ``ids``.
 
     Raises
     ------
@@ -75,14 +86,14 @@ def _check_found(report: FeetReport, skipped: int, ids: Sequence[str], run_id: s
         )
 
 
-def lock_accepted_motion(
+def lock_kept_motion(
     raw: Motion,
     decided: Motion,
     ids: Sequence[str],
     mapping: Mapping[str, str] | None,
     run_id: str,
 ) -> Motion:
-    """Lock the feet of a decided BVH take during the contacts of the accepted skate findings.
+    """Lock the feet of a decided BVH take during the contacts of the kept skate findings.
 
     Parameters
     ----------
@@ -92,7 +103,7 @@ def lock_accepted_motion(
         The same take with the reviewers' other corrections (twist intervals); the locks are
         solved on it.
     ids : sequence of str
-        Accepted skate finding ids (:func:`accepted_locks`); none returns ``decided`` itself.
+        Skate finding ids kept (:func:`kept_locks`); none returns ``decided`` itself.
     mapping : mapping, optional
         The run's role mapping.
     run_id : str
@@ -107,7 +118,7 @@ def lock_accepted_motion(
     Raises
     ------
     ConflictError
-        If the take's check no longer finds an accepted finding.
+        If the take's check no longer finds a kept finding.
     """
     if not ids:
         return decided
@@ -119,10 +130,10 @@ def lock_accepted_motion(
     return fixed.take if isinstance(fixed.take, Motion) else decided
 
 
-def lock_accepted_markers(
+def lock_kept_markers(
     raw: KeypointSequence, positions: FloatArray, ids: Sequence[str], run_id: str
 ) -> FloatArray:
-    """Pin the feet of a decided marker take (C3D or TRC) during the contacts of the accepted skate
+    """Pin the feet of a decided marker take (C3D or TRC) during the contacts of the kept skate
     findings.
 
     Parameters
@@ -145,7 +156,7 @@ def lock_accepted_markers(
     Raises
     ------
     ConflictError
-        If the take's check no longer finds an accepted finding.
+        If the take's check no longer finds a kept finding.
     """
     if not ids:
         return positions

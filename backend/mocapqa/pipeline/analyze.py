@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -33,7 +33,7 @@ from mocapqa.errors import InputError
 from mocapqa.kinematics.bindpose import leading_bind_pose
 from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
 from mocapqa.markers.repair import MarkerRepair
-from mocapqa.pipeline.feet_step import run_feet
+from mocapqa.pipeline.feet_step import lock_run_feet, run_feet
 from mocapqa.pipeline.frames import motion_pose, rigid_bones
 from mocapqa.pipeline.loading import Take
 from mocapqa.pipeline.marker_step import run_markers
@@ -53,6 +53,8 @@ __all__ = ["AnalysisResult", "ProgressCallback", "analyze", "series_json"]
 ProgressCallback = Callable[[int, str], None]
 """Called as ``progress(percent, step)`` with percent in 0–100."""
 
+_Take = TypeVar("_Take", Motion, KeypointSequence)
+
 
 @dataclass(frozen=True, slots=True)
 class AnalysisResult:
@@ -63,7 +65,7 @@ class AnalysisResult:
     report : dict
         JSON-ready report (summary, steps, findings, series).
     corrected_motion : Motion, optional
-        Twist-refined (and optionally filtered) motion, for BVH takes.
+        Twist-refined (and optionally filtered, then foot-locked) motion, for BVH takes.
     filtered_keypoints : KeypointSequence, optional
         Filtered keypoints, for keypoint takes.
     raw_points : ndarray, shape (F, P, 3)
@@ -147,8 +149,29 @@ def _feet_step(
     progress(percent, "feet and floor check")
     mapping = options.mapping if isinstance(take, Motion) else None
     with steps.timed("feet_s"):
-        outcome = run_feet(take, mapping)
+        outcome = run_feet(take, mapping, options.feet_apply)
     steps.record("feet", outcome, plot=outcome.state == "done")
+
+
+def _feet_locks(
+    checked: _Take,
+    target: _Take,
+    options: AnalysisOptions,
+    progress: ProgressCallback,
+    steps: StepLog,
+) -> _Take:
+    """The corrected take with the foot contacts of the run's ``feet_apply`` locked, the last
+    correction (nothing moves a planted foot after it); ``target`` itself when the choice is
+    ``"none"`` or the feet step did not run to the end."""
+    feet = steps.outcomes.get("feet")
+    if options.feet_apply == "none" or feet is None or feet.state != "done":
+        return target
+    progress(80, "locking planted feet")
+    with steps.timed("feet_lock_s"):
+        locked = lock_run_feet(checked, target, options.feet_apply, options.mapping or None)
+    if not isinstance(locked, type(target)):  # pragma: no cover - fix_feet keeps the kind
+        raise TypeError(f"Expected a locked {type(target).__name__}, got {type(locked).__name__}")
+    return locked
 
 
 def _motion_checks(
@@ -246,6 +269,7 @@ def _analyze_motion(
         names, parents, raw_points, raw_rotations = motion_pose(motion)
     corrected = _motion_checks(motion, options, progress, catalog, steps, prior)
     corrected = _motion_filter(corrected, options, progress, steps)
+    corrected = _feet_locks(motion, corrected, options, progress, steps)
     steps.skip("markers", "BVH takes have joints, not markers")
 
     progress(85, "forward kinematics (corrected)")
@@ -340,6 +364,7 @@ def _analyze_keypoints(
     corrected = _keypoint_markers(sequence, options, progress, steps)
     _feet_step(sequence, options, progress, 25, steps)  # the feet of the take as read
     filtered = _keypoint_filter(corrected, options, progress, steps)
+    filtered = _feet_locks(sequence, filtered, options, progress, steps)
     progress(85, "collecting results")
     # Missing keypoints stay NaN: drawing them at the origin would show points never seen.
     points: dict[str, Any] = {

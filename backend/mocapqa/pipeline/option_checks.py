@@ -13,6 +13,7 @@ from typing import Any, Literal, get_args
 
 from mocapqa.core.rig import normalise_mapping
 from mocapqa.errors import InputError, OptionError
+from mocapqa.feet.fix_choice import check_apply
 from mocapqa.filters.apply import apply_overrides
 from mocapqa.filters.registry import FILTERS, DataScale
 from mocapqa.limits.catalog import check_model_name
@@ -26,6 +27,7 @@ __all__ = [
     "check_filter_params",
     "check_mapping",
     "checks_option",
+    "feet_apply_option",
     "filter_option",
     "model_option",
 ]
@@ -101,6 +103,15 @@ def apply_option(apply: str) -> str:
     except InputError as e:
         raise OptionError("twist_apply", str(e)) from e
     return apply
+
+
+def feet_apply_option(apply: str) -> str:
+    """The ``feet_apply`` option, once :func:`mocapqa.feet.fix_choice.check_apply` reads it
+    (whether the take has the ids named is the run's to find out)."""
+    try:
+        return check_apply(apply)
+    except InputError as e:
+        raise OptionError("feet_apply", str(e)) from e
 
 
 def filter_option(method: str | None) -> str | None:

@@ -13,6 +13,7 @@ from typing import Any, Self
 
 from mocapqa.core.rig import ROLE_KEYS
 from mocapqa.errors import InputError, OptionError
+from mocapqa.feet.fix_choice import RUN_APPLY_CHOICES
 from mocapqa.filters.registry import FILTERS
 from mocapqa.pipeline.option_checks import (
     CHECKS,
@@ -22,6 +23,7 @@ from mocapqa.pipeline.option_checks import (
     check_filter_params,
     check_mapping,
     checks_option,
+    feet_apply_option,
     filter_option,
     model_option,
 )
@@ -43,6 +45,7 @@ __all__ = [
     "CHECKS",
     "DEFAULT_KEYPOINT_FILTER",
     "DEFAULT_OPTIONS",
+    "FEET_APPLY_CHOICES",
     "FORM_GROUPS",
     "MARKER_FORMATS",
     "MAX_POINTS_RANGE",
@@ -102,6 +105,8 @@ TWIST_METHODS = METHODS
 """Twist detection methods (those of :mod:`mocapqa.twist.analysis`)."""
 TWIST_APPLY_CHOICES = APPLY_CHOICES
 """Which twist intervals a run applies (besides a list of interval ids such as ``"0,3"``)."""
+FEET_APPLY_CHOICES = RUN_APPLY_CHOICES
+"""Which foot locks a run applies (besides ids such as ``"skate-left-120"``); none by default."""
 MAX_POINTS_RANGE = (10, 100_000)
 """Smallest and largest ``max_points`` (time samples per plotted series)."""
 
@@ -124,6 +129,11 @@ class AnalysisOptions:
     twist_apply : str
         One of :data:`TWIST_APPLY_CHOICES` (default ``"confident"``), or comma-separated
         interval ids of the take (``"0,3"``): which detected intervals the corrected take has.
+    feet_apply : str
+        One of :data:`FEET_APPLY_CHOICES` (default ``"none"``: foot cleanup is off), or
+        comma-separated ids of skate findings and contacts (``"skate-left-120"``): which foot
+        contacts the corrected take has locked (:func:`mocapqa.feet.fix_choice.choose_locks`),
+        after every other correction and the filter.
     filter_method : str, optional
         A name from the filter registry; ``None`` means "adaptive" for keypoint takes and no
         filtering of the corrected BVH.
@@ -184,6 +194,24 @@ class AnalysisOptions:
                 choices=TWIST_APPLY_CHOICES,
                 open_choices=True,
                 check=apply_option,
+            )
+        ),
+    )
+    feet_apply: str = field(
+        default="none",
+        metadata=declare(
+            OptionSpec(
+                "text",
+                "Foot locks in the corrected take: none (cleanup off), confident (the contacts "
+                "of skate findings of confidence at least 0.5), skates (of every skate "
+                "finding), or ids ('skate-left-120'); each lock can be accepted or rejected",
+                label="planted feet locked in the corrected take",
+                group="feet",
+                form="choice",
+                choices=FEET_APPLY_CHOICES,
+                open_choices=True,
+                check=feet_apply_option,
+                check_in_request=True,
             )
         ),
     )
@@ -407,6 +435,7 @@ RUN_PRESETS: dict[str, AnalysisOptions] = {
     "filter only": AnalysisOptions(checks=("filter",)),
     "markers only": AnalysisOptions(checks=("markers",)),
     "feet only": AnalysisOptions(checks=("feet",)),
+    "full check, confident foot locks applied": AnalysisOptions(feet_apply="confident"),
 }
 """Named option sets offered by the re-run form (a preset fills the form; every field stays
 editable). The filter's own presets are the filter registry's."""

@@ -29,6 +29,7 @@ from mocapqa.jobs.accepted import (
     run_swaps,
     with_decisions,
 )
+from mocapqa.jobs.decided_feet import lock_kept
 from mocapqa.pipeline.marker_step import MARKER_APPLY
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.decisions import DecidedItem, IntervalDecisions
@@ -130,12 +131,13 @@ def list_decisions(run: DoneRunDep, services: ServicesDep, decisions: DecisionsD
     item, items, locks = run_decidables(services.files, run_id)
     decided = with_decisions(items, decisions.latest(run_id))
     latest_locks = decisions.latest_locks(run_id)
-    twist_apply = AnalysisOptions.from_json(run["options"]).twist_apply
+    options = AnalysisOptions.from_json(run["options"])
     return DecisionsOut.model_validate(
         {
             "run_id": run_id,
             "item": item,
-            "apply": twist_apply if item == "interval" else MARKER_APPLY,
+            "apply": options.twist_apply if item == "interval" else MARKER_APPLY,
+            "lock_apply": options.feet_apply,
             "intervals": decided if item == "interval" else [],
             "swaps": decided if item == "swap" else [],
             "history": [_out(r, item) for r in decisions.history(run_id)],
@@ -143,7 +145,8 @@ def list_decisions(run: DoneRunDep, services: ServicesDep, decisions: DecisionsD
                 {
                     **lock,
                     "decision": latest_locks.get(str(lock["id"])),
-                    "applied": latest_locks.get(str(lock["id"])) == "accept",
+                    "run_applied": bool(lock.get("applied")),
+                    "applied": lock_kept(lock, latest_locks.get(str(lock["id"]))),
                 }
                 for lock in locks
             ],
@@ -181,9 +184,9 @@ def add_lock_decision(
     body: DecisionIn,
 ) -> LockDecisionOut:
     """Accept or reject the foot lock of one skate finding of the run (its ``id`` in the run's
-    findings, ``skate-left-120``), kept as the interval decisions are. Cleanup is off by
-    default: the decided download locks the accepted ones only. 409 for a run without the
-    feet check."""
+    findings, ``skate-left-120``), kept as the interval decisions are. The decided download
+    locks the accepted ones, and the undecided ones the run locked (its ``feet_apply``; none
+    by default). 409 for a run without the feet check."""
     run_id = str(review.run["id"])
     locks = run_locks(review.services.files, run_id)
     if locks is None:
@@ -214,8 +217,8 @@ def add_lock_decision(
 def download_decided(run: DoneRunDep, services: ServicesDep, decisions: DecisionsDep) -> Response:
     """The raw take with exactly the accepted corrections, as BVH: the levels of accepted
     intervals removed (an undecided interval follows the run's ``twist_apply`` choice), then
-    the accepted foot locks solved on the legs (an undecided lock is not applied). No motion
-    filter is applied."""
+    the kept foot locks solved on the legs (accepted, or undecided and locked by the run's
+    ``feet_apply``). No motion filter is applied."""
     return _decided_download(run, services, decisions, _decided_bvh, "bvh")
 
 
@@ -248,8 +251,8 @@ def download_decided_c3d(
 ) -> Response:
     """The C3D of a marker take with exactly the accepted swaps repaired (an undecided swap
     follows the run's ``applied``), then its gaps filled by the run's rule (the confident
-    fills), as the run's ``corrected.c3d`` is written, then the accepted foot locks pinned
-    (an undecided lock is not applied). No filter."""
+    fills), as the run's ``corrected.c3d`` is written, then the kept foot locks pinned
+    (accepted, or undecided and locked by the run's ``feet_apply``). No filter."""
     return _decided_download(run, services, decisions, decided_c3d, "c3d")
 
 
@@ -263,7 +266,7 @@ def download_decided_trc(
 ) -> Response:
     """The TRC of a marker take (a TRC take, or a C3D take for OpenSim) decided as the C3D is:
     the accepted swaps repaired (an undecided swap follows the run's ``applied``), its gaps
-    filled by the run's rule, the accepted foot locks pinned; the take's rate, unit, marker
+    filled by the run's rule, the kept foot locks pinned; the take's rate, unit, marker
     names and frame numbers. TRC has no residual: the run's ``gap`` findings list the filled
     samples; a sample still missing is ``NaN``. 409 for a motion or keypoint take. No
     filter."""
