@@ -61,7 +61,7 @@ BINS_S = ((0.05, 0.2), (0.2, 0.5), (0.5, 1.0), (1.0, 2.0))
 SEGMENT_STD_MM = 10.0
 """Largest standard deviation (mm) of the distance between two markers of one segment."""
 
-METHOD_COLUMNS = ("spline", "rigid", "pca", "auto")
+METHOD_COLUMNS = ("spline", "rigid", "pca", "relative", "auto")
 
 FILL_CANDIDATES = tuple(
     FillParams(cv_match=match, blend_power=power)

@@ -60,9 +60,9 @@ def test_each_method_reproduces_a_hidden_real_stretch(cmu: tuple[np.ndarray, flo
         FillContext(hide(positions, MARKER, a, b), fps, FillParams(), 1.0), MARKER, a, b
     )
     truth = positions[a : b + 1, MARKER]
-    assert set(plan.fills) == {"spline", "rigid", "pca", "blend"}
+    assert set(plan.fills) == {"spline", "rigid", "pca", "relative", "blend"}
     assert plan.donors.size >= 3
-    for name, limit in (("spline", 20.0), ("rigid", 15.0), ("pca", 20.0)):
+    for name, limit in (("spline", 20.0), ("rigid", 15.0), ("pca", 20.0), ("relative", 20.0)):
         assert rmse(plan.fills[name], truth) < limit, name
         assert np.isfinite(plan.errors[name]), name
 

@@ -98,7 +98,7 @@ def test_the_blend_is_the_weighted_fill_of_the_methods(cmu: tuple[np.ndarray, fl
     hidden = positions.copy()
     hidden[a : b + 1, MARKER] = np.nan
     plan = plan_gap(FillContext(hidden, fps, FillParams(), 1.0), MARKER, a, b)
-    names = [x for x in ("spline", "rigid", "pca") if x in plan.fills]
+    names = [x for x in ("spline", "rigid", "pca", "relative") if x in plan.fills]
     assert len(names) >= 2
     assert "blend" in plan.fills
     w = blend_weights(np.array([plan.errors[x] for x in names]), FillParams().blend_power)
@@ -154,7 +154,7 @@ def test_fill_marks_blended_gaps_like_any_other(cmu: tuple[np.ndarray, float]) -
 
 
 def test_summarise_counts_the_blend() -> None:
-    sq = {"spline": 4.0, "rigid": 1.0, "pca": 1.0, "auto": 1.0}
+    sq = {"spline": 4.0, "rigid": 1.0, "pca": 1.0, "relative": 1.0, "auto": 1.0}
     events = [FillEvent("x", 0, 4, False, sq, "blend"), FillEvent("x", 0, 4, True, sq, "pca")]
     (row, *_) = summarise(events)
     assert row["chosen"]["blend"] == 1

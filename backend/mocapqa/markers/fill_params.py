@@ -8,10 +8,16 @@ import numpy as np
 
 from mocapqa.errors import OptionError
 
-__all__ = ["CHOICES", "METHODS", "FillParams"]
+__all__ = ["CHOICES", "METHODS", "PCA_FAMILY", "FillParams"]
 
-METHODS = ("spline", "rigid", "pca")
-"""The gap-fill methods: cubic spline, rigid-body from donor markers, PCA intercorrelation."""
+METHODS = ("spline", "rigid", "pca", "relative")
+"""The gap-fill methods: cubic spline, rigid-body from donor markers, PCA intercorrelation of
+the markers' positions (Gløersen & Federolf 2016), and the same PCA of their positions relative
+to their neighbours (each frame's weighted centre of the model markers taken out first)."""
+
+PCA_FAMILY = {"pca": False, "relative": True}
+"""The PCA methods, each with whether it takes the neighbours' centre out first
+(:func:`mocapqa.markers.fill_pca.pca_model`)."""
 
 CHOICES = (*METHODS, "blend")
 """What a gap's fill may be: one method or their blend, in the order used to break ties."""

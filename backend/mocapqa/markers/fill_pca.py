@@ -33,6 +33,9 @@ class PcaModel:
         ``z.T @ z``.
     mean, sd, weight : ndarray, shape (3 (K + 1),)
         Per-coordinate mean and standard deviation (file units) and marker weight.
+    centre : ndarray, shape (K,)
+        Weights (summing to 1) of the model markers whose weighted mean, per frame, is taken
+        out of every marker before the PCA; empty: none is.
     """
 
     cols: IntArray
@@ -42,6 +45,7 @@ class PcaModel:
     mean: FloatArray
     sd: FloatArray
     weight: FloatArray
+    centre: FloatArray
 
 
 def pca_model(
@@ -53,6 +57,7 @@ def pca_model(
     exclude: tuple[int, int],
     weight_scale: float,
     max_train: int,
+    centre: bool = False,
 ) -> PcaModel | None:
     """Training matrix of the PCA fill of marker ``m`` from the ``model`` markers.
 
@@ -70,6 +75,10 @@ def pca_model(
         Distance (file units) of the marker weights' fall-off.
     max_train : int
         Most training frames used (evenly spaced).
+    centre : bool
+        Take out of every marker, per frame, the mean of the model markers weighted as the
+        markers are: the PCA then models where the target sits among its neighbours, not where
+        the body is in the room.
 
     Returns
     -------
@@ -88,14 +97,34 @@ def pca_model(
     if train.size > max_train:
         train = train[np.linspace(0, train.size - 1, max_train).round().astype(np.intp)]
     xyz = positions[train[:, None], cols]
+    dist = np.linalg.norm(xyz - xyz[:, :1], axis=2).mean(axis=0)
+    near = np.exp(-((dist / weight_scale) ** 2))
+    weights = near[1:] / max(float(near[1:].sum()), np.finfo(np.float64).tiny)
+    centre_weight = weights if centre else np.zeros(0)
+    xyz = _centred(xyz, centre_weight)
     x = xyz.reshape(train.size, p)
     mean = x.mean(axis=0)
     sd = x.std(axis=0)
     sd[sd == 0] = 1.0
-    dist = np.linalg.norm(xyz - xyz[:, :1], axis=2).mean(axis=0)
-    weight = np.repeat(np.exp(-((dist / weight_scale) ** 2)), 3)
+    weight = np.repeat(near, 3)
     z = (x - mean) / sd * weight
-    return PcaModel(cols, train, z, z.T @ z, mean, sd, weight)
+    return PcaModel(cols, train, z, z.T @ z, mean, sd, weight, centre_weight)
+
+
+def _centre_of(model_xyz: FloatArray, centre: FloatArray) -> FloatArray:
+    """Per frame, the ``centre``-weighted mean of the model markers ``(N, K, 3)``: ``(N, 3)``
+    (zeros when ``centre`` is empty)."""
+    if centre.size == 0:
+        return np.zeros((model_xyz.shape[0], 3))
+    found: FloatArray = np.einsum("k,nkd->nd", centre, model_xyz)
+    return found
+
+
+def _centred(xyz: FloatArray, centre: FloatArray) -> FloatArray:
+    """The target and model markers ``(N, K + 1, 3)`` less their frame's centre
+    (:func:`_centre_of` of the model markers)."""
+    shifted: FloatArray = xyz - _centre_of(xyz[:, 1:], centre)[:, None]
+    return shifted
 
 
 def pca_fill(
@@ -115,6 +144,7 @@ def pca_fill(
     fitted: PcaModel | None = None,
     before: bool = True,
     after: bool = True,
+    centre: bool = False,
 ) -> FloatArray | None:
     """Fill a gap from the take's marker intercorrelations (Gløersen & Federolf 2016).
 
@@ -147,6 +177,8 @@ def pca_fill(
         Frames either side of the gap whose errors correct the prediction.
     smooth : bool
         Correct by a cubic spline of the errors rather than the boundary errors' linear blend.
+    centre : bool
+        Of a matrix built here: positions relative to the neighbours (:func:`pca_model`).
     hidden : tuple of int, optional
         Another stretch of the target (first, last frame) to leave out of training.
     fitted : PcaModel, optional
@@ -166,15 +198,24 @@ def pca_fill(
         fitted = pca_model(
             positions, visible, m, model,
             exclude=hidden or (a, b), weight_scale=weight_scale, max_train=max_train,
+            centre=centre,
         )  # fmt: skip
         if fitted is None:
             return None
-    p = fitted.cols.size * 3
-    y = positions[times[:, None], fitted.cols[1:]].reshape(times.size, p - 3)
-    predicted = _conditional_target(fitted, _gram_without(fitted, {(a, b), hidden or (a, b)}),
-                                    y, variance)  # fmt: skip
+    seen = positions[times[:, None], fitted.cols[1:]]
+    gram = _gram_without(fitted, {(a, b), hidden or (a, b)})
+    predicted = _predicted(fitted, gram, seen, variance)
     recorded = recorded_around(positions, visible, m, times, a, b)
     return anchor(predicted, times, recorded, a, b, smooth=smooth)
+
+
+def _predicted(fitted: PcaModel, gram: FloatArray, seen: FloatArray, variance: float) -> FloatArray:
+    """The target ``(T, 3)`` from the model markers ``seen`` ``(T, K, 3)`` (file units): their
+    centre taken out when the model says so, the conditional mean, the centre put back."""
+    middle = _centre_of(seen, fitted.centre)
+    y = (seen - middle[:, None]).reshape(seen.shape[0], -1)
+    predicted: FloatArray = middle + _conditional_target(fitted, gram, y, variance)
+    return predicted
 
 
 def _usable_times(

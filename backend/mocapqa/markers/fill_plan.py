@@ -24,7 +24,7 @@ from mocapqa.markers.fill_cv import (
     window_motion,
 )
 from mocapqa.markers.fill_methods import rigid_fill, spline_fill
-from mocapqa.markers.fill_params import CHOICES, FillParams
+from mocapqa.markers.fill_params import CHOICES, PCA_FAMILY, FillParams
 from mocapqa.markers.fill_pca import PcaModel, pca_fill, pca_model
 
 __all__ = ["FillContext", "GapPlan", "plan_gap"]
@@ -137,6 +137,8 @@ def _fill(
     hidden: tuple[int, int] | None = None,
     fitted: PcaModel | None = None,
 ) -> FloatArray | None:
+    """Fill ``a..b`` of marker ``m`` by method ``name`` (a PCA method with its ``fitted``
+    training matrix when given)."""
     p, v = take.positions, take.visible
     if name == "spline":
         return spline_fill(
@@ -153,6 +155,7 @@ def _fill(
         weight_scale=take.weight_scale, variance=take.params.pca_variance,
         max_train=take.params.pca_max_train, window=take.rigid_window,
         smooth=take.params.smooth_anchor, hidden=hidden, fitted=fitted,
+        centre=PCA_FAMILY[name],
         before=before, after=after,
     )  # fmt: skip
 
@@ -245,7 +248,7 @@ def _trial_fill(
     """One method's fill of a hidden stretch ``s..e`` of marker ``m``; the PCA fill drops the
     model markers not seen over it (and refits) rather than give up."""
     donors, model, before, after = gap
-    if name == "pca":
+    if name in PCA_FAMILY:
         seen = take.visible[s : e + 1][:, model].all(axis=0)
         if not seen.all():
             model, fitted = model[seen], None
@@ -261,7 +264,7 @@ def _cross_validate(
     b: int,
     methods: list[str],
     gap: tuple[IntArray, IntArray, bool, bool],
-    fitted: PcaModel | None,
+    fitted: dict[str, PcaModel],
 ) -> dict[str, _Trials]:
     """Each method's fills of up to ``cv_trials`` stretches of the gap's length where marker
     ``m`` is recorded: the same stretches for every method where possible."""
@@ -271,7 +274,8 @@ def _cross_validate(
     lead, tail = (2 if before else 0), (2 if after else 0)
     need = {"spline": vis[:, m], "rigid": vis[:, m] & vis[:, donors].all(axis=1)}
     # The PCA trials refit without the model markers not seen over them.
-    need["pca"] = vis[:, m] & (vis[:, model].all(axis=1) if model.size else True)
+    for name in PCA_FAMILY:
+        need[name] = vis[:, m] & (vis[:, model].all(axis=1) if model.size else True)
     motion = _motion(take, m, a, b, donors, model)
 
     def starts_where(ok: BoolArray) -> IntArray:
@@ -280,16 +284,18 @@ def _cross_validate(
 
     shared = starts_where(np.logical_and.reduce([need[x] for x in methods]))
     if shared.size == 0:
-        shared = starts_where(np.logical_and.reduce([need[x] for x in methods if x != "pca"]))
+        shared = starts_where(
+            np.logical_and.reduce([need[x] for x in methods if x not in PCA_FAMILY])
+        )
     out: dict[str, _Trials] = {}
     for name in methods:
         starts = shared if shared.size else starts_where(need[name])
-        if starts.size == 0 and name == "pca":
+        if starts.size == 0 and name in PCA_FAMILY:
             starts = starts_where(need["spline"])
         trials = _Trials([], [], [])
         for s in starts.tolist():
             e = s + length - 1
-            filled = _trial_fill(take, name, m, s, e, gap, fitted)
+            filled = _trial_fill(take, name, m, s, e, gap, fitted.get(name))
             if filled is not None:
                 trials.starts.append(s)
                 trials.fills.append(filled)
@@ -348,19 +354,23 @@ def plan_gap(take: FillContext, m: int, a: int, b: int) -> GapPlan:
     donors = _donors(take, ranked[std[ranked] <= take.max_std], lo if before else hi)
     model = _model_markers(take, m, candidates, a, b)
 
-    fitted = None
-    if "pca" in params.methods:
-        # One training matrix serves the gap and its trials (each trial's frames are taken out
-        # of it; only the normalisation keeps them, a negligible share of the training frames).
-        fitted = pca_model(
-            take.positions, vis, m, model,
-            exclude=(a, b), weight_scale=take.weight_scale, max_train=params.pca_max_train,
-        )  # fmt: skip
+    # One training matrix per PCA method serves the gap and its trials (each trial's frames are
+    # taken out of it; only the normalisation keeps them, a negligible share of the frames).
+    fitted: dict[str, PcaModel] = {}
+    for name in params.methods:
+        if name in PCA_FAMILY:
+            model_fit = pca_model(
+                take.positions, vis, m, model,
+                exclude=(a, b), weight_scale=take.weight_scale, max_train=params.pca_max_train,
+                centre=PCA_FAMILY[name],
+            )  # fmt: skip
+            if model_fit is not None:
+                fitted[name] = model_fit
     fills: dict[str, FloatArray] = {}
     for name in params.methods:
-        if name == "pca" and fitted is None:
+        if name in PCA_FAMILY and name not in fitted:
             continue
-        filled = _fill(take, name, m, a, b, donors, model, before, after, fitted=fitted)
+        filled = _fill(take, name, m, a, b, donors, model, before, after, fitted=fitted.get(name))
         if filled is not None:
             fills[name] = filled
     gap = (donors, model, before, after)

@@ -74,13 +74,13 @@ def _fill_table(rows: list[dict[str, Any]], choices: list[dict[str, Any]]) -> An
         title="Gap fill RMSE (mm) by gap length, each file held out (settings chosen on the "
         "others), gaps where ≥ 3 segment mates stay seen"
     )
-    for column in ("gap (s)", "gaps (occl.)", "spline", "rigid", "PCA", "auto",
+    for column in ("gap (s)", "gaps (occl.)", "spline", "rigid", "PCA", "relative PCA", "auto",
                    "auto / spline", "auto / PCA", "chosen"):  # fmt: skip
         table.add_column(column, justify="left" if column in ("gap (s)", "chosen") else "right")
     for row in rows:
         table.add_row(
             row["bin"], f"{row['gaps']} ({row['occlusions']})",
-            *(f"{row[f'{m}_mm']:.2f}" for m in ("spline", "rigid", "pca", "auto")),
+            *(f"{row[f'{m}_mm']:.2f}" for m in ("spline", "rigid", "pca", "relative", "auto")),
             f"{row['auto_vs_spline']:.2f}", f"{row['auto_vs_pca']:.2f}",
             ", ".join(f"{k} {v}" for k, v in row["chosen"].items() if v),
         )  # fmt: skip
