@@ -26,7 +26,7 @@ from mocapqa.config import Settings
 from mocapqa.jobs.batch import run_batch
 from mocapqa.jobs.batch_dask import CHUNK_TAKES, chunk_size
 from mocapqa.jobs.engine import WORKER_CONFIG, Engine
-from mocapqa.jobs.run_folder import write_outputs
+from mocapqa.jobs.run_outputs import write_outputs
 from mocapqa.jobs.take_task import analyse_path
 from mocapqa.limits.catalog import DEFAULT_MODEL
 from mocapqa.pipeline.analyze import analyze

@@ -5,7 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from mocapqa.jobs.run_folder import RunFolder, load_report
+from mocapqa.jobs.run_folder import RunFolder
+from mocapqa.jobs.stored_run import load_report
 from mocapqa.jobs.take_task import analyse_stored
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.files import FileStore

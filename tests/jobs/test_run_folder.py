@@ -12,19 +12,11 @@ import pytest
 import mocapqa.jobs.take_reading as take_reading
 from mocapqa.errors import InputError, NotFoundError, ParseError
 from mocapqa.jobs.intake import ingest_take
-from mocapqa.jobs.run_folder import (
-    DOWNLOAD_FILES,
-    POINT_ARRAYS,
-    RunFolder,
-    load_points,
-    load_report,
-    read_options_of,
-    read_run,
-    reading_of,
-    write_outputs,
-    write_reading,
-)
+from mocapqa.jobs.reading_record import read_options_of, reading_of, write_reading
+from mocapqa.jobs.run_folder import DOWNLOAD_FILES, POINT_ARRAYS, RunFolder
+from mocapqa.jobs.run_outputs import write_outputs
 from mocapqa.jobs.runner import JobRunner
+from mocapqa.jobs.stored_run import load_points, load_report, read_run
 from mocapqa.jobs.take_reading import MAX_NAME_CHARS, read_checked_take, take_name
 from mocapqa.jobs.take_task import analyse_path
 from mocapqa.pipeline.analyze import analyze

@@ -15,7 +15,7 @@ from mocapqa.errors import InputError
 from mocapqa.io.bvh import read_bvh
 from mocapqa.io.formats import read_take
 from mocapqa.jobs.demo import demo_paths
-from mocapqa.jobs.run_folder import write_outputs
+from mocapqa.jobs.run_outputs import write_outputs
 from mocapqa.kinematics.forward import forward_kinematics
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.frames import motion_points, motion_pose, rigid_bones

@@ -13,7 +13,7 @@ import pytest
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.io.c3d import read_c3d
 from mocapqa.io.formats import read_take
-from mocapqa.jobs.run_folder import write_outputs
+from mocapqa.jobs.run_outputs import write_outputs
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.marker_step import MARKER_FINDING_KINDS, run_markers
 from mocapqa.pipeline.options import AnalysisOptions, describe_options, take_checks

@@ -123,7 +123,7 @@ def analyze_take(
 def load_run(folder: Path) -> TakeRun:
     """Read a stored run's folder (its report and points) without re-analysing."""
     from mocapqa.jobs.rendered import run_tracks
-    from mocapqa.jobs.run_folder import read_run
+    from mocapqa.jobs.stored_run import read_run
 
     stored = read_run(folder)
     raw, corrected = run_tracks(stored)

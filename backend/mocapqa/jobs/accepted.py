@@ -16,7 +16,7 @@ and applied after the other corrections (:mod:`mocapqa.jobs.decided_feet`).
   its gaps filled by the run's rule (the confident fills, chosen again on that take:
   :func:`mocapqa.pipeline.marker_step.decided_repair`), then its kept foot locks pinned,
   written as C3D like the run's ``corrected.c3d``
-  (:func:`mocapqa.jobs.run_folder.write_corrected_c3d`), or as TRC (a TRC take's, or a C3D
+  (:func:`mocapqa.jobs.corrected_takes.write_corrected_c3d`), or as TRC (a TRC take's, or a C3D
   take's for OpenSim: :func:`decided_trc`). No filter. A marker run with the feet check but
   without the markers check has locks only: its decided take is the raw take (no swap
   exchanged, no gap filled) with its kept foot locks pinned.
@@ -41,8 +41,10 @@ from mocapqa.core.motion import Motion
 from mocapqa.errors import ConflictError, NotFoundError
 from mocapqa.io.bvh_write import format_bvh
 from mocapqa.io.trc import format_trc
+from mocapqa.jobs.corrected_takes import write_corrected_c3d
 from mocapqa.jobs.decided_feet import kept_locks, lock_kept_markers, lock_kept_motion
-from mocapqa.jobs.run_folder import RunFolder, read_options_of, write_corrected_c3d
+from mocapqa.jobs.reading_record import read_options_of
+from mocapqa.jobs.run_folder import RunFolder
 from mocapqa.markers.fill import FillResult
 from mocapqa.markers.repair import MarkerRepair
 from mocapqa.markers.swaps import repair_swaps

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import BinaryIO
 
 from mocapqa.errors import InputError, ParseError, TooLargeError
-from mocapqa.jobs.run_folder import write_reading
+from mocapqa.jobs.reading_record import write_reading
 from mocapqa.jobs.runner import JobRunner
 from mocapqa.jobs.take_reading import (
     CheckedTake,

@@ -21,7 +21,8 @@ import numpy as np
 
 from mocapqa.core.arrays import FloatArray
 from mocapqa.errors import InputError, MocapQAError
-from mocapqa.jobs.run_folder import REPORT_HTML, THUMBNAIL_PNG, RunFolder, StoredRun, read_run
+from mocapqa.jobs.run_folder import REPORT_HTML, THUMBNAIL_PNG, RunFolder
+from mocapqa.jobs.stored_run import StoredRun, read_run
 from mocapqa.render.scene import SkeletonTrack, track_from_points
 from mocapqa.render.service import RenderService
 from mocapqa.render.sheet import tiles_from_intervals

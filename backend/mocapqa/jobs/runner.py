@@ -29,17 +29,13 @@ from mocapqa.errors import InputError, MocapQAError
 from mocapqa.io.guards import ReadLimits
 from mocapqa.jobs.engine import Engine
 from mocapqa.jobs.fair_queue import FairQueue
+from mocapqa.jobs.reading_record import read_options_of
 from mocapqa.jobs.rendered import render_thumbnail
-from mocapqa.jobs.run_folder import (
-    RunFolder,
-    load_points,
-    load_report,
-    read_options_of,
-    run_summary,
-    write_outputs,
-)
+from mocapqa.jobs.run_folder import RunFolder
+from mocapqa.jobs.run_outputs import run_summary, write_outputs
 from mocapqa.jobs.sent_files import SentFiles
 from mocapqa.jobs.shoot_prior import shoot_prior
+from mocapqa.jobs.stored_run import load_points, load_report
 from mocapqa.limits.catalog import ModelCatalog
 from mocapqa.pipeline.analyze import analyze
 from mocapqa.pipeline.loading import ReadOptions, Take, read_take_file

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from mocapqa.jobs.run_folder import twist_items_of
+from mocapqa.jobs.twist_items import twist_items_of
 from mocapqa.store.decisions import IntervalDecisions
 from mocapqa.store.files import FileStore
 from mocapqa.twist.reviewer_prior import ReviewerPrior

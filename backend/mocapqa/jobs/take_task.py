@@ -23,7 +23,9 @@ from pathlib import Path
 from typing import Any
 
 from mocapqa.errors import MocapQAError
-from mocapqa.jobs.run_folder import relative_folder, run_summary, write_outputs, write_reading
+from mocapqa.jobs.reading_record import write_reading
+from mocapqa.jobs.run_folder import relative_folder
+from mocapqa.jobs.run_outputs import run_summary, write_outputs
 from mocapqa.jobs.sent_files import SentFiles, pack, pack_tree
 from mocapqa.jobs.take_reading import CheckedTake, read_checked_take
 from mocapqa.pipeline.loading import Take
@@ -181,7 +183,7 @@ def analyse_stored(
     Returns
     -------
     dict
-        The run summary (as :func:`mocapqa.jobs.run_folder.run_summary`). Errors the readers
+        The run summary (as :func:`mocapqa.jobs.run_outputs.run_summary`). Errors the readers
         or the analysis raise on purpose travel back as themselves.
     """
     from mocapqa.pipeline.loading import ReadOptions, read_take_file

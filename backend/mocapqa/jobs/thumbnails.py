@@ -12,7 +12,8 @@ from html import escape
 
 import numpy as np
 
-from mocapqa.jobs.run_folder import RunFolder, load_points, load_report
+from mocapqa.jobs.run_folder import RunFolder
+from mocapqa.jobs.stored_run import load_points, load_report
 from mocapqa.store.files import FileStore
 
 __all__ = ["placeholder_svg", "thumbnail_svg"]

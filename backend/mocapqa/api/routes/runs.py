@@ -16,8 +16,9 @@ from mocapqa.api.frame_windows import Window, read_window, window_json, window_p
 from mocapqa.api.schemas import AnalysisOptionsIn, RunOut
 from mocapqa.api.views import run_out
 from mocapqa.errors import NotFoundError
+from mocapqa.jobs.reading_record import joint_parents_of, joints_of
 from mocapqa.jobs.rendered import html_report
-from mocapqa.jobs.run_folder import RunFolder, joint_parents_of, joints_of
+from mocapqa.jobs.run_folder import RunFolder
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.roles import Action
 

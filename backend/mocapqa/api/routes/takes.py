@@ -14,7 +14,8 @@ from mocapqa.api.views import review_out, run_out, take_fields
 from mocapqa.core.bounds import MAX_FPS, MIN_FPS
 from mocapqa.core.keypoints import LENGTH_UNITS
 from mocapqa.jobs.intake import ingest_take
-from mocapqa.jobs.run_folder import RunFolder, reading_of
+from mocapqa.jobs.reading_record import reading_of
+from mocapqa.jobs.run_folder import RunFolder
 from mocapqa.jobs.thumbnails import thumbnail_svg
 from mocapqa.pipeline.loading import ReadOptions
 from mocapqa.store.repository import ReviewStatus, RunStatus
