@@ -23,13 +23,13 @@ const LOCK_STATES = {
   accept: "accepted: the reviewed download locks it",
   reject: "rejected: left as recorded",
   undecided: "undecided: left as recorded",
-  followed: "undecided: the run locked it, and so does the reviewed download",
+  followed: "undecided: locked in the run's corrected take (its feet_apply), and in the reviewed take unless rejected",
 };
 const LOCK_COLOR = "#1e8449"; // an accepted lock: solid; a rejected one: hatched and dim
 
 /**
  * The inline style of a foot lock's mark by its newest decision: an accepted lock solid, a
- * rejected one hatched and dim, an undecided one an outline, filled half when the run locked it
+ * rejected one hatched and dim, an undecided one an outline, striped when the run locked it
  * (its feet_apply choice: the reviewed download follows the run).
  *
  * @param decision  "accept", "reject", or null / undefined for undecided
@@ -39,14 +39,24 @@ const LOCK_COLOR = "#1e8449"; // an accepted lock: solid; a rejected one: hatche
 export function lockStyle(decision, runLocked = false) {
   if (decision === "accept") return { background: LOCK_COLOR, border: `1px solid ${LOCK_COLOR}`, opacity: "1" };
   if (decision === "reject") return { background: "repeating-linear-gradient(135deg, #95a5a6 0 2px, transparent 2px 5px)", border: "1px dashed #95a5a6", opacity: "0.6" };
-  if (runLocked) return { background: `linear-gradient(${LOCK_COLOR} 0 50%, transparent 50%)`, border: `1px solid ${LOCK_COLOR}`, opacity: "1" };
+  if (runLocked) return { background: `repeating-linear-gradient(90deg, ${LOCK_COLOR} 0 3px, transparent 3px 5px)`, border: `1px solid ${LOCK_COLOR}`, opacity: "1" };
   return { background: "transparent", border: `1px solid ${LOCK_COLOR}`, opacity: "1" };
+}
+
+/** The contact of `foot` that frames `start`–`end` overlap most (the first of equals), or undefined. */
+export function overlappedMost(contacts, foot, start, end) {
+  let best, most = 0;
+  for (const c of contacts) {
+    const shared = Math.min(c.end, end) - Math.max(c.start, start) + 1;
+    if (c.foot === foot && shared > most) { best = c; most = shared; }
+  }
+  return best;
 }
 
 /**
  * The foot locks of a foot's row: one per skate finding with an id, over the frames the lock
- * holds the foot (as `mocapqa feet fix` chooses them: the first contact of that foot the
- * finding overlaps, else the finding's own frames).
+ * holds the foot (as `mocapqa feet fix` chooses them: the contact of that foot the finding
+ * overlaps most, the first of equals, else the finding's own frames).
  *
  * @param contacts  the run's `series.feet.contacts`: [{foot, start, end}], frames inclusive
  * @param findings  the run's findings; the skate ones with a string `id` have a lock
@@ -59,7 +69,7 @@ export function lockStyle(decision, runLocked = false) {
 export function lockMarks(contacts, findings, foot, nFrames, decisions = {}) {
   return findings.filter((f) => f.kind === "skate" && f.foot === foot && typeof f.id === "string" && f.id)
     .map((f) => {
-      const contact = contacts.find((c) => c.foot === foot && c.start <= f.end_frame && c.end >= f.start_frame);
+      const contact = overlappedMost(contacts, foot, f.start_frame, f.end_frame);
       const [start, end] = contact ? [contact.start, contact.end] : [f.start_frame, f.end_frame];
       const [left, width] = spanOf(start, end, nFrames);
       return decidedLock({ id: f.id, foot, start, end, left, width, runLocked: f.applied === true }, decisions[f.id]);
@@ -118,11 +128,13 @@ function styleLock(el, lock) {
 }
 
 /** The legend's keys of the foot locks (only when the take has any). */
-function lockLegend() {
-  return ["accept", "reject", null].flatMap((d) => {
+function lockLegend(runLocked = false) {
+  const keys = [["accept", false, "accepted"], ["reject", false, "rejected"], [null, false, "undecided"]];
+  if (runLocked) keys.push([null, true, "undecided, locked by the run"]);
+  return keys.flatMap(([d, run, name]) => {
     const key = h("span", { class: "ct-key" });
-    Object.assign(key.style, lockStyle(d), { height: "5px" });
-    return [key, ` lock ${d ? LOCK_STATES[d].split(":")[0] : "undecided"} `];
+    Object.assign(key.style, lockStyle(d, run), { height: "5px" });
+    return [key, ` lock ${name} `];
   });
 }
 
@@ -170,7 +182,7 @@ export function createContactTimeline(rows, nFrames, onJump) {
       return [key, ` ${kind} `];
     }), "· click to go to it");
   const el = h("div", { class: "contact-timeline", id: "contact-timeline", role: "group", "aria-label": "foot contacts" }, rows.map(rowEl), legend);
-  if (locks.size) legend.append(h("br"), ...lockLegend());
+  if (locks.size) legend.append(h("br"), ...lockLegend([...locks.values()].some(([, lock]) => lock.runLocked)));
   /** Draw each lock by its newest decision (lock id -> "accept" | "reject"; absent: undecided). */
   const setLockDecisions = (decisions) => {
     for (const [id, [mark, lock]] of locks) styleLock(mark, decidedLock(lock, decisions[id]));

@@ -30,7 +30,7 @@ const DECIDED = {
   [LOCK_KIND]: {
     item: "lock", name: "foot lock", corrected: " → locked",
     ...(({ locked, notLocked, title }) => ({ appliedText: locked, notApplied: notLocked, applied: title }))(runLockText("none")),
-    explain: "Foot locks are cleanup, off by default (a run's feet_apply option: none, confident, skates): the reviewed take holds the foot of each accepted skate finding, and of each undecided one the run locked, where it stands during its contact, eased in and out over 0.1 s (BVH: a two-bone leg IK, only the hips, knees and ankles turn; C3D and TRC: the foot markers are pinned), after the other corrections. Rejected ones, and undecided ones the run did not lock, are left as recorded. A C3D or TRC take's run without the markers check has locks only: its reviewed take is the raw take with the accepted locks pinned, no swap repaired and no gap filled. Keypoint takes other than C3D and TRC marker takes have no reviewed download.",
+    explain: "Foot locks are cleanup, off by default (a run's feet_apply option: none, confident, skates): the reviewed take holds the foot of each accepted skate finding, and of each undecided one the run locked, where it stands during its contact, eased in and out over 0.1 s (BVH: a two-bone leg IK, only the hips, knees and ankles turn; C3D and TRC: the foot markers are pinned), after the other corrections. Rejected ones, and undecided ones the run did not lock, are left as recorded. A C3D or TRC take's run without the markers check has locks only: its reviewed take is the raw take with those locks pinned, no swap repaired and no gap filled. Keypoint takes other than C3D and TRC marker takes have no reviewed download.",
   },
 };
 
@@ -162,7 +162,7 @@ export function intervalDecisions(run, result, take = null) {
   const groups = [main, locks].filter(Boolean);
   const formats = reviewedFormats(result, take);
   const parts = decisionParts(run, formats);
-  // Without a reviewed download an accepted lock changes no file: the cell says so.
+  // Without a reviewed download a kept lock changes no file: the cell says so.
   if (locks && !formats.length) locks.spec = { ...locks.spec, corrected: " → would be locked (no reviewed download of this run)" };
   const { message, note, history } = parts;
   const opened = { main: null, lock: null, kind: null }; // the last opened item of each group, and finding kind

@@ -48,8 +48,10 @@ export function runOptionsLabel(run, described) {
   const parts = [stepsRan(run)];
   const apply = run.options && run.options.twist_apply;
   if (apply && apply !== optionDefaults(described).twist_apply) parts.push(`apply ${apply}`);
+  // Foot locks only where the feet step ran: without it the choice locked nothing.
   const feet = run.options && run.options.feet_apply;
-  if (feet && feet !== optionDefaults(described).feet_apply) parts.push(`feet locked ${feet}`);
+  const feetRan = run.summary && run.summary.steps ? run.summary.steps.feet === "done" : (run.options.checks || []).includes("feet");
+  if (feet && feetRan && feet !== optionDefaults(described).feet_apply) parts.push(`feet locked ${feet}`);
   if (run.options && run.options.filter_method) parts.push(run.options.filter_method);
   return parts.filter(Boolean).join(" · ");
 }

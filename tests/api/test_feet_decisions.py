@@ -268,7 +268,8 @@ def test_a_run_that_locks_feet_writes_them_and_undecided_locks_follow_the_run(
     lock_id = skate_run["skate"]["id"]
     runs = f"/api/v1/takes/{take_id}/runs"
     # The option is checked before a run is queued: contact ids and junk are refused.
-    for bad in ("contact-left-3", "skate-up-3", "all", "", "skate-left-3,"):
+    wide_digits = "skate-left-\uff11\uff12"
+    for bad in ("contact-left-3", "skate-up-3", "all", "", "skate-left-3,", wide_digits):
         answer = client.post(runs, json={"checks": ["feet"], "feet_apply": bad})
         assert answer.status_code == 422, (bad, answer.text)
         assert "feet_apply" in answer.text

@@ -169,7 +169,7 @@ def test_a_run_that_locks_the_skates_is_chosen_in_the_form_and_reviewed_lock_by_
         == f"Download reviewed take ({n} foot lock{'s' if n > 1 else ''} applied of {n})"
     )
     mark = p.locator(f"#contact-timeline .ct-lock[data-lock='{lock}']")
-    assert "the run locked it" in (mark.get_attribute("title") or "")
+    assert "locked in the run's corrected take" in (mark.get_attribute("title") or "")
     assert "linear-gradient" in timeline_lock(page, lock)["background"]
     assert "feet locked skates" in p.inner_text("#run-pick")
     p.locator("#contact-timeline").scroll_into_view_if_needed()

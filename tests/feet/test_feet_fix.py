@@ -314,3 +314,15 @@ def test_the_cleanup_bench_on_the_cmu_walk(cmu_walk: Path) -> None:
     assert np.median([t.fixed_cm for t in trials]) <= 0.5
     # Checked at the joints, the residual "at the joints" is the same reading.
     assert [t.fixed_joints_cm for t in trials] == [t.fixed_cm for t in trials]
+
+
+def test_a_skate_over_two_contacts_locks_the_one_whose_confidence_it_carries() -> None:
+    contacts = [Contact("right", 144, 154, 0.497), Contact("right", 162, 230, 0.803)]
+    skate = Finding("skate", "right", 141, 211, 3.0, 180)
+    assert finding_confidence(skate, contacts) == 0.803
+    assert choose_locks("confident", contacts, [skate]) == [contacts[1]]
+    assert choose_locks("skate-right-141", contacts, [skate]) == [contacts[1]]
+    assert locked_findings("confident", contacts, [skate]) == {"skate-right-141"}
+    # Overlapping no contact, the lock holds the finding's own frames.
+    alone = Finding("skate", "left", 10, 20, 2.0, 15)
+    assert choose_locks("skates", contacts, [alone]) == [Contact("left", 10, 20, 0.0)]

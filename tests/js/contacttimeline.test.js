@@ -1,7 +1,7 @@
 // Unit tests of the contact timeline's rows (node --test).
 import assert from "node:assert/strict";
 import { test } from "node:test";
-import { FEET_COLORS, contactRows, decidedLock, lockMarks, lockStyle } from "../../frontend/js/contacttimeline.js";
+import { FEET_COLORS, contactRows, decidedLock, lockMarks, lockStyle, overlappedMost } from "../../frontend/js/contacttimeline.js";
 
 const contact = (foot, start, end, confidence = 0.8) => ({ foot, start, end, confidence, id: `contact-${foot}-${start}` });
 const finding = (kind, foot, start, end, value = 2.5, unit = "cm") => ({
@@ -73,10 +73,10 @@ test("a lock is drawn by its newest decision: accepted solid, rejected hatched a
   assert.match(decidedLock(locks[0], null).label, /undecided: left as recorded/);
 });
 
-test("an undecided lock the run locked is drawn half filled, and says the reviewed download follows the run", () => {
+test("an undecided lock the run locked is drawn striped, and says the run locked it", () => {
   const followed = decidedLock({ id: "skate-left-0", foot: "left", start: 0, end: 39, left: 0, width: 10, runLocked: true }, null);
   assert.equal(followed.decision, "undecided");
-  assert.match(followed.label, /the run locked it, and so does the reviewed download/);
+  assert.match(followed.label, /locked in the run's corrected take/);
   assert.deepEqual(followed.style, lockStyle(null, true));
   const looks = [lockStyle("accept"), lockStyle("reject"), lockStyle(null), lockStyle(null, true)];
   assert.equal(new Set(looks.map((l) => JSON.stringify(l))).size, 4);
@@ -85,4 +85,11 @@ test("an undecided lock the run locked is drawn half filled, and says the review
   assert.deepEqual(marks.map((l) => l.runLocked), [true, false]);
   // A decision overrides the run: rejected, it is drawn as any rejected lock.
   assert.deepEqual(decidedLock({ ...followed, decision: undefined }, "reject").style, lockStyle("reject"));
+});
+
+test("a skate over two contacts is locked over the one it overlaps most, whose confidence it carries", () => {
+  const contacts = [contact("right", 144, 154), contact("right", 162, 230)];
+  const marks = lockMarks(contacts, [{ ...finding("skate", "right", 141, 211), id: "skate-right-141" }], "right", 300);
+  assert.deepEqual(marks.map((l) => [l.start, l.end]), [[162, 230]]);
+  assert.equal(overlappedMost(contacts, "left", 141, 211), undefined);
 });

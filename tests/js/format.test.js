@@ -79,5 +79,8 @@ test("runOptionsLabel tells two runs of a take apart by what differs", () => {
   assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits", "filter"], twist_apply: "none", filter_method: "quat-pd" }, { ...ran, filter: "done" }), described), "twist+limits+filter · apply none · quat-pd");
   const withFeet = { groups: [...described.groups, { name: "feet", fields: [{ name: "feet_apply", type: "choice", default: "none" }] }] };
   assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "confident", feet_apply: "none" }, ran), withFeet), "twist+limits");
-  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "confident", feet_apply: "confident" }, ran), withFeet), "twist+limits · feet locked confident");
+  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits", "feet"], twist_apply: "confident", feet_apply: "confident" }, { ...ran, feet: "done" }), withFeet), "twist+limits+feet · feet locked confident");
+  // Without the feet step the choice locked nothing, and the label does not claim it did.
+  assert.equal(format.runOptionsLabel(done({ checks: ["twist", "limits"], twist_apply: "confident", feet_apply: "confident" }, ran), withFeet), "twist+limits");
+  assert.equal(format.runOptionsLabel(done({ checks: ["feet"], feet_apply: "skates" }, { feet: "skipped" }), withFeet), "no step ran");
 });

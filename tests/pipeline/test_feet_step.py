@@ -117,6 +117,17 @@ def test_a_run_that_locks_feet_pins_only_the_foot_markers_of_its_skates(corpus_d
     )
     assert moved.size
     assert set(moved.tolist()) <= set(feet)
+    # The corrected C3D is written from the marker repair: its feet are pinned alike.
+    repaired = analyze(take, AnalysisOptions(checks=("markers", "feet")))
+    pinned = analyze(take, AnalysisOptions(checks=("markers", "feet"), feet_apply="skates"))
+    assert repaired.markers is not None
+    assert pinned.markers is not None
+    changed = np.flatnonzero(
+        np.nanmax(np.abs(pinned.markers.positions - repaired.markers.positions), axis=(0, 2)) > 0
+    )
+    assert changed.size
+    assert set(changed.tolist()) <= set(feet)
+    np.testing.assert_array_equal(pinned.markers.residuals, repaired.markers.residuals)
     # Nothing is locked for a choice that names no skate of the take's: the run fails, naming it.
-    with pytest.raises(InputError, match="skate-left-99999"):
+    with pytest.raises(InputError, match=r"feet_apply ids of skate findings.*skate-left-99999"):
         analyze(take, AnalysisOptions(checks=("feet",), feet_apply="skate-left-99999"))

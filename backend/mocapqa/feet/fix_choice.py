@@ -29,7 +29,7 @@ off), the contacts of the confident skate findings, the contacts of every skate 
 offers no ``all`` (every contact): its locks are its skate findings, each one a reviewer can
 accept or reject."""
 
-_SKATE_ID = re.compile(r"^skate-(left|right)-\d{1,9}$")
+_SKATE_ID = re.compile(r"^skate-(left|right)-[0-9]{1,9}$")
 
 CONFIDENT = 0.5
 """Contact confidence (:mod:`mocapqa.feet.contacts`) at and above which ``--apply confident``
@@ -50,24 +50,30 @@ def contact_id(contact: Contact, skipped: int = 0) -> str:
     return f"contact-{contact.foot}-{contact.start + skipped}"
 
 
-def finding_confidence(finding: Finding, contacts: Sequence[Contact]) -> float | None:
-    """Confidence of the foot contact a skate finding lies in (the one it overlaps most), or
-    None for other kinds or when no contact overlaps it."""
-    if finding.kind != "skate":
-        return None
+def _overlapping(finding: Finding, contacts: Sequence[Contact]) -> Contact | None:
+    """The contact of the finding's foot it overlaps most (the first of equals), or None."""
     best, overlap = None, 0
     for c in contacts:
         shared = min(c.end, finding.end) - max(c.start, finding.start) + 1
         if c.foot == finding.foot and shared > overlap:
             best, overlap = c, shared
+    return best
+
+
+def finding_confidence(finding: Finding, contacts: Sequence[Contact]) -> float | None:
+    """Confidence of the foot contact a skate finding lies in (the one it overlaps most), or
+    None for other kinds or when no contact overlaps it."""
+    if finding.kind != "skate":
+        return None
+    best = _overlapping(finding, contacts)
     return None if best is None else best.confidence
 
 
 def _contact_of(finding: Finding, contacts: Sequence[Contact]) -> Contact:
-    for c in contacts:
-        if c.foot == finding.foot and c.start <= finding.end and c.end >= finding.start:
-            return c
-    return Contact(finding.foot, finding.start, finding.end, 0.0)
+    """The contact a skate finding's lock holds: the one it overlaps most, whose confidence
+    is the finding's (:func:`finding_confidence`), else the finding's own frames."""
+    best = _overlapping(finding, contacts)
+    return Contact(finding.foot, finding.start, finding.end, 0.0) if best is None else best
 
 
 def choose_locks(

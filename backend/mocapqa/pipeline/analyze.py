@@ -17,6 +17,7 @@ without a limits model, a keypoint take for twist) reports why, and the take pas
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, TypeVar
@@ -172,6 +173,23 @@ def _feet_locks(
     if not isinstance(locked, type(target)):  # pragma: no cover - fix_feet keeps the kind
         raise TypeError(f"Expected a locked {type(target).__name__}, got {type(locked).__name__}")
     return locked
+
+
+def _locked_repair(
+    sequence: KeypointSequence,
+    repair: MarkerRepair | None,
+    options: AnalysisOptions,
+    steps: StepLog,
+) -> MarkerRepair | None:
+    """The marker repair (what the run's corrected C3D is written from) with the run's foot
+    locks pinned on its positions too, as on the filtered take (:func:`_feet_locks`)."""
+    if repair is None:
+        return None
+    repaired = dataclasses.replace(sequence, positions=repair.positions)
+    pinned = _feet_locks(sequence, repaired, options, _no_progress, steps)
+    if pinned is repaired:
+        return repair
+    return dataclasses.replace(repair, positions=pinned.positions)
 
 
 def _motion_checks(
@@ -385,7 +403,7 @@ def _analyze_keypoints(
         "points": points,
         "series": series,
     }
-    markers = steps.outcomes["markers"].markers
+    markers = _locked_repair(sequence, steps.outcomes["markers"].markers, options, steps)
     return AnalysisResult(
         report,
         None,

@@ -40,7 +40,7 @@ from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion
 from mocapqa.errors import InputError
 from mocapqa.feet.fix import fix_feet
-from mocapqa.feet.fix_choice import add_ids, locked_findings
+from mocapqa.feet.fix_choice import RUN_APPLY_CHOICES, add_ids, locked_findings
 from mocapqa.feet.points import SIDES
 from mocapqa.pipeline.feet import check_take_feet, feet_params_of, feet_report_json
 from mocapqa.pipeline.steps import Plot, StepOutcome
@@ -107,6 +107,26 @@ def feet_findings(
     return findings
 
 
+def _check_ids(apply: str, findings: list[dict[str, Any]]) -> None:
+    """Refuse ``feet_apply`` ids (not a named choice) that are not skate findings of the take.
+
+    Raises
+    ------
+    InputError
+        Naming ``feet_apply``, the ids not found and the take's skate findings.
+    """
+    if apply in RUN_APPLY_CHOICES:
+        return
+    skates = [str(f["id"]) for f in findings if f["kind"] == "skate"]
+    missing = [key for key in apply.split(",") if key not in skates]
+    if missing:
+        listed = ", ".join(skates[:8]) + (", ..." if len(skates) > 8 else "")
+        raise InputError(
+            f"Expected feet_apply ids of skate findings of this take "
+            f"({listed if skates else 'it has none'}), got {', '.join(missing[:4])}"
+        )
+
+
 def run_feet(
     take: Motion | KeypointSequence,
     mapping: Mapping[str, str] | None = None,
@@ -143,6 +163,7 @@ def run_feet(
         return StepOutcome("skipped", f"no feet to check: {e}")
     check = feet_report_json(points, report, skipped)
     add_ids(check, report.contacts, report.findings, skipped)
+    _check_ids(apply, check["findings"])
     locked = frozenset(locked_findings(apply, report.contacts, report.findings, skipped))
     rear: dict[str, str] = {}
     for name, side in zip(points.names, points.sides, strict=True):
