@@ -170,10 +170,12 @@ function walkFindings(t, dir) {
   jump(t, reached.start_frame);
 }
 
-/** The keyboard's commands (keyCommand); keys typed in a field are text. */
+/** The keyboard's commands (keyCommand); keys typed in a field are text. A checkbox is no
+ * field: the commands work while it has the focus, and Space still ticks it. */
 export function onKey(t, e) {
   const target = e.target;
-  const typing = target instanceof HTMLElement && (target.matches("input, textarea, select, [contenteditable]") || target.isContentEditable);
+  const field = "input:not([type=checkbox]):not([type=radio]), textarea, select, [contenteditable]";
+  const typing = target instanceof HTMLElement && (target.matches(field) || target.isContentEditable);
   if (typing || e.ctrlKey || e.metaKey || e.altKey) return;
   const command = keyCommand(e.key, e.shiftKey);
   const { state } = store;
@@ -181,7 +183,7 @@ export function onKey(t, e) {
     // Space plays or pauses on its key-down (a focused play button would wait for the key-up).
     // The time bar (a slider) plays too: it is where a reviewer's focus rests between findings.
     case "play":
-      if (target === t.ui.playButton || target.id === "timebar" || !target.matches("button, a, [tabindex]")) { e.preventDefault(); if (!e.repeat) togglePlay(t); }
+      if (target === t.ui.playButton || target.id === "timebar" || !target.matches("button, a, input, [tabindex]")) { e.preventDefault(); if (!e.repeat) togglePlay(t); }
       break;
     case "step": e.preventDefault(); if (t.player.playing) togglePlay(t); jump(t, state.frame + command.by); break;
     case "walk": walkFindings(t, command.dir); break;

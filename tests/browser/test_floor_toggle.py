@@ -89,6 +89,12 @@ def test_the_floor_checkbox_toggles_a_tilted_floor_by_keyboard_and_mouse(
     assert shown(page) == [True, True]
     # Space in the checkbox toggles it and does not start playback.
     assert not p.evaluate("() => window.mocapqaPlayer.playing")
+    # The take view's keys still work with the checkbox focused: the right arrow steps a frame.
+    before = page.frame()
+    p.keyboard.press("ArrowRight")
+    page.settle()
+    assert page.frame() == before + 1
+    assert p.evaluate("() => document.activeElement.id") == "show-floor"
 
     # Mouse: a click on the checkbox, then on its label's text.
     box.click()
