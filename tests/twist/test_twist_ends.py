@@ -188,3 +188,36 @@ def test_a_small_one_sided_interval_with_an_inexact_counter_rotation_is_reported
     assert applied.tolist() == [False, True, True, True]
     assert rules[0] == "end_evidence"
     assert END_MAX_MISMATCH < 0.1
+
+
+@pytest.mark.parametrize(
+    ("take", "segment", "side", "where"),
+    [
+        ("bvh/cmu/iclone/005_16.bvh", "upper_arm", "right", "head"),
+        ("bvh/bandai/dataset-2_wave-both-hands_youthful_001.bvh", "forearm", "left", "tail"),
+    ],
+)
+def test_a_shift_one_frame_from_an_end_whose_step_back_made_no_event_moves_no_clean_frame(
+    corpus_dir: Path, take: str, segment: str, side: str, where: str
+) -> None:
+    # A 35° shift over frames 1–24 (head) or over the 16 frames before the last (tail) of a fit
+    # take: its event next to the end reads, locally, as a one-frame head's release (a tail's
+    # onset); its other end made no event, and the parent and the child step back by the jump
+    # from one frame to the next, while their levels averaged over ``burst_gap_s`` frames do not
+    # (the other roll moves fast there). No one-sided interval forms, the end frame is left.
+    motion = read_bvh(corpus_dir / take)
+    geometry = _chain(motion, segment, side)
+    rows = slice(1, 25) if where == "head" else slice(motion.n_frames - 17, motion.n_frames - 1)
+    offsets = np.zeros((motion.n_frames, 1))
+    offsets[rows] = np.deg2rad(35.0)
+    shifted = replace(motion, quats=refine_quats(motion.quats, (geometry,), -offsets))
+    clean = np.ones(motion.n_frames, dtype=bool)
+    clean[rows] = False
+    end = 0 if where == "head" else motion.n_frames - 1
+    without = analyze_twist(shifted, params=RobustParams(end_return=0.0))
+    assert [(f.side, f.start_frame, f.end_frame) for f in without.found if f.side] == [
+        (where, end, end)
+    ]
+    analysis = analyze_twist(shifted)
+    assert not [f for f in analysis.found if f.side]
+    assert np.array_equal(analysis.refined.quats[clean], motion.quats[clean])

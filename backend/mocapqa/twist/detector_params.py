@@ -114,9 +114,9 @@ class RobustParams:
     end_return : float
         Such an event forms no one-sided interval when, between it and its neighbouring events
         (within ``max_interval_s``) on either side, the parent's roll steps back by its jump
-        and the child's by the mirror, each within this fraction of the jump, over windows of
-        up to ``burst_gap_s`` (the other end of an interior interval that made no event;
-        :func:`mocapqa.twist.one_sided.one_sided`). 0: off.
+        and the child's by the mirror, each within this fraction of the jump, from one frame to
+        the next or over windows of up to ``burst_gap_s`` (the other end of an interior interval
+        that made no event; :func:`mocapqa.twist.one_sided.one_sided`). 0: off.
     """
 
     min_threshold_deg: float = 2.0

@@ -11,7 +11,8 @@ the natural side (within ``agreement`` of the jump, and ``|wrap(P + C)| ≤`` :d
 ``× min(|P|, |C|)``), and the jump stands out against the parent's steps beside it. A natural
 step that is not held, or that the child does not keep counter-rotating, fails that test. Nor
 does an event whose roll steps back by its jump (the child mirroring it) between it and the next
-event on either side: the other end of an interior interval that made no event.
+event on either side, from one frame to the next or averaged over ``burst_gap_s``: the other end
+of an interior interval that made no event.
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ def one_sided(chain: ChainEvents, groups: list[list[int]]) -> list[IntervalEstim
     (:func:`_held_end`) is within ``agreement`` × |jump| of that level and the child's mirrors
     it (``|wrap(P + C)| ≤`` :data:`END_MIRROR` ``× min(|P|, |C|)``), unless it releases a
     burst (:func:`_releases_burst`), an unmatched event cancels it (:func:`_cancels_loose`) or
-    its roll steps back where no event was found (:func:`_returned`, ``end_return``). One
+    its roll steps back where no event was found (:func:`_stepped_back`, ``end_return``). One
     event is weaker evidence than two that cancel, so its jump must also be ``end_contrast``
     times every raw roll step of the parent within ``burst_gap`` frames other than the
     explained events' (the peak of a fast natural roll the child partly counter-rotates is
@@ -104,7 +105,7 @@ def one_sided(chain: ChainEvents, groups: list[list[int]]) -> list[IntervalEstim
         if gap > agreement * abs(level) or not mirrored:
             continue
         bounds = _next_events(frames, frame, max_frames)
-        if _returned(parent, child, frame, jump, bounds, burst_gap, settings.end_return):
+        if _stepped_back(parent, child, frame, jump, bounds, burst_gap, settings.end_return):
             continue
         taken = k
         features = _features(chain, k, gap, level, stretch.stop - stretch.start)
@@ -131,6 +132,25 @@ def _held_level(roll: FloatArray, natural: FloatArray, stretch: slice, reference
     off = roll - np.cumsum(natural)
     levels = [np.angle(np.mean(np.exp(1j * off[s]))) for s in (stretch, reference)]
     return float(wrap_angle(np.array(levels[0] - levels[1])))
+
+
+def _stepped_back(
+    parent: tuple[FloatArray, FloatArray],
+    child: tuple[FloatArray, FloatArray],
+    frame: int,
+    jump: float,
+    bounds: tuple[int, int],
+    burst_gap: int,
+    tolerance: float,
+) -> bool:
+    """:func:`_returned` with the step read from one frame to the next, or averaged over
+    ``burst_gap`` frames on each side: the averaged levels blur a one-frame counter-rotated
+    step where the other roll moves fast (a child rolling 10–17° a frame beside a still
+    parent), and a step read over one frame misses a step spread over a few."""
+    return any(
+        _returned(parent, child, frame, jump, bounds, window, tolerance)
+        for window in sorted({1, burst_gap})
+    )
 
 
 def _returned(
@@ -169,7 +189,7 @@ def _returned(
         First and last frame (exclusive) searched: the other events next to this one, or the
         farthest frames an interval through it may reach.
     window : int
-        Frames averaged on each side of a step.
+        Frames averaged on each side of a step (1: the step from one frame to the next).
     tolerance : float
         Largest gap of either step from its target, as a fraction of |jump|; 0: no check.
 
