@@ -31,7 +31,13 @@ export async function takeView(main, takeId, params, onTeardown) {
   const run = runs.find((r) => r.id === runParam) || runs[runs.length - 1];
   main.replaceChildren(takeHeader(take, run));
   if (!run) return;
-  if (run.status !== "done") { await waitForRun(main, run); return; }
+  // A run not finished shows its progress; the take's other runs stay one choice away (a
+  // failed run says why, and the picker opens a finished one).
+  if (run.status !== "done") {
+    if (runs.length > 1) main.append(runPicker(take, run, () => 0, await api.getRunOptions()));
+    await waitForRun(main, run);
+    return;
+  }
   const t = await openRun(main, take, run, params);
   layOut(t);
   const { createViews } = await scene;

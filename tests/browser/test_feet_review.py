@@ -144,7 +144,20 @@ def test_a_run_that_locks_the_skates_is_chosen_in_the_form_and_reviewed_lock_by_
     lock = skate["id"]
     n = sum(f["kind"] == "skate" for f in take["result"]["findings"])
     p = page.page
+    # A run naming a lock the take does not have fails, saying why; the page still offers the
+    # take's other runs.
+    bad = httpx.post(
+        f"{live_server}/api/v1/takes/{take['id']}/runs",
+        json={"checks": ["feet"], "feet_apply": "skate-left-99999"},
+        timeout=30,
+    ).json()
     page.open_take(live_server, take)
+    p.evaluate("(hash) => { location.hash = hash; }", f"#/take/{take['id']}?run={bad['id']}")
+    p.wait_for_selector("main p.error", timeout=120_000)
+    assert "feet_apply ids of skate findings" in p.inner_text("main p.error")
+    p.select_option("#run-pick", take["run"])
+    p.wait_for_selector("main[data-ready='1']", timeout=60_000)
+    page.settle()
     # The re-run form offers the cleanup in the feet group, off by default; chosen by keyboard.
     field = p.locator("#option-feet_apply")
     field.scroll_into_view_if_needed()
