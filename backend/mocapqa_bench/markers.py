@@ -36,10 +36,11 @@ from mocapqa.errors import InputError
 from mocapqa.io.c3d import read_c3d
 from mocapqa.markers.check import check_markers
 from mocapqa.markers.inject import InjectedSwap, inject_swaps
+from mocapqa.markers.misfits import misfits, tolerances
 from mocapqa.markers.params import MarkerParams
 from mocapqa.markers.segments import mates, pair_stats
 from mocapqa.markers.spikes import find_spikes
-from mocapqa.markers.swaps import Swap, find_swaps, misfits, tolerances
+from mocapqa.markers.swaps import Swap, find_swaps
 
 __all__ = [
     "BENCH_FILES",

@@ -13,7 +13,7 @@ from mocapqa.core.arrays import column_runs
 from mocapqa.markers.check import check_markers
 from mocapqa.markers.inject import inject_swaps
 from mocapqa.markers.segments import pair_stats
-from mocapqa.markers.swaps import repair_swaps
+from mocapqa.markers.swap_repair import repair_swaps
 
 
 @pytest.mark.parametrize("name", CLEAN_TAKES)

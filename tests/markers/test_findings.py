@@ -15,7 +15,8 @@ from mocapqa.markers.labels import base_label, find_label_problems
 from mocapqa.markers.params import MarkerParams
 from mocapqa.markers.segments import infer_segments, pair_stats
 from mocapqa.markers.spikes import find_spikes
-from mocapqa.markers.swaps import Swap, repair_swaps, select_swaps
+from mocapqa.markers.swap_repair import repair_swaps, select_swaps
+from mocapqa.markers.swaps import Swap
 
 
 def _swap(a: int, b: int, start: int, end: int, confidence: float) -> Swap:

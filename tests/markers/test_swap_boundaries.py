@@ -11,7 +11,8 @@ from tests.markers.conftest import Take
 
 from mocapqa.markers.params import MarkerParams
 from mocapqa.markers.segments import pair_stats
-from mocapqa.markers.swaps import find_swaps, labels_held
+from mocapqa.markers.swap_evidence import labels_held
+from mocapqa.markers.swaps import find_swaps
 from mocapqa_bench.markers import Counts, GridRow, best_point
 
 NICK = "vicon/nick_freeform_001.c3d"

@@ -172,7 +172,7 @@ def markers_fill(
     from mocapqa.io.atomic import write_text
     from mocapqa.io.formats import check_fps, detect_format, write_keypoints
     from mocapqa.markers.repair import repair_markers
-    from mocapqa.markers.swaps import APPLY_RULES
+    from mocapqa.markers.swap_repair import APPLY_RULES
 
     if fps is not None:
         check_fps(fps, "--fps")

@@ -4,7 +4,7 @@ filtered CSV (with its sidecar) or TRC, a C3D marker take's repaired C3D.
 The paths are :class:`~mocapqa.jobs.run_folder.RunFolder`'s (``corrected.bvh``,
 ``filtered.csv``, ``filtered.trc``, ``corrected.c3d``);
 :func:`mocapqa.jobs.run_outputs.write_outputs` chooses which a run has, and a decided
-download (:mod:`mocapqa.jobs.accepted`) writes a reviewer's choice of a C3D repair through
+download (:mod:`mocapqa.jobs.decided_markers`) writes a reviewer's choice of a C3D repair through
 :func:`write_corrected_c3d`. Each file is written atomically. The readers and writers of the
 formats are imported inside the functions: the batch client imports the run folder's names
 without the analysis stack.
@@ -60,7 +60,7 @@ def write_corrected_c3d(path: Path, source: Path, repair: MarkerRepair | None) -
     residual 0 and no cameras on every filled sample (C3D's mark of an interpolated sample);
     the source's analogs, force plates, events and other groups unchanged, or (a source ezc3d
     cannot open) the markers alone. ``repair`` is the run's (``AnalysisResult.markers``) or a
-    reviewer's choice of it (:func:`mocapqa.jobs.accepted.decided_c3d`).
+    reviewer's choice of it (:func:`mocapqa.jobs.decided_markers.decided_c3d`).
 
     Raises
     ------

@@ -25,7 +25,8 @@ from mocapqa.errors import InputError
 from mocapqa.markers.check import check_markers
 from mocapqa.markers.fill import FillParams, FillResult, fill_gaps
 from mocapqa.markers.params import MarkerParams, unit_scale
-from mocapqa.markers.swaps import Swap, repair_swaps, select_swaps, swapped_mask
+from mocapqa.markers.swap_repair import repair_swaps, select_swaps, swapped_mask
+from mocapqa.markers.swaps import Swap
 
 __all__ = ["MarkerRepair", "repair_markers"]
 

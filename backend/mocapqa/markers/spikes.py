@@ -117,7 +117,7 @@ def find_spikes(
     length_unit : str
     params : MarkerParams, optional
     misfit : ndarray, shape (F, M), optional
-        Each marker's misfit against its rigid mates (:func:`mocapqa.markers.swaps.misfits`,
+        Each marker's misfit against its rigid mates (:func:`mocapqa.markers.misfits.misfits`,
         tolerances; NaN where unknown). When given, a run of a marker measured there is a
         spike only if its misfit rises by ``spike_misfit`` in it above its level on the 3
         frames either side: a marker that leaves its path also leaves its segment, while a

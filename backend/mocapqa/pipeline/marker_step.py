@@ -40,7 +40,7 @@ from mocapqa.markers.gaps import gap_severity
 from mocapqa.markers.params import MM_PER_UNIT, MarkerParams
 from mocapqa.markers.repair import MarkerRepair, repair_markers
 from mocapqa.markers.segments import PairStats
-from mocapqa.markers.swaps import repair_swaps
+from mocapqa.markers.swap_repair import repair_swaps
 from mocapqa.pipeline.steps import Plot, StepOutcome
 
 __all__ = [

@@ -20,9 +20,7 @@ from mocapqa.errors import ConflictError, NotFoundError
 from mocapqa.io.guards import ReadLimits
 from mocapqa.jobs.accepted import (
     decided_bvh,
-    decided_c3d,
     decided_motion,
-    decided_trc,
     run_decidables,
     run_intervals,
     run_locks,
@@ -30,6 +28,7 @@ from mocapqa.jobs.accepted import (
     with_decisions,
 )
 from mocapqa.jobs.decided_feet import lock_kept
+from mocapqa.jobs.decided_markers import decided_c3d, decided_trc
 from mocapqa.pipeline.marker_step import MARKER_APPLY
 from mocapqa.pipeline.options import AnalysisOptions
 from mocapqa.store.decisions import DecidedItem, IntervalDecisions
