@@ -188,9 +188,11 @@ def _without_end(chain: ChainEvents, groups: list[list[int]], end: int) -> list[
     (events within ``burst_gap`` of each other whose jumps cancel: a head's release pairs with
     a level shift's onset, not with one flip of a burst) and its new groups cancel better than the
     groups it replaces (the sum of their net jumps beyond the chain's jump threshold: nets
-    within it are as good as exact). The same at the take's end, for a
-    tail's onset. The caller keeps it only when the freed event then forms its one-sided
-    interval.
+    within it are as good as exact), or cancels as well and leaves fewer events unexplained
+    (:func:`_unexplained`: a head's release and the next onset that cancel within the threshold
+    leave that onset's own release unmatched in the middle of the take). The same at the
+    take's end, for a tail's onset. The caller keeps it only when the freed event then forms
+    its one-sided interval.
     """
     if not any(end in g for g in groups):
         return groups
@@ -219,7 +221,24 @@ def _without_end(chain: ChainEvents, groups: list[list[int]], end: int) -> list[
         nets = [abs(float(wrap_angle(np.array(np.sum(chain.jumps[g]))))) for g in chosen]
         return sum(max(net - settings.threshold, 0.0) for net in nets)
 
-    return regrouped if new and residual(new) < residual(old) else groups
+    better = residual(new) < residual(old) or (
+        residual(new) <= residual(old)
+        and _unexplained(chain, regrouped, end) < _unexplained(chain, groups, end)
+    )
+    return regrouped if new and better else groups
+
+
+def _unexplained(chain: ChainEvents, groups: list[list[int]], end: int) -> int:
+    """Events other than ``end`` that no group holds and that cannot be the one event of an
+    interval running to an end of the take (the chain's first or last event within
+    ``max_frames`` of its end): events a reading of the jumps leaves unaccounted for."""
+    frames, max_frames = chain.frames, chain.settings.max_frames
+    loose = set(range(len(frames))) - {k for g in groups for k in g} - {end}
+    if int(frames[0]) <= max_frames:
+        loose.discard(0)
+    if chain.n_frames - int(frames[-1]) <= max_frames:
+        loose.discard(len(frames) - 1)
+    return len(loose)
 
 
 def _spread(values: FloatArray) -> float:

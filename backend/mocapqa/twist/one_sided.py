@@ -8,11 +8,12 @@ no group, lies within ``max_interval_s`` of the take's end and no other event li
 1]`` with the event's jump as its level — when the level holds: next to the event, the parent's
 and the child's rolls (taken off their natural travel) step by the jump and its mirror against
 the natural side (within ``agreement`` of the jump, and ``|wrap(P + C)| ≤`` :data:`END_MIRROR`
-``× min(|P|, |C|)``), and the jump stands out against the parent's steps beside it. A natural
-step that is not held, or that the child does not keep counter-rotating, fails that test. Nor
-does an event whose roll steps back by its jump (the child mirroring it) between it and the next
-event on either side, from one frame to the next or averaged over ``burst_gap_s``: the other end
-of an interior interval that made no event.
+``× min(|P|, |C|)``; the natural side read no farther than the next event there), and the jump
+stands out against the parent's steps beside it. A natural step that is not held, or that the
+child does not keep counter-rotating, fails that test. Nor does an event whose roll steps back
+by its jump (the child mirroring it) between it and the next event on either side, from one
+frame to the next or averaged over ``burst_gap_s``: the other end of an interior interval that
+made no event.
 """
 
 from __future__ import annotations
@@ -95,8 +96,9 @@ def one_sided(chain: ChainEvents, groups: list[list[int]]) -> list[IntervalEstim
             or _cancels_loose(frames, jumps, grouped, k, side, max_frames, agreement)
         ):
             continue
+        bounds = _next_events(frames, frame, max_frames)
         stretch, level, p_level, c_level = _held_end(
-            parent, child, side, frame, jump, (before, after), burst_gap
+            parent, child, side, frame, jump, (before, after), burst_gap, bounds
         )
         gap = abs(float(wrap_angle(np.array(p_level - level))))
         mirrored = abs(float(wrap_angle(np.array(p_level + c_level)))) <= END_MIRROR * min(
@@ -104,7 +106,6 @@ def one_sided(chain: ChainEvents, groups: list[list[int]]) -> list[IntervalEstim
         )
         if gap > agreement * abs(level) or not mirrored:
             continue
-        bounds = _next_events(frames, frame, max_frames)
         if _stepped_back(parent, child, frame, jump, bounds, burst_gap, settings.end_return):
             continue
         taken = k
@@ -315,6 +316,7 @@ def _held_end(
     jump: float,
     anchor: tuple[int, int],
     burst_gap: int,
+    bounds: tuple[int, int] | None = None,
 ) -> tuple[slice, float, float, float]:
     """The stretch a one-sided interval at ``frame`` covers, the level its jump implies, and
     the parent's and the child's levels held next to the event.
@@ -322,17 +324,23 @@ def _held_end(
     The level is read up to ``burst_gap`` frames on each side: on the error side from the
     event on, on the natural side from the anchor (``anchor``: before, after) outwards (a
     single frame may hold a one-frame natural counter-rotation of the child, and far from the
-    event the natural travel near the take's end is read less well).
+    event the natural travel near the take's end is read less well), never across the next
+    event on the natural side (``bounds``: the events next to it, :func:`_next_events`): the
+    roll steps there, so the frames beyond it hold another level (the error of a neighbouring
+    interval whose release is the frame before a tail's onset).
     """
     n_frames = len(parent[0])
     before, after = anchor
+    low, high = (0, n_frames) if bounds is None else (max(bounds[0], 0), min(bounds[1], n_frames))
     if side == "tail":
         stretch, level = slice(frame, n_frames), jump
         held = slice(frame, min(frame + burst_gap, n_frames))
-        reference = slice(max(before - burst_gap + 1, 0), before + 1)
+        start = max(before - burst_gap + 1, 0)
+        reference = slice(max(start, low) if low <= before else start, before + 1)
     else:
         stretch, level = slice(0, frame), -jump
         held = slice(max(frame - burst_gap, 0), frame)
-        reference = slice(after, min(after + burst_gap, n_frames))
+        stop = min(after + burst_gap, n_frames)
+        reference = slice(after, min(stop, high) if high > after else stop)
     p_level, c_level = (_held_level(r, n, held, reference) for r, n in (parent, child))
     return stretch, level, p_level, c_level
