@@ -5,14 +5,11 @@ Conventions
 * An *event* is a frame where the parent's roll steps away from its natural velocity and the
   child counter-rotates by the same amount (found by :func:`mocapqa.twist.detect.detect_robust`).
   Its *jump* is the size of that step, radians.
-* Events are matched like brackets: each event closes the most recent open events whose jumps
-  it cancels (net within ``max(threshold, closure_fraction × largest jump)``), within
-  ``max_interval_s``. This finds isolated level shifts (onset and release), single-frame flips
-  and bursts of flips that return to the natural level. Events left unmatched that lie within
-  ``burst_gap_s`` of each other still form an interval (a burst whose ends do not agree), with a
-  lower confidence. A lone unmatched event is never an interval. A dense burst (events within
-  ``burst_gap_s`` of each other) whose jumps cancel as a whole is one interval, whatever pairs
-  the bracket matching made inside it. Groups whose spans overlap are merged into one.
+* The events that bound each interval are grouped by :mod:`mocapqa.twist.event_groups`
+  (matched like brackets, bursts of flips, overlapping groups merged); a burst whose ends do
+  not agree still forms an interval, with a lower confidence. With ``ends``, the chain's first
+  or last event is freed from its group where it may be a head's release or a tail's onset
+  (:mod:`mocapqa.twist.end_pairing`).
 * The *natural roll* through an interval is the cubic Hermite continuation of the integrated
   roll between two anchors, with the natural velocities there: the last frame before its first
   event and the frame of its last event (where the roll is back at its natural level), moved
@@ -40,205 +37,17 @@ Conventions
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
 from mocapqa.core.arrays import BoolArray, FloatArray, IntArray
 from mocapqa.twist.angles import wrap_angle
 from mocapqa.twist.chain_events import FEATURES, ChainEvents, ChainSettings, IntervalEstimate
+from mocapqa.twist.end_pairing import free_ends
+from mocapqa.twist.event_groups import closes, event_groups
 from mocapqa.twist.one_sided import one_sided
 from mocapqa.twist.outside import anchors, forbidden_frames, hermite_deviation, split_unmirrored
 
 __all__ = ["FEATURES", "ChainSettings", "IntervalEstimate", "chain_intervals"]
-
-
-def _closes(
-    level: float, largest: float, threshold: float, fraction: float, slack: float = 0.0
-) -> bool:
-    return abs(level) <= max(threshold, fraction * largest) + slack
-
-
-def _one_onset(
-    jumps: FloatArray, stack: list[int], cluster: IntArray, which: int, fraction: float
-) -> bool:
-    """Whether the open events of cluster ``which`` are one onset and natural steps: at most
-    one jump larger than ``fraction`` of the largest. A lone release may close such a cluster
-    as a whole (an 85° onset with a 3° roll step in the next frame is a level shift, not a
-    burst of flips)."""
-    sizes = np.abs(jumps[[i for i in stack if cluster[i] == which]])
-    return bool(np.sum(sizes > fraction * sizes.max()) <= 1)
-
-
-def _groups(chain: ChainEvents) -> list[list[int]]:
-    """Event indices of each interval, sorted and frame-disjoint.
-
-    Events are matched like brackets: each new event closes the most recent open events whose
-    jumps it cancels (the shortest closure first); open events older than ``max_frames`` are
-    dropped. Once two events of one burst (events within ``burst_gap`` frames of each other)
-    are open together, they may only be closed from inside that burst, so a burst's last flip
-    is never paired with an unrelated event far away. Events left unmatched that lie within
-    ``burst_gap`` of each other form a burst. A lone event (none other within ``burst_gap``)
-    may close across a burst whose jumps are all within ``closure_fraction`` of its own: such a
-    burst is two or more small natural steps inside a large held shift (an arm's roll jittering
-    by 3–6° inside a 120° shift), not flips that the lone event could end. Groups whose spans
-    overlap (a burst inside a held level shift) are merged. Events farther apart than
-    ``burst_gap`` cancel within the closure tolerance plus the root sum of squares of their
-    jumps' uncertainty (``sigma``); flips inside one burst get no such allowance.
-    """
-    frames, burst_gap = chain.frames, chain.settings.burst_gap
-    groups, paired = _bracket_groups(chain)
-    loose = np.flatnonzero(~paired)
-    if len(loose) >= 2:
-        cuts = np.flatnonzero(np.diff(frames[loose]) > burst_gap) + 1
-        groups += [list(b) for b in np.split(loose, cuts) if len(b) >= 2]
-    groups += _cancelling_bursts(chain)
-    return _merge_overlapping(frames, groups)
-
-
-def _bracket_groups(chain: ChainEvents) -> tuple[list[list[int]], BoolArray]:
-    """The groups the bracket matching of :func:`_groups` closes, and which events they hold
-    (shape (E,))."""
-    frames, jumps, uncertainty = chain.frames, chain.jumps, chain.sigma
-    threshold, closure_fraction = chain.settings.threshold, chain.settings.closure_fraction
-    burst_gap, max_frames = chain.settings.burst_gap, chain.settings.max_frames
-    groups: list[list[int]] = []
-    paired = np.zeros(len(frames), dtype=bool)
-    cluster = np.concatenate(([0], np.cumsum(np.diff(frames) > burst_gap)))
-    bound = np.zeros(len(frames), dtype=bool)
-    alone = np.bincount(cluster)[cluster] == 1
-    stack: list[int] = []
-    for k in range(len(frames)):
-        stack = [i for i in stack if frames[k] - frames[i] <= max_frames]
-        level, largest, closed = float(jumps[k]), abs(float(jumps[k])), -1
-        # A lone event may close across a burst whose flips are all within its own closure
-        # tolerance: small natural steps inside a large held shift, not a burst it could end.
-        minor = closure_fraction * largest
-        variance = float(uncertainty[k]) ** 2
-        for p in range(len(stack) - 1, -1, -1):
-            if (
-                bound[stack[p]]
-                and cluster[stack[p]] != cluster[k]
-                and not (alone[k] and abs(float(jumps[stack[p]])) <= minor)
-                and not (alone[k] and _one_onset(jumps, stack, cluster, cluster[stack[p]],
-                                                 closure_fraction))
-            ):  # fmt: skip
-                break
-            level = float(wrap_angle(np.array(level + jumps[stack[p]])))
-            largest = max(largest, abs(float(jumps[stack[p]])))
-            variance += float(uncertainty[stack[p]]) ** 2
-            slack = np.sqrt(variance) if frames[k] - frames[stack[p]] > burst_gap else 0.0
-            if _closes(level, largest, threshold, closure_fraction, slack):
-                closed = p
-                break
-        if closed < 0:
-            # Two open events of one burst: the burst's events may only close each other.
-            same = [i for i in stack if cluster[i] == cluster[k]]
-            if same:
-                bound[[*same, k]] = True
-            stack.append(k)
-            continue
-        members = [*stack[closed:], k]
-        paired[members] = True
-        stack = stack[:closed]
-        groups.append(members)
-    return groups, paired
-
-
-def _cancelling_bursts(chain: ChainEvents) -> list[list[int]]:
-    """Each dense burst (three or more events, each within ``burst_gap`` of the next) whose
-    jumps cancel as a whole: one interval, whatever pairs the bracket matching made inside it
-    (alternating flips of similar size pair up wrongly)."""
-    frames, jumps, settings = chain.frames, chain.jumps, chain.settings
-    threshold, closure_fraction = settings.threshold, settings.closure_fraction
-    found: list[list[int]] = []
-    cuts = np.flatnonzero(np.diff(frames) > settings.burst_gap) + 1
-    for burst in np.split(np.arange(len(frames)), cuts):
-        largest = float(np.max(np.abs(jumps[burst])))
-        net = float(wrap_angle(np.array(np.sum(jumps[burst]))))
-        if len(burst) >= 3 and _closes(net, largest, threshold, closure_fraction):
-            found.append(list(burst))
-    return found
-
-
-def _merge_overlapping(frames: IntArray, groups: list[list[int]]) -> list[list[int]]:
-    """``groups`` in frame order, those whose spans overlap merged, each sorted."""
-    groups = sorted(groups, key=lambda g: frames[min(g)])
-    merged: list[list[int]] = []
-    for group in groups:
-        if merged and frames[min(group)] < frames[max(merged[-1])]:
-            merged[-1] = sorted(set(merged[-1]) | set(group))
-        else:
-            merged.append(sorted(group))
-    return merged
-
-
-def _without_end(chain: ChainEvents, groups: list[list[int]], end: int) -> list[list[int]]:
-    """``groups`` read again with event ``end`` (the chain's first or last) left out, when that
-    reading pairs the other events better; else ``groups``.
-
-    Bracket matching pairs the chain's first event A with a later event B whenever their jumps
-    cancel, but near the start A may be the release of an error the take began with and B the
-    onset of another interval, whose own release C is then left unmatched or paired with the
-    next interval's onset, and so on down the chain (each interval read between the release
-    of one error and the onset of the next). Both readings fit the jumps; an onset and the
-    release of one error read the same jump twice. The events are matched again without A
-    (the same rules, so pairs nested between A and B stay), and that reading is taken when it
-    leaves no other event unmatched that the first held, keeps every burst whose flips return
-    (events within ``burst_gap`` of each other whose jumps cancel: a head's release pairs with
-    a level shift's onset, not with one flip of a burst) and its new groups cancel better than the
-    groups it replaces (the sum of their net jumps beyond the chain's jump threshold: nets
-    within it are as good as exact), or cancels as well and leaves fewer events unexplained
-    (:func:`_unexplained`: a head's release and the next onset that cancel within the threshold
-    leave that onset's own release unmatched in the middle of the take). The same at the
-    take's end, for a tail's onset. The caller keeps it only when the freed event then forms
-    its one-sided interval.
-    """
-    if not any(end in g for g in groups):
-        return groups
-    keep = np.flatnonzero(np.arange(len(chain.frames)) != end)
-    rest = replace(
-        chain, frames=chain.frames[keep], jumps=chain.jumps[keep],
-        mismatch=chain.mismatch[keep], sigma=chain.sigma[keep],
-    )  # fmt: skip
-    regrouped = [[int(keep[i]) for i in g] for g in _groups(rest)]
-    held = {k for g in groups for k in g} - {end}
-    settings = chain.settings
-    bursts = [
-        g for g in groups
-        if end not in g and np.any(np.diff(chain.frames[g]) <= settings.burst_gap)
-        and _closes(float(wrap_angle(np.array(np.sum(chain.jumps[g])))),
-                    float(np.max(np.abs(chain.jumps[g]))), settings.threshold,
-                    settings.closure_fraction)
-    ]  # fmt: skip
-    kept = all([h for h in regrouped if set(h) & set(g)] == [g] for g in bursts)
-    if not held <= {k for g in regrouped for k in g} or not kept:
-        return groups
-    old = [g for g in groups if g not in regrouped]
-    new = [g for g in regrouped if g not in groups]
-
-    def residual(chosen: list[list[int]]) -> float:
-        nets = [abs(float(wrap_angle(np.array(np.sum(chain.jumps[g]))))) for g in chosen]
-        return sum(max(net - settings.threshold, 0.0) for net in nets)
-
-    better = residual(new) < residual(old) or (
-        residual(new) <= residual(old)
-        and _unexplained(chain, regrouped, end) < _unexplained(chain, groups, end)
-    )
-    return regrouped if new and better else groups
-
-
-def _unexplained(chain: ChainEvents, groups: list[list[int]], end: int) -> int:
-    """Events other than ``end`` that no group holds and that cannot be the one event of an
-    interval running to an end of the take (the chain's first or last event within
-    ``max_frames`` of its end): events a reading of the jumps leaves unaccounted for."""
-    frames, max_frames = chain.frames, chain.settings.max_frames
-    loose = set(range(len(frames))) - {k for g in groups for k in g} - {end}
-    if int(frames[0]) <= max_frames:
-        loose.discard(0)
-    if chain.n_frames - int(frames[-1]) <= max_frames:
-        loose.discard(len(frames) - 1)
-    return len(loose)
 
 
 def _spread(values: FloatArray) -> float:
@@ -325,9 +134,9 @@ def chain_intervals(
         frames[keep], jumps[keep], mismatch[keep], sigma, np.cumsum(increments), natural,
         None if child is None else (np.cumsum(child[0]), child[1]), small_steps, settings,
     )  # fmt: skip
-    groups = _groups(chain)
+    groups = event_groups(chain)
     if settings.ends and chain.child_roll is not None:
-        groups = _free_ends(chain, groups)
+        groups = free_ends(chain, groups)
     split = [False] * len(groups)
     if settings.mirror > 0 and chain.child_roll is not None:
         groups, split = split_unmirrored(
@@ -347,21 +156,6 @@ def chain_intervals(
             offsets[estimate.start_frame : estimate.end_frame + 1] = estimate.offset_rad
             found.append(estimate)
     return offsets, found
-
-
-def _free_ends(chain: ChainEvents, groups: list[list[int]]) -> list[list[int]]:
-    """``groups`` with the first (last) event freed from its group where it may be a head's
-    release (a tail's onset, :func:`_without_end`): re-paired only when it then forms that
-    one-sided interval."""
-    for side, end in (("head", 0), ("tail", len(chain.frames) - 1)):
-        if abs(int(chain.frames[end]) - (0 if side == "head" else chain.n_frames)) > (
-            chain.settings.max_frames
-        ):
-            continue
-        freed = _without_end(chain, groups, end)
-        if freed != groups and any(e.side == side for e in one_sided(chain, freed)):
-            groups = freed
-    return groups
 
 
 def _decay_end(chain: ChainEvents, last: int, last_jump: float) -> int:
@@ -443,7 +237,7 @@ def _group_interval(
     spread_out = bool(np.all(np.diff(events) > chain.settings.burst_gap))
     slack = float(np.sqrt(np.sum(chain.sigma[group] ** 2))) if spread_out else 0.0
     largest = float(np.max(np.abs(steps)))
-    closed = _closes(net, largest, chain.settings.threshold, chain.settings.closure_fraction, slack)
+    closed = closes(net, largest, chain.settings.threshold, chain.settings.closure_fraction, slack)
     disagreement = _stretch_levels(chain, offsets, group, deviation, before, net, closed)
     if len(tail) and offsets[last - 1] != 0.0:
         # The level still to go on each tail frame, measured from the tail's end.
