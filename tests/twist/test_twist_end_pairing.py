@@ -114,3 +114,33 @@ def test_bench_twist_ends_only_prints_only_the_ends_table(
         for apply in ("confident", "all"):
             assert (end, apply, "all: fit set") in chosen
             assert (end, apply, "bandai: held-out") in chosen
+
+
+@pytest.mark.parametrize(
+    ("name", "seed", "repeat", "segment", "side"),
+    [
+        ("cmu/iclone/003_02.bvh", 4, 2, "upper_arm", "left"),
+        ("bandai/dataset-1_bye_childish_001.bvh", 2, 3, "lower_leg", "right"),
+    ],
+)
+def test_a_heads_release_is_freed_beside_a_burst_that_the_new_reading_keeps(
+    corpus_dir: Path, name: str, seed: int, repeat: int, segment: str, side: str
+) -> None:
+    # Fit-take head injections. The head's release paired with a later onset in a group that
+    # also held two events one burst gap apart that cancel (003_02: 115 and 121, the ends of a
+    # 6-frame shift); the whole group was kept as a burst, so the re-pairing without the
+    # first event was refused and the clean frames between two errors read as one (003_02:
+    # 48–142 at 160°, applied). The re-pairing keeps those two events together, so it is taken.
+    path = corpus_dir / "bvh" / name
+    motion = read_bvh(path)
+    rng = np.random.default_rng((seed, zlib.crc32(path.name.encode()), repeat))
+    corrupted, truth = inject_twist_errors(motion, rng, ends="head")
+    joint = _chain(motion, segment, side).chain.parent
+    clean = ~truth.error_mask[:, joint]
+    refined = analyze_twist(corrupted).refined
+    moved = rotation_errors_deg(motion.quats[clean, joint], refined.quats[clean, joint])
+    assert float(moved.max()) < 5.0
+    head = min((i for i in truth.intervals if i.joint == motion.skeleton.names[joint]),
+               key=lambda i: i.start_frame)  # fmt: skip
+    assert head.start_frame == 0
+    assert _corrected(motion, corrupted, joint, slice(0, head.end_frame + 1))

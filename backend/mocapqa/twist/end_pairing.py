@@ -58,19 +58,20 @@ def _without_end(chain: ChainEvents, groups: list[list[int]], end: int) -> list[
     Bracket matching pairs the chain's first event A with a later event B whenever their jumps
     cancel, but near the start A may be the release of an error the take began with and B the
     onset of another interval, whose own release C is then left unmatched or paired with the
-    next interval's onset, and so on down the chain (each interval read between the release
-    of one error and the onset of the next). Both readings fit the jumps; an onset and the
-    release of one error read the same jump twice. The events are matched again without A
-    (the same rules, so pairs nested between A and B stay), and that reading is taken when it
-    leaves no other event unmatched that the first held, keeps every burst whose flips return
-    (events within ``burst_gap`` of each other whose jumps cancel: a head's release pairs with
-    a level shift's onset, not with one flip of a burst) and its new groups cancel better than the
-    groups it replaces (the sum of their net jumps beyond the chain's jump threshold: nets
-    within it are as good as exact), or cancels as well and leaves fewer events unexplained
+    next interval's onset, and so on down the chain (each interval read between the release of
+    one error and the onset of the next). Both readings fit the jumps; an onset and the release
+    of one error read the same jump twice. The events are matched again without A (the same
+    rules, so pairs nested between A and B stay), and that reading is taken when it leaves no
+    other event unmatched that the first held, keeps every burst whose flips return together
+    (:func:`_bursts`: a run of events each within ``burst_gap`` of the next whose jumps cancel;
+    a head's release pairs with a level shift's onset, not with one flip of a burst; the rest of
+    the burst's old group may be read again) and its new groups cancel better than the groups it
+    replaces (the sum of their net jumps beyond the chain's jump threshold: nets within it are
+    as good as exact), or cancels as well and leaves fewer events unexplained
     (:func:`_unexplained`: a head's release and the next onset that cancel within the threshold
-    leave that onset's own release unmatched in the middle of the take). The same at the
-    take's end, for a tail's onset. The caller keeps it only when the freed event then forms
-    its one-sided interval.
+    leave that onset's own release unmatched in the middle of the take). The same at the take's
+    end, for a tail's onset. The caller keeps it only when the freed event then forms its
+    one-sided interval.
     """
     if not any(end in g for g in groups):
         return groups
@@ -82,14 +83,8 @@ def _without_end(chain: ChainEvents, groups: list[list[int]], end: int) -> list[
     regrouped = [[int(keep[i]) for i in g] for g in event_groups(rest)]
     held = {k for g in groups for k in g} - {end}
     settings = chain.settings
-    bursts = [
-        g for g in groups
-        if end not in g and np.any(np.diff(chain.frames[g]) <= settings.burst_gap)
-        and closes(float(wrap_angle(np.array(np.sum(chain.jumps[g])))),
-                    float(np.max(np.abs(chain.jumps[g]))), settings.threshold,
-                    settings.closure_fraction)
-    ]  # fmt: skip
-    kept = all([h for h in regrouped if set(h) & set(g)] == [g] for g in bursts)
+    bursts = [run for g in groups if end not in g for run in _bursts(chain, g)]
+    kept = all(set(run) <= set(h) for run in bursts for h in regrouped if set(run) & set(h))
     if not held <= {k for g in regrouped for k in g} or not kept:
         return groups
     old = [g for g in groups if g not in regrouped]
@@ -117,3 +112,17 @@ def _unexplained(chain: ChainEvents, groups: list[list[int]], end: int) -> int:
     if chain.n_frames - int(frames[-1]) <= max_frames:
         loose.discard(len(frames) - 1)
     return len(loose)
+
+
+def _bursts(chain: ChainEvents, group: list[int]) -> list[list[int]]:
+    """The bursts of ``group`` whose flips return: runs of its events each within
+    ``burst_gap`` of the next whose jumps cancel (:func:`mocapqa.twist.event_groups.closes`)."""
+    settings = chain.settings
+    gaps = np.diff(chain.frames[group]) > settings.burst_gap
+    runs = np.split(np.asarray(group), np.flatnonzero(gaps) + 1)
+    return [
+        [int(k) for k in run] for run in runs
+        if len(run) > 1 and closes(float(wrap_angle(np.array(np.sum(chain.jumps[run])))),
+                                   float(np.max(np.abs(chain.jumps[run]))), settings.threshold,
+                                   settings.closure_fraction)
+    ]  # fmt: skip
