@@ -4,7 +4,6 @@ views (none for a run without the feet step)."""
 
 from __future__ import annotations
 
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -12,7 +11,7 @@ from typing import Any
 import httpx
 import numpy as np
 import pytest
-from tests.browser.test_workstation import ARTIFACTS, Page, upload
+from tests.browser.test_workstation import ARTIFACTS, Page, run_again, upload
 
 pytestmark = pytest.mark.browser
 
@@ -103,15 +102,7 @@ def test_the_floor_plane_lies_at_the_feet_steps_floor_in_both_views(
     assert p.evaluate("() => window.mocapqaViews.floorDrawn().shown") == [False, False]
 
     # A run without the feet step has no floor plane.
-    created = httpx.post(
-        f"{live_server}/api/v1/takes/{take['id']}/runs", json={"checks": ["twist"]}, timeout=30
-    )
-    created.raise_for_status()
-    other = created.json()["id"]
-    deadline = time.monotonic() + 300
-    while httpx.get(f"{live_server}/api/v1/runs/{other}", timeout=30).json()["status"] != "done":
-        assert time.monotonic() < deadline
-        time.sleep(0.3)
+    other = run_again(live_server, take["id"], {"checks": ["twist"]})
     page.open_take(live_server, {**take, "run": other})
     assert p.evaluate("() => window.mocapqaViews.floorDrawn()") is None
     assert not page.errors, page.errors

@@ -39,17 +39,32 @@ def upload(server: str, path: Path) -> dict[str, Any]:
         )
     created.raise_for_status()
     take = created.json()
+    wait_for_run(server, take["run_id"], path.name)
+    result = httpx.get(f"{server}/api/v1/runs/{take['run_id']}/result", timeout=30).json()
+    return {"id": take["id"], "run": take["run_id"], "result": result}
+
+
+def wait_for_run(server: str, run_id: str, what: str = "the run") -> None:
+    """Wait until a run ends (at most 5 minutes, a deadline for a stuck run, not a speed
+    test) and check it is done."""
     deadline = time.monotonic() + 300
     while True:
-        run = httpx.get(f"{server}/api/v1/runs/{take['run_id']}", timeout=30).json()
+        run = httpx.get(f"{server}/api/v1/runs/{run_id}", timeout=30).json()
         if run["status"] in ("done", "failed"):
             break
         if time.monotonic() > deadline:
-            raise TimeoutError(f"analysis of {path.name} did not finish")
+            raise TimeoutError(f"analysis of {what} did not finish")
         time.sleep(0.3)
     assert run["status"] == "done", run
-    result = httpx.get(f"{server}/api/v1/runs/{take['run_id']}/result", timeout=30).json()
-    return {"id": take["id"], "run": take["run_id"], "result": result}
+
+
+def run_again(server: str, take_id: str, options: dict[str, Any]) -> str:
+    """Start a run of a take with ``options`` through the API, wait for it; its id."""
+    created = httpx.post(f"{server}/api/v1/takes/{take_id}/runs", json=options, timeout=30)
+    created.raise_for_status()
+    run_id: str = created.json()["id"]
+    wait_for_run(server, run_id)
+    return run_id
 
 
 @pytest.fixture(scope="module")
@@ -704,17 +719,7 @@ def test_compare_matches_findings_and_diffs_options(
     live_server: str, takes: dict[str, Any], page: Page
 ) -> None:
     knees = takes["knees"]
-    created = httpx.post(
-        f"{live_server}/api/v1/takes/{knees['id']}/runs",
-        json={"checks": ["twist"], "twist_method": "paper"},
-        timeout=30,
-    )
-    created.raise_for_status()
-    other = created.json()["id"]
-    deadline = time.monotonic() + 300
-    while httpx.get(f"{live_server}/api/v1/runs/{other}", timeout=30).json()["status"] != "done":
-        assert time.monotonic() < deadline
-        time.sleep(0.3)
+    other = run_again(live_server, knees["id"], {"checks": ["twist"], "twist_method": "paper"})
     p = page.page
     p.goto(f"{live_server}/#/compare?a={knees['run']}&b={other}")
     p.wait_for_selector("main[data-ready='1']", timeout=60_000)

@@ -6,38 +6,18 @@ from __future__ import annotations
 
 import shutil
 import zlib
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
+from tests.twist.chain_shifts import chain_of, with_shifts
 
 from mocapqa.cli.main import main
 from mocapqa.core.motion import Motion
-from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.io.bvh import read_bvh
 from mocapqa.metrics.twist import rotation_errors_deg
 from mocapqa.twist.analysis import analyze_twist
-from mocapqa.twist.angles import ChainGeometry, chain_geometry
 from mocapqa.twist.inject import inject_twist_errors
-from mocapqa.twist.refine import refine_quats
-
-
-def _chain(motion: Motion, segment: str, side: str) -> ChainGeometry:
-    chains = limb_chains(find_roles(motion.skeleton))
-    chain = next(c for c in chains if c.segment == segment and c.side == side)
-    return chain_geometry(motion.skeleton, chain)
-
-
-def _shifted(
-    motion: Motion, geometry: ChainGeometry, shifts: list[tuple[int, int, float]]
-) -> tuple[Motion, np.ndarray]:
-    """The take with twist offsets ``(first, last, degrees)`` on one chain (child compensated,
-    as the injection does), and the offsets per frame (radians)."""
-    offsets = np.zeros((motion.n_frames, 1))
-    for first, last, degrees in shifts:
-        offsets[first : last + 1] = np.deg2rad(degrees)
-    return replace(motion, quats=refine_quats(motion.quats, (geometry,), -offsets)), offsets[:, 0]
 
 
 def _corrected(motion: Motion, shifted: Motion, joint: int, rows: slice) -> bool:
@@ -55,10 +35,10 @@ def test_a_heads_release_paired_across_a_nested_interval_is_freed(corpus_dir: Pa
     # head was not found. Matched again without the first event, each onset pairs with its
     # own release.
     motion = read_bvh(corpus_dir / "bvh/bandai/dataset-1_guide_masculinity_001.bvh")
-    geometry = _chain(motion, "upper_arm", "right")
+    geometry = chain_of(motion, "upper_arm", "right")
     shifts = [(0, 11, -167.9), (35, 47, -73.9), (72, 75, -147.9), (101, 104, -174.1),
               (124, 132, -164.8)]  # fmt: skip
-    shifted, offsets = _shifted(motion, geometry, shifts)
+    shifted, offsets = with_shifts(motion, geometry, shifts)
     analysis = analyze_twist(shifted, apply="all")
     spans = [(f.side, f.start_frame, f.end_frame) for f in analysis.found]
     assert ("head", 0, 11) in spans
@@ -76,9 +56,9 @@ def test_a_tail_onset_beside_a_level_shifts_release_is_corrected(corpus_dir: Pat
     # two frames before the tail's onset at 50. That release is explained by its own onset,
     # so it is no burst of the tail's.
     motion = read_bvh(corpus_dir / "bvh/bandai/dataset-2_raise-up-right-hand_youthful_001.bvh")
-    geometry = _chain(motion, "forearm", "right")
+    geometry = chain_of(motion, "forearm", "right")
     shifts = [(2, 16, 167.2), (18, 30, -79.1), (34, 47, 34.0), (50, 53, -138.9)]
-    shifted, _ = _shifted(motion, geometry, shifts)
+    shifted, _ = with_shifts(motion, geometry, shifts)
     found = analyze_twist(shifted).found
     assert ("tail", 50, 53) in [(f.side, f.start_frame, f.end_frame) for f in found]
     assert _corrected(motion, shifted, geometry.chain.parent, slice(50, 54))
@@ -135,7 +115,7 @@ def test_a_heads_release_is_freed_beside_a_burst_that_the_new_reading_keeps(
     motion = read_bvh(path)
     rng = np.random.default_rng((seed, zlib.crc32(path.name.encode()), repeat))
     corrupted, truth = inject_twist_errors(motion, rng, ends="head")
-    joint = _chain(motion, segment, side).chain.parent
+    joint = chain_of(motion, segment, side).chain.parent
     clean = ~truth.error_mask[:, joint]
     refined = analyze_twist(corrupted).refined
     moved = rotation_errors_deg(motion.quats[clean, joint], refined.quats[clean, joint])

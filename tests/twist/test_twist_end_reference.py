@@ -5,36 +5,16 @@ fit-take injections rebuilt as offsets)."""
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
+from tests.twist.chain_shifts import chain_of, with_shifts
 
 from mocapqa.core.motion import Motion
-from mocapqa.core.rig import find_roles, limb_chains
 from mocapqa.io.bvh import read_bvh
 from mocapqa.metrics.twist import rotation_errors_deg
 from mocapqa.twist.analysis import analyze_twist
-from mocapqa.twist.angles import ChainGeometry, chain_geometry
-from mocapqa.twist.refine import refine_quats
-
-
-def _chain(motion: Motion, segment: str, side: str) -> ChainGeometry:
-    chains = limb_chains(find_roles(motion.skeleton))
-    chain = next(c for c in chains if c.segment == segment and c.side == side)
-    return chain_geometry(motion.skeleton, chain)
-
-
-def _shifted(
-    motion: Motion, geometry: ChainGeometry, shifts: list[tuple[int, int, float]]
-) -> tuple[Motion, np.ndarray]:
-    """The take with twist offsets ``(first, last, degrees)`` on one chain (child compensated,
-    as the injection does), and the offsets per frame (radians)."""
-    offsets = np.zeros((motion.n_frames, 1))
-    for first, last, degrees in shifts:
-        offsets[first : last + 1] = np.deg2rad(degrees)
-    return replace(motion, quats=refine_quats(motion.quats, (geometry,), -offsets)), offsets[:, 0]
 
 
 def _error_left(motion: Motion, shifted: Motion, refined: Motion, joint: int, rows: slice) -> float:
@@ -66,8 +46,8 @@ def test_a_tails_reference_stops_at_the_neighbouring_release(
     corpus_dir: Path, path: str, segment: str, side: str, shifts: list[tuple[int, int, float]]
 ) -> None:
     motion = read_bvh(corpus_dir / path)
-    geometry = _chain(motion, segment, side)
-    shifted, offsets = _shifted(motion, geometry, shifts)
+    geometry = chain_of(motion, segment, side)
+    shifted, offsets = with_shifts(motion, geometry, shifts)
     analysis = analyze_twist(shifted)
     first, last, _ = shifts[-1]
     tails = [f for f in analysis.found if f.side == "tail"]
@@ -88,10 +68,10 @@ def test_a_heads_release_that_pairs_as_well_with_a_later_onset_is_freed(
     # (−166.6°). Both readings fit the jumps as well; the first leaves the release at 104, in
     # the middle of the take, unexplained, and read 8–95 (the clean frames) as the error.
     motion = read_bvh(corpus_dir / "bvh/cmu/iclone/002_09.bvh")
-    geometry = _chain(motion, "upper_leg", "left")
+    geometry = chain_of(motion, "upper_leg", "left")
     shifts = [(0, 7, 164.5), (96, 103, 166.5), (204, 215, -109.4), (304, 319, -63.5),
               (397, 407, 67.0)]  # fmt: skip
-    shifted, offsets = _shifted(motion, geometry, shifts)
+    shifted, offsets = with_shifts(motion, geometry, shifts)
     analysis = analyze_twist(shifted)
     spans = [(f.side, f.start_frame, f.end_frame) for f in analysis.found]
     assert ("head", 0, 7) in spans
