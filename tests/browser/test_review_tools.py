@@ -76,10 +76,11 @@ def test_findings_grouped_by_joint_filtered_and_walked(
     assert len(rows(page)) == len(findings)
     # Each limits finding shows its anatomical read-out under the joint ("… over-inverted 136°"),
     # each limb spin its sentence ("right arm spun 24° about its axis …"), each twist interval
-    # what the default does with it and why ("default applied: calibrated probability 0.82 …").
+    # what the default does with it and why ("the default applies it: calibrated probability
+    # 0.82 …").
     readouts = [f["readout"] for f in findings if f.get("readout")]
     assert {f["kind"] for f in findings if f.get("readout")} >= {"limits", "twist"}
-    assert any(r.startswith("default ") for r in readouts)
+    assert any(r.startswith("the default ") for r in readouts)
     shown = p.locator("#findings tr.finding .readout").all_inner_texts()
     assert sorted(shown) == sorted(readouts)
     p.locator("#findings-panel").scroll_into_view_if_needed()

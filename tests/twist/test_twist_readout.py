@@ -16,7 +16,7 @@ def test_the_findings_of_real_flips_say_why_they_are_applied_or_listed(corpus_di
     twist = [f for f in report["findings"] if f["kind"] == "twist"]
     assert twist
     for finding in twist:
-        verdict = "default applied" if finding["applied"] else "default listed"
+        verdict = "the default applies it" if finding["applied"] else "the default only reports it"
         assert finding["readout"].startswith(verdict), finding
     by_anatomy = [f for f in twist if "outside the natural range" in f["readout"]]
     assert by_anatomy, [f["readout"] for f in twist]
@@ -29,6 +29,6 @@ def test_a_reason_recorded_with_the_evidence_is_the_readout() -> None:
         "reason": "smaller than this rig's natural upper arm roll (p99 16.5°)",
     }  # fmt: skip
     assert decision_readout(evidence) == (
-        "default listed: smaller than this rig's natural upper arm roll (p99 16.5°)"
+        "the default only reports it: smaller than this rig's natural upper arm roll (p99 16.5°)"
     )
     assert decision_readout({}) == ""

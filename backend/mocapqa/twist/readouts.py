@@ -36,22 +36,27 @@ _READOUTS = {
 }
 
 
+_VERDICTS = {"applied": "the default applies it", "listed": "the default only reports it"}
+"""What the default does with an interval, in words that stay true whatever a run applied (a
+run with another ``apply`` says what it did beside the readout)."""
+
+
 def decision_readout(evidence: dict[str, float | str]) -> str:
     """One line saying what the default (``apply="confident"``) does with an interval and which
     evidence decided (its ``evidence`` as :meth:`mocapqa.twist.choice.TwistInterval.to_json`
     writes it): for the findings list and the report, whatever the run applied.
 
-    Examples: ``"default applied: the raw roll is 31° further outside the natural range than
-    the corrected one (calibrated 0.14)"``; ``"default listed: smaller than this rig's natural
-    upper arm roll (p99 16.5°)"``; with a reviewer prior, ``"default applied: calibrated
-    probability 0.14, raised to 0.75 by 12 accepted intervals on this joint in this shoot,
-    which changed the default (applied from 0.50)"``. Empty when nothing was recorded (the
-    paper's method).
+    Examples: ``"the default applies it: the raw roll is 31° further outside the natural range
+    than the corrected one (calibrated 0.14)"``; ``"the default only reports it: smaller than
+    this rig's natural upper arm roll (p99 16.5°)"``; with a reviewer prior, ``"the default
+    applies it: calibrated probability 0.14, raised to 0.75 by 12 accepted intervals on this
+    joint in this shoot, which changed the default (applied from 0.50)"``. Empty when nothing
+    was recorded (the paper's method).
     """
     rule = str(evidence.get("rule", ""))
     if not rule:
         return ""
-    verdict = f"default {evidence.get('default', 'listed')}"
+    verdict = _VERDICTS.get(str(evidence.get("default", "listed")), _VERDICTS["listed"])
     reviewers = _reviewers_text(evidence)
     suffix = f"; probability {reviewers}" if reviewers else ""
     if "reason" in evidence:
