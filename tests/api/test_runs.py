@@ -333,3 +333,32 @@ def test_twist_apply_choice_decides_the_corrected_take(
             f"/api/v1/takes/{created['id']}/runs", json={"checks": ["twist"], "twist_apply": bad}
         )
         assert response.status_code == 422, bad
+    # Ids the take's newest twist run does not list are refused before a run is queued,
+    # naming the option and the ids that run has.
+    runs_before = len(client.get(f"/api/v1/takes/{created['id']}").json()["runs"])
+    for unknown in (f"0,{len(twist)}", "0,99999999999999999999999"):
+        response = client.post(f"/api/v1/takes/{created['id']}/runs", json={"twist_apply": unknown})
+        assert response.status_code == 422, unknown
+        assert response.json()["field"] == "twist_apply"
+        assert f"0 to {len(twist) - 1}" in response.json()["detail"]
+    assert len(client.get(f"/api/v1/takes/{created['id']}").json()["runs"]) == runs_before
+
+
+def test_twist_apply_ids_need_a_finished_twist_run(
+    client: TestClient, cmu_walk: Path, upload: Uploader, wait_for_run: Waiter
+) -> None:
+    # The clean walk's runs list no twist interval, so there are no ids to name.
+    created = upload(client, cmu_walk)
+    take = created["id"]
+    only_limits = client.post(f"/api/v1/takes/{take}/runs", json={"checks": ["limits"]})
+    assert only_limits.status_code == 201
+    for run_id in (created["run_id"], only_limits.json()["id"]):
+        assert wait_for_run(client, run_id)["status"] == "done"
+    findings = client.get(f"/api/v1/runs/{created['run_id']}/result").json()["findings"]
+    assert not [f for f in findings if f["kind"] == "twist"]
+    response = client.post(f"/api/v1/takes/{take}/runs", json={"twist_apply": "0"})
+    assert response.status_code == 422, response.text
+    assert response.json()["field"] == "twist_apply"
+    assert "no finished run with twist intervals" in response.json()["detail"]
+    named = client.post(f"/api/v1/takes/{take}/runs", json={"twist_apply": "none"})
+    assert named.status_code == 201, named.text

@@ -31,7 +31,7 @@ from mocapqa.core.arrays import BoolArray, FloatArray, IntArray, true_runs
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.core.motion import Motion, Skeleton
 from mocapqa.core.rig import find_roles
-from mocapqa.errors import LimitsFileError
+from mocapqa.errors import LimitsFileError, OptionError
 from mocapqa.filters.apply import filter_keypoints, filter_motion
 from mocapqa.limits.analysis import check_limits
 from mocapqa.limits.catalog import DEFAULT_MODEL, ModelCatalog
@@ -139,7 +139,12 @@ def run_twist(
     removed. Limb spins and flips (:func:`mocapqa.twist.spin.find_limb_spins`) are findings of
     kind ``spin``, never applied.
     """
-    analysis = analyze_twist(motion, method=method, mapping=mapping, apply=apply, prior=prior)
+    try:
+        analysis = analyze_twist(motion, method=method, mapping=mapping, apply=apply, prior=prior)
+    except OptionError as error:
+        if error.field != "apply":
+            raise
+        raise OptionError("twist_apply", error.message) from error
     rig = find_roles(motion.skeleton, mapping)
     missing = rig.unmapped
     if not analysis.chains:

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from mocapqa.core.arrays import FloatArray, IntArray
-from mocapqa.errors import InputError
+from mocapqa.errors import InputError, OptionError
 from mocapqa.twist.anatomy import AnatomyEvidence
 from mocapqa.twist.angles import ChainGeometry
 from mocapqa.twist.confidence import decide
@@ -295,16 +295,25 @@ def _check_ids(choice: str | frozenset[int], n_found: int) -> None:
 
     Raises
     ------
-    InputError
-        For an interval id the take does not have.
+    OptionError
+        Naming ``apply``, for an interval id the take does not have.
     """
     if isinstance(choice, frozenset) and choice and max(choice) >= n_found:
         if not n_found:
-            raise InputError(
-                f"Expected no interval ids in apply on a take with no twist interval, got "
-                f"{sorted(choice)}"
+            raise OptionError(
+                "apply",
+                f"Expected no interval ids on a take with no twist interval, got {sorted(choice)}",
             )
-        raise InputError(f"Expected interval ids 0 to {n_found - 1} in apply, got {sorted(choice)}")
+        raise OptionError(
+            "apply", f"Expected interval ids 0 to {n_found - 1}, got {_shown(choice)}"
+        )
+
+
+def _shown(ids: frozenset[int], most: int = 20) -> str:
+    """``ids`` sorted, the first ``most`` of them (a list of 10,000 ids is not a message)."""
+    ordered = sorted(ids)
+    more = f" and {len(ordered) - most:,} more" if len(ordered) > most else ""
+    return f"{ordered[:most]}{more}"
 
 
 def _evidence(

@@ -16,6 +16,7 @@ from mocapqa.api.frame_windows import Window, read_window, window_json, window_p
 from mocapqa.api.schemas import AnalysisOptionsIn, RunOut
 from mocapqa.api.views import run_out
 from mocapqa.errors import NotFoundError
+from mocapqa.jobs.apply_ids import check_apply_ids
 from mocapqa.jobs.reading_record import joint_parents_of, joints_of
 from mocapqa.jobs.rendered import html_report
 from mocapqa.jobs.run_folder import RunFolder
@@ -51,8 +52,9 @@ def start_run(
 ) -> RunOut:
     """Start another analysis of a take with these options; earlier runs are kept.
 
-    The options are checked here, against the filter registry, the take's kind and (for a
-    ``mapping``) the take's joints (422 naming the field), not when the run executes.
+    The options are checked here, against the filter registry, the take's kind, (for a
+    ``mapping``) the take's joints and (for ``twist_apply`` ids) the take's newest run with twist
+    intervals (422 naming the field), not when the run executes.
     """
     parsed = AnalysisOptions.from_json((options or AnalysisOptionsIn()).model_dump())
     parsed.check_take_kind(str(take["kind"]), float(take["fps"]) if take.get("fps") else None)
@@ -60,6 +62,7 @@ def start_run(
     parsed.check_joints(
         joints_of(services.files, take_id), joint_parents_of(services.files, take_id)
     )
+    check_apply_ids(services.repository, services.files, take_id, parsed.twist_apply)
     with run_places(services, client):
         run_id = services.repository.add_run(str(take["id"]), parsed.to_json())
         services.runner.submit(run_id, client=client)
