@@ -132,3 +132,23 @@ def test_a_take_of_a_shoot_deleted_meanwhile_is_not_found_not_a_database_error(
     with pytest.raises(NotFoundError, match="Expected shoot 'gone' to exist"):
         repository.add_take({**take_values("late.bvh"), "shoot_id": "gone"}, {})
     assert repository.list_takes()[1] == 0
+
+
+@pytest.mark.parametrize("lock_sees_it", [False, True])
+def test_a_run_or_review_of_a_take_deleted_meanwhile_is_not_found(
+    repository: Repository, monkeypatch: pytest.MonkeyPatch, lock_sees_it: bool
+) -> None:
+    # Another user deletes the take between the request's read of it and its write: the write
+    # finds the take gone when it locks it, or (the lock read racing the delete) the insert
+    # fails its foreign key; either way "not found", never a database error.
+    take_id, _ = repository.add_take(take_values("a.bvh"), {})
+    stale = repository.get_take(take_id)
+    repository.delete_take(take_id)
+    monkeypatch.setattr(repository, "get_take", lambda _: stale)
+    if lock_sees_it:
+        monkeypatch.setattr("mocapqa.store.repository.lock_take", lambda conn, take: stale)
+    with pytest.raises(NotFoundError, match="deleted meanwhile"):
+        repository.add_run(take_id, {})
+    with pytest.raises(NotFoundError, match="deleted meanwhile"):
+        repository.add_review(take_id, "approved", "", "ann")
+    assert repository.list_takes()[1] == 0

@@ -91,8 +91,11 @@ def run_report_items(files: FileStore, run_id: str) -> ReportItems:
         When the run has no report.
     """
     path = files.existing(RunFolder.of(files, run_id).report, "the report")
-    stat = path.stat()
-    return _report_items(str(path), stat.st_mtime_ns, stat.st_size)
+    try:
+        stat = path.stat()
+        return _report_items(str(path), stat.st_mtime_ns, stat.st_size)
+    except FileNotFoundError as error:  # its take was deleted since the check above
+        raise NotFoundError(f"Expected the report of run {run_id!r}, got none") from error
 
 
 def run_items(files: FileStore, run_id: str) -> tuple[DecidedItem, list[dict[str, Any]]]:

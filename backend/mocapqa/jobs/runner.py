@@ -247,11 +247,21 @@ class JobRunner:
             self.repository.finish_run(run_id, summary, None, time.perf_counter() - started)
         except _RunCancelledError:
             log.info("run %s cancelled: its take was deleted", run_id)
-        except MocapQAError as e:
-            self._fail(run_id, str(e), started)
-        except Exception as e:  # a bug must not leave the run "running" forever
-            log.exception("run %s failed", run_id)
-            self._fail(run_id, f"internal error: {type(e).__name__}: {e}", started)
+        except Exception as e:
+            if self._was_cancelled(run_id):
+                # Its take and folder were deleted under it (between two progress reports):
+                # whatever that broke, the run is cancelled, not failed.
+                log.info("run %s cancelled: its take was deleted (%s)", run_id, type(e).__name__)
+            elif isinstance(e, MocapQAError):
+                self._fail(run_id, str(e), started)
+            else:  # a bug must not leave the run "running" forever
+                log.exception("run %s failed", run_id)
+                self._fail(run_id, f"internal error: {type(e).__name__}: {e}", started)
+
+    def _was_cancelled(self, run_id: str) -> bool:
+        """Whether the run's take was deleted while it ran."""
+        with self._lock:
+            return run_id in self._cancelled
 
     def _prior(self, take: dict[str, Any], options: AnalysisOptions) -> ReviewerPrior | None:
         """The reviewer prior of a new robust twist run of ``take`` (None for other runs, a

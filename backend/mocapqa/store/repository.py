@@ -195,9 +195,14 @@ class Repository:
         """Queue a new run of a take with the given options; earlier runs are kept."""
         take = self.get_take(take_id)
         run_id = new_id()
-        with self.engine.begin() as conn:
-            lock_take(conn, take_id)
-            add_run(conn, take, run_id, options, utc_now())
+        gone = NotFoundError(f"Expected take {take_id!r} to exist, got none (deleted meanwhile)")
+        try:
+            with self.engine.begin() as conn:
+                if lock_take(conn, take_id) is None:
+                    raise gone
+                add_run(conn, take, run_id, options, utc_now())
+        except IntegrityError as error:  # the take's foreign key: deleted after the lock read
+            raise gone from error
         return run_id
 
     def get_run(self, run_id: str) -> dict[str, Any]:
@@ -327,8 +332,25 @@ class Repository:
         if status not in REVIEW_STATUSES:
             raise InputError(f"Expected review status in {list(REVIEW_STATUSES)}, got {status!r}")
         self.get_take(take_id)
+        gone = NotFoundError(f"Expected take {take_id!r} to exist, got none (deleted meanwhile)")
+        try:
+            return self._insert_review(take_id, status, notes, reviewer, user_id, gone)
+        except IntegrityError as error:  # the take's foreign key: deleted after the lock read
+            raise gone from error
+
+    def _insert_review(
+        self,
+        take_id: str,
+        status: str,
+        notes: str,
+        reviewer: str,
+        user_id: int | None,
+        gone: NotFoundError,
+    ) -> dict[str, Any]:
+        """Insert one review row and rebuild the take's QA row, in one transaction."""
         with self.engine.begin() as conn:
-            lock_take(conn, take_id)
+            if lock_take(conn, take_id) is None:
+                raise gone
             result = conn.execute(
                 insert(reviews)
                 .values(
