@@ -86,10 +86,24 @@ def _shown(name: str) -> str:
     return name if len(name) <= _ECHO_CHARS else f"{name[:_ECHO_CHARS]}…"
 
 
-def _form_problems(form: FormData, declared: dict[str, bool]) -> list[tuple[str, str]]:
+def _form_problems(
+    form: FormData, declared: dict[str, bool], files: Sequence[str] = ()
+) -> list[tuple[str, str]]:
     """(field, message) for each part the route does not read, each field sent more often
-    than it reads, and each file name over the limit."""
+    than it reads, each file part (``files``) sent without a file name and each file name
+    over the limit."""
     problems: list[tuple[str, str]] = []
+    for name in files:
+        if any(isinstance(value, str) for value in form.getlist(name)):
+            # A part whose Content-Disposition has no filename (left out, or only the RFC 5987
+            # filename*) reaches the route as text: "Expected UploadFile, received: str".
+            problems.append(
+                (
+                    name,
+                    f"Expected a {name!r} part with a file name (Content-Disposition "
+                    f'filename="take.bvh"), got a part without one (filename* alone is not read)',
+                )
+            )
     counts = Counter(name for name, _ in form.multi_items())
     expected = ", ".join(declared)
     for name, count in counts.items():
@@ -120,7 +134,7 @@ async def check_form_parts(connection: HTTPConnection) -> None:
         return
     request = connection
     declared = {p.alias: takes_many(p.field_info.annotation) for p in _body_params(route.dependant)}
-    problems = _form_problems(await request.form(), declared)
+    problems = _form_problems(await request.form(), declared, file_fields(route))
     if problems:
         raise RequestValidationError(
             [{"loc": ("body", f), "msg": m, "type": "value_error"} for f, m in problems]

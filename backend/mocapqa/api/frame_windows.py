@@ -9,18 +9,23 @@ from __future__ import annotations
 
 import json
 import struct
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
+from typing import IO, Any
 
 import numpy as np
 
-from mocapqa.errors import InputError
+from mocapqa.errors import OptionError, ShapeError
 from mocapqa.jobs.run_folder import POINT_ARRAYS
 
 __all__ = ["MAX_WINDOW_VALUES", "Window", "read_window", "window_json", "window_packed"]
 
 MAX_WINDOW_VALUES = 3_000_000
-"""Most values (frames × points × components, over every array) one window may hold."""
+"""Most values (frames × points × components, over every array) one window may hold; the
+step grows until a window fits."""
+READ_BLOCK_BYTES = 8 * 2**20
+"""Most bytes of one stored array held at once while a window's rows are picked from it."""
 
 
 @dataclass(frozen=True)
@@ -50,28 +55,106 @@ class Window:
 
 
 def read_window(path: Path, start: int, stop: int | None, step: int, max_frames: int) -> Window:
-    """Frames ``start:stop:step`` of ``points.npz``, the step grown to hold ≤ ``max_frames``.
+    """Frames ``start:stop:step`` of ``points.npz``, the step grown to fit the window's limits.
+
+    The step grows until at most ``max_frames`` frames and at most :data:`MAX_WINDOW_VALUES`
+    values come back, so a window is always served, coarser where the take is long or holds
+    many points. Only the array headers are read before the window is chosen, and then only
+    the bytes up to the window's last frame of each array.
 
     Raises
     ------
-    InputError
-        When ``start ≥ stop`` or the window would exceed :data:`MAX_WINDOW_VALUES`.
+    OptionError
+        Naming ``start`` when it is at or past the take's last frame, ``stop`` when it is not
+        above ``start``, ``max_frames`` when one frame alone holds more than
+        :data:`MAX_WINDOW_VALUES` values.
     """
-    with np.load(path) as data:
-        stored = {name: data[name] for name in POINT_ARRAYS if name in data}
-    n_frames = int(stored["raw"].shape[0])
-    stop = n_frames if stop is None else min(stop, n_frames)
-    if start >= stop:
-        raise InputError(f"Expected start < stop ≤ {n_frames}, got start={start}, stop={stop}")
-    if -(-(stop - start) // step) > max_frames:
-        step = -(-(stop - start) // max_frames)
-    frames = np.arange(start, stop, step)
-    per_frame = sum(int(np.prod(a.shape[1:])) for a in stored.values())
-    if frames.size * per_frame > MAX_WINDOW_VALUES:
-        raise InputError(
-            f"Expected a window of at most {MAX_WINDOW_VALUES} values, got {frames.size} frames"
+    with zipfile.ZipFile(path) as archive:
+        members = {
+            name: f"{name}.npy" for name in POINT_ARRAYS if f"{name}.npy" in archive.namelist()
+        }
+        shapes = {name: _member_shape(archive, member) for name, member in members.items()}
+        frames, step = _window_frames(shapes, start, stop, step, max_frames)
+        arrays = {name: _member_rows(archive, member, frames) for name, member in members.items()}
+    return Window(frames, int(shapes["raw"][0]), step, arrays)
+
+
+def _window_frames(
+    shapes: dict[str, tuple[int, ...]], start: int, stop: int | None, step: int, max_frames: int
+) -> tuple[np.ndarray, int]:
+    """The frame indices of a window and its step, grown to fit both limits."""
+    n_frames = int(shapes["raw"][0])
+    if start >= n_frames:
+        raise OptionError(
+            "start", f"Expected start below the take's {n_frames} frames, got {start}"
         )
-    return Window(frames, n_frames, step, {name: a[frames] for name, a in stored.items()})
+    if stop is not None and stop <= start:
+        raise OptionError("stop", f"Expected stop above start ({start}), got {stop}")
+    stop = n_frames if stop is None else min(stop, n_frames)
+    per_frame = sum(int(np.prod(shape[1:])) for shape in shapes.values())
+    most = min(max_frames, MAX_WINDOW_VALUES // max(per_frame, 1))
+    if most < 1:
+        raise OptionError(
+            "max_frames",
+            f"Expected a frame of at most {MAX_WINDOW_VALUES} values (points × components over "
+            f"every array), got {per_frame}: this take's frames are too large to serve",
+        )
+    if -(-(stop - start) // step) > most:
+        step = -(-(stop - start) // most)
+    return np.arange(start, stop, step), step
+
+
+def _member_shape(archive: zipfile.ZipFile, member: str) -> tuple[int, ...]:
+    """The shape an ``.npy`` member of an archive declares, read from its header alone."""
+    with archive.open(member) as handle:
+        header = _npy_header(handle)
+        if header is None:
+            return tuple(int(n) for n in np.lib.format.read_array(handle).shape)
+        return header[0]
+
+
+def _npy_header(handle: IO[bytes]) -> tuple[tuple[int, ...], bool, np.dtype[Any]] | None:
+    """Shape, Fortran order and dtype of an ``.npy`` stream, the stream left at its data.
+
+    None (the stream rewound) for a header version this reader leaves to numpy.
+    """
+    version = np.lib.format.read_magic(handle)
+    if version == (1, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_1_0(handle)
+    elif version == (2, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_2_0(handle)
+    else:
+        handle.seek(0)
+        return None
+    return tuple(int(n) for n in shape), bool(fortran), dtype
+
+
+def _member_rows(archive: zipfile.ZipFile, member: str, frames: np.ndarray) -> np.ndarray:
+    """Rows ``frames`` (ascending) of an ``.npy`` member, reading up to the last one only.
+
+    The bytes before the last frame are read in blocks of at most :data:`READ_BLOCK_BYTES`
+    and the wanted rows kept, so memory holds one block and the window, never the array.
+    """
+    with archive.open(member) as handle:
+        header = _npy_header(handle)
+        if header is None or header[1] or header[2].hasobject:
+            handle.seek(0)
+            return np.asarray(np.lib.format.read_array(handle)[frames])
+        shape, _, dtype = header
+        row_bytes = int(np.prod(shape[1:])) * dtype.itemsize
+        first, last = int(frames[0]), int(frames[-1])
+        handle.seek(handle.tell() + first * row_bytes)
+        block_rows = max(1, READ_BLOCK_BYTES // max(row_bytes, 1))
+        parts = []
+        for block_start in range(first, last + 1, block_rows):
+            count = min(block_rows, last + 1 - block_start)
+            data = handle.read(count * row_bytes)
+            if len(data) != count * row_bytes:
+                raise ShapeError(f"Expected {count} rows of {member}, got a truncated array")
+            block = np.frombuffer(data, dtype).reshape(count, *shape[1:])
+            inside = frames[(frames >= block_start) & (frames < block_start + count)]
+            parts.append(block[inside - block_start])
+        return np.concatenate(parts)
 
 
 def window_json(window: Window) -> bytes:

@@ -179,7 +179,7 @@ def _read_row(
     if "confidence" in col and cells[col["confidence"]].strip():
         conf = float_from_text(cells[col["confidence"]], path, line, "confidence")
         if not 0.0 <= conf <= 1.0:
-            raise ParseError(f"Expected confidence in [0, 1], got {conf}", path, line)
+            raise ParseError(f"Expected confidence in [0, 1], got {conf}", path, line, "confidence")
     if "time" in col:
         times = read.times
         t = float_from_text(cells[col["time"]], path, line, "time")

@@ -124,8 +124,9 @@ def get_frames(window: WindowDep) -> Response:
     marker takes the markers step checked, ``filled`` (per point, 1 on samples a gap fill
     wrote into the corrected take).
 
-    The step grows so that at most ``max_frames`` frames come back; the answer states the
-    frame indices it holds.
+    The step grows so that at most ``max_frames`` frames and at most 3,000,000 values (frames
+    × points × the arrays sent) come back; the answer states the frame indices it holds. A
+    ``start`` at or past the last frame or a ``stop`` not after ``start`` is a 422 naming it.
     """
     return Response(window_json(window), media_type="application/json")
 

@@ -69,8 +69,9 @@ def upload_take(
     request (403), too many uploads or queued runs from this client (429, ``Retry-After``).
     Refused before parsing: a take beyond the read limits (413, naming the setting). Refused
     at the request: an ``fps`` that is not finite or not from 0.1 to 100,000 (422 naming
-    ``body.fps``, :mod:`mocapqa.core.bounds`); a file's own frame rate meets the same bounds
-    when it is read (422 naming ``fps``).
+    ``body.fps``, :mod:`mocapqa.core.bounds`); a ``file`` part without a file name (422 naming
+    ``body.file``); a file's own frame rate meets the same bounds when it is read (422 naming
+    ``fps``).
     """
     with run_places(services, client):
         max_bytes = int(services.settings.max_upload_mb * 1_000_000)
