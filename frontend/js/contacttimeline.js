@@ -2,8 +2,10 @@
 // and right foot), one bar per contact, the feet findings (skate, penetration, floating, jitter)
 // marked over them, and under each row the foot locks of its skate findings, drawn by their
 // newest decision (lock-events.js keeps them in step with the findings table). A click on a bar
-// or a mark jumps to its first frame. `contactRows`, `lockMarks` and `lockStyle` are pure
-// (unit-tested).
+// or a mark jumps to its first frame; so does Enter or Space on a focused one: the timeline is
+// one Tab stop, the arrow keys move between its bars and marks (left/right in time along a
+// foot's row, up/down to the other foot, Home/End to a row's ends). `contactRows`, `lockMarks`,
+// `lockStyle` and `stopAfter` are pure (unit-tested).
 import { h } from "./dom.js";
 import { onLockDecisions } from "./lock-events.js";
 import { spanOf } from "./timebar.js";
@@ -125,6 +127,7 @@ function styleLock(el, lock) {
   Object.assign(el.style, lock.style);
   el.dataset.decision = lock.decision;
   el.title = lock.label;
+  el.setAttribute("aria-label", lock.label);
 }
 
 /** The legend's keys of the foot locks (only when the take has any). */
@@ -138,6 +141,64 @@ function lockLegend(runLocked = false) {
   });
 }
 
+/** Keys that move between the timeline's stops (stopAfter). */
+const MOVES = new Set(["ArrowLeft", "ArrowRight", "ArrowUp", "ArrowDown", "Home", "End"]);
+
+/**
+ * The stop a key moves to in the contact timeline: along a row (ArrowLeft/ArrowRight one step,
+ * Home/End its ends, staying at either end) or to the next row with stops up or down (ArrowUp /
+ * ArrowDown, on the stop starting nearest the current one's start, the first of equals).
+ *
+ * @param rows  each row's stops' first frames, in the order the row walks them
+ * @param at    the current stop, [row, index]
+ * @param key   the key pressed
+ * @returns [row, index] (`at` itself when there is nowhere to go), or null for another key
+ */
+export function stopAfter(rows, [row, index], key) {
+  const last = rows[row].length - 1;
+  if (key === "ArrowRight") return [row, Math.min(last, index + 1)];
+  if (key === "ArrowLeft") return [row, Math.max(0, index - 1)];
+  if (key === "Home") return [row, 0];
+  if (key === "End") return [row, last];
+  if (key !== "ArrowUp" && key !== "ArrowDown") return null;
+  const step = key === "ArrowDown" ? 1 : -1;
+  let other = row + step;
+  while (other >= 0 && other < rows.length && !rows[other].length) other += step;
+  if (other < 0 || other >= rows.length) return [row, index];
+  const from = rows[row][index];
+  let best = 0;
+  rows[other].forEach((start, k) => { if (Math.abs(start - from) < Math.abs(rows[other][best] - from)) best = k; });
+  return [other, best];
+}
+
+/** Make the timeline's bars and marks (each row's `stops`, in walking order) one Tab stop that
+ * the arrow keys walk (stopAfter); Enter or Space does what a click does. */
+function keyboardStops(el, stops) {
+  const all = stops.flat();
+  all.forEach((stop, k) => stop.setAttribute("tabindex", k === 0 ? "0" : "-1"));
+  const where = (target) => {
+    for (let r = 0; r < stops.length; r++) { const k = stops[r].indexOf(target); if (k >= 0) return [r, k]; }
+    return null;
+  };
+  // The stop last reached keeps the Tab stop: Tab back in lands where the reviewer left.
+  el.addEventListener("focusin", (e) => {
+    if (!where(e.target)) return;
+    for (const stop of all) stop.setAttribute("tabindex", stop === e.target ? "0" : "-1");
+    // Drawn over its neighbours, ringed: a thin mark's own focus ring would hide under them.
+    Object.assign(e.target.style, { outline: "2px solid #1a5276", outlineOffset: "1px", zIndex: "3" });
+  });
+  el.addEventListener("focusout", (e) => { if (where(e.target)) Object.assign(e.target.style, { outline: "", outlineOffset: "", zIndex: "" }); });
+  el.addEventListener("keydown", (e) => {
+    const at = where(e.target);
+    if (!at || e.ctrlKey || e.metaKey || e.altKey) return;
+    if (e.key === "Enter" || e.key === " ") { e.preventDefault(); e.stopPropagation(); e.target.click(); return; }
+    if (!MOVES.has(e.key)) return;
+    e.preventDefault(); e.stopPropagation(); // not the take view's frame steps
+    const [r, k] = stopAfter(stops.map((row) => row.map((stop) => Number(stop.dataset.start))), at, e.key);
+    stops[r][k].focus();
+  });
+}
+
 /**
  * The contact timeline's element: a labelled row per foot, and its frame cursor.
  *
@@ -147,10 +208,13 @@ function lockLegend(runLocked = false) {
  */
 export function createContactTimeline(rows, nFrames, onJump) {
   const cursors = [];
+  const stops = []; // each row's bars and marks, in walking order
   const locks = new Map(); // lock id -> [its mark, its data]
   const place = (el, item) => {
     el.style.left = `${item.left}%`;
     el.style.width = `${item.width}%`;
+    el.setAttribute("role", "button");
+    if (item.label) el.setAttribute("aria-label", item.label);
     el.addEventListener("click", () => onJump(item.start));
     return el;
   };
@@ -173,6 +237,9 @@ export function createContactTimeline(rows, nFrames, onJump) {
     });
     const lane = lockEls.length ? h("div", { class: "ct-locks", "aria-label": `${row.foot} foot locks` }, lockEls) : "";
     if (lane) Object.assign(lane.style, { position: "relative", height: "6px", marginTop: "1px" });
+    // In time order; at one frame a contact, then its findings, then its lock.
+    const order = (x) => (x.classList.contains("ct-bar") ? 0 : x.classList.contains("ct-mark") ? 1 : 2);
+    stops.push([...bars, ...marks, ...lockEls].sort((x, y) => Number(x.dataset.start) - Number(y.dataset.start) || order(x) - order(y)));
     return h("div", { class: "ct-row", "data-foot": row.foot }, h("span", { class: "ct-name" }, `${row.foot} foot`), track, lane);
   };
   const legend = h("p", { class: "muted ct-legend" }, h("span", { class: "ct-key ct-bar-key" }), " contact (foot planted) · ",
@@ -180,8 +247,9 @@ export function createContactTimeline(rows, nFrames, onJump) {
       const key = h("span", { class: "ct-key" });
       key.style.background = color;
       return [key, ` ${kind} `];
-    }), "· click to go to it");
-  const el = h("div", { class: "contact-timeline", id: "contact-timeline", role: "group", "aria-label": "foot contacts" }, rows.map(rowEl), legend);
+    }), "· click one to go to it (keyboard: arrow keys move between them, Enter goes)");
+  const el = h("div", { class: "contact-timeline", id: "contact-timeline", role: "group", "aria-label": "foot contacts: arrow keys move between contacts, findings and foot locks, Enter goes to one" }, rows.map(rowEl), legend);
+  keyboardStops(el, stops.filter((row) => row.length));
   if (locks.size) legend.append(h("br"), ...lockLegend([...locks.values()].some(([, lock]) => lock.runLocked)));
   /** Draw each lock by its newest decision (lock id -> "accept" | "reject"; absent: undecided). */
   const setLockDecisions = (decisions) => {

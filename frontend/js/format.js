@@ -19,9 +19,10 @@ export const FINDING_KEYS = {
   confidence: (f) => f.confidence,
 };
 
-/** A sorted copy of `rows` by `key` (FINDING_KEYS), `dir` 1 ascending or −1; missing last. */
-export function sortFindings(rows, key, dir) {
-  const get = FINDING_KEYS[key];
+/** A sorted copy of `rows` by `key` (of `keys`: FINDING_KEYS, or others alike), `dir` 1
+ * ascending or −1; missing last. */
+export function sortFindings(rows, key, dir, keys = FINDING_KEYS) {
+  const get = keys[key] || FINDING_KEYS.start_frame;
   return [...rows].sort((a, b) => {
     const x = get(a), y = get(b);
     if (x == null && y == null) return a.start_frame - b.start_frame;
@@ -102,12 +103,31 @@ export function matchFindings(a, b) {
   return { both, onlyA, onlyB: [...free].map((k) => b[k]) };
 }
 
-/** Options that differ between two runs, flattened to dotted keys: [key, a, b] rows. */
-export function optionsDiff(a, b) {
+/**
+ * Options that differ between two runs, flattened to dotted keys: [key, a, b] rows. Lists
+ * (the checks) are compared as sets: their order does not matter. Checks named in `idle` (as
+ * idleChecks gives them: asked for, but their step did nothing) are left out of the checks
+ * before comparing.
+ */
+export function optionsDiff(a, b, idle = []) {
+  const skip = new Set(idle);
   const flat = (o, prefix = "") => Object.entries(o || {}).flatMap(([k, v]) =>
-    (v && typeof v === "object" && !Array.isArray(v) ? flat(v, `${prefix}${k}.`) : [[`${prefix}${k}`, v]]));
+    (v && typeof v === "object" && !Array.isArray(v) ? flat(v, `${prefix}${k}.`) : [[`${prefix}${k}`, k === "checks" && Array.isArray(v) ? v.filter((c) => !skip.has(c)) : v]]));
   const left = new Map(flat(a)), right = new Map(flat(b));
   const keys = [...new Set([...left.keys(), ...right.keys()])].sort();
   const show = (v) => (v === undefined ? "–" : Array.isArray(v) ? v.join(", ") : String(v));
-  return keys.filter((k) => JSON.stringify(left.get(k)) !== JSON.stringify(right.get(k))).map((k) => [k, show(left.get(k)), show(right.get(k))]);
+  const same = (x, y) => (Array.isArray(x) && Array.isArray(y)
+    ? new Set(x).size === new Set(y).size && x.every((v) => y.some((w) => JSON.stringify(v) === JSON.stringify(w)))
+    : JSON.stringify(x) === JSON.stringify(y));
+  return keys.filter((k) => !same(left.get(k), right.get(k))).map((k) => [k, show(left.get(k)), show(right.get(k))]);
+}
+
+/** The checks that make no difference between two runs' results (`steps` and `options` of
+ * each): asked for by one or both, and skipped in every run that asked for it (a check the
+ * take's kind cannot run, such as markers on a motion take, or a filter with none chosen). */
+export function idleChecks(a, b) {
+  const asked = (r, c) => ((r.options && r.options.checks) || []).includes(c);
+  const skipped = (r, c) => Boolean(r.steps && r.steps[c] && r.steps[c].state === "skipped");
+  const all = new Set([...((a.options && a.options.checks) || []), ...((b.options && b.options.checks) || [])]);
+  return [...all].filter((c) => [a, b].every((r) => !asked(r, c) || skipped(r, c)));
 }

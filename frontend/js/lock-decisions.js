@@ -72,13 +72,13 @@ export function runLockText(feetApply) {
 }
 
 /** The reviewed download link's text: its format when a marker take has it named (`format`,
- * "c3d" or "trc"; null for BVH), and how many foot locks it applies (`kept`: keptCount), when
- * the run has any. */
+ * "c3d" or "trc"; null for BVH), and how many of the run's `nLocks` foot locks it applies
+ * (`kept`: keptCount), when the run has any: "Download reviewed take (0 of 5 foot locks
+ * applied)". */
 export function downloadText(nLocks, kept, format = null) {
   const base = format ? `Download reviewed take as ${format.toUpperCase()}` : "Download reviewed take";
   if (!nLocks) return base;
-  const locks = kept === 1 ? "1 foot lock" : `${kept} foot locks`;
-  return `${base} (${kept ? locks : "no foot lock"} applied of ${nLocks})`;
+  return `${base} (${kept} of ${nLocks} foot lock${nLocks === 1 ? "" : "s"} applied)`;
 }
 
 /** Both decision histories (twist intervals or swaps, and foot locks) as one list, newest first

@@ -62,24 +62,40 @@ function paramRow(p, given) {
 
 // The filter: its method (the registry's filters for this kind of take, and the one run when none
 // is chosen, as GET /run-options serves them), the filter's presets and its parameters (with
-// units; past the first few, folded), refilled when the method changes.
+// units; past the first few, folded), refilled when the method changes. With no filter chosen
+// and none by default (a motion take), the check would filter nothing: its box is unticked and
+// disabled, and the presets hidden, with the reason, until a filter is chosen.
 function filterControls(take, run, filters, described) {
   const { usable, fallback } = takeFilters(takeChecksKind(take, described), described, filters);
   const method = h("select", { id: "filter-method", "aria-label": "filter" }, h("option", { value: "" }, fallback ? `${fallback} (default)` : "no filter"),
     usable.map((f) => h("option", { value: f.name, selected: f.name === run.options.filter_method }, f.label)));
   const preset = h("select", { id: "filter-preset", "aria-label": "filter preset" });
   const params = h("div", { id: "filter-params", class: "option-fields" });
+  const none = h("p", { class: "muted", id: "filter-none" }, "No filter chosen, and this kind of take has no default one: the check would filter nothing. Choose a filter to use it.");
   let paramFields = [];
+  let box = null; // the filter check's box, once the form has it
+  const sync = () => {
+    const entry = usable.find((f) => f.name === (method.value || fallback)) || null;
+    const row = preset.closest("label");
+    // Inline: the fields' stylesheet display would win over `hidden`.
+    if (row) row.style.display = !entry || !entry.presets.length ? "none" : "";
+    none.style.display = entry ? "none" : "";
+    if (!box) return;
+    box.disabled = !entry;
+    if (!entry) box.checked = false;
+    box.title = entry ? "" : "choose a filter first";
+  };
   const fill = () => {
     const entry = usable.find((f) => f.name === (method.value || fallback)) || null;
     preset.replaceChildren(...(entry ? entry.presets : []).map((p) => h("option", { value: p, selected: p === run.options.filter_preset }, p)));
+    sync();
     paramFields = entry ? entry.parameters : [];
     const given = method.value === (run.options.filter_method || "") ? run.options.filter_params || {} : {};
     const rows = paramFields.map((p) => paramRow(p, given));
     const more = rows.length > SHOWN_PARAMS
       ? [h("details", { class: "more-params" }, h("summary", {}, `${rows.length - SHOWN_PARAMS} more parameters`), h("div", { class: "option-fields" }, rows.slice(SHOWN_PARAMS)))]
       : [];
-    params.replaceChildren(...rows.slice(0, SHOWN_PARAMS), ...more);
+    params.replaceChildren(none, ...rows.slice(0, SHOWN_PARAMS), ...more);
   };
   method.addEventListener("change", fill);
   fill();
@@ -87,7 +103,9 @@ function filterControls(take, run, filters, described) {
     filter_method: method.value, filter_preset: preset.value,
     params: [...params.querySelectorAll("[data-param]")].map((input) => [paramFields.find((p) => p.name === input.dataset.param), input.value]),
   });
-  return { method, preset, params, fill, values, controls: { filter: method, filter_preset: preset } };
+  /** Tie the filter check's box (absent when the take cannot run the check) to the method. */
+  const attach = (checkBox) => { box = checkBox || null; sync(); };
+  return { method, preset, params, fill, attach, values, controls: { filter: method, filter_preset: preset } };
 }
 
 // One group of the form as served: its check's box (only for a check this take can run), its
@@ -120,7 +138,8 @@ function presetPicker(described, form) {
     for (const [name, box] of Object.entries(form.checks)) box.checked = options.checks.includes(name);
     for (const [name, control] of Object.entries(form.inputs)) control.value = options[name] ?? "";
     const { method } = form.filter;
-    if ([...method.options].some((o) => o.value === (options.filter_method || ""))) { method.value = options.filter_method || ""; form.filter.fill(); }
+    if ([...method.options].some((o) => o.value === (options.filter_method || ""))) method.value = options.filter_method || "";
+    form.filter.fill();
   });
   return pick;
 }
@@ -179,6 +198,7 @@ export function rerunPanel(take, run, filters, described, context = {}) {
       : null,
   };
   const groups = described.groups.map((g) => groupBox(g, form));
+  form.filter.attach(form.checks.filter);
   const presetPick = presetPicker(described, form);
   const message = h("span", { class: "muted", id: "rerun-message", role: "status" });
   const start = h("button", { class: "primary", id: "rerun", onclick: () => startRun(take, form, fields, message) }, "re-run");

@@ -84,20 +84,16 @@ export function pageInfo(offset, limit, total) {
 const percent = (v) => (v == null ? "–" : `${fmt(100 * v, 1)} %`);
 const count = (v) => (v == null ? "–" : String(v));
 
-/** The unit the worst-skate column's header names; a size in another unit says its own. */
-export const SKATE_HEADER_UNIT = "cm";
-
-/** A take's largest foot skate as its cell shows it: the number alone in the header's unit
- * (cm), with its share of the body height beside it when known (`share`, in %: "8.6 (5.2 %
- * height)"), the number and its unit otherwise ("2.4 % height": a BVH stores no unit, so the
- * feet check sizes it against the body height); "–" when there is none (no skate found, the
- * feet not checked, or a run made before the figure). The column sorts by the share, the one
- * measure of every take. */
+/** A take's largest foot skate as its cell shows it, always with its unit (the column holds
+ * takes of both units, so its header names none): in cm with its share of the body height
+ * beside it when known (`share`, in %: "8.6 cm (5.2 % height)"), in its own unit otherwise
+ * ("2.4 % height": a BVH stores no unit, so the feet check sizes it against the body height);
+ * "–" when there is none (no skate found, the feet not checked, or a run made before the
+ * figure). The column sorts by the share, the one measure of every take. */
 export function skateSize(value, unit, share = null) {
   if (value == null || !Number.isFinite(Number(value))) return "–";
-  const number = fmt(Number(value), 1);
-  if (unit != null && unit !== SKATE_HEADER_UNIT) return `${number} ${unit}`;
-  const known = share != null && Number.isFinite(Number(share));
+  const number = `${fmt(Number(value), 1)} ${unit || "cm"}`;
+  const known = unit !== "% height" && share != null && Number.isFinite(Number(share));
   return known ? `${number} (${fmt(Number(share), 1)} % height)` : number;
 }
 
@@ -119,8 +115,8 @@ export const TAKE_COLUMNS = [
   { key: "missing_share", label: "missing", format: percent, narrow: true },
   { key: "n_findings", label: "findings", format: count },
   { key: "foot_skates", label: "skates", format: count, title: "foot skate findings: a planted foot sliding (– when the feet were not checked)" },
-  { key: "foot_worst_skate", label: `worst skate (${SKATE_HEADER_UNIT})`, format: (v, row) => skateSize(v, row.foot_skate_unit, row.foot_worst_skate_pct),
-    title: "the largest foot skate, in cm with its % of the body height beside it; in % of the body height alone, marked, when the take's unit does not convert to cm (a BVH stores none). Sorted by the % of the body height, the same measure in every take" },
+  { key: "foot_worst_skate", label: "worst skate", format: (v, row) => skateSize(v, row.foot_skate_unit, row.foot_worst_skate_pct),
+    title: "the largest foot skate, each with its unit: in cm with its % of the body height beside it; in % of the body height alone when the take's unit does not convert to cm (a BVH stores none). Sorted by the % of the body height, the same measure in every take" },
   { key: "foot_penetrations", label: "below floor", format: count, narrow: true, title: "floor penetration findings: a foot below the floor" },
   { key: "foot_floating", label: "floating", format: count, narrow: true, title: "floating findings: a still foot above the floor" },
   { key: "review_status", label: "review", format: (v) => (v || "unreviewed").replace("_", " ") },

@@ -110,7 +110,7 @@ function findingsPart(t) {
   t.filterQuery = filterParams(linkedFilter, kindsOf(findings));
   const open = (f) => { t.decided.opened(f); store.set({ joint: f.joint }); focusCharts(t); jump(t, f.start_frame); t.ui.viewsRow.scrollIntoView({ block: "start" }); };
   const refiltered = (query) => { t.filterQuery = query; remember(t); t.timebar.setMarks(timeMarks(t.list.shown, t.colorOf)); };
-  return findingsList(findings, t.decided, open, linkedFilter, refiltered);
+  return findingsList(findings, t.decided, open, linkedFilter, refiltered, t.result.series.twist);
 }
 
 /** Under the player: the time bar (the findings the list's filters keep, the filter's bridged

@@ -22,6 +22,11 @@ from mocapqa.kinematics.forward import forward_kinematics
 pytestmark = pytest.mark.browser
 
 
+def download_text(kept: int, n: int) -> str:
+    """The reviewed download's link text with ``kept`` of ``n`` foot locks applied."""
+    return f"Download reviewed take ({kept} of {n} foot lock{'s' if n > 1 else ''} applied)"
+
+
 @pytest.fixture
 def page(chromium: Any) -> Iterator[Page]:
     opened = Page(chromium)
@@ -66,7 +71,7 @@ def test_accepting_a_foot_lock_changes_the_foot_and_nothing_above_the_hips(
     assert "undecided" in cell(page, lock)
     assert "→ left as recorded" in cell(page, lock)
     link = p.locator("#download-decided")
-    assert link.inner_text() == f"Download reviewed take (no foot lock applied of {n})"
+    assert link.inner_text() == download_text(0, n)
     before = decided(live_server, run_id)
     # The contact timeline draws each lock, undecided as an outline, over the contact the skate
     # overlaps.
@@ -89,7 +94,7 @@ def test_accepting_a_foot_lock_changes_the_foot_and_nothing_above_the_hips(
     ARTIFACTS.mkdir(exist_ok=True)
     p.locator("#contact-timeline").screenshot(path=str(ARTIFACTS / "feet-lock-timeline.png"))
     p.wait_for_function("() => document.getElementById('download-decided').dataset.locks === '1'")
-    assert link.inner_text() == f"Download reviewed take (1 foot lock applied of {n})"
+    assert link.inner_text() == download_text(1, n)
     p.wait_for_selector("#decision-history li")
     latest = p.inner_text("#decision-history").splitlines()[0]
     assert f"{foot} foot lock frames {skate['start_frame']}–{skate['end_frame']}" in latest
@@ -125,7 +130,7 @@ def test_accepting_a_foot_lock_changes_the_foot_and_nothing_above_the_hips(
     assert "repeating-linear-gradient" in rejected["background"]
     assert len({rejected["background"], accepted["background"], undecided["background"]}) == 3
     p.wait_for_function("() => document.querySelectorAll('#decision-history li').length === 2")
-    assert link.inner_text() == f"Download reviewed take (no foot lock applied of {n})"
+    assert link.inner_text() == download_text(0, n)
     assert decided(live_server, run_id) == before
     # After a reload the newest decision is still there (it comes from the server).
     page.open_take(live_server, take)
@@ -177,10 +182,7 @@ def test_a_run_that_locks_the_skates_is_chosen_in_the_form_and_reviewed_lock_by_
     assert "undecided" in cell(page, lock)
     assert "→ locked" in cell(page, lock)
     link = p.locator("#download-decided")
-    assert (
-        link.inner_text()
-        == f"Download reviewed take ({n} foot lock{'s' if n > 1 else ''} applied of {n})"
-    )
+    assert link.inner_text() == download_text(n, n)
     mark = p.locator(f"#contact-timeline .ct-lock[data-lock='{lock}']")
     assert "locked in the run's corrected take" in (mark.get_attribute("title") or "")
     assert "linear-gradient" in timeline_lock(page, lock)["background"]

@@ -1,7 +1,7 @@
 // Unit tests of the contact timeline's rows (node --test).
 import assert from "node:assert/strict";
 import { test } from "node:test";
-import { FEET_COLORS, contactRows, decidedLock, lockMarks, lockStyle, overlappedMost } from "../../frontend/js/contacttimeline.js";
+import { FEET_COLORS, contactRows, decidedLock, lockMarks, lockStyle, overlappedMost, stopAfter } from "../../frontend/js/contacttimeline.js";
 
 const contact = (foot, start, end, confidence = 0.8) => ({ foot, start, end, confidence, id: `contact-${foot}-${start}` });
 const finding = (kind, foot, start, end, value = 2.5, unit = "cm") => ({
@@ -92,4 +92,19 @@ test("a skate over two contacts is locked over the one it overlaps most, whose c
   const marks = lockMarks(contacts, [{ ...finding("skate", "right", 141, 211), id: "skate-right-141" }], "right", 300);
   assert.deepEqual(marks.map((l) => [l.start, l.end]), [[162, 230]]);
   assert.equal(overlappedMost(contacts, "left", 141, 211), undefined);
+});
+
+test("the arrow keys walk a row's stops and move to the nearest stop of the other foot", () => {
+  const rows = [[0, 10, 40, 90], [], [5, 38, 80]];
+  assert.deepEqual(stopAfter(rows, [0, 1], "ArrowRight"), [0, 2]);
+  assert.deepEqual(stopAfter(rows, [0, 3], "ArrowRight"), [0, 3]); // the end stays
+  assert.deepEqual(stopAfter(rows, [0, 0], "ArrowLeft"), [0, 0]);
+  assert.deepEqual(stopAfter(rows, [0, 2], "ArrowLeft"), [0, 1]);
+  assert.deepEqual(stopAfter(rows, [0, 2], "Home"), [0, 0]);
+  assert.deepEqual(stopAfter(rows, [0, 0], "End"), [0, 3]);
+  // Down skips a row without stops and lands on the start nearest 40 (38).
+  assert.deepEqual(stopAfter(rows, [0, 2], "ArrowDown"), [2, 1]);
+  assert.deepEqual(stopAfter(rows, [2, 2], "ArrowUp"), [0, 3]);
+  assert.deepEqual(stopAfter(rows, [0, 1], "ArrowUp"), [0, 1]); // no row above
+  assert.equal(stopAfter(rows, [0, 1], "Enter"), null);
 });

@@ -33,6 +33,6 @@ test("the links: the take's own format first as #download-decided, named for mar
 test("a named link says its format, and its foot locks when the run has any", () => {
   assert.equal(downloadText(0, 0, "trc"), "Download reviewed take as TRC");
   assert.equal(downloadText(0, 0, "c3d"), "Download reviewed take as C3D");
-  assert.equal(downloadText(2, 1, "trc"), "Download reviewed take as TRC (1 foot lock applied of 2)");
-  assert.equal(downloadText(2, 0, null), "Download reviewed take (no foot lock applied of 2)");
+  assert.equal(downloadText(2, 1, "trc"), "Download reviewed take as TRC (1 of 2 foot locks applied)");
+  assert.equal(downloadText(2, 0, null), "Download reviewed take (0 of 2 foot locks applied)");
 });

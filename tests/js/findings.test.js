@@ -163,16 +163,20 @@ test("a link's loop range is read back only when it fits the take", async () => 
 
 test("a findings filter goes into link parameters and comes back the same", () => {
   const kinds = ["twist", "limits"], joints = ["L_Calf", "R_Calf"];
-  const filter = { kinds: new Set(["twist"]), joint: "R_Calf", minValue: 20, text: "calf 12" };
+  const filter = { kinds: new Set(["twist"]), joint: "R_Calf", minValue: 20, unit: "deg", text: "calf 12", sortKey: "confidence", sortDir: -1 };
   const query = findings.filterParams(filter, kinds);
-  assert.deepEqual(query, { kinds: "twist", only: "R_Calf", atleast: "20", q: "calf 12" });
+  assert.deepEqual(query, { kinds: "twist", only: "R_Calf", atleast: "20", unit: "deg", q: "calf 12", sort: "confidence", order: "desc" });
   const back = findings.filterFromParams(new URLSearchParams(query), kinds, joints);
   assert.deepEqual(back, filter);
   // Every kind kept, no joint, no minimum, no words: nothing in the link.
-  assert.deepEqual(findings.filterParams({ kinds: new Set(kinds), joint: "", minValue: null, text: "" }, kinds), {});
-  // Unknown kinds and joints and a minimum that is not a number are left out.
-  const odd = findings.filterFromParams(new URLSearchParams("kinds=twist,bogus&only=Nobody&atleast=abc"), kinds, joints);
-  assert.deepEqual(odd, { kinds: new Set(["twist"]), joint: "", minValue: null, text: "" });
+  assert.deepEqual(findings.filterParams({ kinds: new Set(kinds), joint: "", minValue: null, unit: "deg", text: "", sortKey: "start_frame", sortDir: 1 }, kinds), {});
+  // Unknown kinds, joints and sort keys and a minimum that is not a number are left out.
+  const odd = findings.filterFromParams(new URLSearchParams("kinds=twist,bogus&only=Nobody&atleast=abc&sort=bogus"), kinds, joints);
+  assert.deepEqual(odd, { kinds: new Set(["twist"]), joint: "", minValue: null, unit: "", text: "", sortKey: "start_frame", sortDir: 1 });
+  // The order alone travels too (a reload keeps it).
+  assert.deepEqual(findings.filterParams({ kinds: new Set(), sortKey: "value", sortDir: 1 }, kinds), { sort: "value" });
+  const sorted = findings.filterFromParams(new URLSearchParams("sort=duration&order=desc"), kinds, joints);
+  assert.deepEqual([sorted.sortKey, sorted.sortDir], ["duration", -1]);
 });
 
 test("a typed hyphen finds the en dash of a frame range", () => {
@@ -180,4 +184,53 @@ test("a typed hyphen finds the en dash of a frame range", () => {
   assert.equal(findings.filterFindings(spun, { text: "161-161" }).length, 1);
   assert.equal(findings.filterFindings(spun, { text: "161–161" }).length, 1);
   assert.equal(findings.filterFindings(spun, { text: "162-162" }).length, 0);
+});
+
+const mixed = [
+  { kind: "limits", joint: "L_Foot", start_frame: 0, end_frame: 9, value: 135.3, unit: "deg", confidence: null },
+  { kind: "skate", joint: "L_Foot", start_frame: 20, end_frame: 29, value: 4.6, unit: "% height", confidence: 0.7 },
+  { kind: "skate", joint: "L_Foot", start_frame: 40, end_frame: 49, value: 1.3, unit: "% height", confidence: 0.8 },
+  { kind: "twist", joint: "L_Calf", start_frame: 5, end_frame: 9, value: -40, unit: "deg", confidence: 0.5 },
+  { kind: "jitter", joint: "L_Foot", start_frame: 60, end_frame: 61, value: null, unit: null, confidence: null },
+];
+
+test("a group's worst value keeps its unit: one worst per unit, largest first", () => {
+  const [foot] = findings.groupByJoint(mixed).filter((g) => g.joint === "L_Foot");
+  assert.deepEqual(foot.worstByUnit, [["deg", 135.3], ["% height", 4.6]]);
+  assert.equal(findings.worstText(foot), "135.3 °, 4.6 % height");
+  const calf = findings.groupByJoint(mixed).find((g) => g.joint === "L_Calf");
+  assert.equal(findings.worstText(calf), "40.0 °");
+  assert.equal(findings.worstText(findings.groupByJoint([mixed[4]])[0]), "");
+  assert.deepEqual(findings.unitsOf(mixed), ["deg", "% height"]);
+  assert.equal(findings.unitLabel("deg"), "°");
+  assert.equal(findings.unitLabel("% height"), "% height");
+});
+
+test("a smallest value in one unit keeps only the findings in that unit", () => {
+  const starts = (filter) => findings.filterFindings(mixed, filter).map((x) => x.start_frame);
+  // 5 % height keeps no skate of 4.6 % height, and hides the findings in degrees.
+  assert.deepEqual(starts({ minValue: 5, unit: "% height" }), []);
+  assert.deepEqual(starts({ minValue: 2, unit: "% height" }), [20]);
+  assert.deepEqual(starts({ minValue: 5, unit: "deg" }), [0, 5]);
+  // No minimum: the unit narrows nothing.
+  assert.deepEqual(starts({ minValue: null, unit: "deg" }), [0, 20, 40, 5, 60]);
+});
+
+test("a twist interval's confidence shows the probability its decision used when a reviewer prior moved it", () => {
+  const twist = { kind: "twist", id: 3, confidence: 0.11 };
+  const intervals = new Map([[3, { id: 3, evidence: { calibrated: 0.11, reviewer_probability: 0.62 } }], [4, { id: 4, evidence: { calibrated: 0.9 } }]]);
+  assert.equal(findings.usedProbability(twist, intervals), 0.62);
+  assert.equal(findings.usedProbability({ ...twist, id: 4 }, intervals), null);
+  assert.equal(findings.usedProbability(twist, null), null);
+  assert.equal(findings.usedProbability({ ...twist, reviewer_probability: 0.3 }, null), 0.3);
+  assert.equal(findings.usedProbability({ kind: "skate", id: 3, confidence: 0.5 }, intervals), null);
+  assert.equal(findings.confidenceText(twist, 0.62), "11 % → 62 %");
+  assert.equal(findings.confidenceText(twist, null), "11 %");
+  assert.equal(findings.confidenceText({ kind: "skate", confidence: 0.745 }), "0.74");
+  // Sorted by the probability used: the moved interval goes above one of 0.5.
+  const rows = [twist, { kind: "twist", id: 5, confidence: 0.5, start_frame: 1 }];
+  twist.start_frame = 0;
+  const keys = findings.listSortKeys(intervals);
+  assert.deepEqual(findings.groupByJoint(rows, "confidence", -1, keys)[0].rows.map((x) => x.id), [3, 5]);
+  assert.deepEqual(findings.groupByJoint(rows, "confidence", -1)[0].rows.map((x) => x.id), [5, 3]);
 });

@@ -70,6 +70,36 @@ test("the options diff lists only what differs, as readable values", () => {
   ]);
 });
 
+test("the options diff compares the checks as sets: their order is no difference", () => {
+  const a = { checks: ["twist", "limits", "feet", "filter"], twist_method: "robust" };
+  const b = { checks: ["twist", "limits", "filter", "markers", "feet"], twist_method: "robust" };
+  assert.deepEqual(format.optionsDiff(a, { ...a, checks: ["filter", "feet", "twist", "limits"] }), []);
+  // markers is a difference, unless its step did nothing (a motion take has no markers).
+  assert.deepEqual(format.optionsDiff(a, b), [["checks", "twist, limits, feet, filter", "twist, limits, filter, markers, feet"]]);
+  assert.deepEqual(format.optionsDiff(a, b, ["markers"]), []);
+  assert.deepEqual(format.optionsDiff({ checks: ["twist"] }, { checks: ["twist", "twist"] }), []);
+  assert.deepEqual(format.optionsDiff({ checks: ["twist", "limits"] }, { checks: ["twist", "feet"] }), [["checks", "twist, limits", "twist, feet"]]);
+});
+
+test("idleChecks names the checks skipped in every run that asked for them", () => {
+  const run = (checks, steps) => ({ options: { checks }, steps: Object.fromEntries(Object.entries(steps).map(([k, state]) => [k, { state }])) });
+  const a = run(["twist", "limits", "feet", "filter"], { twist: "done", limits: "done", feet: "done", filter: "skipped" });
+  const b = run(["twist", "limits", "filter", "markers", "feet"], { twist: "done", limits: "done", feet: "done", filter: "skipped", markers: "skipped" });
+  assert.deepEqual(format.idleChecks(a, b).sort(), ["filter", "markers"]);
+  // A check that ran in one run and is missing from the other is a difference.
+  const c = run(["twist", "feet"], { twist: "done", feet: "done" });
+  assert.deepEqual(format.idleChecks(a, c), ["filter"]);
+  // Shown without the idle checks: what is compared.
+  assert.deepEqual(format.optionsDiff(a.options, c.options, format.idleChecks(a, c)), [["checks", "twist, limits, feet", "twist, feet"]]);
+});
+
+test("sortFindings takes other sort keys alike", () => {
+  const rows = [{ start_frame: 1, confidence: 0.9 }, { start_frame: 2, confidence: 0.1, moved: 0.95 }];
+  const keys = { ...format.FINDING_KEYS, confidence: (f) => f.moved ?? f.confidence };
+  assert.deepEqual(format.sortFindings(rows, "confidence", 1).map((f) => f.start_frame), [2, 1]);
+  assert.deepEqual(format.sortFindings(rows, "confidence", 1, keys).map((f) => f.start_frame), [1, 2]);
+});
+
 test("runOptionsLabel tells two runs of a take apart by what differs", () => {
   const done = (options, steps) => ({ status: "done", options, summary: { steps } });
   const ran = { twist: "done", limits: "done", filter: "skipped" };

@@ -33,9 +33,11 @@ test("the download link says how many foot locks it applies: accepted ones, and 
   assert.equal(lockKept({ applied: true }, undefined), true);
   assert.equal(lockKept({}, undefined), false); // a run recorded before the flag locked none
   assert.equal(downloadText(0, 0), "Download reviewed take");
-  assert.equal(downloadText(3, 0), "Download reviewed take (no foot lock applied of 3)");
-  assert.equal(downloadText(3, 1), "Download reviewed take (1 foot lock applied of 3)");
-  assert.equal(downloadText(3, 2), "Download reviewed take (2 foot locks applied of 3)");
+  assert.equal(downloadText(3, 0), "Download reviewed take (0 of 3 foot locks applied)");
+  assert.equal(downloadText(3, 1), "Download reviewed take (1 of 3 foot locks applied)");
+  assert.equal(downloadText(3, 2), "Download reviewed take (2 of 3 foot locks applied)");
+  assert.equal(downloadText(1, 1), "Download reviewed take (1 of 1 foot lock applied)");
+  assert.equal(downloadText(5, 0), "Download reviewed take (0 of 5 foot locks applied)");
 });
 
 test("a lock's cell says what the run chose: cleanup off by default, else locked or not", () => {
