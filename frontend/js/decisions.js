@@ -55,7 +55,8 @@ export async function decidedElsewhere(take, run, getDecisions = api.getDecision
   const others = (take?.runs || []).map((r, k) => [r, k + 1]).filter(([r]) => r.id !== run.id && r.status === "done").reverse();
   for (const [other, number] of others) {
     const body = await getDecisions(other.id).catch(() => null);
-    const count = body ? body.history.length + (body.lock_history || []).length : 0;
+    // The histories come a page at a time: their totals count every decision.
+    const count = body ? (body.history_total ?? body.history.length) + (body.lock_history_total ?? (body.lock_history || []).length) : 0;
     if (count) return { run: other, number, count };
   }
   return null;

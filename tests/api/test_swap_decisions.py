@@ -94,9 +94,7 @@ def test_swap_decisions_are_history_and_the_download_repairs_exactly_the_accepte
     listed = {f["id"]: f["markers"] for f in result["findings"] if f["kind"] == "swap"}
     assert listed == {s["id"]: s["markers"] for s in swaps}
 
-    # The take is approved first: decisions change the decided download only.
-    approved = client.post(f"/api/v1/takes/{take_id}/reviews", json={"status": "approved"})
-    assert approved.status_code == 201, approved.text
+    # Decisions change the decided download only.
     stored = client.get(f"/api/v1/runs/{run_id}/download/c3d").content
     raw = take_files(client, take_id)
 
@@ -137,6 +135,17 @@ def test_swap_decisions_are_history_and_the_download_repairs_exactly_the_accepte
     np.testing.assert_array_equal(decided_positions(client, run_id, tmp_path), expected)
 
     decide(client, run_id, first, "reject")
+    np.testing.assert_array_equal(decided_positions(client, run_id, tmp_path), injected)
+
+    # Once the take is approved its decisions are closed: a further one is a 409 and the
+    # decided download stays as it was.
+    approved = client.post(f"/api/v1/takes/{take_id}/reviews", json={"status": "approved"})
+    assert approved.status_code == 201, approved.text
+    refused = client.post(
+        f"/api/v1/runs/{run_id}/swaps/{first}/decisions", json={"decision": "accept"}
+    )
+    assert refused.status_code == 409, refused.text
+    assert "approved" in refused.json()["detail"]
     np.testing.assert_array_equal(decided_positions(client, run_id, tmp_path), injected)
 
     # The approved take, its file and the run's own corrected C3D are as they were.

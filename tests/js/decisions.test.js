@@ -14,6 +14,12 @@ test("a re-run without decisions points at the newest finished run that has some
   assert.deepEqual(fetched, ["r3", "r1"]);
 });
 
+test("a history longer than its page counts every decision, by its totals", async () => {
+  const paged = async () => ({ history: Array(200).fill({}), history_total: 3000, lock_history: [{}], lock_history_total: 7 });
+  const found = await decidedElsewhere({ runs: [{ id: "r1", status: "done" }, { id: "r2", status: "done" }] }, { id: "r2" }, paged);
+  assert.equal(found.count, 3007);
+});
+
 test("nothing to point at: no other run has decisions, or the request fails", async () => {
   assert.equal(await decidedElsewhere({ runs: [{ id: "r3", status: "done" }, { id: "r4", status: "done" }] }, { id: "r4" }, getDecisions), null);
   const failing = async () => { throw new Error("offline"); };

@@ -2,11 +2,12 @@
 
 A run of a take in a shoot uses the labels of the shoot's *other* takes (the take's own
 decisions are applied by its decided download already, :mod:`mocapqa.jobs.accepted`): the
-newest decision of each twist interval of each take's decided run
-(:meth:`mocapqa.store.decisions.IntervalDecisions.shoot_labels`), each interval's joint and
-probability read from that run's report findings, its rig family from the take's QA row. A
-take whose review status is ``approved`` gets no prior: a decision never changes an approved
-take. The prior is data from here on (:class:`mocapqa.twist.reviewer_prior.ReviewerPrior`):
+newest decision of each twist interval of each take's decided run of the robust twist method
+(:meth:`mocapqa.store.decisions.IntervalDecisions.shoot_labels`; a run of the paper's method
+scores no calibrated probability, so its decisions are no labels), each interval's joint and
+calibrated probability read from that run's report findings, its rig family from the take's
+QA row. A take whose review status is ``approved`` gets no prior: a decision never changes an
+approved take. The prior is data from here on (:class:`mocapqa.twist.reviewer_prior.ReviewerPrior`):
 the run records it (:data:`mocapqa.jobs.run_folder.PRIOR_JSON`) and the analysis takes it as an
 argument.
 """
@@ -16,14 +17,11 @@ from __future__ import annotations
 from typing import Any
 
 from mocapqa.jobs.twist_items import twist_items_of
-from mocapqa.store.decisions import IntervalDecisions
+from mocapqa.store.decisions import APPROVED, IntervalDecisions
 from mocapqa.store.files import FileStore
 from mocapqa.twist.reviewer_prior import ReviewerPrior
 
 __all__ = ["APPROVED", "shoot_prior"]
-
-APPROVED = "approved"
-"""The review status of a take no decision changes."""
 
 
 def shoot_prior(

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from mocapqa.jobs.run_folder import RunFolder
 from mocapqa.jobs.stored_run import load_report
+from mocapqa.store.decisions import CALIBRATED_METHOD
 from mocapqa.store.files import FileStore
 
 __all__ = ["twist_items_of"]
@@ -19,9 +20,11 @@ __all__ = ["twist_items_of"]
 
 def twist_items_of(files: FileStore, run_id: str) -> dict[int, tuple[str, float]]:
     """A finished run's twist intervals: id → (joint, calibrated probability as the run
-    scored it), from its report's findings (empty for a run without twist findings or whose
-    report cannot be read). A shoot's every run reads those of all its decided runs, so they
-    are kept per report file (path, size and modification time) for the process's life."""
+    scored it), from its report's findings (empty for a run without twist findings, a run of
+    a twist method other than :data:`~mocapqa.store.decisions.CALIBRATED_METHOD`, whose
+    ``confidence`` is no calibrated probability, or a run whose report cannot be read). A
+    shoot's every run reads those of all its decided runs, so they are kept per report file
+    (path, size and modification time) for the process's life."""
     path = RunFolder.of(files, run_id).report
     try:
         stat = path.stat()
@@ -37,9 +40,14 @@ def _twist_items(
     """:func:`twist_items_of` of one report file version (``size`` and ``modified_ns`` only
     key the cache)."""
     try:
-        findings = load_report(Path(path)).get("findings") or []
+        report = load_report(Path(path))
     except (OSError, ValueError):
         return ()
+    options = report.get("options")
+    method = options.get("twist_method") if isinstance(options, dict) else None
+    if method not in (None, CALIBRATED_METHOD):
+        return ()
+    findings = report.get("findings") or []
     return tuple(
         (int(f["id"]), (str(f["joint"]), float(f.get("confidence") or 0.0)))
         for f in findings

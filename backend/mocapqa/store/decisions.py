@@ -8,8 +8,16 @@ finding's string id ``lock_id``, :data:`LOCK_ITEM`) are decided the same way; th
 where, who, an optional note); the newest row of an item is its decision. Rows go with their
 run (``ON DELETE CASCADE``).
 
+A take whose review status is :data:`APPROVED` takes no decision: a decision never changes an
+approved take (reopen it, with another review status, to decide again). A note is at most
+:data:`NOTE_MAX_CHARS` characters; a run's history is read a page at a time
+(:meth:`IntervalDecisions.history`, :meth:`IntervalDecisions.count`), while the decision of
+each item is read from every row whatever their number (:meth:`IntervalDecisions.latest`).
+
 Decisions are also labels: :meth:`IntervalDecisions.shoot_labels` gives a shoot's, from which
-its later runs build their reviewer prior (:mod:`mocapqa.jobs.shoot_prior`).
+its later runs build their reviewer prior (:mod:`mocapqa.jobs.shoot_prior`). Only decisions
+on runs of the twist method :data:`CALIBRATED_METHOD` are labels: the paper's method scores
+no calibrated probability.
 """
 
 from __future__ import annotations
@@ -17,20 +25,26 @@ from __future__ import annotations
 from typing import Any, Literal, get_args
 
 from sqlalchemy import func, insert, select
+from sqlalchemy.engine import Connection
+from sqlalchemy.exc import IntegrityError
 
-from mocapqa.errors import InputError
+from mocapqa.errors import ConflictError, InputError, NotFoundError, OptionError
 from mocapqa.store.access import TableAccess
+from mocapqa.store.qa import lock_take
 from mocapqa.store.rows import plain, read_rows
 from mocapqa.store.stamps import utc_now
 from mocapqa.store.tables import interval_decisions, runs, take_qa, takes
 from mocapqa.store.take_listing import REVIEW_STATUS
 
 __all__ = [
+    "APPROVED",
+    "CALIBRATED_METHOD",
     "CORRECTION_ITEM",
     "DECIDED_ITEMS",
     "INTERVAL_DECISIONS",
     "ITEM_KINDS",
     "LOCK_ITEM",
+    "NOTE_MAX_CHARS",
     "DecidedItem",
     "Decision",
     "IntervalDecisions",
@@ -55,6 +69,13 @@ CORRECTION_ITEM: ItemKind = "correction"
 """The ``item_kind`` of a twist interval's or a swap's decision (every row before locks)."""
 LOCK_ITEM: ItemKind = "lock"
 """The ``item_kind`` of a foot lock's decision."""
+APPROVED = "approved"
+"""The review status of a take no decision changes."""
+CALIBRATED_METHOD = "robust"
+"""The twist method whose intervals carry a calibrated probability (a run's
+``options["twist_method"]``, this when absent): only decisions on its runs are labels."""
+NOTE_MAX_CHARS = 4000
+"""The longest note a decision keeps, in characters."""
 
 
 class IntervalDecisions(TableAccess):
@@ -98,35 +119,77 @@ class IntervalDecisions(TableAccess):
         reviewer: str,
         client: str,
     ) -> dict[str, Any]:
+        """Append one decision row, in one transaction with the checks that its run and take
+        exist (a take deleted meanwhile answers :class:`NotFoundError`, never a foreign key
+        error) and that the take is not approved.
+
+        Raises
+        ------
+        InputError
+            For a decision not in :data:`INTERVAL_DECISIONS`, or a note longer than
+            :data:`NOTE_MAX_CHARS` (an :class:`OptionError` naming ``note``).
+        NotFoundError
+            If the run or its take no longer exists.
+        ConflictError
+            If the run's take is approved.
+        """
         if decision not in INTERVAL_DECISIONS:
             raise InputError(f"Expected decision in {list(INTERVAL_DECISIONS)}, got {decision!r}")
-        with self.engine.begin() as conn:
-            result = conn.execute(
-                insert(interval_decisions)
-                .values(
-                    run_id=run_id,
-                    **item,
-                    decision=decision,
-                    note=note,
-                    reviewer=reviewer or "anonymous",
-                    client=client[:255],
-                    created_at=utc_now(),
-                )
-                .returning(interval_decisions)
+        if len(note) > NOTE_MAX_CHARS:
+            raise OptionError(
+                "note", f"Expected at most {NOTE_MAX_CHARS} characters, got {len(note)}"
             )
-            return plain(result.mappings().one())
+        values = {
+            "run_id": run_id,
+            **item,
+            "decision": decision,
+            "note": note,
+            "reviewer": reviewer or "anonymous",
+            "client": client[:255],
+            "created_at": utc_now(),
+        }
+        gone = NotFoundError(f"Expected run {run_id!r} and its take to exist, got none")
+        try:
+            with self.engine.begin() as conn:
+                _check_open(conn, run_id, gone)
+                result = conn.execute(
+                    insert(interval_decisions).values(**values).returning(interval_decisions)
+                )
+                return plain(result.mappings().one())
+        except IntegrityError as error:  # the run's foreign key: its take was deleted meanwhile
+            raise gone from error
 
-    def history(self, run_id: str, kind: ItemKind = CORRECTION_ITEM) -> list[dict[str, Any]]:
-        """Every decision on a run's items of ``kind`` (its twist intervals or swaps, or its
-        foot locks), newest first."""
+    def history(
+        self,
+        run_id: str,
+        kind: ItemKind = CORRECTION_ITEM,
+        limit: int | None = None,
+        offset: int = 0,
+    ) -> list[dict[str, Any]]:
+        """The decisions on a run's items of ``kind`` (its twist intervals or swaps, or its
+        foot locks), newest first: ``limit`` of them (every one when None) after skipping
+        the ``offset`` newest."""
         table = interval_decisions
         query = (
             select(table)
             .where(table.c.run_id == run_id, table.c.item_kind == kind)
             .order_by(table.c.id.desc())
+            .offset(offset)
+            .limit(limit)
         )
         with self.engine.connect() as conn:
             return read_rows(conn, query)
+
+    def count(self, run_id: str, kind: ItemKind = CORRECTION_ITEM) -> int:
+        """How many decisions a run's items of ``kind`` have had (its history's length)."""
+        table = interval_decisions
+        query = (
+            select(func.count())
+            .select_from(table)
+            .where(table.c.run_id == run_id, table.c.item_kind == kind)
+        )
+        with self.engine.connect() as conn:
+            return int(conn.execute(query).scalar_one())
 
     def latest(self, run_id: str) -> dict[int, str]:
         """Item id → its newest decision, for the items (intervals or swaps) that have one."""
@@ -156,8 +219,10 @@ class IntervalDecisions(TableAccess):
     def shoot_labels(self, shoot_id: str) -> list[dict[str, Any]]:
         """The labels a shoot's reviewers gave: for each take of the shoot, the newest decision
         of each twist interval (or swap) of its decided run, the run of its newest decision
-        (a take decided, re-run and decided again gives the new run's labels only). Foot
-        lock decisions are not labels and count for neither.
+        among its runs of the twist method :data:`CALIBRATED_METHOD` (a take decided, re-run
+        and decided again gives the new run's labels only). Decisions on a run of another
+        method (the paper's, with no calibrated probability) and foot lock decisions are not
+        labels and count for neither.
 
         Returns
         -------
@@ -178,7 +243,8 @@ class IntervalDecisions(TableAccess):
         query = (
             select(
                 table.c.id, table.c.run_id, table.c.interval_id, table.c.decision,
-                runs.c.take_id, runs.c.summary, REVIEW_STATUS.label("review_status"),
+                runs.c.take_id, runs.c.summary, runs.c.options,
+                REVIEW_STATUS.label("review_status"),
             )
             .join(newest, table.c.id == newest.c.id)
             .join(runs, runs.c.id == table.c.run_id)
@@ -186,7 +252,7 @@ class IntervalDecisions(TableAccess):
             .order_by(table.c.id)
         )  # fmt: skip
         with self.engine.connect() as conn:
-            rows = conn.execute(query).all()
+            rows = [r for r in conn.execute(query).all() if _calibrated(r.options)]
         decided_run = {str(r.take_id): str(r.run_id) for r in rows}  # the newest wins
         return sorted(
             (
@@ -203,6 +269,38 @@ class IntervalDecisions(TableAccess):
             ),
             key=lambda label: (label["take_id"], label["interval_id"]),
         )
+
+
+def _check_open(conn: Connection, run_id: str, gone: NotFoundError) -> None:
+    """Check, in the transaction that writes a decision, that the run and its take exist and
+    that the take is not approved; the take's row stays locked to the transaction's end (a
+    review or a delete of the take waits for it, PostgreSQL).
+
+    Raises
+    ------
+    NotFoundError
+        ``gone``, if the run or its take no longer exists.
+    ConflictError
+        If the take's review status is :data:`APPROVED`.
+    """
+    take_id = conn.execute(select(runs.c.take_id).where(runs.c.id == run_id)).scalar()
+    if take_id is None or lock_take(conn, str(take_id)) is None:
+        raise gone
+    status = conn.execute(
+        select(take_qa.c.review_status).where(take_qa.c.take_id == take_id)
+    ).scalar()
+    if status == APPROVED:
+        raise ConflictError(
+            f"Expected a take that is not approved to decide on, got take {take_id} approved: "
+            "reopen it (a review of another status) to change decisions"
+        )
+
+
+def _calibrated(options: Any) -> bool:
+    """Whether a run of ``options`` (its stored JSON) scored its twist intervals with a
+    calibrated probability: its twist method is :data:`CALIBRATED_METHOD`."""
+    method = options.get("twist_method") if isinstance(options, dict) else None
+    return method in (None, CALIBRATED_METHOD)
 
 
 def _rig_of(summary: Any) -> str:

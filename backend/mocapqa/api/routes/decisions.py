@@ -7,8 +7,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
-from fastapi import APIRouter, Depends, Path, Request
+from fastapi import APIRouter, Depends, Path, Query, Request
 from fastapi.responses import Response
+from pydantic import Field
 
 from mocapqa.api.auth import Principal, audit, client_address, require
 from mocapqa.api.decision_schemas import DecisionIn, DecisionOut, DecisionsOut, LockDecisionOut
@@ -35,7 +36,10 @@ from mocapqa.store.decisions import DecidedItem, IntervalDecisions
 from mocapqa.store.files import FileStore
 from mocapqa.store.roles import Action
 
-__all__ = ["router"]
+__all__ = ["HISTORY_MAX_LIMIT", "PagedDecisionsOut", "router"]
+
+HISTORY_MAX_LIMIT = 500
+"""The most decisions of each history one answer of ``GET /runs/{id}/decisions`` holds."""
 
 router = APIRouter(prefix="/runs/{run_id}", tags=["decisions"])
 """Routes of this resource, included under ``/api/v1``."""
@@ -54,6 +58,25 @@ def _done_run(run_id: str, services: ServicesDep) -> dict[str, Any]:
 
 
 DoneRunDep = Annotated[dict[str, Any], Depends(_done_run)]
+
+
+class PagedDecisionsOut(DecisionsOut):
+    """:class:`DecisionsOut` whose histories are one page (``limit`` newest after ``offset``),
+    with the length of each whole history."""
+
+    history: list[DecisionOut] = Field(
+        description="The decisions on a twist interval or swap, newest first: one page "
+        "(``limit`` after the ``offset`` newest)"
+    )
+    history_total: int = Field(
+        description="Decisions on the run's twist intervals or swaps; ``history`` is a page"
+    )
+    lock_history: list[LockDecisionOut] = Field(
+        [], description="The decisions on a foot lock, newest first: a page as ``history`` is"
+    )
+    lock_history_total: int = Field(
+        description="Decisions on the run's foot locks; ``lock_history`` is a page"
+    )
 
 
 def _out(row: dict[str, Any], item: DecidedItem) -> DecisionOut:
@@ -98,7 +121,11 @@ def _decide(review: _Review, item: DecidedItem, item_id: int, body: DecisionIn) 
     Raises
     ------
     NotFoundError
-        If the run has no such interval or swap.
+        If the run has no such interval or swap, or the run or its take is gone.
+    ConflictError
+        If the run's take is approved.
+    InputError
+        For a note longer than :data:`~mocapqa.store.decisions.NOTE_MAX_CHARS`.
     """
     run_id = str(review.run["id"])
     listed = run_intervals if item == "interval" else run_swaps
@@ -122,16 +149,28 @@ _DECISION_POST: dict[str, Any] = {
 
 
 @router.get("/decisions", responses=responses(401, 404, 409))
-def list_decisions(run: DoneRunDep, services: ServicesDep, decisions: DecisionsDep) -> DecisionsOut:
+def list_decisions(
+    run: DoneRunDep,
+    services: ServicesDep,
+    decisions: DecisionsDep,
+    limit: Annotated[
+        int, Query(ge=1, le=HISTORY_MAX_LIMIT, description="Decisions per history page")
+    ] = 200,
+    offset: Annotated[
+        int, Query(ge=0, le=2**31 - 1, description="Newest decisions before the page")
+    ] = 0,
+) -> PagedDecisionsOut:
     """The run's twist intervals (a motion take) or swaps (a marker take) and its foot locks
-    (the skate findings of its feet step) with their newest decision, and every decision
-    (newest first). 409 for a run with none of these to decide."""
+    (the skate findings of its feet step) with their newest decision (whatever the length of
+    the history), and a page of each decision history: ``limit`` decisions, newest first,
+    after the ``offset`` newest; ``history_total`` and ``lock_history_total`` count each
+    whole history. 409 for a run with none of these to decide."""
     run_id = str(run["id"])
     item, items, locks = run_decidables(services.files, run_id)
     decided = with_decisions(items, decisions.latest(run_id))
     latest_locks = decisions.latest_locks(run_id)
     options = AnalysisOptions.from_json(run["options"])
-    return DecisionsOut.model_validate(
+    return PagedDecisionsOut.model_validate(
         {
             "run_id": run_id,
             "item": item,
@@ -139,7 +178,10 @@ def list_decisions(run: DoneRunDep, services: ServicesDep, decisions: DecisionsD
             "lock_apply": options.feet_apply,
             "intervals": decided if item == "interval" else [],
             "swaps": decided if item == "swap" else [],
-            "history": [_out(r, item) for r in decisions.history(run_id)],
+            "history": [
+                _out(r, item) for r in decisions.history(run_id, limit=limit, offset=offset)
+            ],
+            "history_total": decisions.count(run_id),
             "locks": [
                 {
                     **lock,
@@ -149,7 +191,10 @@ def list_decisions(run: DoneRunDep, services: ServicesDep, decisions: DecisionsD
                 }
                 for lock in locks
             ],
-            "lock_history": [_lock_out(r) for r in decisions.history(run_id, "lock")],
+            "lock_history": [
+                _lock_out(r) for r in decisions.history(run_id, "lock", limit, offset)
+            ],
+            "lock_history_total": decisions.count(run_id, "lock"),
         }
     )
 
