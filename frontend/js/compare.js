@@ -4,12 +4,15 @@ import * as api from "./api.js";
 import { h } from "./dom.js";
 import { MARGIN } from "./charts.js";
 import { compareViews } from "./compare3d.js";
-import { fmt, matchFindings, optionsDiff, runOptionsLabel } from "./format.js";
+import { fmt, idleChecks, matchFindings, optionsDiff, runOptionsLabel } from "./format.js";
 import { loadPlotly, untabbableModebar } from "./plotly.js";
+import { refocus } from "./take-layout.js";
 
 // Each choice starts the view again: an older call still waiting for its answers must not
 // draw after a newer one (two comparisons stacked on the page).
 let drawing = 0;
+// The run chosen in A's or B's picker ({name, value}), until the view it opens has its picker.
+let picked = null;
 
 export async function compareView(main, params, onTeardown = () => {}) {
   const mine = ++drawing;
@@ -40,13 +43,16 @@ async function runChoices() {
   return options;
 }
 
-/** The choice of run `name` ("a" or "b"); a choice opens the view again with it. Each choice is
- * as wide as the window allows, not as the longest take name (they can be 240 characters): the
- * closed list cuts the name, the open one shows it whole. */
+/** The choice of run `name` ("a" or "b"); a choice opens the view again with it, its picker
+ * given the focus back (a keyboard user goes on choosing). Each choice is as wide as the window
+ * allows, not as the longest take name (they can be 240 characters): the closed list cuts the
+ * name, the open one shows it whole. */
 function runPick(name, params, options) {
   const pick = h("select", { id: `compare-${name}`, onchange: (e) => {
+    picked = { name, value: e.target.value };
     const next = new URLSearchParams(params); next.set(name, e.target.value); location.hash = `#/compare?${next}`; } },
-    h("option", { value: "" }, "choose…"), options.map(([v, l]) => h("option", { value: v, selected: v === params.get(name) }, l)));
+  h("option", { value: "" }, "choose…"), options.map(([v, l]) => h("option", { value: v, selected: v === params.get(name) }, l)));
+  if (picked && picked.name === name && (params.get(name) || "") === picked.value) { picked = null; refocus(pick); }
   return h("label", { class: "compare-pick" }, `${name.toUpperCase()} `, pick);
 }
 
@@ -72,9 +78,10 @@ function metricsTable(results, label) {
       metric("server time (s)", (x, run) => fmt(run.server_time_s, 3))));
 }
 
-/** The options the two runs were made with that differ. */
+/** The options the two runs were made with that differ (a check neither run could run, as
+ * markers on a motion take, is no difference). */
 function optionsDiffPanel(a, b) {
-  const diff = optionsDiff(a.options, b.options);
+  const diff = optionsDiff(a.options, b.options, idleChecks(a, b));
   return [h("h2", {}, "Options that differ"),
     diff.length ? h("table", { class: "kv", id: "compare-options" }, h("thead", {}, h("tr", {}, h("th", {}, "option"), h("th", {}, "A"), h("th", {}, "B"))),
       h("tbody", {}, diff.map(([k, x, y]) => h("tr", {}, h("td", {}, k), h("td", {}, x), h("td", {}, y)))))

@@ -26,6 +26,8 @@ export function render(t) {
   t.views.show(frame);
   ui.frameLabel.textContent = frameText(f, t.nFrames, t.fps, frame.flagged.size);
   ui.jointLabel.textContent = store.state.joint ? `selected: ${store.state.joint}` : "click a joint to select it";
+  // A narrow bar cuts a long name: the whole of it on hover.
+  ui.jointLabel.title = ui.jointLabel.textContent;
   ui.rawTitle.textContent = `raw — frame ${frame.shown}`;
   ui.corrTitle.textContent = store.state.overlay ? `${t.outcome} (solid) and raw (ghost) — frame ${frame.shown}` : `${t.outcome} — frame ${frame.shown}`;
   ui.scrubber.value = f;
@@ -33,11 +35,26 @@ export function render(t) {
   if (t.gapTimeline) t.gapTimeline.setFrame(f);
   if (t.contactTimeline) t.contactTimeline.setFrame(f);
   if (t.timeline) t.timeline.setFrame(f);
+  if (t.player && t.player.playing && linkDue(t.linkedAt, performance.now())) remember(t);
 }
 
-/** Keep the view's state in the address (a reload or a shared link opens it again). */
+/** Milliseconds between two updates of the link while playing (a reload then opens close to
+ * the frame shown; replacing the address, not adding to the history). */
+export const LINK_INTERVAL_MS = 250;
+
+/** Whether the link is due again `now` (ms) when it was last written at `last` (ms; undefined
+ * when never). */
+export function linkDue(last, now, interval = LINK_INTERVAL_MS) {
+  return last === undefined || now - last >= interval;
+}
+
+/** Keep the view's state in the address (a reload or a shared link opens it again): frame,
+ * joint, in/out, the findings filter and the view options. */
 export function remember(t) {
-  history.replaceState(null, "", `#/take/${t.take.id}?${takeQuery(t.run.id, store.state, t.filterQuery)}`);
+  const query = takeQuery(t.run.id, store.state, t.filterQuery);
+  for (const [name, value] of store.viewOptionParams(store.state)) query.set(name, value);
+  history.replaceState(null, "", `#/take/${t.take.id}?${query}`);
+  t.linkedAt = performance.now();
 }
 
 /** Frames: the overview (whole take, decimated) or, when paused, a full-rate window around. */
@@ -111,7 +128,7 @@ function loopFinding(t) {
 }
 
 /** The player's, camera's, loop's and view options' controls. A link may carry the in/out
- * range (&loop=A-B): shown, not yet looping. */
+ * range (&loop=A-B): shown, not yet looping; and the view options (viewOptionsOf). */
 export function wireControls(t) {
   const { ui, player, views } = t;
   ui.playButton.addEventListener("click", () => togglePlay(t));
@@ -126,14 +143,34 @@ export function wireControls(t) {
   ui.clearLoopButton.addEventListener("click", () => { store.set({ loop: null, looping: false }); showLoop(t); remember(t); });
   const linked = parseRange(t.params.get("loop"), t.nFrames);
   if (linked) setRange(t, linked);
-  ui.triadsBox.addEventListener("change", () => views.setTriads(ui.triadsBox.checked));
-  ui.overlayBox.addEventListener("change", () => {
-    store.set({ overlay: ui.overlayBox.checked });
-    ui.rawPanel.hidden = ui.overlayBox.checked;
-    views.setOverlay(ui.overlayBox.checked);
-    render(t);
-  });
+  wireViewOptions(t);
+  trackPlayerHeight(t);
+}
+
+/** The joint axes' and overlay's checkboxes and the floor's, as the link left them. */
+function wireViewOptions(t) {
+  const { ui } = t;
+  store.set(store.viewOptionsOf(t.params));
+  if (store.state.triads && t.oriented) showTriads(t, true);
+  if (store.state.overlay) showOverlay(t, true);
+  ui.triadsBox.addEventListener("change", () => { showTriads(t, ui.triadsBox.checked); remember(t); });
+  ui.overlayBox.addEventListener("change", () => { showOverlay(t, ui.overlayBox.checked); remember(t); });
   wireFloorToggle(t);
+}
+
+function showTriads(t, on) {
+  store.set({ triads: on });
+  t.ui.triadsBox.checked = on;
+  t.views.setTriads(on);
+}
+
+function showOverlay(t, on) {
+  const { ui, views } = t;
+  store.set({ overlay: on });
+  ui.overlayBox.checked = on;
+  ui.rawPanel.hidden = on;
+  views.setOverlay(on);
+  render(t);
 }
 
 /** The floor plane's checkbox, shown when the views draw the feet step's floor; its label says
@@ -146,13 +183,28 @@ function wireFloorToggle(t) {
   if (!floor) return;
   const feet = t.result.series.feet;
   const tilted = Boolean(feet.floor_check && feet.floor_check.tilted);
-  ui.floorBox.checked = floor.shown.some(Boolean);
+  if (!store.state.floor) views.setFloorShown(false);
+  ui.floorBox.checked = floor.shown.some(Boolean) && store.state.floor;
   ui.floorText.textContent = floorLabel(feet);
   ui.floorToggle.classList.toggle("tilted", tilted);
   ui.floorToggle.title = tilted
     ? "show or hide the feet step's floor; the floor is tilted: the plane drawn is the one fitted to the feet at rest"
     : "show or hide the feet step's floor";
-  ui.floorBox.addEventListener("change", () => views.setFloorShown(ui.floorBox.checked));
+  ui.floorBox.addEventListener("change", () => {
+    store.set({ floor: ui.floorBox.checked });
+    views.setFloorShown(ui.floorBox.checked);
+    remember(t);
+  });
+}
+
+/** The player bar is pinned to the window's top while the page scrolls: what scrolls into sight
+ * under it (a row N/P reached, a control Tab focused) stops below it (app.css reads the bar's
+ * height, --player-height, for the scroll margin). */
+function trackPlayerHeight(t) {
+  const { player } = t.ui;
+  const measure = () => t.main.style.setProperty("--player-height", `${player.offsetHeight}px`);
+  measure();
+  if (typeof ResizeObserver === "function") new ResizeObserver(measure).observe(player);
 }
 
 /** N/P walk the findings the list's filters keep, across its groups. */
@@ -170,20 +222,43 @@ function walkFindings(t, dir) {
   jump(t, reached.start_frame);
 }
 
-/** The keyboard's commands (keyCommand); keys typed in a field are text. A checkbox is no
- * field: the commands work while it has the focus, and Space still ticks it. */
+// Keys a range slider (the scrubber) keeps as its own: every other key is the view's command.
+const SLIDER_KEYS = new Set(["ArrowLeft", "ArrowRight", "ArrowUp", "ArrowDown", "Home", "End", "PageUp", "PageDown"]);
+// Inputs typed in by no key: their keys are the view's commands (Space still ticks a checkbox).
+const KEYLESS_INPUTS = new Set(["checkbox", "radio", "range"]);
+
+/**
+ * Whether `key` pressed on `element` is the element's own (typed in a field, chosen in a list,
+ * moving a slider), not a command of the view. A checkbox or a radio button is no field; a range
+ * slider keeps its arrows, Home, End and the page keys, and leaves the rest (Space, N, P, I, O,
+ * A, …) to the view.
+ *
+ * @param element {tagName, type, isContentEditable}: the key's target (an element)
+ * @param key     the KeyboardEvent's key
+ */
+export function elementKeepsKey(element, key) {
+  if (!element || !element.tagName) return false;
+  if (element.isContentEditable) return true;
+  const tag = element.tagName.toUpperCase();
+  if (tag === "TEXTAREA" || tag === "SELECT") return true;
+  if (tag !== "INPUT") return false;
+  const type = String(element.type || "text").toLowerCase();
+  if (type === "range") return SLIDER_KEYS.has(key);
+  return !KEYLESS_INPUTS.has(type);
+}
+
+/** The keyboard's commands (keyCommand); keys typed in a field are text (elementKeepsKey). */
 export function onKey(t, e) {
   const target = e.target;
-  const field = "input:not([type=checkbox]):not([type=radio]), textarea, select, [contenteditable]";
-  const typing = target instanceof HTMLElement && (target.matches(field) || target.isContentEditable);
-  if (typing || e.ctrlKey || e.metaKey || e.altKey) return;
+  if (elementKeepsKey(target, e.key) || e.ctrlKey || e.metaKey || e.altKey) return;
   const command = keyCommand(e.key, e.shiftKey);
   const { state } = store;
   switch (command && command.name) {
     // Space plays or pauses on its key-down (a focused play button would wait for the key-up).
-    // The time bar (a slider) plays too: it is where a reviewer's focus rests between findings.
+    // The time bar and the scrubber (sliders) play too: where a reviewer's focus rests between
+    // findings, or after a drag.
     case "play":
-      if (target === t.ui.playButton || target.id === "timebar" || !target.matches("button, a, input, [tabindex]")) { e.preventDefault(); if (!e.repeat) togglePlay(t); }
+      if (playsOnSpace(t, target)) { e.preventDefault(); if (!e.repeat) togglePlay(t); }
       break;
     case "step": e.preventDefault(); if (t.player.playing) togglePlay(t); jump(t, state.frame + command.by); break;
     case "walk": walkFindings(t, command.dir); break;
@@ -197,4 +272,11 @@ export function onKey(t, e) {
     case "help": t.ui.help.hidden = !t.ui.help.hidden; break;
     default: break;
   }
+}
+
+/** Space plays or pauses on the page, the play button and the two sliders (the time bar, the
+ * scrubber); on another control (a button, a link, a checkbox) it is that control's. */
+function playsOnSpace(t, target) {
+  if (target === t.ui.playButton || target === t.ui.scrubber || target.id === "timebar") return true;
+  return !(target.matches && target.matches("button, a, input, [tabindex]"));
 }

@@ -97,16 +97,40 @@ export function uncheckedNote(steps) {
     unchecked.some(([, st]) => st.state === "no_roles") ? " — name the rig's joints in \u201cRig roles (mapping)\u201d below and re-run." : "");
 }
 
+// The run chosen in the run picker, until the view it opens has the picker again.
+let pickedRun = null;
+
 /** The run list, each run labelled by what differs from the defaults of `described` (GET
  * /run-options); another run opens at the frame shown now (`frameNow()`), as a reviewer
- * comparing runs expects, rather than at frame 0. */
+ * comparing runs expects, rather than at frame 0. A choice draws the view again: the new
+ * picker takes the focus back (a keyboard user goes on choosing, ↑/↓ stepping through the runs). */
 export function runPicker(take, run, frameNow, described) {
-  const select = h("select", { id: "run-pick", "aria-label": "run", onchange: (e) => { location.hash = `${api.takeLink(take.id, e.target.value)}&frame=${frameNow()}`; } },
-    take.runs.map((r, i) => h("option", { value: r.id, selected: r.id === run.id },
-      `run ${i + 1} · ${r.status} · ${runOptionsLabel(r, described)}`)));
+  const select = h("select", { id: "run-pick", "aria-label": "run", onchange: (e) => {
+    pickedRun = e.target.value;
+    location.hash = `${api.takeLink(take.id, e.target.value)}&frame=${frameNow()}`;
+  } },
+  take.runs.map((r, i) => h("option", { value: r.id, selected: r.id === run.id },
+    `run ${i + 1} · ${r.status} · ${runOptionsLabel(r, described)}`)));
+  if (pickedRun === run.id) {
+    // A run still going draws the view again when it ends: the focus comes back then too.
+    if (run.status === "done") pickedRun = null;
+    refocus(select);
+  }
   return h("div", { class: "controls" }, "Run ", select,
     run.server_time_s != null ? h("span", { class: "muted" }, `server time ${fmt(run.server_time_s, 2)} s`) : null,
     h("a", { href: `#/compare?a=${run.id}` }, "compare…"));
+}
+
+/**
+ * Give `control` the focus once it is on the page (the caller appends it in the same task),
+ * unless the focus went on to another control meanwhile: a control drawn again in place of the
+ * one that had the focus.
+ */
+export function refocus(control) {
+  queueMicrotask(() => {
+    const now = document.activeElement;
+    if (control.isConnected && (!now || now === document.body)) control.focus();
+  });
 }
 
 export function downloadsPanel(run, result) {
