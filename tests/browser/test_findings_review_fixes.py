@@ -233,6 +233,13 @@ def test_compare_ignores_the_order_of_the_checks(
     p.goto(f"{live_server}/#/compare?a={knees['run']}&b={reordered}")
     p.wait_for_selector("main[data-ready='1']", timeout=60_000)
     assert p.inner_text("#compare-options") == "Same options."
+    # Nor is a check that cannot run on a motion take (markers) a difference.
+    asked = sorted({*first, "markers"})
+    without = run_again(live_server, knees["id"], {"checks": [c for c in asked if c != "markers"]})
+    with_markers = run_again(live_server, knees["id"], {"checks": asked})
+    p.goto(f"{live_server}/#/compare?a={with_markers}&b={without}")
+    p.wait_for_selector("main[data-ready='1']", timeout=60_000)
+    assert p.inner_text("#compare-options") == "Same options."
 
 
 def test_the_shoot_table_and_the_reviewed_download_say_their_units_and_counts(
