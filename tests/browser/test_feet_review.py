@@ -176,6 +176,13 @@ def test_a_run_that_locks_the_skates_is_chosen_in_the_form_and_reviewed_lock_by_
     run_id = re.search(r"run=([0-9a-f]+)", p.url).group(1)  # type: ignore[union-attr]
     run = httpx.get(f"{live_server}/api/v1/runs/{run_id}", timeout=30).json()
     assert run["options"]["feet_apply"] == "skates"
+    # The new run's view replaces the old one's rows (the same lock ids) once the run is done.
+    p.wait_for_function(
+        "(run) => document.querySelector('#run-pick')?.value === run"
+        " && document.querySelector('main')?.dataset.ready === '1'",
+        arg=run_id,
+        timeout=120_000,
+    )
     p.wait_for_selector(f"#findings tr[data-lock='{lock}'] button.decide-accept", timeout=120_000)
     # Undecided, each lock follows the run: locked in its corrected take and the reviewed one.
     assert cell(page, lock).startswith("run: locked")
