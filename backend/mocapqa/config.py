@@ -59,6 +59,8 @@ class Settings(BaseSettings):
         Largest frames × points (joints or keypoints) of a take.
     max_joints : int
         Largest number of joints in a BVH hierarchy.
+    max_markers : int
+        Largest number of markers (points) of a marker take (TRC, C3D).
     max_line_bytes : int
         Longest line of a text take, bytes.
     max_json_depth : int
@@ -125,6 +127,7 @@ class Settings(BaseSettings):
     max_unpacked_mb: float = 200.0
     max_frame_points: int = 5_000_000
     max_joints: int = 500
+    max_markers: int = 1000
     max_line_bytes: int = 1_000_000
     max_json_depth: int = 64
     max_run_attempts: int = 2
@@ -145,6 +148,7 @@ class Settings(BaseSettings):
             max_unpacked_bytes=int(self.max_unpacked_mb * 1_000_000),
             max_frame_points=self.max_frame_points,
             max_joints=self.max_joints,
+            max_markers=self.max_markers,
             max_line_bytes=self.max_line_bytes,
             max_json_depth=self.max_json_depth,
         )

@@ -15,17 +15,24 @@ lines (a lower bound of frames × points: the read take spans every frame number
 first and the last). Lines are counted with ``bytes.count`` in 1 MB chunks; blank lines count
 as data lines, so the estimate errs toward refusing, by the number of blank lines.
 
+Marker takes (TRC, C3D) are also refused over ``max_markers`` markers, from the TRC's
+marker-name line (its first lines split as the reader splits them, at a lone carriage return
+too) or the C3D header's point count: the marker check's pair statistics cost time in
+proportion to the number of marker pairs.
+
 The limits are parameters (:class:`ReadLimits`); the server builds them from its settings.
 """
 
 from __future__ import annotations
 
 import codecs
+import lzma
 import math
 import re
 import struct
 import tokenize
 import zipfile
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
@@ -37,6 +44,7 @@ from mocapqa.errors import ParseError, TooLargeError
 __all__ = [
     "JSON_FORMATS",
     "TEXT_FORMATS",
+    "ZIP_READ_ERRORS",
     "C3DHeader",
     "NpyHeader",
     "ReadLimits",
@@ -44,6 +52,7 @@ __all__ = [
     "check_frame_points",
     "check_json_depth",
     "check_line_length",
+    "check_marker_count",
     "check_take_input",
     "check_take_size",
     "json_nesting",
@@ -57,6 +66,19 @@ TEXT_FORMATS = frozenset(
 """Formats read as text lines (their line length is limited)."""
 JSON_FORMATS = frozenset({"json", "mediapipe-json", "openpose"})
 """Formats parsed as JSON documents (their nesting depth is limited)."""
+
+ZIP_READ_ERRORS: tuple[type[Exception], ...] = (
+    zipfile.BadZipFile,
+    zipfile.LargeZipFile,
+    OSError,  # damaged bzip2 data among others
+    EOFError,
+    ValueError,
+    RuntimeError,  # an encrypted member ("password required"); NotImplementedError, a
+    # RuntimeError, for a compression method zipfile lacks (Deflate64, method 9)
+    zlib.error,  # damaged deflate data
+    lzma.LZMAError,  # damaged LZMA data
+)
+"""What opening or reading a member of a damaged or unsupported zip (``.npz``) raises."""
 
 _CHUNK = 1 << 20
 # Keywords in any case, as the reader takes them.
@@ -81,6 +103,8 @@ class ReadLimits:
         Largest frames × points (joints or keypoints) of a take.
     max_joints : int
         Largest number of joints in a BVH hierarchy.
+    max_markers : int
+        Largest number of markers (points) of a marker take (TRC, C3D).
     max_line_bytes : int
         Longest line of a text format, bytes.
     max_json_depth : int
@@ -90,6 +114,7 @@ class ReadLimits:
     max_unpacked_bytes: int = 200_000_000
     max_frame_points: int = 5_000_000
     max_joints: int = 500
+    max_markers: int = 1000
     max_line_bytes: int = 1_000_000
     max_json_depth: int = 64
 
@@ -297,7 +322,7 @@ def _check_arrays(path: Path, kind: str, limits: ReadLimits) -> None:
                     if member.filename.endswith(".npy"):
                         with archive.open(member) as handle:
                             total += _frame_points(read_npy_header(handle, path), path, limits)
-        except (zipfile.BadZipFile, OSError, EOFError, ValueError) as e:
+        except ZIP_READ_ERRORS as e:
             raise ParseError(f"Expected a readable .npz archive, got {e}", path) from e
     if total > limits.max_unpacked_bytes:
         raise TooLargeError(
@@ -364,13 +389,13 @@ def _long_csv_header_lines(path: Path, kind: str) -> int:
     return lines
 
 
-def _trc_cells(line: bytes) -> list[str]:
-    text = line.decode("utf-8", "replace")
+def _trc_cells(text: str) -> list[str]:
     return text.split("\t") if "\t" in text else text.split()
 
 
 def _trc_size(path: Path) -> tuple[int, int]:
-    head = _head(path, 8)
+    # Split as the reader splits (str.splitlines: "\r" and the other separators too).
+    head = b"".join(_head(path, 8)).decode("utf-8", "replace").splitlines()[:8]
     if len(head) < 4:
         return 0, 0  # the reader names what is missing
     markers = sum(1 for c in _trc_cells(head[3])[2:] if c.strip())
@@ -381,9 +406,33 @@ def _trc_size(path: Path) -> tuple[int, int]:
     return max(_count_lines(path) - start, 0), markers
 
 
+def check_marker_count(markers: int, name: str, limits: ReadLimits) -> None:
+    """Refuse a marker take (TRC, C3D) of more than ``limits.max_markers`` markers.
+
+    Parameters
+    ----------
+    markers : int
+        The markers (points) the file declares.
+    name : str
+        The file named in the message.
+    limits : ReadLimits
+
+    Raises
+    ------
+    TooLargeError
+        Naming the file, the setting and the count.
+    """
+    if markers > limits.max_markers:
+        raise TooLargeError(
+            f"{name}: Expected at most {limits.max_markers} markers (setting max_markers), "
+            f"got {markers}"
+        )
+
+
 def check_frame_points(path: str | Path, kind: str, limits: ReadLimits) -> None:
     """Refuse a TRC, keypoint CSV or MediaPipe CSV with more than ``max_frame_points``
-    frames × points, counting lines instead of parsing (see the module notes).
+    frames × points, counting lines instead of parsing (see the module notes), and a TRC
+    of more than ``max_markers`` markers.
 
     Raises
     ------
@@ -394,6 +443,7 @@ def check_frame_points(path: str | Path, kind: str, limits: ReadLimits) -> None:
     limit = limits.max_frame_points
     if kind == "trc":
         rows, markers = _trc_size(path)
+        check_marker_count(markers, path.name, limits)
         if rows * markers > limit:
             raise TooLargeError(
                 f"{path.name}: Expected at most {limit} frames × points (setting "
@@ -565,8 +615,10 @@ def check_c3d_header(header: C3DHeader, name: str, limits: ReadLimits) -> None:
     Raises
     ------
     TooLargeError
-        Frames × points over ``max_frame_points``, or data bytes over ``max_unpacked_bytes``.
+        Points over ``max_markers``, frames × points over ``max_frame_points``, or data
+        bytes over ``max_unpacked_bytes``.
     """
+    check_marker_count(header.n_points, name, limits)
     if header.n_frames * header.n_points > limits.max_frame_points:
         raise TooLargeError(
             f"{name}: Expected at most {limits.max_frame_points} frames × points (setting "

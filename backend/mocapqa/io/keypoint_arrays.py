@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 from mocapqa.core.keypoints import KeypointSequence
 from mocapqa.errors import ParseError
 from mocapqa.io.atomic import atomic_path
-from mocapqa.io.guards import read_npy_header
+from mocapqa.io.guards import ZIP_READ_ERRORS, read_npy_header
 from mocapqa.io.keypoint_input import (
     build_keypoint_sequence,
     read_file_bytes,
@@ -105,15 +105,21 @@ def _check_headers(data: bytes, path: str) -> None:
                         header = read_npy_header(stream, path)
                     key = member.filename.removesuffix(".npy")
                     _check_declared(header.n_bytes, member.file_size - header.offset, path, key)
-    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, ValueError) as e:
+    except ZIP_READ_ERRORS as e:
         raise ParseError(f"Expected a readable .npz archive, got {e}", path) from e
+
+
+_LOAD_ERRORS: tuple[type[Exception], ...] = (*ZIP_READ_ERRORS, KeyError)
+"""What NumPy's loading of a damaged ``.npy``/``.npz`` raises."""
+_NPZ_READ_ERRORS: tuple[type[Exception], ...] = (*ZIP_READ_ERRORS, TypeError)
+"""What reading an ``.npz`` archive's arrays raises on damaged members or wrong types."""
 
 
 def _load(data: bytes, path: str) -> Any:
     _check_headers(data, path)
     try:
         return np.load(io.BytesIO(data), allow_pickle=False)
-    except (ValueError, OSError, EOFError, zipfile.BadZipFile, KeyError) as e:
+    except _LOAD_ERRORS as e:
         raise ParseError(f"Expected a NumPy file, got unreadable data ({e})", path) from e
 
 
@@ -221,7 +227,7 @@ def parse_keypoint_npz(
             unit = str(_scalar(archive, "unit", path)) if "unit" in archive.files else None
             if "n_dims" in archive.files:
                 n_dims = int(_scalar(archive, "n_dims", path))
-    except (ValueError, TypeError, OSError, zipfile.BadZipFile, EOFError) as e:
+    except _NPZ_READ_ERRORS as e:
         raise ParseError(f"Expected a readable .npz archive, got {e}", path) from e
     if len(names) != positions.shape[1]:
         raise ParseError(

@@ -36,6 +36,7 @@ import stat
 import struct
 import tarfile
 import zipfile
+import zlib
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -43,6 +44,7 @@ from pathlib import Path, PurePosixPath
 from typing import IO
 
 from mocapqa.errors import InputError, TooLargeError
+from mocapqa.io.guards import ZIP_READ_ERRORS
 
 __all__ = ["ARCHIVE_SUFFIXES", "Member", "archive_kind", "unpack"]
 
@@ -216,10 +218,12 @@ def _check_zip_directory(path: Path, max_members: int) -> None:
             handle.seek(lengths, io.SEEK_CUR)
 
 
-_ZIP_DAMAGE = (zipfile.BadZipFile, OSError, EOFError, ValueError)
-"""What reading a damaged zip member raises."""
-_TAR_DAMAGE = (tarfile.TarError, OSError, EOFError, ValueError)
-"""What reading a damaged tar member raises."""
+_ZIP_DAMAGE = ZIP_READ_ERRORS
+"""What reading a damaged zip member raises: besides damaged data (``zlib.error``,
+``lzma.LZMAError``, bzip2's ``OSError``, a bad CRC), an encrypted member (``RuntimeError``) and
+a compression method :mod:`zipfile` lacks (``NotImplementedError``, Deflate64)."""
+_TAR_DAMAGE = (tarfile.TarError, OSError, EOFError, ValueError, zlib.error, lzma.LZMAError)
+"""What reading a damaged tar member raises (damaged gzip data: ``zlib.error``)."""
 _Entry = tuple[str, str | None, Callable[[], IO[bytes] | None]]
 """A member to unpack: its name, why it is not unpacked (None: it is) and its stream's opener."""
 
@@ -275,7 +279,7 @@ def _zip_entries(
     try:
         _check_zip_directory(path, max_members)
         archive = zipfile.ZipFile(path)
-    except (zipfile.BadZipFile, OSError) as e:
+    except ZIP_READ_ERRORS as e:
         raise InputError(f"Expected a readable .zip archive, got {e}") from e
     with archive:
         listed = archive.infolist()
@@ -357,7 +361,7 @@ def _scan_tar_headers(path: Path, max_members: int, max_bytes: int) -> None:
                     if skipped == 0:
                         return  # truncated: tarfile reports it below
                     left -= skipped
-    except (OSError, EOFError, lzma.LZMAError) as e:
+    except (OSError, EOFError, zlib.error, lzma.LZMAError) as e:
         raise InputError(f"Expected a readable .tar.gz archive, got {e}") from e
 
 
@@ -382,7 +386,7 @@ def _tar_entries(
     _scan_tar_headers(path, max_members, max_bytes)
     try:
         archive = tarfile.open(path, mode="r:*")  # noqa: SIM115 - closed by the with below
-    except (tarfile.TarError, OSError, EOFError) as e:
+    except (tarfile.TarError, OSError, EOFError, zlib.error, lzma.LZMAError) as e:
         raise InputError(f"Expected a readable .tar.gz archive, got {e}") from e
     with archive:
         infos: list[tarfile.TarInfo] = []
@@ -395,7 +399,7 @@ def _tar_entries(
                 infos.append(info)
                 declared += info.size if info.isfile() else 0
                 _check_totals(entries, declared, max_members, max_bytes)
-        except (tarfile.TarError, OSError, EOFError) as e:
+        except (tarfile.TarError, OSError, EOFError, zlib.error, lzma.LZMAError) as e:
             raise InputError(f"Expected a readable .tar.gz archive, got {e}") from e
         yield (
             declared,

@@ -15,8 +15,10 @@ Conventions
   threshold), cut at 1: every pair inside a segment is rigid. A marker rigid to nothing is in
   no segment. Segments are named by their members; :data:`KNOWN_SEGMENTS` names the common
   Plug-in Gait and CMU 41 groups when a segment holds most of one.
-* The percentiles come from one sort along time (NaN sorts last), so the cost is that of
-  sorting ``(S, M, M)`` distances with S ≤ ``segment_frames``.
+* The percentiles come from one sort along time (NaN sorts last), so the time is that of
+  sorting the ``S × M × (M + 1) / 2`` distances of the pairs, S ≤ ``segment_frames``; the
+  pairs are taken a block of markers at a time, so the memory stays near ``_BLOCK_VALUES``
+  distances whatever M (the upload limit ``max_markers`` bounds M, and so the time).
 """
 
 from __future__ import annotations
@@ -105,16 +107,46 @@ class Segment:
     markers: tuple[str, ...]
 
 
+_BLOCK_VALUES = 1 << 21
+"""Distances :func:`pair_stats` holds at once (sampled frames × markers × block width): with
+the coordinate differences, about 32 bytes each, 64 MB."""
+
+
 def _sample(n_frames: int, limit: int) -> IntArray:
     if n_frames <= limit:
         return np.arange(n_frames, dtype=np.intp)
     return np.unique(np.linspace(0, n_frames - 1, limit).round().astype(np.intp))
 
 
+def _block_stats(
+    sampled: FloatArray, start: int, columns: slice
+) -> tuple[IntArray, FloatArray, FloatArray]:
+    """Count, median and spread of the distances of markers ``start:`` to the ``columns``
+    markers, each ``(M - start, C)``, from one sort along time (NaN sorts last)."""
+    diff = sampled[:, start:, None, :] - sampled[:, None, columns, :]
+    distances = np.einsum("smnk,smnk->smn", diff, diff)  # (S, M - start, C), NaN if missing
+    del diff
+    np.sqrt(distances, out=distances)
+    counts = np.isfinite(distances).sum(axis=0)
+    distances.sort(axis=0)
+
+    def percentile(q: float) -> FloatArray:
+        index = np.clip(np.round(q * (counts - 1)).astype(np.intp), 0, None)
+        value: FloatArray = np.take_along_axis(distances, index[None], axis=0)[0]
+        return np.where(counts > 0, value, np.nan)
+
+    return counts, percentile(0.5), percentile(0.9) - percentile(0.1)
+
+
 def pair_stats(
     positions: FloatArray, length_unit: str, params: MarkerParams | None = None
 ) -> PairStats:
     """Median and spread of every pair's distance, and which pairs are rigid.
+
+    The pairs are measured a block of markers at a time, each block against the markers from
+    its first on (the statistics are symmetric), so the memory held at once is about
+    ``_BLOCK_VALUES`` distances whatever the marker count; the time still grows with the
+    number of pairs.
 
     Parameters
     ----------
@@ -130,18 +162,16 @@ def pair_stats(
     p = params or MarkerParams()
     n_markers = positions.shape[1]
     sampled = positions[_sample(positions.shape[0], p.segment_frames)]
-    diff = sampled[:, :, None, :] - sampled[:, None, :, :]
-    distances = np.sqrt(np.einsum("smnk,smnk->smn", diff, diff))  # (S, M, M), NaN if missing
-    counts = np.isfinite(distances).sum(axis=0)
-    ordered = np.sort(distances, axis=0)  # NaN last
-
-    def percentile(q: float) -> FloatArray:
-        index = np.clip(np.round(q * (counts - 1)).astype(np.intp), 0, None)
-        value: FloatArray = np.take_along_axis(ordered, index[None], axis=0)[0]
-        return np.where(counts > 0, value, np.nan)
-
-    median = percentile(0.5)
-    spread = percentile(0.9) - percentile(0.1)
+    counts = np.zeros((n_markers, n_markers), dtype=np.intp)
+    median = np.full((n_markers, n_markers), np.nan)
+    spread = np.full((n_markers, n_markers), np.nan)
+    width = max(1, _BLOCK_VALUES // max(1, sampled.shape[0] * n_markers))
+    for start in range(0, n_markers, width):
+        columns = slice(start, min(start + width, n_markers))
+        block = _block_stats(sampled, start, columns)
+        for whole, part in zip((counts, median, spread), block, strict=True):
+            whole[start:, columns] = part
+            whole[columns, start:] = part.T
     threshold = p.rigid_spread * unit_scale(length_unit) + p.rigid_relative * median
     enough = counts >= max(2, p.rigid_min_visible * sampled.shape[0])
     off_diagonal = ~np.eye(n_markers, dtype=bool)
