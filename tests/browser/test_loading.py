@@ -41,7 +41,14 @@ def test_a_slow_take_shows_loading_until_it_is_drawn(
     p.evaluate(f"() => {{ location.hash = '#/take/{walk['id']}?run={walk['run']}'; }}")
     p.wait_for_selector("#route-loading", state="visible", timeout=30_000)
     assert p.get_attribute("#main", "aria-busy") == "true"
+    # The indicator may show while the view's earlier requests are still out: wait (a bound
+    # for a request that never comes, not a speed test) until the result's is parked.
+    for _ in range(600):
+        if held:
+            break
+        p.wait_for_timeout(50)
     assert held
+    assert p.locator("#route-loading").is_visible()
     for request in held:
         request.continue_()
     p.unroute(f"**/api/v1/runs/{walk['run']}/result*", park)
