@@ -9,7 +9,6 @@ outside 0–1 name their field.
 from __future__ import annotations
 
 import io
-import json
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -17,6 +16,7 @@ from typing import Any
 import numpy as np
 import pytest
 from fastapi.testclient import TestClient
+from tests.api.test_runs import unpack_frames
 
 from mocapqa.api import frame_windows
 from mocapqa.api.frame_windows import MAX_WINDOW_VALUES
@@ -25,20 +25,6 @@ Waiter = Callable[[TestClient, str], dict[str, Any]]
 Uploader = Callable[[TestClient, Path], dict[str, Any]]
 REPEATS = 20
 """Copies of the CMU walk's frames in the long take (10,480 frames × 31 joints)."""
-
-
-def unpack(body: bytes) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
-    """A ``/frames.f32`` answer: its header and its arrays, shape (count, points, components)."""
-    length = int(np.frombuffer(body[:4], "<u4")[0])
-    header = json.loads(body[4 : 4 + length])
-    offset, arrays = 4 + length, {}
-    for name, components in header["arrays"]:
-        shape = (header["count"], header["points"], components)
-        size = int(np.prod(shape))
-        arrays[name] = np.frombuffer(body, "<f4", size, offset).reshape(shape)
-        offset += 4 * size
-    assert offset == len(body)
-    return header, arrays
 
 
 def values_of(header: dict[str, Any]) -> int:
@@ -71,7 +57,7 @@ def test_a_long_take_is_served_whole_with_a_grown_step(
     run_id = done_run(client, upload(client, long_walk), wait_for_run)
     answer = client.get(f"/api/v1/runs/{run_id}/frames.f32?max_frames=20000")
     assert answer.status_code == 200, answer.text
-    header, arrays = unpack(answer.content)
+    header, arrays = unpack_frames(answer.content)
     n_frames = header["n_frames"]
     assert n_frames == 524 * REPEATS
     per_frame = values_of(header) // header["count"]
@@ -83,7 +69,7 @@ def test_a_long_take_is_served_whole_with_a_grown_step(
     # The rows picked from the stored arrays are those of the frames named: a full-rate
     # window of ten frames holds the same values at the frames both hold.
     near_end = n_frames - 20
-    _, fine = unpack(
+    _, fine = unpack_frames(
         client.get(f"/api/v1/runs/{run_id}/frames.f32?start={near_end}&stop={n_frames}").content
     )
     shared = [k for k in range(near_end, n_frames) if k % header["step"] == 0]
@@ -94,7 +80,7 @@ def test_a_long_take_is_served_whole_with_a_grown_step(
     assert window.status_code == 200, window.text
     assert window.json()["step"] == header["step"]
     overview = client.get(f"/api/v1/runs/{run_id}/frames.f32?max_frames=800")
-    assert unpack(overview.content)[0]["step"] == -(-n_frames // 800)
+    assert unpack_frames(overview.content)[0]["step"] == -(-n_frames // 800)
 
 
 def test_a_take_of_many_keypoints_is_served_with_a_grown_step(
@@ -115,7 +101,7 @@ def test_a_take_of_many_keypoints_is_served_with_a_grown_step(
     run_id = done_run(client, response.json(), wait_for_run)
     answer = client.get(f"/api/v1/runs/{run_id}/frames.f32?max_frames=800")
     assert answer.status_code == 200, answer.text
-    header, arrays = unpack(answer.content)
+    header, arrays = unpack_frames(answer.content)
     assert values_of(header) <= MAX_WINDOW_VALUES
     assert (header["step"], header["count"]) == (2, 200)
     np.testing.assert_array_equal(arrays["raw"], points[::2])
@@ -129,10 +115,10 @@ def test_a_frame_alone_over_the_budget_is_refused_naming_max_frames(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     run_id = done_run(client, upload(client, cmu_walk), wait_for_run)
-    header, _ = unpack(client.get(f"/api/v1/runs/{run_id}/frames.f32?stop=1").content)
+    header, _ = unpack_frames(client.get(f"/api/v1/runs/{run_id}/frames.f32?stop=1").content)
     per_frame = values_of(header)
     monkeypatch.setattr(frame_windows, "MAX_WINDOW_VALUES", per_frame * 5)
-    header, _ = unpack(client.get(f"/api/v1/runs/{run_id}/frames.f32?start=3").content)
+    header, _ = unpack_frames(client.get(f"/api/v1/runs/{run_id}/frames.f32?start=3").content)
     assert header["count"] == 5
     assert header["step"] == -(-(header["n_frames"] - 3) // 5)
     monkeypatch.setattr(frame_windows, "MAX_WINDOW_VALUES", per_frame - 1)
