@@ -48,10 +48,12 @@ from mocapqa.markers.take import visible
 __all__ = [
     "ExchangeEvidence",
     "candidate_intervals",
+    "crossing_intervals",
     "crossings",
     "exchange_evidence",
     "interval_confidence",
     "labels_held",
+    "run_intervals",
 ]
 
 _CONTEXT = 3
@@ -225,21 +227,41 @@ def labels_held(
 
 def candidate_intervals(evidence: ExchangeEvidence) -> list[tuple[int, int, int]]:
     """Candidate intervals ``(column, start, end)``, frames 0-based and ends inclusive: runs
-    without contradiction trimmed to explained frames, and the stretches between successive
-    crossings of one pair."""
+    without contradiction trimmed to explained frames (:func:`run_intervals`), then the
+    stretches between successive crossings of one pair (:func:`crossing_intervals`)."""
+    return run_intervals(evidence) + crossing_intervals(evidence.crossed)
+
+
+def run_intervals(evidence: ExchangeEvidence) -> list[tuple[int, int, int]]:
+    """Runs without contradiction trimmed to explained frames, ``(column, start, end)`` by
+    column then start, frames 0-based and ends inclusive."""
     found: list[tuple[int, int, int]] = []
     columns, starts, ends = column_runs(~evidence.contradicted)
     for column, start, end in zip(columns, starts, ends, strict=True):
         hits = np.flatnonzero(evidence.explained[start : end + 1, column])
         if hits.size:
             found.append((int(column), int(start + hits[0]), int(start + hits[-1])))
-    frames, columns = np.nonzero(evidence.crossed)
+    return found
+
+
+def crossing_intervals(crossed: BoolArray) -> list[tuple[int, int, int]]:
+    """The stretches between successive crossings of one pair, ``(column, start, end)`` by
+    column then start, frames 0-based and ends inclusive.
+
+    Parameters
+    ----------
+    crossed : ndarray of bool, shape (F, P)
+        The pairs' crossing cue (:func:`crossings`).
+
+    Returns
+    -------
+    list of tuple of int
+    """
+    frames, columns = np.nonzero(crossed)
     order = np.lexsort((frames, columns))
     frames, columns = frames[order], columns[order]
     same = columns[1:] == columns[:-1]
-    for i in np.flatnonzero(same):
-        found.append((int(columns[i]), int(frames[i]), int(frames[i + 1]) - 1))
-    return found
+    return [(int(columns[i]), int(frames[i]), int(frames[i + 1]) - 1) for i in np.flatnonzero(same)]
 
 
 def interval_confidence(
